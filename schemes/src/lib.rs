@@ -1,0 +1,18 @@
+//! Subdivision schemes as data.
+//!
+//! A subdivision scheme is described here only by the numbers that define it: its masks
+//! (the columns of the subdivision matrix S in `p_{j+1} = S p_j`, Schaefer–Warren eq. (1))
+//! and, for stationary non-uniform schemes, the finite set of special columns around the
+//! non-uniformity. Nothing in this crate solves anything: `stencilgen` turns these data into
+//! evaluation stencils through the scaling relation (Schaefer–Warren eq. (3)).
+//!
+//! ```
+//! use schemes::curve::CurveScheme;
+//! let four_point = CurveScheme::by_name("four-point").expect("a catalogued scheme");
+//! assert!(four_point.is_uniform());
+//! assert!(four_point.reproduces_linear());
+//! ```
+
+pub mod curve;
+
+pub use curve::{Component, CurveScheme, Term, Translates};

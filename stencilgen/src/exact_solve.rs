@@ -1,0 +1,180 @@
+//! Exact solution of a residue cycle over the rationals.
+//!
+//! Substituting the relations of the cycle into each other, `x_j = P_j x_0` with
+//! `P_L = I` and `P_j = A_j P_{j+1}`; the relation of step 0 closes the loop as
+//! `(P_0 - I) x_0 = 0`: `x_0` is a fixed vector of the product of the cycle's transition
+//! matrices (Schaefer–Warren section 3: a dominant left eigenvector of the upsampled
+//! subdivision matrix). Each normalization equation of step `j` becomes `(c^T P_j) x_0 = 1`.
+//! This reduced system has only `|x_0|` unknowns (the support width), however long the
+//! cycle, and it is equivalent to the block's full system: the eliminated equations hold
+//! by construction. Gauss–Jordan elimination over Q then decides consistency and uniqueness.
+
+use num_rational::BigRational;
+use num_traits::{One, Zero};
+
+use crate::cycle_block::{CycleBlock, CycleFailure};
+
+type Dense = Vec<Vec<BigRational>>;
+
+/// Solve the cycle exactly; values per step, in the block's local order.
+pub fn solve_cycle(block: &CycleBlock) -> Result<Vec<Vec<BigRational>>, CycleFailure> {
+    let len = block.steps.len();
+    let width = block.steps[0].len();
+    // products[j] = P_j, an (|x_j| x width) matrix; P_len = I.
+    let mut products: Vec<Dense> = vec![Vec::new(); len];
+    let mut next: Dense = identity(width);
+    for j in (0..len).rev() {
+        let p: Dense = block.transitions[j]
+            .iter()
+            .map(|row| {
+                let mut out = vec![BigRational::zero(); width];
+                for (l, w) in row {
+                    for (o, x) in out.iter_mut().zip(&next[*l]) {
+                        if !x.is_zero() {
+                            *o += w * x;
+                        }
+                    }
+                }
+                out
+            })
+            .collect();
+        products[j] = p.clone();
+        next = p;
+    }
+    let mut rows: Vec<(Vec<BigRational>, BigRational)> = Vec::new();
+    for (i, row) in products[0].iter().enumerate() {
+        let mut r = row.clone();
+        r[i] -= BigRational::one();
+        rows.push((r, BigRational::zero()));
+    }
+    for (step, terms, rhs) in &block.normalization {
+        let mut r = vec![BigRational::zero(); width];
+        for (l, c) in terms {
+            for (o, x) in r.iter_mut().zip(&products[*step][*l]) {
+                *o += c * x;
+            }
+        }
+        rows.push((r, rhs.clone()));
+    }
+    let x0 = solve_dense(rows, width)?;
+    Ok(products
+        .iter()
+        .map(|p| p.iter().map(|row| dot(row, &x0)).collect())
+        .collect())
+}
+
+fn identity(n: usize) -> Dense {
+    (0..n)
+        .map(|i| {
+            (0..n)
+                .map(|j| {
+                    if i == j {
+                        BigRational::one()
+                    } else {
+                        BigRational::zero()
+                    }
+                })
+                .collect()
+        })
+        .collect()
+}
+
+fn dot(a: &[BigRational], b: &[BigRational]) -> BigRational {
+    a.iter()
+        .zip(b)
+        .filter(|(x, y)| !x.is_zero() && !y.is_zero())
+        .fold(BigRational::zero(), |acc, (x, y)| acc + x * y)
+}
+
+/// Gauss–Jordan elimination of an overdetermined system `rows = [(a_i, b_i)]` in `width`
+/// unknowns: the unique solution, or why there is none.
+pub fn solve_dense(
+    mut rows: Vec<(Vec<BigRational>, BigRational)>,
+    width: usize,
+) -> Result<Vec<BigRational>, CycleFailure> {
+    let mut rank = 0;
+    let mut pivots = Vec::new();
+    for col in 0..width {
+        let Some(p) = (rank..rows.len()).find(|&i| !rows[i].0[col].is_zero()) else {
+            continue;
+        };
+        rows.swap(rank, p);
+        let inv = rows[rank].0[col].recip();
+        for x in rows[rank].0.iter_mut() {
+            *x *= &inv;
+        }
+        rows[rank].1 *= &inv;
+        let (pivot_row, pivot_rhs) = rows[rank].clone();
+        for (i, (a, b)) in rows.iter_mut().enumerate() {
+            if i == rank || a[col].is_zero() {
+                continue;
+            }
+            let f = a[col].clone();
+            for (x, y) in a.iter_mut().zip(&pivot_row) {
+                if !y.is_zero() {
+                    *x -= &f * y;
+                }
+            }
+            *b -= &f * &pivot_rhs;
+        }
+        pivots.push(col);
+        rank += 1;
+    }
+    if let Some((i, (_, b))) = rows
+        .iter()
+        .enumerate()
+        .skip(rank)
+        .find(|(_, (_, b))| !b.is_zero())
+    {
+        return Err(CycleFailure::Inconsistent {
+            detail: format!("after elimination equation {i} reads 0 = {b}"),
+        });
+    }
+    if rank < width {
+        return Err(CycleFailure::NotUnique {
+            rank,
+            unknowns: width,
+        });
+    }
+    let mut x = vec![BigRational::zero(); width];
+    for (i, &col) in pivots.iter().enumerate() {
+        x[col] = rows[i].1.clone();
+    }
+    Ok(x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use num_bigint::BigInt;
+
+    fn q(n: i64, d: i64) -> BigRational {
+        BigRational::new(BigInt::from(n), BigInt::from(d))
+    }
+
+    #[test]
+    fn dense_solver_reports_rank_and_consistency() {
+        // x + y = 1, x - y = 0, 2x = 1: consistent and unique.
+        let rows = vec![
+            (vec![q(1, 1), q(1, 1)], q(1, 1)),
+            (vec![q(1, 1), q(-1, 1)], q(0, 1)),
+            (vec![q(2, 1), q(0, 1)], q(1, 1)),
+        ];
+        assert_eq!(solve_dense(rows, 2), Ok(vec![q(1, 2), q(1, 2)]));
+        // x + y = 1 alone: rank 1 of 2.
+        let rows = vec![(vec![q(1, 1), q(1, 1)], q(1, 1))];
+        assert_eq!(
+            solve_dense(rows, 2),
+            Err(CycleFailure::NotUnique {
+                rank: 1,
+                unknowns: 2
+            })
+        );
+        // x = 1, x = 2.
+        let rows = vec![(vec![q(1, 1)], q(1, 1)), (vec![q(1, 1)], q(2, 1))];
+        assert!(matches!(
+            solve_dense(rows, 1),
+            Err(CycleFailure::Inconsistent { .. })
+        ));
+    }
+}

@@ -1,0 +1,37 @@
+//! Evaluation stencils from the scaling relation (Schaefer and Warren, "Exact evaluation of
+//! limits and tangents for non-polynomial subdivision schemes").
+//!
+//! A convergent stationary subdivision scheme has basis functions that satisfy the scaling
+//! relation `phi(x) = sum_i s_i phi(2x - i)` (eq. (3)) at *every* x, not only at dyadic points.
+//! Written at every point of the grid `(1/n) Z` inside the support, together with the partition
+//! of unity `sum_i phi(x - i) = 1` (eq. (4)), it is a linear system whose solution is the exact
+//! value of the basis functions on that grid: the evaluation stencils. Differentiating gives
+//! the tangent masks (section 4).
+//!
+//! The system relates `phi` at `x` only to `phi` at `2x - i`, so it splits along the orbits of
+//! the residues `r -> 2r (mod n)` ([`residue_orbits`]). Only the cycle of each orbit is a real
+//! linear solve; every other residue follows by substitution. The exact path solves each cycle
+//! over the rationals ([`exact_solve`]), the f64 path by an SVD least-squares solve
+//! ([`float_solve`]); both share everything else through [`Scalar`].
+//!
+//! ```
+//! use num_rational::BigRational;
+//! use schemes::CurveScheme;
+//! let scheme = CurveScheme::by_name("four-point").expect("catalogued");
+//! let stencils = stencilgen::curve_stencils::<BigRational>(&scheme, 3, false).expect("solvable");
+//! // Schaefer–Warren section 2: phi(1/3) = 4240/5589.
+//! assert_eq!(stencils.functions[0].at(1).to_string(), "4240/5589");
+//! ```
+
+pub mod curve_stencils;
+pub mod curve_system;
+pub mod cycle_block;
+pub mod error;
+pub mod exact_solve;
+pub mod float_solve;
+pub mod residue_orbits;
+pub mod scalar;
+
+pub use curve_stencils::{curve_stencils, BasisFunction, CurveStencils};
+pub use error::StencilError;
+pub use scalar::Scalar;
