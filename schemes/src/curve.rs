@@ -291,6 +291,9 @@ fn mask_terms(
 const LEFT: usize = 0;
 const RIGHT: usize = 4;
 
+/// `(fine point k, numerator, denominator)`: one entry of a subdivision-matrix column.
+type MatrixEntry = (i64, i64, i64);
+
 /// Component serving the fine control point `k` of the non-uniform example.
 fn nonuniform_component_of(k: i64) -> usize {
     match k {
@@ -312,7 +315,7 @@ fn nonuniform_component_of(k: i64) -> usize {
 fn nonuniform_cubic_bspline() -> CurveScheme {
     let cubic = [1, 4, 6, 4, 1];
     // Column h of S: (fine point k, numerator, denominator).
-    let special_columns: [(i64, [(i64, i64, i64); 5]); 3] = [
+    let special_columns: [(i64, [MatrixEntry; 5]); 3] = [
         (
             -1,
             [(-4, 1, 8), (-3, 1, 2), (-2, 25, 32), (-1, 5, 8), (0, 5, 24)],

@@ -5,7 +5,7 @@ use num_rational::BigRational;
 use schemes::CurveScheme;
 
 use crate::curve_system::CurveSystem;
-use crate::cycle_block::{CycleBlock, CycleFailure};
+use crate::orbit_block::{BlockFailure, OrbitBlock};
 use crate::residue_orbits::residue_orbits;
 use crate::{Scalar, StencilError};
 
@@ -91,14 +91,14 @@ pub fn curve_stencils<S: Scalar>(
     let by_residue = system.unknowns_by_residue();
     let mut values: Vec<Option<S>> = vec![None; system.unknowns()];
     for orbit in residue_orbits(n) {
-        let block = CycleBlock::new(&system, &orbit.cycle, &by_residue);
-        let solved = S::solve_cycle(&block).map_err(|failure| match failure {
-            CycleFailure::Inconsistent { detail } => StencilError::Inconsistent {
+        let block = OrbitBlock::new(&system, &orbit, &by_residue);
+        let solved = S::solve_orbit(&block).map_err(|failure| match failure {
+            BlockFailure::Inconsistent { detail } => StencilError::Inconsistent {
                 scheme: scheme.name.clone(),
                 n,
-                detail: format!("residue cycle {:?}: {detail}", orbit.cycle),
+                detail: format!("residue orbit with cycle {:?}: {detail}", orbit.cycle),
             },
-            CycleFailure::NotUnique { rank, unknowns } => StencilError::NotUnique {
+            BlockFailure::NotUnique { rank, unknowns } => StencilError::NotUnique {
                 scheme: scheme.name.clone(),
                 n,
                 residues: orbit.cycle.clone(),
@@ -109,12 +109,6 @@ pub fn curve_stencils<S: Scalar>(
         for (step, step_values) in block.steps.iter().zip(solved) {
             for (&u, value) in step.iter().zip(step_values) {
                 values[u] = Some(value);
-            }
-        }
-        // Tree residues: each is given explicitly by its image 2r, already known.
-        for &r in &orbit.tree {
-            for &u in &by_residue[r as usize] {
-                values[u] = Some(evaluate(&system.scaling[u], &values));
             }
         }
     }

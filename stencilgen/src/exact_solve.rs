@@ -1,43 +1,33 @@
-//! Exact solution of a residue cycle over the rationals.
+//! Exact solution of a residue orbit over the rationals.
 //!
-//! Substituting the relations of the cycle into each other, `x_j = P_j x_0` with
+//! On the cycle, substituting the relations into each other gives `x_j = P_j x_0` with
 //! `P_L = I` and `P_j = A_j P_{j+1}`; the relation of step 0 closes the loop as
 //! `(P_0 - I) x_0 = 0`: `x_0` is a fixed vector of the product of the cycle's transition
 //! matrices (Schaefer–Warren section 3: a dominant left eigenvector of the upsampled
-//! subdivision matrix). Each normalization equation of step `j` becomes `(c^T P_j) x_0 = 1`.
-//! This reduced system has only `|x_0|` unknowns (the support width), however long the
-//! cycle, and it is equivalent to the block's full system: the eliminated equations hold
-//! by construction. Gauss–Jordan elimination over Q then decides consistency and uniqueness.
+//! subdivision matrix). Each normalization equation of cycle step `j` becomes
+//! `(c^T P_j) x_0 = 1`. This reduced system has only `|x_0|` unknowns (one support width),
+//! however long the cycle, and it is equivalent to the cycle's full system: the eliminated
+//! equations hold by construction. Gauss–Jordan elimination over Q decides consistency and
+//! uniqueness; tree residues then follow by substitution, `x_r = A_r x_{2r}`. The
+//! normalization equations of tree residues are not needed to determine anything; the caller
+//! verifies them.
 
 use num_rational::BigRational;
 use num_traits::{One, Zero};
 
-use crate::cycle_block::{CycleBlock, CycleFailure};
+use crate::orbit_block::{BlockFailure, LocalNormalization, OrbitBlock};
 
 type Dense = Vec<Vec<BigRational>>;
 
-/// Solve the cycle exactly; values per step, in the block's local order.
-pub fn solve_cycle(block: &CycleBlock) -> Result<Vec<Vec<BigRational>>, CycleFailure> {
-    let len = block.steps.len();
+/// Solve the orbit exactly; values per step, in the block's local order.
+pub fn solve_orbit(block: &OrbitBlock) -> Result<Vec<Vec<BigRational>>, BlockFailure> {
+    let len = block.cycle_len;
     let width = block.steps[0].len();
     // products[j] = P_j, an (|x_j| x width) matrix; P_len = I.
     let mut products: Vec<Dense> = vec![Vec::new(); len];
     let mut next: Dense = identity(width);
     for j in (0..len).rev() {
-        let p: Dense = block.transitions[j]
-            .iter()
-            .map(|row| {
-                let mut out = vec![BigRational::zero(); width];
-                for (l, w) in row {
-                    for (o, x) in out.iter_mut().zip(&next[*l]) {
-                        if !x.is_zero() {
-                            *o += w * x;
-                        }
-                    }
-                }
-                out
-            })
-            .collect();
+        let p = apply(&block.transitions[j], &next, width);
         products[j] = p.clone();
         next = p;
     }
@@ -47,7 +37,9 @@ pub fn solve_cycle(block: &CycleBlock) -> Result<Vec<Vec<BigRational>>, CycleFai
         r[i] -= BigRational::one();
         rows.push((r, BigRational::zero()));
     }
-    for (step, terms, rhs) in &block.normalization {
+    for LocalNormalization { step, terms, rhs } in
+        block.normalization.iter().filter(|e| e.step < len)
+    {
         let mut r = vec![BigRational::zero(); width];
         for (l, c) in terms {
             for (o, x) in r.iter_mut().zip(&products[*step][*l]) {
@@ -57,10 +49,39 @@ pub fn solve_cycle(block: &CycleBlock) -> Result<Vec<Vec<BigRational>>, CycleFai
         rows.push((r, rhs.clone()));
     }
     let x0 = solve_dense(rows, width)?;
-    Ok(products
+    let mut values: Vec<Vec<BigRational>> = products
         .iter()
         .map(|p| p.iter().map(|row| dot(row, &x0)).collect())
-        .collect())
+        .collect();
+    for j in len..block.steps.len() {
+        let image = &values[block.next[j]];
+        let step: Vec<BigRational> = block.transitions[j]
+            .iter()
+            .map(|row| {
+                row.iter()
+                    .fold(BigRational::zero(), |acc, (l, w)| acc + w * &image[*l])
+            })
+            .collect();
+        values.push(step);
+    }
+    Ok(values)
+}
+
+/// `A P` for a sparse `A` (rows of `(column, weight)`) and a dense `P` of `width` columns.
+fn apply(a: &[Vec<(usize, BigRational)>], p: &Dense, width: usize) -> Dense {
+    a.iter()
+        .map(|row| {
+            let mut out = vec![BigRational::zero(); width];
+            for (l, w) in row {
+                for (o, x) in out.iter_mut().zip(&p[*l]) {
+                    if !x.is_zero() {
+                        *o += w * x;
+                    }
+                }
+            }
+            out
+        })
+        .collect()
 }
 
 fn identity(n: usize) -> Dense {
@@ -91,7 +112,7 @@ fn dot(a: &[BigRational], b: &[BigRational]) -> BigRational {
 pub fn solve_dense(
     mut rows: Vec<(Vec<BigRational>, BigRational)>,
     width: usize,
-) -> Result<Vec<BigRational>, CycleFailure> {
+) -> Result<Vec<BigRational>, BlockFailure> {
     let mut rank = 0;
     let mut pivots = Vec::new();
     for col in 0..width {
@@ -126,12 +147,12 @@ pub fn solve_dense(
         .skip(rank)
         .find(|(_, (_, b))| !b.is_zero())
     {
-        return Err(CycleFailure::Inconsistent {
+        return Err(BlockFailure::Inconsistent {
             detail: format!("after elimination equation {i} reads 0 = {b}"),
         });
     }
     if rank < width {
-        return Err(CycleFailure::NotUnique {
+        return Err(BlockFailure::NotUnique {
             rank,
             unknowns: width,
         });
@@ -165,7 +186,7 @@ mod tests {
         let rows = vec![(vec![q(1, 1), q(1, 1)], q(1, 1))];
         assert_eq!(
             solve_dense(rows, 2),
-            Err(CycleFailure::NotUnique {
+            Err(BlockFailure::NotUnique {
                 rank: 1,
                 unknowns: 2
             })
@@ -174,7 +195,7 @@ mod tests {
         let rows = vec![(vec![q(1, 1)], q(1, 1)), (vec![q(1, 1)], q(2, 1))];
         assert!(matches!(
             solve_dense(rows, 1),
-            Err(CycleFailure::Inconsistent { .. })
+            Err(BlockFailure::Inconsistent { .. })
         ));
     }
 }

@@ -25,10 +25,10 @@
 
 pub mod curve_stencils;
 pub mod curve_system;
-pub mod cycle_block;
 pub mod error;
 pub mod exact_solve;
 pub mod float_solve;
+pub mod orbit_block;
 pub mod residue_orbits;
 pub mod scalar;
 

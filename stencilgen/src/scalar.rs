@@ -8,7 +8,7 @@ use num_bigint::BigInt;
 use num_rational::BigRational;
 use num_traits::{ToPrimitive, Zero};
 
-use crate::cycle_block::{CycleBlock, CycleFailure};
+use crate::orbit_block::{BlockFailure, OrbitBlock};
 
 /// A field the scaling-relation system can be solved in.
 pub trait Scalar:
@@ -30,9 +30,9 @@ pub trait Scalar:
     /// arithmetic, within [`FLOAT_TOLERANCE`] for f64.
     fn is_negligible(&self) -> bool;
 
-    /// Solve the closed system of one residue cycle (see [`CycleBlock`]): the values of the
+    /// Solve the closed system of one residue cycle (see [`OrbitBlock`]): the values of the
     /// block's unknowns, step by step.
-    fn solve_cycle(block: &CycleBlock) -> Result<Vec<Vec<Self>>, CycleFailure>;
+    fn solve_orbit(block: &OrbitBlock) -> Result<Vec<Vec<Self>>, BlockFailure>;
 }
 
 /// Largest residual an f64 solution may leave in any equation and still count as a solution.
@@ -57,8 +57,8 @@ impl Scalar for BigRational {
         Zero::is_zero(self)
     }
 
-    fn solve_cycle(block: &CycleBlock) -> Result<Vec<Vec<Self>>, CycleFailure> {
-        crate::exact_solve::solve_cycle(block)
+    fn solve_orbit(block: &OrbitBlock) -> Result<Vec<Vec<Self>>, BlockFailure> {
+        crate::exact_solve::solve_orbit(block)
     }
 }
 
@@ -81,8 +81,8 @@ impl Scalar for f64 {
         self.abs() <= FLOAT_TOLERANCE
     }
 
-    fn solve_cycle(block: &CycleBlock) -> Result<Vec<Vec<Self>>, CycleFailure> {
-        crate::float_solve::solve_cycle(block)
+    fn solve_orbit(block: &OrbitBlock) -> Result<Vec<Vec<Self>>, BlockFailure> {
+        crate::float_solve::solve_orbit(block)
     }
 }
 

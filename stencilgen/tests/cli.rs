@@ -1,0 +1,113 @@
+//! The `stencilgen` command line: the DESIGN.md contract and its errors.
+
+use std::process::{Command, Output};
+
+fn stencilgen(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_stencilgen"))
+        .args(args)
+        .output()
+        .expect("stencilgen runs")
+}
+
+fn json(args: &[&str]) -> serde_json::Value {
+    let out = stencilgen(args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("valid JSON")
+}
+
+#[test]
+fn curve_json_follows_the_contract() {
+    let v = json(&["curve", "--scheme", "four-point", "--n", "3", "--json"]);
+    assert_eq!(v["scheme"], "four-point");
+    assert_eq!(v["n"], 3);
+    assert_eq!(v["support"], serde_json::json!([-3, 3]));
+    let x = v["x"].as_array().expect("x");
+    let values = v["values"].as_array().expect("values");
+    assert_eq!(x.len(), 19);
+    assert_eq!(values.len(), 19);
+    assert_eq!(x[1], "-8/3");
+    // Schaefer–Warren section 2: phi(-8/3) = -1/5589, phi(0) = 1.
+    assert_eq!(values[1], "-1/5589");
+    assert_eq!(values[9], "1");
+}
+
+#[test]
+fn f64_values_are_numbers_with_a_residual() {
+    let v = json(&[
+        "curve",
+        "--scheme",
+        "four-point",
+        "--n",
+        "3",
+        "--derivative",
+        "--f64",
+        "--json",
+    ]);
+    let third = v["values"][10].as_f64().expect("a number");
+    assert!((third + 584.0 / 540.0).abs() < 1e-12, "phi'(1/3) = {third}");
+    assert!(v["residual"].as_f64().expect("residual") < 1e-12);
+}
+
+#[test]
+fn vector_schemes_list_their_components() {
+    let v = json(&[
+        "curve",
+        "--scheme",
+        "nonuniform-cubic-bspline",
+        "--n",
+        "2",
+        "--json",
+    ]);
+    let functions = v["functions"].as_array().expect("functions");
+    assert_eq!(functions.len(), 5);
+    assert_eq!(functions[2]["name"], "point0");
+}
+
+#[test]
+fn bad_input_is_a_clear_error_not_a_panic() {
+    let cases: [(&[&str], &str); 6] = [
+        (
+            &["curve", "--scheme", "loop-de-loop", "--n", "3"],
+            "unknown scheme `loop-de-loop`",
+        ),
+        (
+            &["curve", "--scheme", "four-point", "--n", "0"],
+            "0 is not in 1..=1024",
+        ),
+        (
+            &["curve", "--scheme", "four-point", "--n", "three"],
+            "invalid value 'three'",
+        ),
+        (&["curve", "--scheme", "four-point"], "--n <N>"),
+        (
+            &["curve", "--scheme", "four-point", "--n", "3", "--wat"],
+            "--wat",
+        ),
+        (
+            &[
+                "curve",
+                "--scheme",
+                "nonuniform-cubic-bspline",
+                "--n",
+                "3",
+                "--derivative",
+            ],
+            "does not map linear data to linear data",
+        ),
+    ];
+    for (args, message) in cases {
+        let out = stencilgen(args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?} succeeded");
+        assert!(
+            out.status.code().is_some(),
+            "{args:?} was killed by a signal"
+        );
+        assert!(stderr.contains(message), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    }
+}
