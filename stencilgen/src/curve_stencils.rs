@@ -5,8 +5,7 @@ use num_rational::BigRational;
 use schemes::CurveScheme;
 
 use crate::curve_system::CurveSystem;
-use crate::orbit_block::{BlockFailure, OrbitBlock};
-use crate::residue_orbits::residue_orbits;
+use crate::solve::{solve_system, Solution};
 use crate::{Scalar, StencilError};
 
 /// Largest grid rate accepted (the solver itself has no limit; this keeps a mistyped rate
@@ -87,49 +86,21 @@ pub fn curve_stencils<S: Scalar>(
     if n == 0 || n > MAX_RATE {
         return Err(StencilError::RateOutOfRange { n, max: MAX_RATE });
     }
-    let system = CurveSystem::new(scheme, n, derivative)?;
-    let by_residue = system.unknowns_by_residue();
-    let mut values: Vec<Option<S>> = vec![None; system.unknowns()];
-    for orbit in residue_orbits(n) {
-        let block = OrbitBlock::new(&system, &orbit, &by_residue);
-        let solved = S::solve_orbit(&block).map_err(|failure| match failure {
-            BlockFailure::Inconsistent { detail } => StencilError::Inconsistent {
-                scheme: scheme.name.clone(),
-                n,
-                detail: format!("residue orbit with cycle {:?}: {detail}", orbit.cycle),
-            },
-            BlockFailure::NotUnique { rank, unknowns } => StencilError::NotUnique {
-                scheme: scheme.name.clone(),
-                n,
-                residues: orbit.cycle.clone(),
-                rank,
-                unknowns,
-            },
-        })?;
-        for (step, step_values) in block.steps.iter().zip(solved) {
-            for (&u, value) in step.iter().zip(step_values) {
-                values[u] = Some(value);
-            }
-        }
-    }
-    let values: Vec<S> = values
-        .into_iter()
-        .map(|v| v.unwrap_or_else(S::zero))
-        .collect();
-    let residual = verify(scheme, &system, &values)?;
+    let curve = CurveSystem::new(scheme, n, derivative)?;
+    let Solution { values, residual } = solve_system::<S>(&curve.system, &scheme.name, n)?;
     let n_i = i64::from(n);
     let functions = scheme
         .components
         .iter()
         .enumerate()
         .map(|(c, component)| {
-            let (lo, hi) = system.supports[c];
+            let (lo, hi) = curve.supports[c];
             BasisFunction {
                 name: component.name.clone(),
                 support: (lo, hi),
                 values: (lo * n_i..=hi * n_i)
                     .map(|k| {
-                        system
+                        curve
                             .unknown(c, k)
                             .map_or_else(S::zero, |u| values[u].clone())
                     })
@@ -145,52 +116,4 @@ pub fn curve_stencils<S: Scalar>(
         functions,
         residual,
     })
-}
-
-fn evaluate<S: Scalar>(row: &[(usize, BigRational)], values: &[Option<S>]) -> S {
-    row.iter().fold(S::zero(), |acc, (v, w)| {
-        let x = values[*v]
-            .clone()
-            .unwrap_or_else(|| unreachable!("residue order puts 2r first"));
-        acc + S::from_rational(w) * x
-    })
-}
-
-/// Check every equation of the system; the largest absolute residual.
-fn verify<S: Scalar>(
-    scheme: &CurveScheme,
-    system: &CurveSystem,
-    values: &[S],
-) -> Result<f64, StencilError> {
-    let known: Vec<Option<S>> = values.iter().cloned().map(Some).collect();
-    let mut worst = 0f64;
-    let mut check = |residual: S, what: &dyn Fn() -> String| {
-        worst = worst.max(residual.to_f64().abs());
-        if residual.is_negligible() {
-            Ok(())
-        } else {
-            Err(StencilError::Inconsistent {
-                scheme: scheme.name.clone(),
-                n: system.n,
-                detail: format!("{} is off by {:?}", what(), residual),
-            })
-        }
-    };
-    for (u, row) in system.scaling.iter().enumerate() {
-        let residual = values[u].clone() - evaluate(row, &known);
-        check(residual, &|| {
-            let (c, k) = system.point_of(u);
-            format!(
-                "the scaling relation of component {c} at x = {k}/{}",
-                system.n
-            )
-        })?;
-    }
-    for row in &system.normalization {
-        let residual = evaluate(&row.terms, &known) - S::from_rational(&row.rhs);
-        check(residual, &|| {
-            format!("the normalization at x = {}/{}", row.numerator, system.n)
-        })?;
-    }
-    Ok(worst)
 }

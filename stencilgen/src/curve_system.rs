@@ -20,21 +20,9 @@ use num_rational::BigRational;
 use num_traits::{One, Zero};
 use schemes::{CurveScheme, Translates};
 
+use crate::orbits::doubling;
+use crate::scaling_system::{add_to_row, NormalizationRow, Relation, ScalingSystem, SparseRow};
 use crate::StencilError;
-
-/// A sparse linear form: `(unknown, coefficient)` pairs.
-pub type SparseRow = Vec<(usize, BigRational)>;
-
-/// A normalization equation `sum coef * phi = rhs` at `x = numerator / n`.
-#[derive(Clone, Debug, PartialEq)]
-pub struct NormalizationRow {
-    /// `x * n`.
-    pub numerator: i64,
-    /// The linear form over unknowns, all of residue `numerator mod n`.
-    pub terms: SparseRow,
-    /// Right-hand side (1).
-    pub rhs: BigRational,
-}
 
 /// The scaling-relation system of one scheme at one grid rate.
 #[derive(Clone, Debug)]
@@ -47,11 +35,9 @@ pub struct CurveSystem {
     pub supports: Vec<(i64, i64)>,
     /// First unknown of every component; component `c` owns `offsets[c]..offsets[c + 1]`.
     pub offsets: Vec<usize>,
-    /// For unknown `u` its scaling relation `phi_u = sum coef * phi_v` (the `v` all have residue
-    /// `2 r mod n`); the right-hand side is zero.
-    pub scaling: Vec<SparseRow>,
-    /// The normalization equations.
-    pub normalization: Vec<NormalizationRow>,
+    /// The equations; unknown `u` stands for `phi_c(k/n)` with `(c, k) = point_of(u)`, its
+    /// class is the residue `k mod n`.
+    pub system: ScalingSystem,
 }
 
 impl CurveSystem {
@@ -74,8 +60,10 @@ impl CurveSystem {
             derivative,
             supports,
             offsets,
-            scaling: Vec::new(),
-            normalization: Vec::new(),
+            system: ScalingSystem {
+                next: doubling(n),
+                ..ScalingSystem::default()
+            },
         };
         let factor = BigRational::from_integer(BigInt::from(if derivative { 2 } else { 1 }));
         for (c, component) in scheme.components.iter().enumerate() {
@@ -87,7 +75,14 @@ impl CurveSystem {
                         add_to_row(&mut row, v, &factor * ratio(term.weight));
                     }
                 }
-                system.scaling.push(row);
+                let relation = Relation {
+                    terms: row,
+                    constant: BigRational::zero(),
+                };
+                let label = format!("{}({k}/{n})", component.name);
+                system
+                    .system
+                    .push_unknown(k.rem_euclid(n_i) as u32, relation, label);
             }
         }
         for numerator in normalization_points(scheme, &system.supports, n_i) {
@@ -112,10 +107,11 @@ impl CurveSystem {
                     }
                 }
             }
-            system.normalization.push(NormalizationRow {
-                numerator,
+            system.system.normalization.push(NormalizationRow {
+                class: numerator.rem_euclid(n_i) as u32,
                 terms,
                 rhs: BigRational::one(),
+                label: format!("x = {x}"),
             });
         }
         Ok(system)
@@ -142,33 +138,10 @@ impl CurveSystem {
         let (lo, _) = self.supports[c];
         (c, lo * i64::from(self.n) + 1 + (u - self.offsets[c]) as i64)
     }
-
-    /// The residue `k mod n` of unknown `u`.
-    pub fn residue_of(&self, u: usize) -> u32 {
-        let (_, k) = self.point_of(u);
-        k.rem_euclid(i64::from(self.n)) as u32
-    }
-
-    /// The unknowns of every residue class, each in increasing order.
-    pub fn unknowns_by_residue(&self) -> Vec<Vec<usize>> {
-        let mut classes = vec![Vec::new(); self.n as usize];
-        for u in 0..self.unknowns() {
-            classes[self.residue_of(u) as usize].push(u);
-        }
-        classes
-    }
 }
 
 fn ratio(r: num_rational::Rational64) -> BigRational {
     BigRational::new(BigInt::from(*r.numer()), BigInt::from(*r.denom()))
-}
-
-fn add_to_row(row: &mut SparseRow, u: usize, coef: BigRational) {
-    match row.iter_mut().find(|(v, _)| *v == u) {
-        Some((_, c)) => *c += coef,
-        None => row.push((u, coef)),
-    }
-    row.retain(|(_, c)| !c.is_zero());
 }
 
 /// Numerators `X` of the points `x = X/n` where the normalization is imposed.

@@ -1,78 +1,99 @@
-//! Exact solution of a residue orbit over the rationals.
+//! Exact solution of an orbit over the rationals.
 //!
-//! On the cycle, substituting the relations into each other gives `x_j = P_j x_0` with
-//! `P_L = I` and `P_j = A_j P_{j+1}`; the relation of step 0 closes the loop as
-//! `(P_0 - I) x_0 = 0`: `x_0` is a fixed vector of the product of the cycle's transition
-//! matrices (Schaefer–Warren section 3: a dominant left eigenvector of the upsampled
-//! subdivision matrix). Each normalization equation of cycle step `j` becomes
-//! `(c^T P_j) x_0 = 1`. This reduced system has only `|x_0|` unknowns (one support width),
-//! however long the cycle, and it is equivalent to the cycle's full system: the eliminated
-//! equations hold by construction. Gauss–Jordan elimination over Q decides consistency and
-//! uniqueness; tree residues then follow by substitution, `x_r = A_r x_{2r}`. The
-//! normalization equations of tree residues are not needed to determine anything; the caller
-//! verifies them.
+//! On the cycle, substituting the relations `x_j = A_j x_{j+1} + c_j` into each other gives
+//! `x_j = P_j x_0 + q_j` with `P_L = I, q_L = 0`, `P_j = A_j P_{j+1}`, `q_j = A_j q_{j+1} + c_j`;
+//! the relation of step 0 closes the loop as `(P_0 - I) x_0 = -q_0`. For a uniform scheme `x_0`
+//! is a fixed vector of the product of the cycle's matrices (Schaefer–Warren section 3: a
+//! dominant left eigenvector of the upsampled subdivision matrix). Each normalization equation
+//! of cycle step `j` becomes `(c^T P_j) x_0 = rhs - c^T q_j`. This reduced system has only
+//! `|x_0|` unknowns (one support width), however long the cycle, and it is equivalent to the
+//! cycle's full system: the eliminated equations hold by construction. Gauss–Jordan
+//! elimination over Q decides consistency and uniqueness; tree classes then follow by
+//! substitution, `x_r = A_r x_{next(r)} + c_r`. The normalization equations of tree classes
+//! determine nothing; the caller verifies them.
 
 use num_rational::BigRational;
 use num_traits::{One, Zero};
 
-use crate::orbit_block::{BlockFailure, LocalNormalization, OrbitBlock};
+use crate::orbit_block::{BlockFailure, LocalNormalization, LocalRelation, OrbitBlock};
 
 type Dense = Vec<Vec<BigRational>>;
 
 /// Solve the orbit exactly; values per step, in the block's local order.
 pub fn solve_orbit(block: &OrbitBlock) -> Result<Vec<Vec<BigRational>>, BlockFailure> {
     let len = block.cycle_len;
-    let width = block.steps[0].len();
-    // products[j] = P_j, an (|x_j| x width) matrix; P_len = I.
-    let mut products: Vec<Dense> = vec![Vec::new(); len];
-    let mut next: Dense = identity(width);
-    for j in (0..len).rev() {
-        let p = apply(&block.transitions[j], &next, width);
-        products[j] = p.clone();
-        next = p;
-    }
-    let mut rows: Vec<(Vec<BigRational>, BigRational)> = Vec::new();
-    for (i, row) in products[0].iter().enumerate() {
-        let mut r = row.clone();
-        r[i] -= BigRational::one();
-        rows.push((r, BigRational::zero()));
-    }
-    for LocalNormalization { step, terms, rhs } in
-        block.normalization.iter().filter(|e| e.step < len)
-    {
-        let mut r = vec![BigRational::zero(); width];
-        for (l, c) in terms {
-            for (o, x) in r.iter_mut().zip(&products[*step][*l]) {
-                *o += c * x;
-            }
+    let mut values: Vec<Vec<BigRational>> = Vec::with_capacity(block.steps.len());
+    if len > 0 {
+        let width = block.steps[0].len();
+        // affine[j] = (P_j, q_j); (P_len, q_len) = (I, 0).
+        let mut affine: Vec<(Dense, Vec<BigRational>)> = vec![(Vec::new(), Vec::new()); len];
+        let mut next: (Dense, Vec<BigRational>) =
+            (identity(width), vec![BigRational::zero(); width]);
+        for j in (0..len).rev() {
+            let p = apply(&block.relations[j], &next.0, width);
+            let q = block.relations[j]
+                .iter()
+                .map(|r| combine(r, &next.1))
+                .collect();
+            affine[j] = (p, q);
+            next = affine[j].clone();
         }
-        rows.push((r, rhs.clone()));
+        let (p0, q0) = &affine[0];
+        let mut rows: Vec<(Vec<BigRational>, BigRational)> = Vec::new();
+        for (i, row) in p0.iter().enumerate() {
+            let mut r = row.clone();
+            r[i] -= BigRational::one();
+            rows.push((r, -q0[i].clone()));
+        }
+        for LocalNormalization { step, terms, rhs } in
+            block.normalization.iter().filter(|e| e.step < len)
+        {
+            let (p, q) = &affine[*step];
+            let mut r = vec![BigRational::zero(); width];
+            let mut b = rhs.clone();
+            for (l, c) in terms {
+                for (o, x) in r.iter_mut().zip(&p[*l]) {
+                    *o += c * x;
+                }
+                b -= c * &q[*l];
+            }
+            rows.push((r, b));
+        }
+        let x0 = solve_dense(rows, width)?;
+        for (p, q) in &affine {
+            values.push(p.iter().zip(q).map(|(row, c)| dot(row, &x0) + c).collect());
+        }
     }
-    let x0 = solve_dense(rows, width)?;
-    let mut values: Vec<Vec<BigRational>> = products
-        .iter()
-        .map(|p| p.iter().map(|row| dot(row, &x0)).collect())
-        .collect();
     for j in len..block.steps.len() {
-        let image = &values[block.next[j]];
-        let step: Vec<BigRational> = block.transitions[j]
-            .iter()
-            .map(|row| {
-                row.iter()
-                    .fold(BigRational::zero(), |acc, (l, w)| acc + w * &image[*l])
-            })
-            .collect();
+        let step = match block.next[j] {
+            Some(s) => block.relations[j]
+                .iter()
+                .map(|r| combine(r, &values[s]))
+                .collect(),
+            None => block.relations[j]
+                .iter()
+                .map(|r| r.constant.clone())
+                .collect(),
+        };
         values.push(step);
     }
     Ok(values)
 }
 
-/// `A P` for a sparse `A` (rows of `(column, weight)`) and a dense `P` of `width` columns.
-fn apply(a: &[Vec<(usize, BigRational)>], p: &Dense, width: usize) -> Dense {
+/// `sum w x[l] + constant` for one relation.
+fn combine(relation: &LocalRelation, x: &[BigRational]) -> BigRational {
+    relation
+        .terms
+        .iter()
+        .fold(relation.constant.clone(), |acc, (l, w)| acc + w * &x[*l])
+}
+
+/// `A P` for a sparse `A` (the relations' terms) and a dense `P` of `width` columns.
+fn apply(a: &[LocalRelation], p: &Dense, width: usize) -> Dense {
     a.iter()
         .map(|row| {
             let mut out = vec![BigRational::zero(); width];
-            for (l, w) in row {
+            for (l, w) in &row.terms {
                 for (o, x) in out.iter_mut().zip(&p[*l]) {
                     if !x.is_zero() {
                         *o += w * x;

@@ -1,11 +1,14 @@
-//! f64 solution of a residue orbit by a rank-revealing least-squares solve (SVD).
+//! f64 solution of an orbit by a rank-revealing least-squares solve (SVD).
 //!
-//! Unlike the exact path, this one assembles the orbit's whole system, every scaling relation
-//! `x_r - A_r x_{2r} = 0` plus every normalization equation of its residues, and solves it in
-//! the least-squares sense through the singular value decomposition: the numerical rank tells
-//! whether the solution is unique, and the residual whether the system is consistent.
-//! Substituting along the orbit, as the exact path does, would amplify rounding by up to
-//! `2^d` for tangents at depth `d` (each derivative relation doubles its weights).
+//! For an orbit with a cycle, unlike the exact path, this one assembles the orbit's whole
+//! system, every relation `x_r - A_r x_{next(r)} = c_r` plus every normalization equation of its
+//! classes, and solves it in the least-squares sense through the singular value decomposition:
+//! the numerical rank tells whether the solution is unique, and the residual whether the
+//! system is consistent. Substituting along a long residue tree, as the exact path does, would
+//! amplify rounding by up to `2^d` for tangents at depth `d` (each derivative relation doubles
+//! its weights). An orbit that ends in a terminal class (a point next to an extraordinary
+//! vertex whose doubles leave the patch after a few steps) is triangular with known values at
+//! its root and short trees: it is solved by substitution.
 
 use nalgebra::{DMatrix, DVector};
 
@@ -20,6 +23,9 @@ const REFINEMENT_PASSES: usize = 4;
 
 /// Solve the orbit in f64; values per step, in the block's local order.
 pub fn solve_orbit(block: &OrbitBlock) -> Result<Vec<Vec<f64>>, BlockFailure> {
+    if block.cycle_len == 0 {
+        return Ok(substitute(block));
+    }
     let len = block.steps.len();
     let mut start = vec![0usize; len + 1];
     for j in 0..len {
@@ -30,12 +36,14 @@ pub fn solve_orbit(block: &OrbitBlock) -> Result<Vec<Vec<f64>>, BlockFailure> {
     let mut a = DMatrix::<f64>::zeros(equations, unknowns);
     let mut b = DVector::<f64>::zeros(equations);
     for j in 0..len {
-        let next = block.next[j];
-        for (i, row) in block.transitions[j].iter().enumerate() {
+        for (i, relation) in block.relations[j].iter().enumerate() {
             let e = start[j] + i;
             a[(e, start[j] + i)] += 1.0;
-            for (l, w) in row {
-                a[(e, start[next] + l)] -= rational_to_f64(w);
+            b[e] = rational_to_f64(&relation.constant);
+            if let Some(next) = block.next[j] {
+                for (l, w) in &relation.terms {
+                    a[(e, start[next] + l)] -= rational_to_f64(w);
+                }
             }
         }
     }
@@ -82,4 +90,24 @@ pub fn solve_orbit(block: &OrbitBlock) -> Result<Vec<Vec<f64>>, BlockFailure> {
     Ok((0..len)
         .map(|j| x.as_slice()[start[j]..start[j + 1]].to_vec())
         .collect())
+}
+
+/// Values of a terminal orbit, step by step from its root.
+fn substitute(block: &OrbitBlock) -> Vec<Vec<f64>> {
+    let mut values: Vec<Vec<f64>> = Vec::with_capacity(block.steps.len());
+    for (j, relations) in block.relations.iter().enumerate() {
+        let step = relations
+            .iter()
+            .map(|r| {
+                let known = block.next[j].map_or(&[][..], |s| values[s].as_slice());
+                r.terms
+                    .iter()
+                    .fold(rational_to_f64(&r.constant), |acc, (l, w)| {
+                        acc + rational_to_f64(w) * known[*l]
+                    })
+            })
+            .collect();
+        values.push(step);
+    }
+    values
 }

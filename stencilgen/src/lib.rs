@@ -29,8 +29,10 @@ pub mod error;
 pub mod exact_solve;
 pub mod float_solve;
 pub mod orbit_block;
-pub mod residue_orbits;
+pub mod orbits;
 pub mod scalar;
+pub mod scaling_system;
+pub mod solve;
 
 pub use curve_stencils::{curve_stencils, BasisFunction, CurveStencils};
 pub use error::StencilError;

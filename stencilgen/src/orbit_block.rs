@@ -1,16 +1,15 @@
-//! The closed sub-system of one residue orbit.
+//! The closed sub-system of one orbit, in step-local indices.
 //!
-//! Write `x_r` for the unknowns of residue `r`. The scaling relation reads `x_r = A_r x_{2r}`
-//! (residues mod n), where `A_r` holds the mask weights (doubled for tangents). Along the
-//! orbit's cycle `r_0 -> r_1 = 2 r_0 -> ... -> r_{L-1} -> r_0` these equations close on
-//! themselves; every tree residue hangs off the cycle through its image `2r`. Together with
-//! the normalization equations of its residues an orbit is a closed system: nothing outside
-//! it enters.
+//! Write `x_r` for the unknowns of class `r`. The relations read `x_r = A_r x_{next(r)} + c_r`
+//! (mask weights in `A_r`, doubled for tangents; known values in `c_r`). Along the orbit's cycle
+//! `r_0 -> r_1 -> ... -> r_{L-1} -> r_0` they close on themselves; every tree class hangs off
+//! the cycle, or off a terminal class, through its successor. Together with the normalization
+//! equations of its classes an orbit is a closed system: nothing outside it enters.
 
 use num_rational::BigRational;
 
-use crate::curve_system::CurveSystem;
-use crate::residue_orbits::ResidueOrbit;
+use crate::orbits::Orbit;
+use crate::scaling_system::ScalingSystem;
 
 /// Why an orbit block has no unique solution.
 #[derive(Clone, Debug, PartialEq)]
@@ -29,25 +28,13 @@ pub enum BlockFailure {
     },
 }
 
-/// The equations of one residue orbit, in step-local indices.
-///
-/// Steps `0..cycle_len` are the cycle in map order (`next[j] = j + 1 mod cycle_len`); the
-/// remaining steps are the tree residues, each after the step it maps to.
+/// A relation in step-local indices: `x_i = sum (local unknown of step next, weight) + constant`.
 #[derive(Clone, Debug)]
-pub struct OrbitBlock {
-    /// The residue `r_j` of each step.
-    pub residues: Vec<u32>,
-    /// How many of the first steps form the cycle.
-    pub cycle_len: usize,
-    /// The step holding residue `2 r_j mod n`.
-    pub next: Vec<usize>,
-    /// Global unknown ids of each step `j` (residue `r_j`).
-    pub steps: Vec<Vec<usize>>,
-    /// `transitions[j][i]`: the scaling relation of local unknown `i` of step `j`, as
-    /// `(local unknown of step next[j], weight)` pairs.
-    pub transitions: Vec<Vec<Vec<(usize, BigRational)>>>,
-    /// The normalization equations of the orbit's residues.
-    pub normalization: Vec<LocalNormalization>,
+pub struct LocalRelation {
+    /// Coefficients on the unknowns of step `next[j]`.
+    pub terms: Vec<(usize, BigRational)>,
+    /// Known part.
+    pub constant: BigRational,
 }
 
 /// A normalization equation `sum coef * x = rhs` over the unknowns of one step.
@@ -61,73 +48,111 @@ pub struct LocalNormalization {
     pub rhs: BigRational,
 }
 
+/// The equations of one orbit.
+///
+/// Steps `0..cycle_len` are the cycle in map order (`next[j] = j + 1 mod cycle_len`); the
+/// remaining steps are the tree classes, each after the step it maps to (terminal steps have
+/// no successor and only constants on their right-hand sides).
+#[derive(Clone, Debug)]
+pub struct OrbitBlock {
+    /// The class of each step.
+    pub classes: Vec<u32>,
+    /// How many of the first steps form the cycle (0 for a terminal orbit).
+    pub cycle_len: usize,
+    /// The step holding the successor class, `None` for a terminal step.
+    pub next: Vec<Option<usize>>,
+    /// Global unknown ids of each step.
+    pub steps: Vec<Vec<usize>>,
+    /// `relations[j][i]`: the relation of local unknown `i` of step `j`.
+    pub relations: Vec<Vec<LocalRelation>>,
+    /// The normalization equations of the orbit's classes.
+    pub normalization: Vec<LocalNormalization>,
+}
+
 impl OrbitBlock {
-    /// Extract the block of `orbit` from `system`; `by_residue` is
-    /// [`CurveSystem::unknowns_by_residue`].
-    pub fn new(system: &CurveSystem, orbit: &ResidueOrbit, by_residue: &[Vec<usize>]) -> Self {
-        let residues: Vec<u32> = orbit.cycle.iter().chain(&orbit.tree).copied().collect();
-        let step_of = |r: u32| residues.iter().position(|&s| s == r);
-        let double = |r: u32| ((2 * u64::from(r)) % u64::from(system.n)) as u32;
-        let next: Vec<usize> = residues
+    /// Extract the block of `orbit` from `system`. `by_class` is
+    /// [`ScalingSystem::unknowns_by_class`]; `normalization_by_class` lists the indices of
+    /// each class's normalization rows.
+    pub fn new(
+        system: &ScalingSystem,
+        orbit: &Orbit,
+        by_class: &[Vec<usize>],
+        normalization_by_class: &[Vec<usize>],
+    ) -> Self {
+        let classes: Vec<u32> = orbit.cycle.iter().chain(&orbit.tree).copied().collect();
+        let mut step_of = std::collections::HashMap::with_capacity(classes.len());
+        for (j, &c) in classes.iter().enumerate() {
+            step_of.insert(c, j);
+        }
+        let next: Vec<Option<usize>> = classes
             .iter()
-            .map(|&r| {
-                step_of(double(r))
-                    .unwrap_or_else(|| unreachable!("orbits are closed under doubling"))
+            .map(|&c| {
+                system.next[c as usize].map(|s| {
+                    *step_of
+                        .get(&s)
+                        .unwrap_or_else(|| unreachable!("orbits are closed under next"))
+                })
             })
             .collect();
-        let steps: Vec<Vec<usize>> = residues
+        let steps: Vec<Vec<usize>> = classes
             .iter()
-            .map(|&r| by_residue[r as usize].clone())
+            .map(|&c| by_class[c as usize].clone())
             .collect();
         let local = |step: usize, u: usize| -> usize {
             steps[step]
                 .binary_search(&u)
-                .unwrap_or_else(|_| unreachable!("the scaling relation maps residue r to 2r"))
+                .unwrap_or_else(|_| unreachable!("relations refer to the successor class"))
         };
-        let transitions = (0..steps.len())
+        let relations = (0..steps.len())
             .map(|j| {
                 steps[j]
                     .iter()
                     .map(|&u| {
-                        system.scaling[u]
-                            .iter()
-                            .map(|(v, w)| (local(next[j], *v), w.clone()))
-                            .collect()
+                        let relation = &system.relations[u];
+                        let terms = match next[j] {
+                            Some(s) => relation
+                                .terms
+                                .iter()
+                                .map(|(v, w)| (local(s, *v), w.clone()))
+                                .collect(),
+                            None => Vec::new(),
+                        };
+                        LocalRelation {
+                            terms,
+                            constant: relation.constant.clone(),
+                        }
                     })
                     .collect()
             })
             .collect();
-        let n = i64::from(system.n);
-        let normalization = system
-            .normalization
+        let normalization = classes
             .iter()
-            .filter_map(|row| {
-                let residue = row.numerator.rem_euclid(n) as u32;
-                let step = step_of(residue)?;
-                let terms = row
-                    .terms
+            .enumerate()
+            .flat_map(|(step, &c)| {
+                normalization_by_class[c as usize]
                     .iter()
-                    .map(|(u, c)| (local(step, *u), c.clone()))
-                    .collect();
-                Some(LocalNormalization {
+                    .map(move |&e| (step, e))
+            })
+            .map(|(step, e)| {
+                let row = &system.normalization[e];
+                LocalNormalization {
                     step,
-                    terms,
+                    terms: row
+                        .terms
+                        .iter()
+                        .map(|(u, c)| (local(step, *u), c.clone()))
+                        .collect(),
                     rhs: row.rhs.clone(),
-                })
+                }
             })
             .collect();
         OrbitBlock {
             cycle_len: orbit.cycle.len(),
-            residues,
+            classes,
             next,
             steps,
-            transitions,
+            relations,
             normalization,
         }
-    }
-
-    /// Total number of unknowns in the block.
-    pub fn unknowns(&self) -> usize {
-        self.steps.iter().map(Vec::len).sum()
     }
 }
