@@ -13,6 +13,10 @@
 //! assert!(four_point.reproduces_linear());
 //! ```
 
+pub mod bivariate;
 pub mod curve;
+pub mod quad;
 
+pub use bivariate::BivariateMask;
 pub use curve::{Component, CurveScheme, Term, Translates};
+pub use quad::{QuadScheme, VertexRule};

@@ -86,7 +86,7 @@ pub fn curve_stencils<S: Scalar>(
     if n == 0 || n > MAX_RATE {
         return Err(StencilError::RateOutOfRange { n, max: MAX_RATE });
     }
-    let curve = CurveSystem::new(scheme, n, derivative)?;
+    let curve = CurveSystem::<S>::new(scheme, n, derivative)?;
     let Solution { values, residual } = solve_system::<S>(&curve.system, &scheme.name, n)?;
     let n_i = i64::from(n);
     let functions = scheme

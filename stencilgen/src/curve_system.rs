@@ -17,16 +17,16 @@
 
 use num_bigint::BigInt;
 use num_rational::BigRational;
-use num_traits::{One, Zero};
+use num_traits::One;
 use schemes::{CurveScheme, Translates};
 
 use crate::orbits::doubling;
 use crate::scaling_system::{add_to_row, NormalizationRow, Relation, ScalingSystem, SparseRow};
-use crate::StencilError;
+use crate::{Scalar, StencilError};
 
 /// The scaling-relation system of one scheme at one grid rate.
 #[derive(Clone, Debug)]
-pub struct CurveSystem {
+pub struct CurveSystem<S> {
     /// Grid rate: the grid is `(1/n) Z`.
     pub n: u32,
     /// Whether the unknowns are derivatives `phi'` (tangent masks) instead of values.
@@ -37,10 +37,10 @@ pub struct CurveSystem {
     pub offsets: Vec<usize>,
     /// The equations; unknown `u` stands for `phi_c(k/n)` with `(c, k) = point_of(u)`, its
     /// class is the residue `k mod n`.
-    pub system: ScalingSystem,
+    pub system: ScalingSystem<S>,
 }
 
-impl CurveSystem {
+impl<S: Scalar> CurveSystem<S> {
     /// Build the system of `scheme` on `(1/n) Z`.
     pub fn new(scheme: &CurveScheme, n: u32, derivative: bool) -> Result<Self, StencilError> {
         if derivative && !scheme.reproduces_linear() {
@@ -60,10 +60,7 @@ impl CurveSystem {
             derivative,
             supports,
             offsets,
-            system: ScalingSystem {
-                next: doubling(n),
-                ..ScalingSystem::default()
-            },
+            system: ScalingSystem::new(doubling(n)),
         };
         let factor = BigRational::from_integer(BigInt::from(if derivative { 2 } else { 1 }));
         for (c, component) in scheme.components.iter().enumerate() {
@@ -77,7 +74,7 @@ impl CurveSystem {
                 }
                 let relation = Relation {
                     terms: row,
-                    constant: BigRational::zero(),
+                    constant: S::zero(),
                 };
                 let label = format!("{}({k}/{n})", component.name);
                 system

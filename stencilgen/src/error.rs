@@ -28,6 +28,26 @@ pub enum StencilError {
         /// The scheme.
         scheme: String,
     },
+    /// The scheme cannot be used for what was asked.
+    #[error("scheme `{scheme}` cannot be used here: {reason}")]
+    UnsupportedScheme {
+        /// The scheme.
+        scheme: String,
+        /// Why.
+        reason: String,
+    },
+    /// The quantity asked for is irrational, so exact mode cannot give it.
+    #[error("{what} is irrational; use the f64 mode")]
+    Irrational {
+        /// What was asked.
+        what: String,
+    },
+    /// A parameter is out of its domain.
+    #[error("{what}")]
+    OutOfDomain {
+        /// What is wrong.
+        what: String,
+    },
     /// The equations contradict each other: no function satisfies all of them.
     #[error("the scaling-relation system of `{scheme}` at n = {n} is inconsistent: {detail}")]
     Inconsistent {

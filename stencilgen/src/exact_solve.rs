@@ -20,7 +20,7 @@ use crate::orbit_block::{BlockFailure, LocalNormalization, LocalRelation, OrbitB
 type Dense = Vec<Vec<BigRational>>;
 
 /// Solve the orbit exactly; values per step, in the block's local order.
-pub fn solve_orbit(block: &OrbitBlock) -> Result<Vec<Vec<BigRational>>, BlockFailure> {
+pub fn solve_orbit(block: &OrbitBlock<BigRational>) -> Result<Vec<Vec<BigRational>>, BlockFailure> {
     let len = block.cycle_len;
     let mut values: Vec<Vec<BigRational>> = Vec::with_capacity(block.steps.len());
     if len > 0 {
@@ -81,7 +81,7 @@ pub fn solve_orbit(block: &OrbitBlock) -> Result<Vec<Vec<BigRational>>, BlockFai
 }
 
 /// `sum w x[l] + constant` for one relation.
-fn combine(relation: &LocalRelation, x: &[BigRational]) -> BigRational {
+fn combine(relation: &LocalRelation<BigRational>, x: &[BigRational]) -> BigRational {
     relation
         .terms
         .iter()
@@ -89,7 +89,7 @@ fn combine(relation: &LocalRelation, x: &[BigRational]) -> BigRational {
 }
 
 /// `A P` for a sparse `A` (the relations' terms) and a dense `P` of `width` columns.
-fn apply(a: &[LocalRelation], p: &Dense, width: usize) -> Dense {
+fn apply(a: &[LocalRelation<BigRational>], p: &Dense, width: usize) -> Dense {
     a.iter()
         .map(|row| {
             let mut out = vec![BigRational::zero(); width];

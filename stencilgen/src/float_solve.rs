@@ -22,7 +22,7 @@ const RANK_TOLERANCE: f64 = 1e-11;
 const REFINEMENT_PASSES: usize = 4;
 
 /// Solve the orbit in f64; values per step, in the block's local order.
-pub fn solve_orbit(block: &OrbitBlock) -> Result<Vec<Vec<f64>>, BlockFailure> {
+pub fn solve_orbit(block: &OrbitBlock<f64>) -> Result<Vec<Vec<f64>>, BlockFailure> {
     if block.cycle_len == 0 {
         return Ok(substitute(block));
     }
@@ -39,7 +39,7 @@ pub fn solve_orbit(block: &OrbitBlock) -> Result<Vec<Vec<f64>>, BlockFailure> {
         for (i, relation) in block.relations[j].iter().enumerate() {
             let e = start[j] + i;
             a[(e, start[j] + i)] += 1.0;
-            b[e] = rational_to_f64(&relation.constant);
+            b[e] = relation.constant;
             if let Some(next) = block.next[j] {
                 for (l, w) in &relation.terms {
                     a[(e, start[next] + l)] -= rational_to_f64(w);
@@ -93,18 +93,16 @@ pub fn solve_orbit(block: &OrbitBlock) -> Result<Vec<Vec<f64>>, BlockFailure> {
 }
 
 /// Values of a terminal orbit, step by step from its root.
-fn substitute(block: &OrbitBlock) -> Vec<Vec<f64>> {
+fn substitute(block: &OrbitBlock<f64>) -> Vec<Vec<f64>> {
     let mut values: Vec<Vec<f64>> = Vec::with_capacity(block.steps.len());
     for (j, relations) in block.relations.iter().enumerate() {
         let step = relations
             .iter()
             .map(|r| {
                 let known = block.next[j].map_or(&[][..], |s| values[s].as_slice());
-                r.terms
-                    .iter()
-                    .fold(rational_to_f64(&r.constant), |acc, (l, w)| {
-                        acc + rational_to_f64(w) * known[*l]
-                    })
+                r.terms.iter().fold(r.constant, |acc, (l, w)| {
+                    acc + rational_to_f64(w) * known[*l]
+                })
             })
             .collect();
         values.push(step);

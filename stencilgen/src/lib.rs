@@ -23,16 +23,22 @@
 //! assert_eq!(stencils.functions[0].at(1).to_string(), "4240/5589");
 //! ```
 
+pub mod bivariate_system;
 pub mod curve_stencils;
 pub mod curve_system;
 pub mod error;
+pub mod ev_tangents;
 pub mod exact_solve;
+pub mod extraordinary_patch;
 pub mod float_solve;
 pub mod orbit_block;
 pub mod orbits;
+pub mod patch_stencils;
+pub mod regular_patch;
 pub mod scalar;
 pub mod scaling_system;
 pub mod solve;
+pub mod substitution;
 
 pub use curve_stencils::{curve_stencils, BasisFunction, CurveStencils};
 pub use error::StencilError;

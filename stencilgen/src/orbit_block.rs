@@ -30,11 +30,11 @@ pub enum BlockFailure {
 
 /// A relation in step-local indices: `x_i = sum (local unknown of step next, weight) + constant`.
 #[derive(Clone, Debug)]
-pub struct LocalRelation {
+pub struct LocalRelation<S> {
     /// Coefficients on the unknowns of step `next[j]`.
     pub terms: Vec<(usize, BigRational)>,
     /// Known part.
-    pub constant: BigRational,
+    pub constant: S,
 }
 
 /// A normalization equation `sum coef * x = rhs` over the unknowns of one step.
@@ -54,7 +54,7 @@ pub struct LocalNormalization {
 /// remaining steps are the tree classes, each after the step it maps to (terminal steps have
 /// no successor and only constants on their right-hand sides).
 #[derive(Clone, Debug)]
-pub struct OrbitBlock {
+pub struct OrbitBlock<S> {
     /// The class of each step.
     pub classes: Vec<u32>,
     /// How many of the first steps form the cycle (0 for a terminal orbit).
@@ -64,17 +64,17 @@ pub struct OrbitBlock {
     /// Global unknown ids of each step.
     pub steps: Vec<Vec<usize>>,
     /// `relations[j][i]`: the relation of local unknown `i` of step `j`.
-    pub relations: Vec<Vec<LocalRelation>>,
+    pub relations: Vec<Vec<LocalRelation<S>>>,
     /// The normalization equations of the orbit's classes.
     pub normalization: Vec<LocalNormalization>,
 }
 
-impl OrbitBlock {
+impl<S: Clone> OrbitBlock<S> {
     /// Extract the block of `orbit` from `system`. `by_class` is
     /// [`ScalingSystem::unknowns_by_class`]; `normalization_by_class` lists the indices of
     /// each class's normalization rows.
     pub fn new(
-        system: &ScalingSystem,
+        system: &ScalingSystem<S>,
         orbit: &Orbit,
         by_class: &[Vec<usize>],
         normalization_by_class: &[Vec<usize>],

@@ -12,13 +12,10 @@ use crate::orbit_block::{BlockFailure, OrbitBlock};
 
 /// A field the scaling-relation system can be solved in.
 pub trait Scalar:
-    Clone + Debug + PartialEq + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self>
+    Clone + Debug + PartialEq + Zero + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self>
 {
     /// Whether values are exact (residuals must be exactly zero).
     const EXACT: bool;
-
-    /// The additive identity.
-    fn zero() -> Self;
 
     /// The (exact) rational `r` in this field.
     fn from_rational(r: &BigRational) -> Self;
@@ -26,13 +23,17 @@ pub trait Scalar:
     /// The nearest f64.
     fn to_f64(&self) -> f64;
 
+    /// An f64 as a value of this field, where the field takes approximate values (`None` for
+    /// exact arithmetic: an f64 there would pass for exact).
+    fn from_f64(x: f64) -> Option<Self>;
+
     /// Whether an equation's residual counts as satisfied: exactly zero for exact
     /// arithmetic, within [`FLOAT_TOLERANCE`] for f64.
     fn is_negligible(&self) -> bool;
 
     /// Solve the closed system of one residue cycle (see [`OrbitBlock`]): the values of the
     /// block's unknowns, step by step.
-    fn solve_orbit(block: &OrbitBlock) -> Result<Vec<Vec<Self>>, BlockFailure>;
+    fn solve_orbit(block: &OrbitBlock<Self>) -> Result<Vec<Vec<Self>>, BlockFailure>;
 }
 
 /// Largest residual an f64 solution may leave in any equation and still count as a solution.
@@ -40,10 +41,6 @@ pub const FLOAT_TOLERANCE: f64 = 1e-9;
 
 impl Scalar for BigRational {
     const EXACT: bool = true;
-
-    fn zero() -> Self {
-        <BigRational as Zero>::zero()
-    }
 
     fn from_rational(r: &BigRational) -> Self {
         r.clone()
@@ -53,21 +50,21 @@ impl Scalar for BigRational {
         rational_to_f64(self)
     }
 
+    fn from_f64(_: f64) -> Option<Self> {
+        None
+    }
+
     fn is_negligible(&self) -> bool {
         Zero::is_zero(self)
     }
 
-    fn solve_orbit(block: &OrbitBlock) -> Result<Vec<Vec<Self>>, BlockFailure> {
+    fn solve_orbit(block: &OrbitBlock<Self>) -> Result<Vec<Vec<Self>>, BlockFailure> {
         crate::exact_solve::solve_orbit(block)
     }
 }
 
 impl Scalar for f64 {
     const EXACT: bool = false;
-
-    fn zero() -> Self {
-        0.0
-    }
 
     fn from_rational(r: &BigRational) -> Self {
         rational_to_f64(r)
@@ -77,11 +74,15 @@ impl Scalar for f64 {
         *self
     }
 
+    fn from_f64(x: f64) -> Option<Self> {
+        Some(x)
+    }
+
     fn is_negligible(&self) -> bool {
         self.abs() <= FLOAT_TOLERANCE
     }
 
-    fn solve_orbit(block: &OrbitBlock) -> Result<Vec<Vec<Self>>, BlockFailure> {
+    fn solve_orbit(block: &OrbitBlock<Self>) -> Result<Vec<Vec<Self>>, BlockFailure> {
         crate::float_solve::solve_orbit(block)
     }
 }

@@ -19,13 +19,14 @@ use num_rational::BigRational;
 /// A sparse linear form: `(unknown, coefficient)` pairs.
 pub type SparseRow = Vec<(usize, BigRational)>;
 
-/// The relation `x_u = sum terms + constant` of one unknown.
+/// The relation `x_u = sum terms + constant` of one unknown; the constant (known values, such
+/// as regular basis functions next to an extraordinary vertex) is in the solver's field `S`.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Relation {
+pub struct Relation<S> {
     /// Coefficients on unknowns of class `next(class(u))`.
     pub terms: SparseRow,
     /// Contribution of known values (zero for uniform schemes).
-    pub constant: BigRational,
+    pub constant: S,
 }
 
 /// A normalization equation `sum terms = rhs` over the unknowns of one class.
@@ -42,28 +43,39 @@ pub struct NormalizationRow {
 }
 
 /// The whole system.
-#[derive(Clone, Debug, Default)]
-pub struct ScalingSystem {
+#[derive(Clone, Debug)]
+pub struct ScalingSystem<S> {
     /// Class of every unknown.
     pub class_of: Vec<u32>,
     /// `next[r]`: the class that class `r`'s relations refer to; `None` for terminal classes.
     pub next: Vec<Option<u32>>,
     /// One relation per unknown.
-    pub relations: Vec<Relation>,
+    pub relations: Vec<Relation<S>>,
     /// The normalization equations.
     pub normalization: Vec<NormalizationRow>,
     /// A label per unknown for error messages (`"phi(4/3)"`).
     pub labels: Vec<String>,
 }
 
-impl ScalingSystem {
+impl<S> ScalingSystem<S> {
+    /// An empty system over the class map `next`.
+    pub fn new(next: Vec<Option<u32>>) -> Self {
+        ScalingSystem {
+            class_of: Vec::new(),
+            next,
+            relations: Vec::new(),
+            normalization: Vec::new(),
+            labels: Vec::new(),
+        }
+    }
+
     /// Number of unknowns.
     pub fn unknowns(&self) -> usize {
         self.relations.len()
     }
 
     /// Add an unknown of `class` with its relation; its id.
-    pub fn push_unknown(&mut self, class: u32, relation: Relation, label: String) -> usize {
+    pub fn push_unknown(&mut self, class: u32, relation: Relation<S>, label: String) -> usize {
         self.class_of.push(class);
         self.relations.push(relation);
         self.labels.push(label);

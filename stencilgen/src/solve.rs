@@ -18,7 +18,7 @@ pub struct Solution<S> {
 
 /// Solve `system` in the field `S`; `scheme` and `n` only label errors.
 pub fn solve_system<S: Scalar>(
-    system: &ScalingSystem,
+    system: &ScalingSystem<S>,
     scheme: &str,
     n: u32,
 ) -> Result<Solution<S>, StencilError> {
@@ -66,7 +66,7 @@ fn evaluate<S: Scalar>(terms: &[(usize, BigRational)], values: &[S]) -> S {
 
 /// Check every equation of the system; the largest absolute residual.
 fn verify<S: Scalar>(
-    system: &ScalingSystem,
+    system: &ScalingSystem<S>,
     values: &[S],
     scheme: &str,
     n: u32,
@@ -85,9 +85,8 @@ fn verify<S: Scalar>(
         }
     };
     for (u, relation) in system.relations.iter().enumerate() {
-        let residual = values[u].clone()
-            - evaluate(&relation.terms, values)
-            - S::from_rational(&relation.constant);
+        let residual =
+            values[u].clone() - evaluate(&relation.terms, values) - relation.constant.clone();
         check(residual, &|| {
             format!("the relation of {}", system.labels[u])
         })?;
