@@ -34,6 +34,7 @@ pub mod float_solve;
 pub mod orbit_block;
 pub mod orbits;
 pub mod patch_stencils;
+pub mod rational;
 pub mod regular_patch;
 pub mod scalar;
 pub mod scaling_system;

@@ -1,16 +1,21 @@
 //! `stencilgen`: evaluation stencils from the scaling relation, on the command line.
 //!
 //! `stencilgen curve --scheme NAME --n N [--derivative] [--f64] [--json]` prints the values of
-//! a curve scheme's basis function(s) (or their derivatives) on the grid `(1/n) Z`; see
-//! `docs/cli.md` for the JSON layout.
+//! a curve scheme's basis function(s) (or their derivatives) on the grid `(1/n) Z`;
+//! `stencilgen stencil --scheme S --valence V --u p/q --v p/q [--f64] [--json]` the stencil of
+//! the patch next to an extraordinary vertex. See `docs/cli.md` for the JSON layouts.
 
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use num_rational::BigRational;
 use schemes::curve::CURVE_SCHEME_NAMES;
-use schemes::CurveScheme;
+use schemes::quad::QUAD_SCHEME_NAMES;
+use schemes::{CurveScheme, QuadScheme};
 use serde_json::{json, Value};
+use stencilgen::rational::parse_rational;
+use stencilgen::regular_patch::StencilKind;
+use stencilgen::substitution::Substitution;
 use stencilgen::{curve_stencils, CurveStencils, Scalar, StencilError};
 
 #[derive(Parser)]
@@ -44,7 +49,28 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// List the curve schemes.
+    /// Stencil of the patch next to an extraordinary vertex at a rational (u, v).
+    Stencil {
+        /// Quad scheme name (catmull-clark, sw-nonpoly-quad).
+        #[arg(long)]
+        scheme: String,
+        /// Valence of the extraordinary vertex at (0, 0).
+        #[arg(long, value_parser = clap::value_parser!(u32).range(3..=64))]
+        valence: u32,
+        /// u in [0, 1], as p/q.
+        #[arg(long, allow_hyphen_values = true)]
+        u: String,
+        /// v in [0, 1], as p/q.
+        #[arg(long, allow_hyphen_values = true)]
+        v: String,
+        /// Weights in f64 (and the EV's irrational tangent masks).
+        #[arg(long = "f64")]
+        float: bool,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
+    /// List the schemes.
     Schemes,
 }
 
@@ -61,10 +87,35 @@ fn main() -> ExitCode {
 fn run(cli: Cli) -> Result<(), StencilError> {
     match cli.command {
         Command::Schemes => {
+            println!("curve schemes (stencilgen curve):");
             for name in CURVE_SCHEME_NAMES {
                 if let Some(scheme) = CurveScheme::by_name(name) {
-                    println!("{name:<26} {}", scheme.description);
+                    println!("  {name:<26} {}", scheme.description);
                 }
+            }
+            println!("quad schemes (stencilgen stencil):");
+            for name in QUAD_SCHEME_NAMES {
+                if let Some(scheme) = QuadScheme::by_name(name) {
+                    println!("  {name:<26} {}", scheme.description);
+                }
+            }
+            Ok(())
+        }
+        Command::Stencil { scheme, valence, u, v, float, json } => {
+            let scheme = QuadScheme::by_name(&scheme).ok_or_else(|| StencilError::UnknownScheme {
+                name: scheme.clone(),
+                known: QUAD_SCHEME_NAMES.join(", "),
+            })?;
+            let (u, v) = (parse_rational(&u)?, parse_rational(&v)?);
+            let out = if float {
+                stencil_json::<f64>(&scheme, valence, &u, &v, |x| json!(x))?
+            } else {
+                stencil_json::<BigRational>(&scheme, valence, &u, &v, |x| json!(x.to_string()))?
+            };
+            if json {
+                println!("{out}");
+            } else {
+                println!("{}", serde_json::to_string_pretty(&out).unwrap_or_default());
             }
             Ok(())
         }
@@ -90,6 +141,49 @@ fn run(cli: Cli) -> Result<(), StencilError> {
             Ok(())
         }
     }
+}
+
+/// `{"weights","du","dv"}` (DESIGN.md / issue contract) plus what they mean: the scheme,
+/// valence, point and the control-point order. Tangents that exact arithmetic cannot give
+/// (at the EV itself) are `null`, with the reason in `"note"`.
+fn stencil_json<S: Scalar>(
+    scheme: &QuadScheme,
+    valence: u32,
+    u: &BigRational,
+    v: &BigRational,
+    value: impl Fn(&S) -> Value,
+) -> Result<Value, StencilError> {
+    let mut substitution = Substitution::<S>::new(scheme, valence)?;
+    let weights = substitution.stencil(u, v, StencilKind::Position)?;
+    let mut out = json!({
+        "scheme": scheme.name,
+        "valence": valence,
+        "u": u.to_string(),
+        "v": v.to_string(),
+        "exact": S::EXACT,
+        "order": layout_names(valence),
+        "weights": weights.iter().map(&value).collect::<Vec<_>>(),
+    });
+    for (key, kind) in [("du", StencilKind::DerivativeU), ("dv", StencilKind::DerivativeV)] {
+        match substitution.stencil(u, v, kind) {
+            Ok(mask) => out[key] = mask.iter().map(&value).collect(),
+            Err(e @ StencilError::Irrational { .. }) => {
+                out[key] = Value::Null;
+                out["note"] = json!(e.to_string());
+            }
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(out)
+}
+
+/// Names of the layout's control points: `V`, `E1..Ev`, `F1..Fv`, `O1..O7`.
+fn layout_names(valence: u32) -> Vec<String> {
+    let mut names = vec!["V".to_owned()];
+    names.extend((1..=valence).map(|i| format!("E{i}")));
+    names.extend((1..=valence).map(|i| format!("F{i}")));
+    names.extend((1..=7).map(|i| format!("O{i}")));
+    names
 }
 
 fn print<S: Scalar + std::fmt::Display>(
