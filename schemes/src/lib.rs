@@ -19,4 +19,4 @@ pub mod quad;
 
 pub use bivariate::BivariateMask;
 pub use curve::{Component, CurveScheme, Term, Translates};
-pub use quad::{QuadScheme, VertexRule};
+pub use quad::{BoundaryMode, BoundaryRules, QuadScheme, VertexRule};

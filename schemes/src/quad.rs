@@ -45,6 +45,26 @@ impl VertexRule {
     }
 }
 
+/// What a boundary vertex with a single face does (OpenSubdiv's boundary interpolation).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum BoundaryMode {
+    /// "Edge only", OpenSubdiv's default: every boundary vertex, a single face's corner too,
+    /// follows the smooth boundary rule.
+    EdgeOnly,
+    /// "Edge and corner": a boundary vertex with one face (valence 2) is a pinned corner.
+    EdgeAndCorner,
+}
+
+/// The boundary rules of a scheme: boundary edges are curves of the scheme's boundary curve
+/// rule, independent of the interior.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BoundaryRules {
+    /// Boundary vertex point: `centre * V + end * (the two boundary neighbours)`.
+    pub vertex_centre: Rational64,
+    /// Weight of each boundary neighbour in a boundary vertex point.
+    pub vertex_end: Rational64,
+}
+
 /// A quad subdivision scheme, as data.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct QuadScheme {
@@ -60,6 +80,8 @@ pub struct QuadScheme {
     pub vertex: VertexRule,
     /// The curve scheme whose tensor product the scheme is in regular regions.
     pub regular_curve: &'static str,
+    /// Boundary rules (boundary edge points are always midpoints), if the scheme has them.
+    pub boundary: Option<BoundaryRules>,
 }
 
 /// Names of the quad schemes [`QuadScheme::by_name`] knows.
@@ -76,6 +98,11 @@ impl QuadScheme {
                 edge_side: Rational64::new(1, 16),
                 vertex: VertexRule::CatmullClark,
                 regular_curve: "cubic-bspline",
+                // Boundary edges are cubic B-spline curves: (1/8, 3/4, 1/8) and midpoints.
+                boundary: Some(BoundaryRules {
+                    vertex_centre: Rational64::new(3, 4),
+                    vertex_end: Rational64::new(1, 8),
+                }),
             }),
             "sw-nonpoly-quad" => Some(QuadScheme {
                 name: "sw-nonpoly-quad",
@@ -84,6 +111,7 @@ impl QuadScheme {
                 edge_side: Rational64::new(1, 12),
                 vertex: VertexRule::SwNonpoly,
                 regular_curve: "sw-nonpoly",
+                boundary: None,
             }),
             _ => None,
         }

@@ -2,17 +2,18 @@
 //! eigenvectors of the local subdivision matrix (Halstead, Kass and DeRose; Schaefer–Warren
 //! section 5.3 points to the eigen-structure for this).
 //!
-//! The 1-ring `V, E_1..E_v, F_1..F_v` is invariant under subdivision, so its `(2v+1)`-square
-//! block `A_1` of `A` carries the tangent plane: if `w A_1 = lambda w` for the subdominant
-//! eigenvalue `lambda`, then `w . P` is a tangent vector of the limit surface at the EV. The
-//! eigenvalue pair comes from the Fourier frequencies 1 and v-1; its left eigenspace is spanned
-//! by a "cosine" and a "sine" mode. The `u` mask is the cosine mode (its weights on `E_i` vary
-//! as `cos(2 pi (i-1)/v)`: the direction of `E_1`), the `v` mask the same rotated by one sector
-//! (the direction of `E_2`). The scale is fixed by applying the mask to the planar net
-//! `V = 0, E_i = (cos t_i, sin t_i), F_i = E_i + E_{i+1}` and asking for the vector `(1, 0)`:
-//! at valence 4 this is the regular net and the masks are exactly the bicubic (or tensor
-//! product) derivatives at the corner; at other valences they are tangent *directions* (the
-//! patch's parametric derivatives at the EV vanish or diverge with `(2 lambda)^k`).
+//! The 1-ring `V, E_i, F_i` is invariant under subdivision, so its block `A_1` of `A` carries
+//! the tangent plane: if `w A_1 = lambda w` for one of the two largest eigenvalues below 1,
+//! then `w . P` is a tangent vector of the limit surface at the vertex. (Interior vertices: the
+//! double eigenvalue of Fourier frequencies 1 and v-1, a "cosine" and a "sine" mode. Boundary
+//! vertices: the boundary curve's tangent, eigenvalue 1/2, and the cross-boundary mode.)
+//! Which tangent is "d/du" is a choice of normalization; it is fixed on a reference planar net
+//! `V = 0, E_i = (cos t_i, sin t_i), F_i = E_i + E_{i+1}` with `t_i = 2 pi (i-1)/v` (interior)
+//! or `pi (i-1)/max(f, 2)` (boundary, f faces): the `u` mask of sector `s` maps that net to the
+//! unit vector of `E_{s+1}`, the `v` mask to that of `E_{s+2}`. At valence 4, and at a regular
+//! boundary vertex (two faces), the net is the regular grid and the masks are exactly the
+//! tensor-product derivatives at the corner; elsewhere they are tangent *directions* (the
+//! patch's parametric derivatives at the vertex vanish or diverge like `(2 lambda)^k`).
 //! The values are irrational for most valences, so this is f64 only.
 
 use nalgebra::DMatrix;
@@ -21,8 +22,8 @@ use crate::extraordinary_patch::LocalMatrices;
 use crate::scalar::rational_to_f64;
 use crate::StencilError;
 
-/// The subdominant eigenvalue and the `u`, `v` tangent masks at the EV (`K` weights each, zero
-/// beyond the 1-ring).
+/// The largest eigenvalue below 1 and the `u`, `v` tangent masks at the vertex (`K` weights
+/// each, zero beyond the 1-ring).
 #[derive(Clone, Debug, PartialEq)]
 pub struct EvTangents {
     /// The subdominant eigenvalue of `A`.
@@ -33,68 +34,111 @@ pub struct EvTangents {
     pub dv: Vec<f64>,
 }
 
-/// Compute the EV tangent masks of `matrices`.
+/// Compute the tangent masks at the vertex of `matrices`' patch.
 pub fn ev_tangents(matrices: &LocalMatrices) -> Result<EvTangents, StencilError> {
-    let v = matrices.valence as usize;
-    let ring = 2 * v + 1;
+    let nb = matrices.neighbourhood;
+    let (edges, faces) = (nb.edges() as usize, nb.faces as usize);
+    let ring = 1 + edges + faces;
     let a1 = DMatrix::from_fn(ring, ring, |i, j| rational_to_f64(&matrices.a[i][j]));
-    let lambda = a1
+    let failure = |what: &str| StencilError::Inconsistent {
+        scheme: "tangents at the extraordinary vertex".to_owned(),
+        n: 0,
+        detail: format!("{}: {what}", matrices.describe()),
+    };
+    let mut eigenvalues: Vec<f64> = a1
         .complex_eigenvalues()
         .iter()
         .filter(|z| (z.norm() - 1.0).abs() > 1e-9)
         .map(|z| z.re)
-        .fold(f64::NEG_INFINITY, f64::max);
-    let failure = |what: &str| StencilError::Inconsistent {
-        scheme: "extraordinary tangents".to_owned(),
-        n: 0,
-        detail: format!("valence {v}: {what}"),
+        .collect();
+    eigenvalues.sort_by(|x, y| y.total_cmp(x));
+    let (&l1, &l2) = (
+        eigenvalues
+            .first()
+            .ok_or_else(|| failure("no subdominant eigenvalue"))?,
+        eigenvalues
+            .get(1)
+            .ok_or_else(|| failure("no second subdominant eigenvalue"))?,
+    );
+    // Left eigenvectors spanning the tangent plane: the null spaces of A1^T - lambda I.
+    let mut basis: Vec<Vec<f64>> = left_null_space(&a1, l1);
+    if (l1 - l2).abs() > 1e-9 {
+        basis.truncate(1);
+        basis.extend(left_null_space(&a1, l2).into_iter().take(1));
+    }
+    if basis.len() != 2 {
+        return Err(failure(
+            "the tangent plane is not spanned by two eigenvectors",
+        ));
+    }
+    // The reference net: V = 0, E_i at angle theta_i, F_i = E_i + E_{i+1}.
+    let step = match nb.boundary {
+        None => 2.0 * std::f64::consts::PI / faces as f64,
+        Some(_) => std::f64::consts::PI / faces.max(2) as f64,
     };
-    // Left eigenvectors: the null space of A1^T - lambda I.
-    let m = a1.transpose() - DMatrix::identity(ring, ring) * lambda;
+    let edge = |i: usize| {
+        let t = step * ((i % edges) as f64);
+        [t.cos(), t.sin()]
+    };
+    let image = |w: &[f64]| -> [f64; 2] {
+        let points = (0..edges)
+            .map(|i| (w[1 + i], edge(i)))
+            .chain((0..faces).map(|i| {
+                let (e, f) = (edge(i), edge(i + 1));
+                (w[1 + edges + i], [e[0] + f[0], e[1] + f[1]])
+            }));
+        points.fold([0.0, 0.0], |acc, (weight, p)| {
+            [acc[0] + weight * p[0], acc[1] + weight * p[1]]
+        })
+    };
+    let (g0, g1) = (image(&basis[0]), image(&basis[1]));
+    let det = g0[0] * g1[1] - g0[1] * g1[0];
+    if det.abs() < 1e-12 {
+        return Err(failure(
+            "the eigenvectors do not span the reference net's plane",
+        ));
+    }
+    // The mask c0 w0 + c1 w1 with image `target`: solve [g0 g1]^T c = target.
+    let mask = |target: [f64; 2]| -> Vec<f64> {
+        let c0 = (target[0] * g1[1] - target[1] * g1[0]) / det;
+        let c1 = (g0[0] * target[1] - g0[1] * target[0]) / det;
+        let mut m: Vec<f64> = basis[0]
+            .iter()
+            .zip(&basis[1])
+            .map(|(a, b)| c0 * a + c1 * b)
+            .collect();
+        m.resize(matrices.size(), 0.0);
+        m
+    };
+    let sector = matrices.sector as usize;
+    Ok(EvTangents {
+        lambda: l1,
+        du: mask(edge(sector)),
+        dv: mask(edge(sector + 1)),
+    })
+}
+
+/// An orthonormal basis of the left null space of `a - lambda I` (singular values below 1e-8).
+fn left_null_space(a: &DMatrix<f64>, lambda: f64) -> Vec<Vec<f64>> {
+    let n = a.nrows();
+    let m = a.transpose() - DMatrix::identity(n, n) * lambda;
     let svd = m.svd(false, true);
-    let v_t = svd.v_t.ok_or_else(|| failure("SVD without vectors"))?;
-    let mut order: Vec<usize> = (0..ring).collect();
+    let Some(v_t) = svd.v_t else {
+        return Vec::new();
+    };
+    let mut order: Vec<usize> = (0..n).collect();
     order.sort_by(|&i, &j| svd.singular_values[i].total_cmp(&svd.singular_values[j]));
-    let null: Vec<Vec<f64>> = order[..2]
-        .iter()
-        .map(|&i| v_t.row(i).iter().copied().collect())
-        .collect();
-    if svd.singular_values[order[1]] > 1e-8 {
-        return Err(failure("the subdominant eigenvalue is not a double one"));
-    }
-    let theta = |i: usize| 2.0 * std::f64::consts::PI * (i as f64) / (v as f64);
-    let sine = |w: &[f64]| (0..v).map(|i| w[1 + i] * theta(i).sin()).sum::<f64>();
-    let (s0, s1) = (sine(&null[0]), sine(&null[1]));
-    let mut du: Vec<f64> = null[0]
-        .iter()
-        .zip(&null[1])
-        .map(|(a, b)| s1 * a - s0 * b)
-        .collect();
-    // Scale: the planar net E_i = (cos t_i, sin t_i), F_i = E_i + E_{i+1} maps to (1, 0).
-    let x = |i: usize| theta(i % v).cos();
-    let along_u: f64 = (0..v)
-        .map(|i| du[1 + i] * x(i) + du[1 + v + i] * (x(i) + x(i + 1)))
-        .sum();
-    if along_u.abs() < 1e-12 {
-        return Err(failure("the cosine mode vanishes"));
-    }
-    for w in &mut du {
-        *w /= along_u;
-    }
-    let mut dv = vec![0.0; ring];
-    for i in 0..v {
-        dv[1 + (i + 1) % v] = du[1 + i];
-        dv[1 + v + (i + 1) % v] = du[1 + v + i];
-    }
-    let k = matrices.size();
-    du.resize(k, 0.0);
-    dv.resize(k, 0.0);
-    Ok(EvTangents { lambda, du, dv })
+    order
+        .into_iter()
+        .take_while(|&i| svd.singular_values[i] < 1e-8)
+        .map(|i| v_t.row(i).iter().copied().collect())
+        .collect()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::extraordinary_patch::Neighbourhood;
     use schemes::QuadScheme;
 
     #[test]
@@ -102,7 +146,10 @@ mod tests {
         // lambda = (5 + cos(2pi/v) + cos(pi/v) sqrt(18 + 2 cos(2pi/v))) / 16 (Stam 1998, eq. 9).
         let cc = QuadScheme::by_name("catmull-clark").expect("catalogued");
         for v in 3..=8u32 {
-            let t = ev_tangents(&LocalMatrices::new(&cc, v)).expect("tangents");
+            let t = ev_tangents(
+                &LocalMatrices::new(&cc, Neighbourhood::interior(v), 0).expect("valid"),
+            )
+            .expect("tangents");
             let c = (2.0 * std::f64::consts::PI / f64::from(v)).cos();
             let h = (std::f64::consts::PI / f64::from(v)).cos();
             let expected = (5.0 + c + h * (18.0 + 2.0 * c).sqrt()) / 16.0;
@@ -118,7 +165,9 @@ mod tests {
     fn valence_four_masks_are_the_bicubic_corner_derivatives() {
         // d/du of the bicubic at a corner: (1/2)(E_1 - E_3) x (1/6, 4/6, 1/6) across.
         let cc = QuadScheme::by_name("catmull-clark").expect("catalogued");
-        let t = ev_tangents(&LocalMatrices::new(&cc, 4)).expect("tangents");
+        let t =
+            ev_tangents(&LocalMatrices::new(&cc, Neighbourhood::interior(4), 0).expect("valid"))
+                .expect("tangents");
         let expected = [
             0.0,
             1.0 / 3.0,

@@ -11,8 +11,9 @@ use clap::{Parser, Subcommand};
 use num_rational::BigRational;
 use schemes::curve::CURVE_SCHEME_NAMES;
 use schemes::quad::QUAD_SCHEME_NAMES;
-use schemes::{CurveScheme, QuadScheme};
+use schemes::{BoundaryMode, CurveScheme, QuadScheme};
 use serde_json::{json, Value};
+use stencilgen::extraordinary_patch::{canonical, Neighbourhood, OUTER_POINTS};
 use stencilgen::rational::parse_rational;
 use stencilgen::regular_patch::StencilKind;
 use stencilgen::substitution::Substitution;
@@ -54,9 +55,18 @@ enum Command {
         /// Quad scheme name (catmull-clark, sw-nonpoly-quad).
         #[arg(long)]
         scheme: String,
-        /// Valence of the extraordinary vertex at (0, 0).
-        #[arg(long, value_parser = clap::value_parser!(u32).range(3..=64))]
-        valence: u32,
+        /// Valence of the (interior) extraordinary vertex at (0, 0).
+        #[arg(long, value_parser = clap::value_parser!(u32).range(3..=64), required_unless_present = "boundary", conflicts_with = "boundary")]
+        valence: Option<u32>,
+        /// The vertex at (0, 0) is a boundary vertex with this many faces.
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=64))]
+        boundary: Option<u32>,
+        /// Which of the boundary vertex's patches: 0 has the boundary along u = 0..1, v = 0.
+        #[arg(long, default_value_t = 0, requires = "boundary")]
+        sector: u32,
+        /// A boundary vertex with one face is a pinned corner (OpenSubdiv "edge and corner").
+        #[arg(long, requires = "boundary")]
+        corners: bool,
         /// u in [0, 1], as p/q.
         #[arg(long, allow_hyphen_values = true)]
         u: String,
@@ -101,16 +111,37 @@ fn run(cli: Cli) -> Result<(), StencilError> {
             }
             Ok(())
         }
-        Command::Stencil { scheme, valence, u, v, float, json } => {
-            let scheme = QuadScheme::by_name(&scheme).ok_or_else(|| StencilError::UnknownScheme {
-                name: scheme.clone(),
-                known: QUAD_SCHEME_NAMES.join(", "),
-            })?;
+        Command::Stencil {
+            scheme,
+            valence,
+            boundary,
+            sector,
+            corners,
+            u,
+            v,
+            float,
+            json,
+        } => {
+            let scheme =
+                QuadScheme::by_name(&scheme).ok_or_else(|| StencilError::UnknownScheme {
+                    name: scheme.clone(),
+                    known: QUAD_SCHEME_NAMES.join(", "),
+                })?;
             let (u, v) = (parse_rational(&u)?, parse_rational(&v)?);
-            let out = if float {
-                stencil_json::<f64>(&scheme, valence, &u, &v, |x| json!(x))?
+            let mode = if corners {
+                BoundaryMode::EdgeAndCorner
             } else {
-                stencil_json::<BigRational>(&scheme, valence, &u, &v, |x| json!(x.to_string()))?
+                BoundaryMode::EdgeOnly
+            };
+            let nb = match (valence, boundary) {
+                (_, Some(faces)) => Neighbourhood::boundary(faces, mode),
+                (Some(v), None) => Neighbourhood::interior(v),
+                (None, None) => unreachable!("clap requires --valence or --boundary"),
+            };
+            let out = if float {
+                stencil_json::<f64>(&scheme, nb, sector, &u, &v, |x| json!(x))?
+            } else {
+                stencil_json::<BigRational>(&scheme, nb, sector, &u, &v, |x| json!(x.to_string()))?
             };
             if json {
                 println!("{out}");
@@ -148,23 +179,29 @@ fn run(cli: Cli) -> Result<(), StencilError> {
 /// (at the EV itself) are `null`, with the reason in `"note"`.
 fn stencil_json<S: Scalar>(
     scheme: &QuadScheme,
-    valence: u32,
+    nb: Neighbourhood,
+    sector: u32,
     u: &BigRational,
     v: &BigRational,
     value: impl Fn(&S) -> Value,
 ) -> Result<Value, StencilError> {
-    let mut substitution = Substitution::<S>::new(scheme, valence)?;
+    let mut substitution = Substitution::<S>::new(scheme, nb, sector)?;
     let weights = substitution.stencil(u, v, StencilKind::Position)?;
     let mut out = json!({
         "scheme": scheme.name,
-        "valence": valence,
+        "valence": nb.faces,
+        "boundary": nb.boundary.is_some(),
+        "sector": sector,
         "u": u.to_string(),
         "v": v.to_string(),
         "exact": S::EXACT,
-        "order": layout_names(valence),
+        "order": layout_names(nb, sector),
         "weights": weights.iter().map(&value).collect::<Vec<_>>(),
     });
-    for (key, kind) in [("du", StencilKind::DerivativeU), ("dv", StencilKind::DerivativeV)] {
+    for (key, kind) in [
+        ("du", StencilKind::DerivativeU),
+        ("dv", StencilKind::DerivativeV),
+    ] {
         match substitution.stencil(u, v, kind) {
             Ok(mask) => out[key] = mask.iter().map(&value).collect(),
             Err(e @ StencilError::Irrational { .. }) => {
@@ -177,12 +214,19 @@ fn stencil_json<S: Scalar>(
     Ok(out)
 }
 
-/// Names of the layout's control points: `V`, `E1..Ev`, `F1..Fv`, `O1..O7`.
-fn layout_names(valence: u32) -> Vec<String> {
+/// Names of the layout's control points: `V`, `E1..`, `F1..`, and the outer points `O1..O7`
+/// that exist.
+fn layout_names(nb: Neighbourhood, sector: u32) -> Vec<String> {
     let mut names = vec!["V".to_owned()];
-    names.extend((1..=valence).map(|i| format!("E{i}")));
-    names.extend((1..=valence).map(|i| format!("F{i}")));
-    names.extend((1..=7).map(|i| format!("O{i}")));
+    names.extend((1..=nb.edges()).map(|i| format!("E{i}")));
+    names.extend((1..=nb.faces).map(|i| format!("F{i}")));
+    names.extend(
+        OUTER_POINTS
+            .iter()
+            .enumerate()
+            .filter(|(_, &(a, b))| canonical(nb, i64::from(sector), a, b).is_some())
+            .map(|(i, _)| format!("O{}", i + 1)),
+    );
     names
 }
 

@@ -28,7 +28,7 @@ use num_traits::{One, Zero};
 use schemes::{CurveScheme, QuadScheme};
 
 use crate::ev_tangents::ev_tangents;
-use crate::extraordinary_patch::{LocalMatrices, SUB_PATCH_ORIGINS};
+use crate::extraordinary_patch::{LocalMatrices, Neighbourhood, SUB_PATCH_ORIGINS};
 use crate::regular_patch::{RegularBasis, StencilKind};
 use crate::scaling_system::{NormalizationRow, Relation, ScalingSystem, SparseRow};
 use crate::solve::{solve_system, Solution};
@@ -39,8 +39,10 @@ use crate::{Scalar, StencilError};
 pub struct PatchStencils<S> {
     /// The scheme's name.
     pub scheme: String,
-    /// Valence of the extraordinary vertex.
-    pub valence: u32,
+    /// The vertex's neighbourhood.
+    pub neighbourhood: Neighbourhood,
+    /// The sector whose patch this is.
+    pub sector: u32,
     /// Grid rate.
     pub n: u32,
     /// Positions or derivatives.
@@ -83,14 +85,16 @@ pub fn sub_patch_of(a: i64, b: i64, n: i64) -> (usize, (i64, i64)) {
     (index, (a - a0 * n, b - b0 * n))
 }
 
-/// Solve the EV patch system of `scheme` at valence `valence` and rate `n` for one `kind`.
+/// Solve the patch system of `scheme` around `neighbourhood`, patch `sector`, at rate `n`, for
+/// one `kind`.
 pub fn patch_stencils<S: Scalar>(
     scheme: &QuadScheme,
-    valence: u32,
+    neighbourhood: Neighbourhood,
+    sector: u32,
     n: u32,
     kind: StencilKind,
 ) -> Result<PatchStencils<S>, StencilError> {
-    let matrices = LocalMatrices::new(scheme, valence);
+    let matrices = LocalMatrices::new(scheme, neighbourhood, sector)?;
     let curve = regular_curve(scheme)?;
     let basis = RegularBasis::<S>::new(&curve, n)?;
     patch_stencils_with(scheme, &matrices, &basis, kind)
@@ -225,7 +229,8 @@ pub fn patch_stencils_with<S: Scalar>(
     }
     Ok(PatchStencils {
         scheme: scheme.name.to_owned(),
-        valence: matrices.valence,
+        neighbourhood: matrices.neighbourhood,
+        sector: matrices.sector,
         n: basis.n,
         kind,
         points,

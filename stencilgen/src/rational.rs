@@ -16,8 +16,12 @@ pub fn parse_rational(text: &str) -> Result<BigRational, StencilError> {
         Some((p, q)) => (p.trim(), q.trim()),
         None => (text.trim(), "1"),
     };
-    let p: BigInt = p.parse().map_err(|_| bad("the numerator is not an integer"))?;
-    let q: BigInt = q.parse().map_err(|_| bad("the denominator is not an integer"))?;
+    let p: BigInt = p
+        .parse()
+        .map_err(|_| bad("the numerator is not an integer"))?;
+    let q: BigInt = q
+        .parse()
+        .map_err(|_| bad("the denominator is not an integer"))?;
     if q.is_zero() {
         return Err(bad("the denominator is zero"));
     }
@@ -33,10 +37,22 @@ mod tests {
 
     #[test]
     fn parses_the_design_syntax() {
-        assert_eq!(parse_rational("1/3").map(|r| r.to_string()), Ok("1/3".to_owned()));
-        assert_eq!(parse_rational("2/4").map(|r| r.to_string()), Ok("1/2".to_owned()));
-        assert_eq!(parse_rational("0").map(|r| r.to_string()), Ok("0".to_owned()));
-        assert_eq!(parse_rational("-3/5").map(|r| r.to_string()), Ok("-3/5".to_owned()));
+        assert_eq!(
+            parse_rational("1/3").map(|r| r.to_string()),
+            Ok("1/3".to_owned())
+        );
+        assert_eq!(
+            parse_rational("2/4").map(|r| r.to_string()),
+            Ok("1/2".to_owned())
+        );
+        assert_eq!(
+            parse_rational("0").map(|r| r.to_string()),
+            Ok("0".to_owned())
+        );
+        assert_eq!(
+            parse_rational("-3/5").map(|r| r.to_string()),
+            Ok("-3/5".to_owned())
+        );
         for bad in ["", "1/0", "a/2", "1/2/3", "0.5", "1/-2"] {
             assert!(parse_rational(bad).is_err(), "{bad}");
         }

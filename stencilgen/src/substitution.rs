@@ -22,7 +22,7 @@ use schemes::{CurveScheme, QuadScheme};
 
 use crate::ev_tangents::ev_tangents;
 use crate::exact_solve::solve_dense;
-use crate::extraordinary_patch::{LocalMatrices, SUB_PATCH_ORIGINS};
+use crate::extraordinary_patch::{LocalMatrices, Neighbourhood, SUB_PATCH_ORIGINS};
 use crate::patch_stencils::regular_curve;
 use crate::regular_patch::{RegularBasis, StencilKind};
 use crate::{Scalar, StencilError};
@@ -38,12 +38,16 @@ pub struct Substitution<S> {
 }
 
 impl<S: Scalar> Substitution<S> {
-    /// Prepare for `scheme` at valence `v`.
-    pub fn new(scheme: &QuadScheme, v: u32) -> Result<Self, StencilError> {
+    /// Prepare for `scheme` around `neighbourhood`, patch `sector`.
+    pub fn new(
+        scheme: &QuadScheme,
+        neighbourhood: Neighbourhood,
+        sector: u32,
+    ) -> Result<Self, StencilError> {
         Ok(Substitution {
             scheme: scheme.clone(),
             curve: regular_curve(scheme)?,
-            matrices: LocalMatrices::new(scheme, v),
+            matrices: LocalMatrices::new(scheme, neighbourhood, sector)?,
             bases: HashMap::new(),
         })
     }
@@ -139,7 +143,7 @@ impl<S: Scalar> Substitution<S> {
             let mask = solve_dense(rows, size).map_err(|e| StencilError::Inconsistent {
                 scheme: self.scheme.name.to_owned(),
                 n: 1,
-                detail: format!("limit mask at valence {}: {e:?}", self.matrices.valence),
+                detail: format!("limit mask at {}: {e:?}", self.matrices.describe()),
             })?;
             return Ok(mask.iter().map(S::from_rational).collect());
         }
@@ -154,8 +158,8 @@ impl<S: Scalar> Substitution<S> {
             .collect::<Option<Vec<S>>>()
             .ok_or_else(|| StencilError::Irrational {
                 what: format!(
-                    "the tangent mask at the extraordinary vertex (valence {})",
-                    self.matrices.valence
+                    "the tangent mask at the vertex ({})",
+                    self.matrices.describe()
                 ),
             })
     }

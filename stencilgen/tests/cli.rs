@@ -114,7 +114,18 @@ fn bad_input_is_a_clear_error_not_a_panic() {
 
 #[test]
 fn stencil_json_follows_the_contract() {
-    let v = json(&["stencil", "--scheme", "catmull-clark", "--valence", "5", "--u", "1/3", "--v", "2/7", "--json"]);
+    let v = json(&[
+        "stencil",
+        "--scheme",
+        "catmull-clark",
+        "--valence",
+        "5",
+        "--u",
+        "1/3",
+        "--v",
+        "2/7",
+        "--json",
+    ]);
     let weights = v["weights"].as_array().expect("weights");
     assert_eq!(weights.len(), 2 * 5 + 8);
     assert_eq!(v["du"].as_array().expect("du").len(), 18);
@@ -122,23 +133,98 @@ fn stencil_json_follows_the_contract() {
     assert_eq!(v["order"][1], "E1");
     // At the EV the position is the classical limit mask (v^2 V + 4 sum E + sum F)/(v(v+5));
     // exact tangents there are irrational: null, with a note.
-    let v = json(&["stencil", "--scheme", "catmull-clark", "--valence", "5", "--u", "0", "--v", "0", "--json"]);
+    let v = json(&[
+        "stencil",
+        "--scheme",
+        "catmull-clark",
+        "--valence",
+        "5",
+        "--u",
+        "0",
+        "--v",
+        "0",
+        "--json",
+    ]);
     assert_eq!(v["weights"][0], "1/2");
     assert_eq!(v["weights"][1], "2/25");
     assert_eq!(v["weights"][6], "1/50");
     assert!(v["du"].is_null());
     assert!(v["note"].as_str().expect("note").contains("irrational"));
-    let v = json(&["stencil", "--scheme", "catmull-clark", "--valence", "5", "--u", "0", "--v", "0", "--f64", "--json"]);
+    let v = json(&[
+        "stencil",
+        "--scheme",
+        "catmull-clark",
+        "--valence",
+        "5",
+        "--u",
+        "0",
+        "--v",
+        "0",
+        "--f64",
+        "--json",
+    ]);
     assert!(v["du"].as_array().expect("f64 tangents").len() == 18);
 }
 
 #[test]
 fn stencil_bad_input() {
     let cases: [(&[&str], &str); 4] = [
-        (&["stencil", "--scheme", "catmull-clark", "--valence", "5", "--u", "3/2", "--v", "0"], "outside the patch"),
-        (&["stencil", "--scheme", "catmull-clark", "--valence", "5", "--u", "1/0", "--v", "0"], "denominator is zero"),
-        (&["stencil", "--scheme", "catmull-clark", "--valence", "2", "--u", "0", "--v", "0"], "2 is not in 3..=64"),
-        (&["stencil", "--scheme", "loop", "--valence", "5", "--u", "0", "--v", "0"], "unknown scheme `loop`"),
+        (
+            &[
+                "stencil",
+                "--scheme",
+                "catmull-clark",
+                "--valence",
+                "5",
+                "--u",
+                "3/2",
+                "--v",
+                "0",
+            ],
+            "outside the patch",
+        ),
+        (
+            &[
+                "stencil",
+                "--scheme",
+                "catmull-clark",
+                "--valence",
+                "5",
+                "--u",
+                "1/0",
+                "--v",
+                "0",
+            ],
+            "denominator is zero",
+        ),
+        (
+            &[
+                "stencil",
+                "--scheme",
+                "catmull-clark",
+                "--valence",
+                "2",
+                "--u",
+                "0",
+                "--v",
+                "0",
+            ],
+            "2 is not in 3..=64",
+        ),
+        (
+            &[
+                "stencil",
+                "--scheme",
+                "loop",
+                "--valence",
+                "5",
+                "--u",
+                "0",
+                "--v",
+                "0",
+            ],
+            "unknown scheme `loop`",
+        ),
     ];
     for (args, message) in cases {
         let out = stencilgen(args);

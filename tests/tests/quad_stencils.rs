@@ -9,7 +9,7 @@ use num_traits::{One, Zero};
 use schemes::{BivariateMask, CurveScheme, QuadScheme};
 use stencilgen::bivariate_system::bivariate_stencils;
 use stencilgen::curve_stencils;
-use stencilgen::extraordinary_patch::{canonical, patch_layout, GridPoint};
+use stencilgen::extraordinary_patch::{canonical, patch_layout, GridPoint, Neighbourhood};
 use stencilgen::patch_stencils::{patch_stencils, PatchStencils};
 use stencilgen::regular_patch::StencilKind;
 use stencilgen::scalar::rational_to_f64;
@@ -23,7 +23,17 @@ fn scheme(name: &str) -> QuadScheme {
 }
 
 fn exact(s: &QuadScheme, v: u32, n: u32, kind: StencilKind) -> PatchStencils<BigRational> {
-    patch_stencils::<BigRational>(s, v, n, kind).expect("solvable")
+    exact_at(s, Neighbourhood::interior(v), 0, n, kind)
+}
+
+fn exact_at(
+    s: &QuadScheme,
+    nb: Neighbourhood,
+    sector: u32,
+    n: u32,
+    kind: StencilKind,
+) -> PatchStencils<BigRational> {
+    patch_stencils::<BigRational>(s, nb, sector, n, kind).expect("solvable")
 }
 
 fn point(a: i64, b: i64, n: u32) -> (BigRational, BigRational) {
@@ -37,7 +47,8 @@ fn point(a: i64, b: i64, n: u32) -> (BigRational, BigRational) {
 fn grid_solve_equals_substitution(name: &str) {
     let s = scheme(name);
     for v in 3..=8 {
-        let mut substitution = Substitution::<BigRational>::new(&s, v).expect("substitution");
+        let mut substitution = Substitution::<BigRational>::new(&s, Neighbourhood::interior(v), 0)
+            .expect("substitution");
         for n in RATES {
             for kind in StencilKind::ALL {
                 let grid = exact(&s, v, n, kind);
@@ -194,14 +205,17 @@ fn sums_and_the_limit_mask() {
 
 /// Index permutation of the layout under the reflection u <-> v (sector s -> -s, a <-> b).
 fn mirror(v: u32) -> Vec<usize> {
-    let layout = patch_layout(v);
+    let nb = Neighbourhood::interior(v);
+    let layout = patch_layout(nb, 0);
     let index: HashMap<GridPoint, usize> =
         layout.iter().enumerate().map(|(i, &p)| (p, i)).collect();
     layout
         .iter()
         .map(|p| match *p {
             GridPoint::Centre => 0,
-            GridPoint::Sector { s, a, b } => index[&canonical(v, -i64::from(s), b, a)],
+            GridPoint::Sector { s, a, b } => {
+                index[&canonical(nb, -i64::from(s), b, a).expect("interior")]
+            }
         })
         .collect()
 }
@@ -243,14 +257,17 @@ fn swapping_u_and_v_mirrors_the_stencil() {
 /// A stencil as weights on named grid points; `rotate` shifts sector indices (the same patch
 /// one sector further round the vertex).
 fn named(v: u32, stencil: &[BigRational], rotate: i64) -> HashMap<GridPoint, BigRational> {
-    patch_layout(v)
+    let nb = Neighbourhood::interior(v);
+    patch_layout(nb, 0)
         .into_iter()
         .zip(stencil)
         .filter(|(_, w)| !w.is_zero())
         .map(|(p, w)| {
             let p = match p {
                 GridPoint::Centre => p,
-                GridPoint::Sector { s, a, b } => canonical(v, i64::from(s) + rotate, a, b),
+                GridPoint::Sector { s, a, b } => {
+                    canonical(nb, i64::from(s) + rotate, a, b).expect("interior")
+                }
             };
             (p, w.clone())
         })
@@ -294,9 +311,9 @@ fn neighbouring_patches_agree_along_shared_edges() {
                     for p in -1..=2 {
                         let w = phi.at(-p * ni) * phi.at(t - qq * ni);
                         if !w.is_zero() {
-                            *regular
-                                .entry(canonical(v, 0, 1 + p, qq))
-                                .or_insert_with(BigRational::zero) += w;
+                            let point = canonical(Neighbourhood::interior(v), 0, 1 + p, qq)
+                                .expect("interior");
+                            *regular.entry(point).or_insert_with(BigRational::zero) += w;
                         }
                     }
                 }
@@ -316,7 +333,8 @@ fn f64_agrees_with_exact() {
             for n in [1u32, 3, 7, 12] {
                 for kind in StencilKind::ALL {
                     let e = exact(&s, v, n, kind);
-                    let f = patch_stencils::<f64>(&s, v, n, kind).expect("f64");
+                    let f = patch_stencils::<f64>(&s, Neighbourhood::interior(v), 0, n, kind)
+                        .expect("f64");
                     assert!(
                         f.residual < 1e-12,
                         "{name} v = {v} n = {n}: residual {}",
@@ -383,7 +401,8 @@ fn substitution_reaches_rationals_off_every_grid() {
     // (1/7, 2/9) is on no grid the tables use; positions still sum to one and equal the grid
     // solve at n = 63 (the lcm of 7 and 9).
     let s = scheme("catmull-clark");
-    let mut substitution = Substitution::<BigRational>::new(&s, 5).expect("substitution");
+    let mut substitution =
+        Substitution::<BigRational>::new(&s, Neighbourhood::interior(5), 0).expect("substitution");
     let (u, w) = (q(1, 7), q(2, 9));
     let stencil = substitution
         .stencil(&u, &w, StencilKind::Position)
