@@ -39,6 +39,7 @@ pub mod regular_patch;
 pub mod scalar;
 pub mod scaling_system;
 pub mod solve;
+pub mod stencil_set;
 pub mod substitution;
 
 pub use curve_stencils::{curve_stencils, BasisFunction, CurveStencils};

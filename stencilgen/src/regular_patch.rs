@@ -70,17 +70,23 @@ impl<S: Scalar> RegularBasis<S> {
         })
     }
 
+    /// The weights `phi(t/n - p)` (or `phi'`) of the four control points `p` in
+    /// [`CELL_OFFSETS`] of one axis at `t/n`.
+    pub fn axis_weights(&self, t: i64, derivative: bool) -> [S; 4] {
+        let n = i64::from(self.n);
+        let f = if derivative {
+            &self.derivatives
+        } else {
+            &self.values
+        };
+        CELL_OFFSETS.map(|p| f.at(t - p * n))
+    }
+
     /// The 16 tensor-product weights at `t = (tu/n, tv/n)` in `[0,1]^2`, control points
     /// `(p, q)` in [`CELL_OFFSETS`] order with `q` outer.
     pub fn evaluate(&self, tu: i64, tv: i64, kind: StencilKind) -> Vec<S> {
-        let n = i64::from(self.n);
-        let (fu, fv) = match kind {
-            StencilKind::Position => (&self.values, &self.values),
-            StencilKind::DerivativeU => (&self.derivatives, &self.values),
-            StencilKind::DerivativeV => (&self.values, &self.derivatives),
-        };
-        let wu: Vec<S> = CELL_OFFSETS.iter().map(|p| fu.at(tu - p * n)).collect();
-        let wv: Vec<S> = CELL_OFFSETS.iter().map(|q| fv.at(tv - q * n)).collect();
+        let wu = self.axis_weights(tu, kind == StencilKind::DerivativeU);
+        let wv = self.axis_weights(tv, kind == StencilKind::DerivativeV);
         wv.iter()
             .flat_map(|b| wu.iter().map(move |a| a.clone() * b.clone()))
             .collect()

@@ -1,0 +1,69 @@
+//! A whole set of patch stencils — every neighbourhood, sector, rate and kind a table holds —
+//! generated in parallel (rayon; each job is one independent grid solve).
+
+use rayon::prelude::*;
+use schemes::{BoundaryMode, QuadScheme};
+
+use crate::extraordinary_patch::Neighbourhood;
+use crate::patch_stencils::{patch_stencils, PatchStencils};
+use crate::regular_patch::StencilKind;
+use crate::{Scalar, StencilError};
+
+/// Which stencils to generate.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct StencilSetSpec {
+    /// Interior valences (e.g. 3..=8).
+    pub valences: Vec<u32>,
+    /// Boundary face counts (e.g. 1..=6); empty for none.
+    pub boundary_faces: Vec<u32>,
+    /// The boundary interpolation mode of the boundary entries.
+    pub boundary_mode: BoundaryMode,
+    /// Grid rates (e.g. 1..=24).
+    pub rates: Vec<u32>,
+}
+
+impl StencilSetSpec {
+    /// The default table's contents: interior valences 3..=8, boundary 1..=6 faces
+    /// ("edge only"), n = 1..=24.
+    pub fn default_catmull_clark() -> Self {
+        StencilSetSpec {
+            valences: (3..=8).collect(),
+            boundary_faces: (1..=6).collect(),
+            boundary_mode: BoundaryMode::EdgeOnly,
+            rates: (1..=24).collect(),
+        }
+    }
+
+    /// Every `(neighbourhood, sector)` patch of the set.
+    pub fn patches(&self) -> Vec<(Neighbourhood, u32)> {
+        let interior = self
+            .valences
+            .iter()
+            .map(|&v| (Neighbourhood::interior(v), 0));
+        let boundary = self.boundary_faces.iter().flat_map(|&f| {
+            let nb = Neighbourhood::boundary(f, self.boundary_mode);
+            (0..f).map(move |s| (nb, s))
+        });
+        interior.chain(boundary).collect()
+    }
+}
+
+/// Generate every stencil of `spec` (positions and both derivatives at every primal and dual
+/// point), in the order patches x rates x kinds.
+pub fn stencil_set<S: Scalar + Send + Sync>(
+    scheme: &QuadScheme,
+    spec: &StencilSetSpec,
+) -> Result<Vec<PatchStencils<S>>, StencilError> {
+    let jobs: Vec<(Neighbourhood, u32, u32, StencilKind)> = spec
+        .patches()
+        .into_iter()
+        .flat_map(|(nb, s)| {
+            spec.rates
+                .iter()
+                .flat_map(move |&n| StencilKind::ALL.map(|k| (nb, s, n, k)))
+        })
+        .collect();
+    jobs.into_par_iter()
+        .map(|(nb, s, n, kind)| patch_stencils::<S>(scheme, nb, s, n, kind))
+        .collect()
+}
