@@ -48,6 +48,17 @@ pub enum StencilError {
         /// What is wrong.
         what: String,
     },
+    /// A file could not be written or read.
+    #[error("{path}: {message}")]
+    Io {
+        /// The file.
+        path: String,
+        /// What went wrong.
+        message: String,
+    },
+    /// The table writer refused the sections.
+    #[error(transparent)]
+    Table(#[from] table_format::TableError),
     /// The equations contradict each other: no function satisfies all of them.
     #[error("the scaling-relation system of `{scheme}` at n = {n} is inconsistent: {detail}")]
     Inconsistent {

@@ -41,6 +41,7 @@ pub mod scaling_system;
 pub mod solve;
 pub mod stencil_set;
 pub mod substitution;
+pub mod table;
 
 pub use curve_stencils::{curve_stencils, BasisFunction, CurveStencils};
 pub use error::StencilError;

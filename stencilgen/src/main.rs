@@ -16,8 +16,11 @@ use serde_json::{json, Value};
 use stencilgen::extraordinary_patch::{canonical, Neighbourhood, OUTER_POINTS};
 use stencilgen::rational::parse_rational;
 use stencilgen::regular_patch::StencilKind;
+use stencilgen::stencil_set::StencilSetSpec;
 use stencilgen::substitution::Substitution;
+use stencilgen::table::{build_table, TableSpec};
 use stencilgen::{curve_stencils, CurveStencils, Scalar, StencilError};
+use table_format::Precision;
 
 #[derive(Parser)]
 #[command(
@@ -80,6 +83,37 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Write a versioned binary stencil table (docs/table-format.md).
+    Tables {
+        /// Quad schemes, comma separated (one file each; with several, the scheme name is
+        /// appended to the file stem).
+        #[arg(long, default_value = "catmull-clark", value_delimiter = ',')]
+        schemes: Vec<String>,
+        /// Interior valences: a range `3..8` (inclusive) or a list `3,5,6`.
+        #[arg(long, default_value = "3..8")]
+        valences: String,
+        /// Include boundary vertices (with --boundary-faces faces).
+        #[arg(long)]
+        boundary: bool,
+        /// Face counts of the boundary vertices, as a range or list.
+        #[arg(long, default_value = "1..6")]
+        boundary_faces: String,
+        /// One-face boundary vertices are pinned corners (OpenSubdiv "edge and corner").
+        #[arg(long)]
+        corners: bool,
+        /// Grid rates, as a range or list.
+        #[arg(long, default_value = "1..24")]
+        n: String,
+        /// Stored precision.
+        #[arg(long, default_value = "f32", value_parser = ["f32", "f64"])]
+        precision: String,
+        /// Generate from exact rationals (slower) instead of the f64 path.
+        #[arg(long)]
+        exact: bool,
+        /// Output file.
+        #[arg(short = 'o', long = "output")]
+        output: std::path::PathBuf,
+    },
     /// List the schemes.
     Schemes,
 }
@@ -108,6 +142,59 @@ fn run(cli: Cli) -> Result<(), StencilError> {
                 if let Some(scheme) = QuadScheme::by_name(name) {
                     println!("  {name:<26} {}", scheme.description);
                 }
+            }
+            Ok(())
+        }
+        Command::Tables {
+            schemes,
+            valences,
+            boundary,
+            boundary_faces,
+            corners,
+            n,
+            precision,
+            exact,
+            output,
+        } => {
+            let set = StencilSetSpec {
+                valences: parse_set("--valences", &valences)?,
+                boundary_faces: if boundary {
+                    parse_set("--boundary-faces", &boundary_faces)?
+                } else {
+                    Vec::new()
+                },
+                boundary_mode: if corners {
+                    BoundaryMode::EdgeAndCorner
+                } else {
+                    BoundaryMode::EdgeOnly
+                },
+                rates: parse_set("--n", &n)?,
+            };
+            let precision = if precision == "f64" {
+                Precision::F64
+            } else {
+                Precision::F32
+            };
+            for name in &schemes {
+                let scheme =
+                    QuadScheme::by_name(name).ok_or_else(|| StencilError::UnknownScheme {
+                        name: name.clone(),
+                        known: QUAD_SCHEME_NAMES.join(", "),
+                    })?;
+                let path = if schemes.len() > 1 {
+                    with_suffix(&output, name)
+                } else {
+                    output.clone()
+                };
+                write_table(
+                    TableSpec {
+                        scheme,
+                        set: set.clone(),
+                        precision,
+                        exact,
+                    },
+                    &path,
+                )?;
             }
             Ok(())
         }
@@ -172,6 +259,75 @@ fn run(cli: Cli) -> Result<(), StencilError> {
             Ok(())
         }
     }
+}
+
+/// A set of positive integers: `a..b` (inclusive), `a,b,c`, or `a`.
+fn parse_set(flag: &str, text: &str) -> Result<Vec<u32>, StencilError> {
+    let bad = || StencilError::OutOfDomain {
+        what: format!(
+            "{flag} `{text}` is not a range `a..b` or a list `a,b,c` of positive integers"
+        ),
+    };
+    let number = |s: &str| {
+        s.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|&v| v > 0)
+            .ok_or_else(bad)
+    };
+    let values: Vec<u32> = match text.split_once("..") {
+        Some((a, b)) => {
+            let (a, b) = (number(a)?, number(b.trim_start_matches('='))?);
+            if a > b {
+                return Err(bad());
+            }
+            (a..=b).collect()
+        }
+        None => text.split(',').map(number).collect::<Result<_, _>>()?,
+    };
+    Ok(values)
+}
+
+/// `dir/name.ext` -> `dir/name-suffix.ext`.
+fn with_suffix(path: &std::path::Path, suffix: &str) -> std::path::PathBuf {
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let name = match path.extension() {
+        Some(ext) => format!("{stem}-{suffix}.{}", ext.to_string_lossy()),
+        None => format!("{stem}-{suffix}"),
+    };
+    path.with_file_name(name)
+}
+
+/// Generate one table with a progress bar on stderr, and write it.
+fn write_table(spec: TableSpec, path: &std::path::Path) -> Result<(), StencilError> {
+    let started = std::time::Instant::now();
+    let bar = indicatif::ProgressBar::new(0);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} grids, {elapsed}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    bar.set_message(format!("{} stencils", spec.scheme.name));
+    let bytes = build_table(&spec, &|done, total| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    })?;
+    bar.finish_and_clear();
+    std::fs::write(path, &bytes).map_err(|e| StencilError::Io {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    })?;
+    eprintln!(
+        "wrote {} ({} bytes, {:.1} MiB) in {:.1?}",
+        path.display(),
+        bytes.len(),
+        bytes.len() as f64 / (1024.0 * 1024.0),
+        started.elapsed()
+    );
+    Ok(())
 }
 
 /// `{"weights","du","dv"}` (DESIGN.md / issue contract) plus what they mean: the scheme,

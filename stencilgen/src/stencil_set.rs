@@ -54,6 +54,16 @@ pub fn stencil_set<S: Scalar + Send + Sync>(
     scheme: &QuadScheme,
     spec: &StencilSetSpec,
 ) -> Result<Vec<PatchStencils<S>>, StencilError> {
+    stencil_set_with_progress(scheme, spec, &|_, _| {})
+}
+
+/// [`stencil_set`], calling `progress(done, total)` (from worker threads) after each grid.
+pub fn stencil_set_with_progress<S: Scalar + Send + Sync>(
+    scheme: &QuadScheme,
+    spec: &StencilSetSpec,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Vec<PatchStencils<S>>, StencilError> {
+    let done = std::sync::atomic::AtomicUsize::new(0);
     let jobs: Vec<(Neighbourhood, u32, u32, StencilKind)> = spec
         .patches()
         .into_iter()
@@ -63,7 +73,15 @@ pub fn stencil_set<S: Scalar + Send + Sync>(
                 .flat_map(move |&n| StencilKind::ALL.map(|k| (nb, s, n, k)))
         })
         .collect();
+    let total = jobs.len();
     jobs.into_par_iter()
-        .map(|(nb, s, n, kind)| patch_stencils::<S>(scheme, nb, s, n, kind))
+        .map(|(nb, s, n, kind)| {
+            let result = patch_stencils::<S>(scheme, nb, s, n, kind);
+            progress(
+                done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1,
+                total,
+            );
+            result
+        })
         .collect()
 }

@@ -411,3 +411,45 @@ fn substitution_reaches_rationals_off_every_grid() {
     let grid = exact(&s, 5, 63, StencilKind::Position);
     assert_eq!(grid.at(18, 28).expect("grid point"), stencil.as_slice());
 }
+
+/// sw-nonpoly-quad is C1 at valences 3..=8 by the eigen-analysis of its local subdivision
+/// matrix (docs/algorithms/sw-nonpoly-quad.md): 1 is simple, the subdominant eigenvalue is
+/// double and equals the closed form (T + sqrt(T^2 - 1/6))/2, T = 7/12 + cos(2 pi/v)/6, of the
+/// Fourier blocks, and every other eigenvalue is smaller in modulus. Its limit mask is
+/// 9/25 V + 12/(25v) sum E + 4/(25v) sum F.
+#[test]
+fn sw_nonpoly_quad_eigen_structure_and_limit_mask() {
+    let s = scheme("sw-nonpoly-quad");
+    for v in 3..=8u32 {
+        let m =
+            stencilgen::extraordinary_patch::LocalMatrices::new(&s, Neighbourhood::interior(v), 0)
+                .expect("valid");
+        let k = m.size();
+        let a = nalgebra::DMatrix::from_fn(k, k, |i, j| rational_to_f64(&m.a[i][j]));
+        let mut moduli: Vec<f64> = a.complex_eigenvalues().iter().map(|z| z.norm()).collect();
+        moduli.sort_by(|x, y| y.total_cmp(x));
+        let t = 7.0 / 12.0 + (2.0 * std::f64::consts::PI / f64::from(v)).cos() / 6.0;
+        let lambda = (t + (t * t - 1.0 / 6.0).sqrt()) / 2.0;
+        assert!(
+            (moduli[0] - 1.0).abs() < 1e-12 && moduli[1] < 1.0 - 1e-9,
+            "v = {v}: {moduli:?}"
+        );
+        assert!(
+            (moduli[1] - lambda).abs() < 1e-9 && (moduli[2] - lambda).abs() < 1e-9,
+            "v = {v}: {moduli:?}"
+        );
+        assert!(moduli[3] < lambda - 1e-3, "v = {v}: {moduli:?}");
+        let mask = exact(&s, v, 1, StencilKind::Position);
+        let mask = mask.at(0, 0).expect("limit mask");
+        let vi = i64::from(v);
+        for (i, w) in mask.iter().enumerate() {
+            let expected = match i {
+                0 => q(9, 25),
+                i if i <= v as usize => q(12, 25 * vi),
+                i if i <= 2 * v as usize => q(4, 25 * vi),
+                _ => BigRational::zero(),
+            };
+            assert_eq!(*w, expected, "v = {v} index {i}");
+        }
+    }
+}

@@ -1,0 +1,12 @@
+//! The subtess runtime: loads stencil tables (never runs the solver) and, as it grows,
+//! evaluates and tessellates subdivision surfaces from them.
+//!
+//! ```
+//! let table = runtime::stencil_table::StencilTable::default_catmull_clark().expect("embedded table");
+//! assert!(!table.index().entries.is_empty());
+//! ```
+
+pub mod error;
+pub mod stencil_table;
+
+pub use error::RuntimeError;

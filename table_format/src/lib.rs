@@ -1,0 +1,811 @@
+//! The versioned binary stencil-table format (documented byte by byte in
+//! `docs/table-format.md`).
+//!
+//! A table holds, for one subdivision scheme, the evaluation stencils of patches next to
+//! interior vertices of some valences and boundary vertices of some face counts, on the primal
+//! and dual grids of some rates `n`, for positions and both first derivatives. `stencilgen`
+//! writes tables with [`encode`]; the runtime reads them with [`Table::parse`], which validates
+//! everything (magic, version, endianness, checksum, every section's bounds, alignment and
+//! shape) before it hands out weights as zero-copy `&[f32]` (or `&[f64]`) slices.
+//!
+//! ```
+//! use table_format::{encode, PointSet, Precision, SchemeId, SectionKey, StencilKind, Table, TableMeta};
+//! let key = SectionKey { kind: StencilKind::Position, points: PointSet::Dual, boundary: false, faces: 4, sector: 0, n: 1 };
+//! let meta = TableMeta { scheme: SchemeId::CatmullClark, precision: Precision::F32, corners: false };
+//! let bytes = encode(meta, &[(key, 16, vec![1.0 / 16.0; 16])]).expect("valid sections");
+//! let aligned = table_format::AlignedBytes::from_slice(&bytes);
+//! let table = Table::parse(aligned.as_bytes()).expect("a valid table");
+//! assert_eq!(table.weights_f32(&key).expect("present").len(), 16);
+//! ```
+
+use std::collections::BTreeMap;
+use std::fmt;
+
+use thiserror::Error;
+
+/// The first eight bytes of every table.
+pub const MAGIC: [u8; 8] = *b"SUBTESS\0";
+/// The format version this crate reads and writes.
+pub const VERSION: u32 = 1;
+/// Size of the fixed header.
+pub const HEADER_SIZE: usize = 64;
+/// Size of one section-index entry.
+pub const ENTRY_SIZE: usize = 40;
+/// Every section starts at a multiple of this.
+pub const SECTION_ALIGN: usize = 64;
+/// Written as a little-endian u32 at offset 12: reads back as this only on a little-endian
+/// reading of a little-endian file.
+pub const ENDIAN_MARK: u32 = 0x0102_0304;
+
+/// Everything that can be wrong with a table, or with a request to it.
+#[derive(Debug, Error, Clone, PartialEq, Eq)]
+pub enum TableError {
+    /// The file does not start with [`MAGIC`].
+    #[error("not a subtess stencil table: the file starts with {found:02x?}, not \"SUBTESS\\0\"")]
+    BadMagic {
+        /// The first bytes found.
+        found: Vec<u8>,
+    },
+    /// A format version this reader does not know.
+    #[error("stencil table format version {found} is not supported (this build reads version {supported}); regenerate the table with this build's `stencilgen tables`")]
+    UnsupportedVersion {
+        /// The version in the file.
+        found: u32,
+        /// The version this build reads.
+        supported: u32,
+    },
+    /// The endianness mark is wrong.
+    #[error("the table's endianness mark reads {found:#010x}, expected {ENDIAN_MARK:#010x} (tables are little-endian)")]
+    Endianness {
+        /// The mark found.
+        found: u32,
+    },
+    /// The file is shorter than its header says.
+    #[error("the table is truncated: {what} needs {needed} bytes, the file has {len}")]
+    Truncated {
+        /// What did not fit.
+        what: String,
+        /// Bytes needed.
+        needed: u64,
+        /// Bytes present.
+        len: u64,
+    },
+    /// The checksum over everything after the header does not match.
+    #[error("the table is corrupt: checksum {computed:#018x} over bytes {HEADER_SIZE}.. does not match the stored {stored:#018x}")]
+    Checksum {
+        /// The stored checksum.
+        stored: u64,
+        /// The checksum of the bytes present.
+        computed: u64,
+    },
+    /// A header field holds a value this format does not define.
+    #[error("the table's {field} field holds {value}, which this format does not define")]
+    BadField {
+        /// The field.
+        field: &'static str,
+        /// Its value.
+        value: u64,
+    },
+    /// A section lies (partly) outside the file.
+    #[error("section {index} ({key}) spans bytes {offset}..{end}, outside the {len}-byte file")]
+    SectionOutOfBounds {
+        /// Section index.
+        index: usize,
+        /// The section.
+        key: SectionKey,
+        /// Start.
+        offset: u64,
+        /// End.
+        end: u64,
+        /// File length.
+        len: u64,
+    },
+    /// A section is not aligned for its float type, or overlaps the header or index.
+    #[error(
+        "section {index} ({key}) at offset {offset} is misaligned or overlaps the header/index"
+    )]
+    Misaligned {
+        /// Section index.
+        index: usize,
+        /// The section.
+        key: SectionKey,
+        /// Its offset.
+        offset: u64,
+    },
+    /// A section's byte length disagrees with its shape.
+    #[error("section {index} ({key}) has {length} bytes, but {points} points x {width} weights x {precision} bytes = {expected}")]
+    WrongShape {
+        /// Section index.
+        index: usize,
+        /// The section.
+        key: SectionKey,
+        /// Stored length.
+        length: u64,
+        /// Points (rows).
+        points: u32,
+        /// Weights per point.
+        width: u32,
+        /// Bytes per weight.
+        precision: u32,
+        /// The length the shape implies.
+        expected: u64,
+    },
+    /// Two index entries describe the same section.
+    #[error("section {key} appears twice in the index")]
+    DuplicateSection {
+        /// The section.
+        key: SectionKey,
+    },
+    /// The table has no section for what was asked.
+    #[error("this table has no {key}: it covers {coverage}; `stencilgen tables` can generate a table that has it (e.g. with --valences, --boundary, --n)")]
+    MissingSection {
+        /// What was asked.
+        key: SectionKey,
+        /// What the table covers.
+        coverage: String,
+    },
+    /// The weights were asked in the other precision.
+    #[error("the table stores {stored} weights, not {asked}")]
+    PrecisionMismatch {
+        /// Stored precision.
+        stored: Precision,
+        /// Asked precision.
+        asked: Precision,
+    },
+    /// The buffer handed to the reader is not aligned for zero-copy access.
+    #[error("the table buffer is not 8-byte aligned; load it with AlignedBytes")]
+    UnalignedBuffer,
+    /// Sections handed to the writer are inconsistent.
+    #[error("cannot encode the table: {0}")]
+    Encode(String),
+}
+
+/// The scheme a table belongs to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum SchemeId {
+    /// Catmull–Clark.
+    CatmullClark = 1,
+    /// Schaefer–Warren's non-polynomial quad scheme.
+    SwNonpolyQuad = 2,
+}
+
+impl SchemeId {
+    /// The catalogue name.
+    pub fn name(self) -> &'static str {
+        match self {
+            SchemeId::CatmullClark => "catmull-clark",
+            SchemeId::SwNonpolyQuad => "sw-nonpoly-quad",
+        }
+    }
+
+    /// From the catalogue name.
+    pub fn from_name(name: &str) -> Option<Self> {
+        [SchemeId::CatmullClark, SchemeId::SwNonpolyQuad]
+            .into_iter()
+            .find(|s| s.name() == name)
+    }
+
+    fn from_u32(v: u32) -> Option<Self> {
+        match v {
+            1 => Some(SchemeId::CatmullClark),
+            2 => Some(SchemeId::SwNonpolyQuad),
+            _ => None,
+        }
+    }
+}
+
+/// Bytes per stored weight.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Precision {
+    /// IEEE binary32.
+    F32 = 4,
+    /// IEEE binary64.
+    F64 = 8,
+}
+
+impl fmt::Display for Precision {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Precision::F32 => "f32",
+            Precision::F64 => "f64",
+        })
+    }
+}
+
+/// What a section's stencils evaluate.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum StencilKind {
+    /// Limit positions.
+    Position = 0,
+    /// d/du.
+    DerivativeU = 1,
+    /// d/dv.
+    DerivativeV = 2,
+}
+
+/// Which grid a section covers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum PointSet {
+    /// `(i/n, j/n)`, `0 <= i, j <= n`, `j` outer: `(n+1)^2` points.
+    Primal = 0,
+    /// `((2i+1)/2n, (2j+1)/2n)`, `0 <= i, j < n`, `j` outer: `n^2` points.
+    Dual = 1,
+}
+
+impl PointSet {
+    /// Number of points at rate `n`.
+    pub fn count(self, n: u32) -> u64 {
+        let n = u64::from(n);
+        match self {
+            PointSet::Primal => (n + 1) * (n + 1),
+            PointSet::Dual => n * n,
+        }
+    }
+}
+
+/// Identifies one section: one kind of stencil on one grid of one patch.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct SectionKey {
+    /// Position or derivative.
+    pub kind: StencilKind,
+    /// Primal or dual grid.
+    pub points: PointSet,
+    /// Whether the patch's corner vertex is a boundary vertex.
+    pub boundary: bool,
+    /// The vertex's valence (interior) or number of faces (boundary).
+    pub faces: u32,
+    /// Which of a boundary vertex's patches (0 for interior vertices).
+    pub sector: u32,
+    /// Grid rate.
+    pub n: u32,
+}
+
+impl fmt::Display for SectionKey {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let kind = match self.kind {
+            StencilKind::Position => "positions",
+            StencilKind::DerivativeU => "d/du",
+            StencilKind::DerivativeV => "d/dv",
+        };
+        let grid = match self.points {
+            PointSet::Primal => "primal",
+            PointSet::Dual => "dual",
+        };
+        if self.boundary {
+            write!(
+                f,
+                "{kind} on the {grid} grid, n = {}, boundary vertex with {} faces, sector {}",
+                self.n, self.faces, self.sector
+            )
+        } else {
+            write!(
+                f,
+                "{kind} on the {grid} grid, n = {}, valence {}",
+                self.n, self.faces
+            )
+        }
+    }
+}
+
+/// Table-wide metadata.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TableMeta {
+    /// The scheme.
+    pub scheme: SchemeId,
+    /// Stored precision.
+    pub precision: Precision,
+    /// Boundary mode of the boundary sections: a one-face boundary vertex is a pinned corner
+    /// (OpenSubdiv "edge and corner") rather than smooth ("edge only").
+    pub corners: bool,
+}
+
+/// One index entry.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SectionEntry {
+    /// What the section holds.
+    pub key: SectionKey,
+    /// Rows: grid points.
+    pub points: u32,
+    /// Weights per point (the patch's control-point count).
+    pub width: u32,
+    /// Byte offset from the start of the file.
+    pub offset: u64,
+    /// Byte length.
+    pub length: u64,
+}
+
+fn put_u32(out: &mut Vec<u8>, v: u32) {
+    out.extend_from_slice(&v.to_le_bytes());
+}
+
+fn put_u64(out: &mut Vec<u8>, v: u64) {
+    out.extend_from_slice(&v.to_le_bytes());
+}
+
+/// Write a table. Each section is `(key, width, weights)` with `weights.len()` equal to
+/// `points(key) * width`, point-major (the `width` weights of a point are contiguous). Sections
+/// are written in key order, so the output does not depend on the input order.
+pub fn encode(
+    meta: TableMeta,
+    sections: &[(SectionKey, u32, Vec<f64>)],
+) -> Result<Vec<u8>, TableError> {
+    let mut sorted: Vec<&(SectionKey, u32, Vec<f64>)> = sections.iter().collect();
+    sorted.sort_by_key(|(key, _, _)| *key);
+    for pair in sorted.windows(2) {
+        if pair[0].0 == pair[1].0 {
+            return Err(TableError::DuplicateSection { key: pair[0].0 });
+        }
+    }
+    let bytes_per = meta.precision as u64;
+    let index_offset = HEADER_SIZE as u64;
+    let mut offset = align_up(index_offset + (ENTRY_SIZE * sorted.len()) as u64);
+    let mut entries = Vec::with_capacity(sorted.len());
+    for (key, width, weights) in &sorted {
+        let points = key.points.count(key.n);
+        if weights.len() as u64 != points * u64::from(*width) {
+            return Err(TableError::Encode(format!(
+                "{key}: {} weights for {points} points x {width}",
+                weights.len()
+            )));
+        }
+        let length = weights.len() as u64 * bytes_per;
+        entries.push(SectionEntry {
+            key: *key,
+            points: u32::try_from(points)
+                .map_err(|_| TableError::Encode(format!("{key}: too many points")))?,
+            width: *width,
+            offset,
+            length,
+        });
+        offset = align_up(offset + length);
+    }
+    let file_size = offset;
+    let mut out = Vec::with_capacity(file_size as usize);
+    out.extend_from_slice(&MAGIC);
+    put_u32(&mut out, VERSION);
+    put_u32(&mut out, ENDIAN_MARK);
+    put_u32(&mut out, HEADER_SIZE as u32);
+    put_u32(&mut out, sorted.len() as u32);
+    put_u64(&mut out, index_offset);
+    put_u64(&mut out, file_size);
+    put_u64(&mut out, 0); // checksum, filled in below
+    put_u32(&mut out, meta.precision as u32);
+    put_u32(&mut out, meta.scheme as u32);
+    put_u32(&mut out, u32::from(meta.corners));
+    put_u32(&mut out, 0); // reserved
+    debug_assert_eq!(out.len(), HEADER_SIZE);
+    for e in &entries {
+        out.extend_from_slice(&[
+            e.key.kind as u8,
+            e.key.points as u8,
+            u8::from(e.key.boundary),
+            0,
+        ]);
+        put_u32(&mut out, e.key.faces);
+        put_u32(&mut out, e.key.sector);
+        put_u32(&mut out, e.key.n);
+        put_u32(&mut out, e.points);
+        put_u32(&mut out, e.width);
+        put_u64(&mut out, e.offset);
+        put_u64(&mut out, e.length);
+    }
+    for (e, (_, _, weights)) in entries.iter().zip(&sorted) {
+        out.resize(e.offset as usize, 0);
+        for &w in weights {
+            match meta.precision {
+                Precision::F32 => out.extend_from_slice(&(w as f32).to_le_bytes()),
+                Precision::F64 => out.extend_from_slice(&w.to_le_bytes()),
+            }
+        }
+    }
+    out.resize(file_size as usize, 0);
+    let checksum = xxhash_rust::xxh3::xxh3_64(&out[HEADER_SIZE..]);
+    out[40..48].copy_from_slice(&checksum.to_le_bytes());
+    Ok(out)
+}
+
+fn align_up(x: u64) -> u64 {
+    x.div_ceil(SECTION_ALIGN as u64) * SECTION_ALIGN as u64
+}
+
+fn u32_at(bytes: &[u8], at: usize) -> u32 {
+    let mut b = [0u8; 4];
+    b.copy_from_slice(&bytes[at..at + 4]);
+    u32::from_le_bytes(b)
+}
+
+fn u64_at(bytes: &[u8], at: usize) -> u64 {
+    let mut b = [0u8; 8];
+    b.copy_from_slice(&bytes[at..at + 8]);
+    u64::from_le_bytes(b)
+}
+
+/// A validated table over borrowed bytes.
+#[derive(Clone, Debug)]
+pub struct Table<'a> {
+    bytes: &'a [u8],
+    index: TableIndex,
+}
+
+impl<'a> std::ops::Deref for Table<'a> {
+    type Target = TableIndex;
+
+    fn deref(&self) -> &TableIndex {
+        &self.index
+    }
+}
+
+impl<'a> Table<'a> {
+    /// Validate `bytes` as a table. `bytes` must be 8-byte aligned (see [`AlignedBytes`]) so
+    /// that weights can be handed out without copying.
+    pub fn parse(bytes: &'a [u8]) -> Result<Self, TableError> {
+        Ok(Table {
+            bytes,
+            index: TableIndex::parse(bytes)?,
+        })
+    }
+
+    /// The f32 weights of a section: `points x width`, point-major.
+    pub fn weights_f32(&self, key: &SectionKey) -> Result<&'a [f32], TableError> {
+        self.index.weights_f32(self.bytes, key)
+    }
+
+    /// The f64 weights of a section: `points x width`, point-major.
+    pub fn weights_f64(&self, key: &SectionKey) -> Result<&'a [f64], TableError> {
+        self.index.weights_f64(self.bytes, key)
+    }
+
+    /// Total size in bytes.
+    pub fn size(&self) -> usize {
+        self.bytes.len()
+    }
+
+    /// The owned index, to keep beside bytes that outlive this borrow.
+    pub fn into_index(self) -> TableIndex {
+        self.index
+    }
+}
+
+/// Everything a validated table says about itself, without its bytes: keep it beside the
+/// bytes it was parsed from and pass them back in to read weights.
+#[derive(Clone, Debug)]
+pub struct TableIndex {
+    /// Table-wide metadata.
+    pub meta: TableMeta,
+    /// The format version read.
+    pub version: u32,
+    /// The stored checksum (verified).
+    pub checksum: u64,
+    /// The section index, in file order.
+    pub entries: Vec<SectionEntry>,
+    lookup: BTreeMap<SectionKey, usize>,
+    len: usize,
+}
+
+impl TableIndex {
+    /// Validate `bytes` as a table (see [`Table::parse`]).
+    pub fn parse(bytes: &[u8]) -> Result<Self, TableError> {
+        let len = bytes.len() as u64;
+        if bytes.len() < MAGIC.len() || bytes[..MAGIC.len()] != MAGIC {
+            return Err(TableError::BadMagic {
+                found: bytes[..bytes.len().min(MAGIC.len())].to_vec(),
+            });
+        }
+        if bytes.len() < HEADER_SIZE {
+            return Err(TableError::Truncated {
+                what: "the header".to_owned(),
+                needed: HEADER_SIZE as u64,
+                len,
+            });
+        }
+        let version = u32_at(bytes, 8);
+        if version != VERSION {
+            return Err(TableError::UnsupportedVersion {
+                found: version,
+                supported: VERSION,
+            });
+        }
+        let mark = u32_at(bytes, 12);
+        if mark != ENDIAN_MARK {
+            return Err(TableError::Endianness { found: mark });
+        }
+        let header_size = u32_at(bytes, 16);
+        if header_size as usize != HEADER_SIZE {
+            return Err(TableError::BadField {
+                field: "header size",
+                value: u64::from(header_size),
+            });
+        }
+        let count = u32_at(bytes, 20) as u64;
+        let index_offset = u64_at(bytes, 24);
+        let file_size = u64_at(bytes, 32);
+        let stored = u64_at(bytes, 40);
+        if file_size > len {
+            return Err(TableError::Truncated {
+                what: "the file size in the header".to_owned(),
+                needed: file_size,
+                len,
+            });
+        }
+        if file_size < len {
+            return Err(TableError::BadField {
+                field: "file size",
+                value: file_size,
+            });
+        }
+        let computed = xxhash_rust::xxh3::xxh3_64(&bytes[HEADER_SIZE..]);
+        if computed != stored {
+            return Err(TableError::Checksum { stored, computed });
+        }
+        let precision = match u32_at(bytes, 48) {
+            4 => Precision::F32,
+            8 => Precision::F64,
+            p => {
+                return Err(TableError::BadField {
+                    field: "precision",
+                    value: u64::from(p),
+                })
+            }
+        };
+        let scheme_raw = u32_at(bytes, 52);
+        let scheme = SchemeId::from_u32(scheme_raw).ok_or(TableError::BadField {
+            field: "scheme",
+            value: u64::from(scheme_raw),
+        })?;
+        let corners = match u32_at(bytes, 56) {
+            0 => false,
+            1 => true,
+            c => {
+                return Err(TableError::BadField {
+                    field: "boundary mode",
+                    value: u64::from(c),
+                })
+            }
+        };
+        let index_end = count
+            .checked_mul(ENTRY_SIZE as u64)
+            .and_then(|x| x.checked_add(index_offset))
+            .unwrap_or(u64::MAX);
+        if index_offset < HEADER_SIZE as u64 || index_end > len {
+            return Err(TableError::Truncated {
+                what: format!("the index of {count} sections"),
+                needed: index_end,
+                len,
+            });
+        }
+        if bytes.as_ptr() as usize % 8 != 0 {
+            return Err(TableError::UnalignedBuffer);
+        }
+        let mut entries = Vec::with_capacity(count as usize);
+        let mut lookup = BTreeMap::new();
+        for index in 0..count as usize {
+            let at = index_offset as usize + index * ENTRY_SIZE;
+            let e = &bytes[at..at + ENTRY_SIZE];
+            let kind = match e[0] {
+                0 => StencilKind::Position,
+                1 => StencilKind::DerivativeU,
+                2 => StencilKind::DerivativeV,
+                k => {
+                    return Err(TableError::BadField {
+                        field: "section kind",
+                        value: u64::from(k),
+                    })
+                }
+            };
+            let points = match e[1] {
+                0 => PointSet::Primal,
+                1 => PointSet::Dual,
+                p => {
+                    return Err(TableError::BadField {
+                        field: "section point set",
+                        value: u64::from(p),
+                    })
+                }
+            };
+            let boundary = match e[2] {
+                0 => false,
+                1 => true,
+                b => {
+                    return Err(TableError::BadField {
+                        field: "section boundary flag",
+                        value: u64::from(b),
+                    })
+                }
+            };
+            let key = SectionKey {
+                kind,
+                points,
+                boundary,
+                faces: u32_at(e, 4),
+                sector: u32_at(e, 8),
+                n: u32_at(e, 12),
+            };
+            let entry = SectionEntry {
+                key,
+                points: u32_at(e, 16),
+                width: u32_at(e, 20),
+                offset: u64_at(e, 24),
+                length: u64_at(e, 32),
+            };
+            let end = entry.offset.saturating_add(entry.length);
+            if end > len {
+                return Err(TableError::SectionOutOfBounds {
+                    index,
+                    key,
+                    offset: entry.offset,
+                    end,
+                    len,
+                });
+            }
+            if entry.offset % precision as u64 != 0 || entry.offset < index_end {
+                return Err(TableError::Misaligned {
+                    index,
+                    key,
+                    offset: entry.offset,
+                });
+            }
+            let expected = u64::from(entry.points) * u64::from(entry.width) * precision as u64;
+            if entry.length != expected || u64::from(entry.points) != key.points.count(key.n) {
+                return Err(TableError::WrongShape {
+                    index,
+                    key,
+                    length: entry.length,
+                    points: entry.points,
+                    width: entry.width,
+                    precision: precision as u32,
+                    expected,
+                });
+            }
+            if lookup.insert(key, index).is_some() {
+                return Err(TableError::DuplicateSection { key });
+            }
+            entries.push(entry);
+        }
+        Ok(TableIndex {
+            meta: TableMeta {
+                scheme,
+                precision,
+                corners,
+            },
+            version,
+            checksum: stored,
+            entries,
+            lookup,
+            len: bytes.len(),
+        })
+    }
+
+    /// The index entry of `key`, or which sections the table does have.
+    pub fn entry(&self, key: &SectionKey) -> Result<&SectionEntry, TableError> {
+        self.lookup
+            .get(key)
+            .map(|&i| &self.entries[i])
+            .ok_or_else(|| TableError::MissingSection {
+                key: *key,
+                coverage: self.coverage(),
+            })
+    }
+
+    /// The f32 weights of a section of `bytes` (the bytes this index was parsed from).
+    pub fn weights_f32<'b>(
+        &self,
+        bytes: &'b [u8],
+        key: &SectionKey,
+    ) -> Result<&'b [f32], TableError> {
+        if self.meta.precision != Precision::F32 {
+            return Err(TableError::PrecisionMismatch {
+                stored: self.meta.precision,
+                asked: Precision::F32,
+            });
+        }
+        bytemuck::try_cast_slice(self.section_bytes(bytes, key)?)
+            .map_err(|_| TableError::UnalignedBuffer)
+    }
+
+    /// The f64 weights of a section of `bytes` (the bytes this index was parsed from).
+    pub fn weights_f64<'b>(
+        &self,
+        bytes: &'b [u8],
+        key: &SectionKey,
+    ) -> Result<&'b [f64], TableError> {
+        if self.meta.precision != Precision::F64 {
+            return Err(TableError::PrecisionMismatch {
+                stored: self.meta.precision,
+                asked: Precision::F64,
+            });
+        }
+        bytemuck::try_cast_slice(self.section_bytes(bytes, key)?)
+            .map_err(|_| TableError::UnalignedBuffer)
+    }
+
+    fn section_bytes<'b>(&self, bytes: &'b [u8], key: &SectionKey) -> Result<&'b [u8], TableError> {
+        let e = *self.entry(key)?;
+        if bytes.len() != self.len {
+            return Err(TableError::Encode(
+                "weights asked of bytes other than the parsed table's".to_owned(),
+            ));
+        }
+        Ok(&bytes[e.offset as usize..(e.offset + e.length) as usize])
+    }
+
+    /// A one-line summary of what the table covers: valences, boundary face counts, rates.
+    pub fn coverage(&self) -> String {
+        let mut valences = std::collections::BTreeSet::new();
+        let mut boundary = std::collections::BTreeSet::new();
+        let mut rates = std::collections::BTreeSet::new();
+        for e in &self.entries {
+            if e.key.boundary {
+                boundary.insert(e.key.faces);
+            } else {
+                valences.insert(e.key.faces);
+            }
+            rates.insert(e.key.n);
+        }
+        format!(
+            "interior valences {}, boundary vertices with {} faces, n = {}",
+            ranges(&valences),
+            ranges(&boundary),
+            ranges(&rates)
+        )
+    }
+}
+
+/// `1..=6, 8` style summary of a set of integers.
+fn ranges(set: &std::collections::BTreeSet<u32>) -> String {
+    if set.is_empty() {
+        return "none".to_owned();
+    }
+    let mut parts = Vec::new();
+    let mut iter = set.iter().copied().peekable();
+    while let Some(start) = iter.next() {
+        let mut end = start;
+        while iter.peek() == Some(&(end + 1)) {
+            end += 1;
+            iter.next();
+        }
+        parts.push(if end > start {
+            format!("{start}..={end}")
+        } else {
+            start.to_string()
+        });
+    }
+    parts.join(", ")
+}
+
+/// An owned, 8-byte-aligned byte buffer, so that a table read from a file (one copy) can be
+/// parsed and viewed without further copies.
+#[derive(Clone, Debug, Default)]
+pub struct AlignedBytes {
+    words: Vec<u64>,
+    len: usize,
+}
+
+impl AlignedBytes {
+    /// Copy `bytes` into an aligned buffer.
+    pub fn from_slice(bytes: &[u8]) -> Self {
+        let mut words = vec![0u64; bytes.len().div_ceil(8)];
+        bytemuck::cast_slice_mut::<u64, u8>(&mut words)[..bytes.len()].copy_from_slice(bytes);
+        AlignedBytes {
+            words,
+            len: bytes.len(),
+        }
+    }
+
+    /// Read a file straight into an aligned buffer.
+    pub fn read(path: &std::path::Path) -> std::io::Result<Self> {
+        use std::io::Read;
+        let mut file = std::fs::File::open(path)?;
+        let len = usize::try_from(file.metadata()?.len()).unwrap_or(usize::MAX);
+        let mut words = vec![0u64; len.div_ceil(8)];
+        file.read_exact(&mut bytemuck::cast_slice_mut::<u64, u8>(&mut words)[..len])?;
+        Ok(AlignedBytes { words, len })
+    }
+
+    /// The bytes.
+    pub fn as_bytes(&self) -> &[u8] {
+        &bytemuck::cast_slice::<u64, u8>(&self.words)[..self.len]
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,235 @@
+//! Every way a table can be broken gets its own error, never a panic.
+
+use proptest::prelude::*;
+
+use super::*;
+
+fn key(kind: StencilKind, points: PointSet, faces: u32, n: u32) -> SectionKey {
+    SectionKey {
+        kind,
+        points,
+        boundary: false,
+        faces,
+        sector: 0,
+        n,
+    }
+}
+
+fn sample() -> Vec<u8> {
+    let meta = TableMeta {
+        scheme: SchemeId::CatmullClark,
+        precision: Precision::F32,
+        corners: false,
+    };
+    let mut sections = Vec::new();
+    for n in 1..=3u32 {
+        for (points, count) in [
+            (PointSet::Primal, (n + 1) * (n + 1)),
+            (PointSet::Dual, n * n),
+        ] {
+            let weights = (0..count * 14).map(|i| f64::from(i) / 7.0).collect();
+            sections.push((key(StencilKind::Position, points, 3, n), 14, weights));
+        }
+    }
+    encode(meta, &sections).expect("valid")
+}
+
+fn parse(bytes: &[u8]) -> Result<(), TableError> {
+    let aligned = AlignedBytes::from_slice(bytes);
+    let table = Table::parse(aligned.as_bytes())?;
+    for e in table.entries.clone() {
+        table.weights_f32(&e.key)?;
+    }
+    Ok(())
+}
+
+/// Re-seal a modified file with a correct checksum, to reach the checks behind it.
+fn reseal(bytes: &mut [u8]) {
+    let c = xxhash_rust::xxh3::xxh3_64(&bytes[HEADER_SIZE..]);
+    bytes[40..48].copy_from_slice(&c.to_le_bytes());
+}
+
+#[test]
+fn round_trip() {
+    let bytes = sample();
+    let aligned = AlignedBytes::from_slice(&bytes);
+    let table = Table::parse(aligned.as_bytes()).expect("valid");
+    let w = table
+        .weights_f32(&key(StencilKind::Position, PointSet::Dual, 3, 2))
+        .expect("present");
+    assert_eq!(w.len(), 4 * 14);
+    assert_eq!(w[7], 1.0);
+    assert_eq!(
+        table.coverage(),
+        "interior valences 3, boundary vertices with none faces, n = 1..=3"
+    );
+    // Byte-for-byte deterministic, whatever the order sections are given in.
+    assert_eq!(bytes, sample());
+}
+
+#[test]
+fn wrong_magic() {
+    let mut b = sample();
+    b[0] = b'X';
+    assert!(matches!(parse(&b), Err(TableError::BadMagic { .. })));
+    assert!(matches!(parse(b"PNG"), Err(TableError::BadMagic { .. })));
+}
+
+#[test]
+fn newer_and_older_versions() {
+    for v in [0u32, 2, 99] {
+        let mut b = sample();
+        b[8..12].copy_from_slice(&v.to_le_bytes());
+        assert_eq!(
+            parse(&b),
+            Err(TableError::UnsupportedVersion {
+                found: v,
+                supported: VERSION
+            })
+        );
+    }
+}
+
+#[test]
+fn big_endian_mark() {
+    let mut b = sample();
+    b[12..16].copy_from_slice(&ENDIAN_MARK.to_be_bytes());
+    assert!(matches!(parse(&b), Err(TableError::Endianness { .. })));
+}
+
+#[test]
+fn truncated() {
+    let b = sample();
+    for cut in [10, HEADER_SIZE - 1, HEADER_SIZE + 5, b.len() - 1] {
+        let e = parse(&b[..cut]).expect_err("truncated");
+        assert!(
+            matches!(e, TableError::Truncated { .. }),
+            "cut at {cut}: {e}"
+        );
+    }
+}
+
+#[test]
+fn flipped_byte_fails_the_checksum() {
+    let b = sample();
+    for at in [HEADER_SIZE, HEADER_SIZE + 17, b.len() / 2, b.len() - 1] {
+        let mut c = b.clone();
+        c[at] ^= 0x10;
+        assert!(
+            matches!(parse(&c), Err(TableError::Checksum { .. })),
+            "byte {at}"
+        );
+    }
+}
+
+#[test]
+fn section_outside_the_file() {
+    let mut b = sample();
+    let at = HEADER_SIZE + 24; // first entry's offset
+    let len = b.len() as u64;
+    b[at..at + 8].copy_from_slice(&len.to_le_bytes());
+    reseal(&mut b);
+    assert!(matches!(
+        parse(&b),
+        Err(TableError::SectionOutOfBounds { index: 0, .. })
+    ));
+}
+
+#[test]
+fn misaligned_and_wrong_shape() {
+    let mut b = sample();
+    let at = HEADER_SIZE + 24;
+    let offset = u64_at(&b, at);
+    b[at..at + 8].copy_from_slice(&(offset + 2).to_le_bytes());
+    reseal(&mut b);
+    assert!(matches!(
+        parse(&b),
+        Err(TableError::Misaligned { index: 0, .. })
+    ));
+    let mut b = sample();
+    let width_at = HEADER_SIZE + 20;
+    b[width_at..width_at + 4].copy_from_slice(&15u32.to_le_bytes());
+    reseal(&mut b);
+    assert!(matches!(
+        parse(&b),
+        Err(TableError::WrongShape { index: 0, .. })
+    ));
+    // A section pointing into the header or index.
+    let mut b = sample();
+    b[at..at + 8].copy_from_slice(&8u64.to_le_bytes());
+    reseal(&mut b);
+    assert!(matches!(
+        parse(&b),
+        Err(TableError::Misaligned { index: 0, .. })
+    ));
+}
+
+#[test]
+fn missing_valence_or_rate_names_the_coverage() {
+    let bytes = sample();
+    let aligned = AlignedBytes::from_slice(&bytes);
+    let table = Table::parse(aligned.as_bytes()).expect("valid");
+    let e = table
+        .weights_f32(&key(StencilKind::Position, PointSet::Dual, 9, 2))
+        .expect_err("no valence 9");
+    assert!(matches!(e, TableError::MissingSection { .. }));
+    assert!(
+        e.to_string().contains("valence 9") && e.to_string().contains("interior valences 3"),
+        "{e}"
+    );
+    let e = table
+        .weights_f32(&key(StencilKind::Position, PointSet::Dual, 3, 24))
+        .expect_err("no n = 24");
+    assert!(e.to_string().contains("n = 1..=3"), "{e}");
+    let e = table
+        .weights_f64(&key(StencilKind::Position, PointSet::Dual, 3, 2))
+        .expect_err("f32 table");
+    assert!(matches!(e, TableError::PrecisionMismatch { .. }));
+}
+
+#[test]
+fn unaligned_buffer_is_an_error() {
+    let bytes = sample();
+    let aligned = AlignedBytes::from_slice(&[&[0u8][..], &bytes].concat());
+    assert_eq!(
+        Table::parse(&aligned.as_bytes()[1..]).err(),
+        Some(TableError::UnalignedBuffer)
+    );
+}
+
+#[test]
+fn duplicate_sections_are_refused_by_the_writer() {
+    let meta = TableMeta {
+        scheme: SchemeId::CatmullClark,
+        precision: Precision::F32,
+        corners: false,
+    };
+    let k = key(StencilKind::Position, PointSet::Dual, 3, 1);
+    let e = encode(meta, &[(k, 1, vec![1.0]), (k, 1, vec![1.0])]).expect_err("duplicate");
+    assert!(matches!(e, TableError::DuplicateSection { .. }));
+    let e = encode(meta, &[(k, 2, vec![1.0])]).expect_err("wrong length");
+    assert!(matches!(e, TableError::Encode(_)));
+}
+
+proptest! {
+    /// Mutating random bytes of a valid table (re-sealed or not) gives Ok or a clean Err.
+    #[test]
+    fn random_mutations_never_panic(
+        edits in proptest::collection::vec((0usize..4096, any::<u8>()), 1..8),
+        reseal_it in any::<bool>(),
+        cut in proptest::option::of(0usize..4096),
+    ) {
+        let mut b = sample();
+        for (at, value) in edits {
+            let at = at % b.len();
+            b[at] = value;
+        }
+        if reseal_it && b.len() > HEADER_SIZE {
+            reseal(&mut b);
+        }
+        if let Some(cut) = cut {
+            b.truncate(cut % (b.len() + 1));
+        }
+        let _ = parse(&b);
+    }
+}

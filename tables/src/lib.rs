@@ -1,0 +1,34 @@
+//! The default stencil tables, embedded.
+//!
+//! The default Catmull–Clark table (interior valences 3..=8, boundary vertices with 1..=6 faces
+//! "edge only", n = 1..=24, primal and dual grids, positions and both derivatives, f32) is about
+//! 57 MiB, too large to keep in the repository and in its history. It is generated
+//! deterministically by `stencilgen::table::default_table()` in this crate's build script and
+//! embedded with `include_bytes!`, aligned for zero-copy reads. `stencilgen tables --boundary
+//! -o FILE` writes the same bytes to a file, and a test checks that a fresh generation is
+//! byte-identical to what is embedded.
+
+/// `include_bytes!` gives 1-byte alignment; the table format hands out `&[f32]` views, so the
+/// bytes are wrapped in a 64-byte-aligned static.
+#[repr(C, align(64))]
+struct Aligned<T: ?Sized>(T);
+
+static CATMULL_CLARK: &Aligned<[u8]> = &Aligned(*include_bytes!(concat!(
+    env!("OUT_DIR"),
+    "/catmull-clark.subtess"
+)));
+
+/// The default Catmull–Clark table's bytes (64-byte aligned).
+pub fn default_catmull_clark() -> &'static [u8] {
+    &CATMULL_CLARK.0
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn embedded_table_is_aligned_and_starts_with_the_magic() {
+        let bytes = super::default_catmull_clark();
+        assert_eq!(bytes.as_ptr() as usize % 64, 0);
+        assert_eq!(&bytes[..8], b"SUBTESS\0");
+    }
+}

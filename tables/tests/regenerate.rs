@@ -1,0 +1,19 @@
+//! The embedded default table is exactly what the generator makes today.
+
+#[test]
+fn regenerated_default_table_is_byte_identical() {
+    let fresh = stencilgen::table::default_table().expect("the default table generates");
+    let embedded = tables::default_catmull_clark();
+    assert_eq!(fresh.len(), embedded.len(), "sizes differ");
+    assert!(
+        fresh == embedded,
+        "the embedded default table differs from a fresh generation"
+    );
+    let table = table_format::Table::parse(embedded).expect("the embedded table is valid");
+    println!(
+        "default table: {} bytes, {} sections; {}",
+        table.size(),
+        table.entries.len(),
+        table.coverage()
+    );
+}
