@@ -233,3 +233,38 @@ fn stencil_bad_input() {
         assert!(stderr.contains(message), "{args:?}: {stderr}");
     }
 }
+
+#[test]
+fn tables_writes_a_valid_table() {
+    let path = std::env::temp_dir().join(format!("stencilgen-cli-{}.subtess", std::process::id()));
+    let out = Command::new(env!("CARGO_BIN_EXE_stencilgen"))
+        .args([
+            "tables",
+            "--valences",
+            "3,5",
+            "--n",
+            "1..2",
+            "--precision",
+            "f64",
+            "-o",
+        ])
+        .arg(&path)
+        .output()
+        .expect("stencilgen runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let bytes = table_format::AlignedBytes::read(&path).expect("written");
+    let table = table_format::Table::parse(bytes.as_bytes()).expect("valid");
+    assert_eq!(table.meta.precision, table_format::Precision::F64);
+    assert_eq!(table.entries.len(), 2 * 2 * 3 * 2);
+    assert_eq!(
+        table.coverage(),
+        "interior valences 3, 5, no boundary vertices, n = 1..=2"
+    );
+    let _ = std::fs::remove_file(&path);
+    let bad = stencilgen(&["tables", "--valences", "8..3", "-o", "/tmp/x.subtess"]);
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--valences `8..3`"));
+}

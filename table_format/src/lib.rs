@@ -741,20 +741,22 @@ impl TableIndex {
             }
             rates.insert(e.key.n);
         }
-        format!(
-            "interior valences {}, boundary vertices with {} faces, n = {}",
-            ranges(&valences),
-            ranges(&boundary),
-            ranges(&rates)
-        )
+        let interior = if valences.is_empty() {
+            "no interior vertices".to_owned()
+        } else {
+            format!("interior valences {}", ranges(&valences))
+        };
+        let boundary = if boundary.is_empty() {
+            "no boundary vertices".to_owned()
+        } else {
+            format!("boundary vertices with {} faces", ranges(&boundary))
+        };
+        format!("{interior}, {boundary}, n = {}", ranges(&rates))
     }
 }
 
 /// `1..=6, 8` style summary of a set of integers.
 fn ranges(set: &std::collections::BTreeSet<u32>) -> String {
-    if set.is_empty() {
-        return "none".to_owned();
-    }
     let mut parts = Vec::new();
     let mut iter = set.iter().copied().peekable();
     while let Some(start) = iter.next() {

@@ -61,7 +61,7 @@ fn round_trip() {
     assert_eq!(w[7], 1.0);
     assert_eq!(
         table.coverage(),
-        "interior valences 3, boundary vertices with none faces, n = 1..=3"
+        "interior valences 3, no boundary vertices, n = 1..=3"
     );
     // Byte-for-byte deterministic, whatever the order sections are given in.
     assert_eq!(bytes, sample());
