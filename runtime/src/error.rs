@@ -2,12 +2,78 @@
 
 use thiserror::Error;
 
+/// What is wrong with a mesh's topology or geometry; every variant names the face or vertex
+/// (0-based, with the OBJ file's 1-based number or line beside it).
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum MeshError {
+    /// No faces.
+    #[error("the mesh has no faces")]
+    Empty,
+    /// A coordinate is NaN or infinite.
+    #[error("vertex {vertex} (OBJ `v` number {}) has a non-finite coordinate {position:?}", vertex + 1)]
+    NonFinite {
+        /// 0-based vertex.
+        vertex: usize,
+        /// Its position.
+        position: [f64; 3],
+    },
+    /// A face is malformed.
+    #[error("face {face} (OBJ line {line}): {reason}")]
+    BadFace {
+        /// 0-based face.
+        face: usize,
+        /// 1-based OBJ line (0 when not from a file).
+        line: usize,
+        /// What is wrong.
+        reason: String,
+    },
+    /// An edge has more than two faces, or two faces that traverse it the same way.
+    #[error("edge ({a}, {b}) (OBJ `v` numbers {}, {}) is non-manifold or inconsistently oriented: faces {faces:?} use it in the same direction", a + 1, b + 1)]
+    NonManifoldEdge {
+        /// 0-based endpoints.
+        a: usize,
+        /// 0-based endpoints.
+        b: usize,
+        /// The faces involved.
+        faces: Vec<usize>,
+    },
+    /// The faces around a vertex form more than one fan.
+    #[error("vertex {vertex} (OBJ `v` number {}) is non-manifold: its {faces} faces form more than one fan", vertex + 1)]
+    NonManifoldVertex {
+        /// 0-based vertex.
+        vertex: usize,
+        /// Number of faces at it.
+        faces: usize,
+    },
+}
+
 /// Everything the runtime can fail at.
 #[derive(Debug, Error)]
 pub enum RuntimeError {
     /// A stencil table is invalid, or lacks what was asked of it.
     #[error(transparent)]
     Table(#[from] table_format::TableError),
+    /// An OBJ line is malformed (text parsed without a file name).
+    #[error("OBJ line {line}: {message}")]
+    Obj {
+        /// 1-based line.
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// An OBJ file line is malformed.
+    #[error("{path}:{line}: {message}")]
+    ObjFile {
+        /// The file.
+        path: String,
+        /// 1-based line.
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// The mesh is not one the surface can be built on.
+    #[error("invalid mesh: {0}")]
+    Mesh(#[from] MeshError),
     /// A file could not be read.
     #[error("{path}: {source}")]
     Io {

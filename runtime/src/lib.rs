@@ -7,6 +7,9 @@
 //! ```
 
 pub mod error;
+pub mod obj;
+pub mod refine;
 pub mod stencil_table;
+pub mod topology;
 
-pub use error::RuntimeError;
+pub use error::{MeshError, RuntimeError};

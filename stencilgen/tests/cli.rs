@@ -9,6 +9,19 @@ fn stencilgen(args: &[&str]) -> Output {
         .expect("stencilgen runs")
 }
 
+/// The command fails cleanly (an exit status, not a signal or a panic) and says `message`.
+fn fails_with(args: &[&str], message: &str) {
+    let out = stencilgen(args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{args:?} succeeded");
+    assert!(
+        out.status.code().is_some(),
+        "{args:?} was killed by a signal"
+    );
+    assert!(stderr.contains(message), "{args:?}: {stderr}");
+    assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+}
+
 fn json(args: &[&str]) -> serde_json::Value {
     let out = stencilgen(args);
     assert!(
@@ -100,15 +113,7 @@ fn bad_input_is_a_clear_error_not_a_panic() {
         ),
     ];
     for (args, message) in cases {
-        let out = stencilgen(args);
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert!(!out.status.success(), "{args:?} succeeded");
-        assert!(
-            out.status.code().is_some(),
-            "{args:?} was killed by a signal"
-        );
-        assert!(stderr.contains(message), "{args:?}: {stderr}");
-        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        fails_with(args, message);
     }
 }
 
@@ -227,10 +232,7 @@ fn stencil_bad_input() {
         ),
     ];
     for (args, message) in cases {
-        let out = stencilgen(args);
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert!(!out.status.success(), "{args:?} succeeded");
-        assert!(stderr.contains(message), "{args:?}: {stderr}");
+        fails_with(args, message);
     }
 }
 
@@ -265,6 +267,8 @@ fn tables_writes_a_valid_table() {
         "interior valences 3, 5, no boundary vertices, n = 1..=2"
     );
     let _ = std::fs::remove_file(&path);
-    let bad = stencilgen(&["tables", "--valences", "8..3", "-o", "/tmp/x.subtess"]);
-    assert!(String::from_utf8_lossy(&bad.stderr).contains("--valences `8..3`"));
+    fails_with(
+        &["tables", "--valences", "8..3", "-o", "/tmp/x.subtess"],
+        "--valences `8..3`",
+    );
 }

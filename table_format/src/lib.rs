@@ -692,14 +692,7 @@ impl TableIndex {
         bytes: &'b [u8],
         key: &SectionKey,
     ) -> Result<&'b [f32], TableError> {
-        if self.meta.precision != Precision::F32 {
-            return Err(TableError::PrecisionMismatch {
-                stored: self.meta.precision,
-                asked: Precision::F32,
-            });
-        }
-        bytemuck::try_cast_slice(self.section_bytes(bytes, key)?)
-            .map_err(|_| TableError::UnalignedBuffer)
+        self.weights(bytes, key, Precision::F32)
     }
 
     /// The f64 weights of a section of `bytes` (the bytes this index was parsed from).
@@ -708,10 +701,19 @@ impl TableIndex {
         bytes: &'b [u8],
         key: &SectionKey,
     ) -> Result<&'b [f64], TableError> {
-        if self.meta.precision != Precision::F64 {
+        self.weights(bytes, key, Precision::F64)
+    }
+
+    fn weights<'b, T: bytemuck::Pod>(
+        &self,
+        bytes: &'b [u8],
+        key: &SectionKey,
+        asked: Precision,
+    ) -> Result<&'b [T], TableError> {
+        if self.meta.precision != asked {
             return Err(TableError::PrecisionMismatch {
                 stored: self.meta.precision,
-                asked: Precision::F64,
+                asked,
             });
         }
         bytemuck::try_cast_slice(self.section_bytes(bytes, key)?)
