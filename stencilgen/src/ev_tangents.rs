@@ -45,7 +45,10 @@ pub fn ev_tangents(matrices: &LocalMatrices) -> Result<EvTangents, StencilError>
         n: 0,
         detail: format!("{}: {what}", matrices.describe()),
     };
-    let mut eigenvalues: Vec<f64> = a1
+    // A bounded Schur iteration, so that a matrix it cannot settle is an error, not a hang.
+    let schur = nalgebra::linalg::Schur::try_new(a1.clone(), 1e-14, 100_000)
+        .ok_or_else(|| failure("the eigenvalue iteration did not converge"))?;
+    let mut eigenvalues: Vec<f64> = schur
         .complex_eigenvalues()
         .iter()
         .filter(|z| (z.norm() - 1.0).abs() > 1e-9)

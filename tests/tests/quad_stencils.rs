@@ -426,7 +426,14 @@ fn sw_nonpoly_quad_eigen_structure_and_limit_mask() {
                 .expect("valid");
         let k = m.size();
         let a = nalgebra::DMatrix::from_fn(k, k, |i, j| rational_to_f64(&m.a[i][j]));
-        let mut moduli: Vec<f64> = a.complex_eigenvalues().iter().map(|z| z.norm()).collect();
+        // A bounded Schur iteration: a matrix it cannot settle fails the test instead of hanging it.
+        let schur = nalgebra::linalg::Schur::try_new(a, 1e-14, 100_000)
+            .expect("Schur decomposition converges");
+        let mut moduli: Vec<f64> = schur
+            .complex_eigenvalues()
+            .iter()
+            .map(|z| z.norm())
+            .collect();
         moduli.sort_by(|x, y| y.total_cmp(x));
         let t = 7.0 / 12.0 + (2.0 * std::f64::consts::PI / f64::from(v)).cos() / 6.0;
         let lambda = (t + (t * t - 1.0 / 6.0).sqrt()) / 2.0;
@@ -450,6 +457,114 @@ fn sw_nonpoly_quad_eigen_structure_and_limit_mask() {
                 _ => BigRational::zero(),
             };
             assert_eq!(*w, expected, "v = {v} index {i}");
+        }
+    }
+}
+
+/// The characteristic map (the patch evaluated on the subdominant right eigenvectors of `A`)
+/// is regular and injective for both schemes at valences 3..=8, checked on the primal grid at
+/// n = 16: every grid triangle has the same orientation, and, normalized so that the images of
+/// the edges V-E_1 and V-E_2 lie on the rays at angles 0 and 2 pi/v, the whole patch stays in
+/// that wedge — so by the rotational symmetry the v sectors do not overlap (Reif's criterion,
+/// with the eigenvalue test above).
+#[test]
+fn characteristic_maps_are_regular_and_injective() {
+    for name in ["catmull-clark", "sw-nonpoly-quad"] {
+        let s = scheme(name);
+        for v in 3..=8u32 {
+            let m = stencilgen::extraordinary_patch::LocalMatrices::new(
+                &s,
+                Neighbourhood::interior(v),
+                0,
+            )
+            .expect("valid");
+            let k = m.size();
+            let a = nalgebra::DMatrix::from_fn(k, k, |i, j| rational_to_f64(&m.a[i][j]));
+            // The subdominant eigenvalue, from the invariant 1-ring block (the full K x K matrix has
+            // defective outer blocks, on which nalgebra's Schur iteration does not settle).
+            let lambda = stencilgen::ev_tangents::ev_tangents(&m)
+                .expect("tangents")
+                .lambda;
+            // Right eigenvectors: the null space of A - lambda I.
+            let svd = (a - nalgebra::DMatrix::identity(k, k) * lambda).svd(false, true);
+            let v_t = svd.v_t.expect("vectors");
+            let mut order: Vec<usize> = (0..k).collect();
+            order.sort_by(|&i, &j| svd.singular_values[i].total_cmp(&svd.singular_values[j]));
+            assert!(
+                svd.singular_values[order[1]] < 1e-9,
+                "{name} v = {v}: not a double eigenvalue"
+            );
+            let net: Vec<[f64; 2]> = (0..k)
+                .map(|j| [v_t[(order[0], j)], v_t[(order[1], j)]])
+                .collect();
+            let n = 16u32;
+            let grid =
+                patch_stencils::<f64>(&s, Neighbourhood::interior(v), 0, n, StencilKind::Position)
+                    .expect("f64");
+            let eval = |i: i64, j: i64| -> [f64; 2] {
+                let w = grid.at(2 * i, 2 * j).expect("primal point");
+                w.iter().zip(&net).fold([0.0, 0.0], |acc, (w, p)| {
+                    [acc[0] + w * p[0], acc[1] + w * p[1]]
+                })
+            };
+            let ni = i64::from(n);
+            // Normalize: S(1,0) -> (1, 0), S(0,1) -> (cos t, sin t).
+            let theta = 2.0 * std::f64::consts::PI / f64::from(v);
+            let (e1, e2) = (eval(ni, 0), eval(0, ni));
+            let det = e1[0] * e2[1] - e1[1] * e2[0];
+            assert!(det.abs() > 1e-12, "{name} v = {v}: degenerate edge images");
+            let target = [[1.0, theta.cos()], [0.0, theta.sin()]];
+            let inv = [[e2[1] / det, -e2[0] / det], [-e1[1] / det, e1[0] / det]];
+            let map = |p: [f64; 2]| -> [f64; 2] {
+                let c = [
+                    inv[0][0] * p[0] + inv[0][1] * p[1],
+                    inv[1][0] * p[0] + inv[1][1] * p[1],
+                ];
+                [
+                    target[0][0] * c[0] + target[0][1] * c[1],
+                    target[1][0] * c[0] + target[1][1] * c[1],
+                ]
+            };
+            let points: Vec<Vec<[f64; 2]>> = (0..=ni)
+                .map(|j| (0..=ni).map(|i| map(eval(i, j))).collect())
+                .collect();
+            let angle = |p: [f64; 2]| p[1].atan2(p[0]);
+            for t in 1..=ni {
+                let (on_u, on_v) = (points[0][t as usize], points[t as usize][0]);
+                assert!(
+                    angle(on_u).abs() < 1e-9,
+                    "{name} v = {v}: edge V-E1 leaves its ray"
+                );
+                assert!(
+                    (angle(on_v) - theta).abs() < 1e-9,
+                    "{name} v = {v}: edge V-E2 leaves its ray"
+                );
+            }
+            let mut sign = 0.0f64;
+            for j in 0..ni as usize {
+                for i in 0..ni as usize {
+                    let (p00, p10, p11, p01) = (
+                        points[j][i],
+                        points[j][i + 1],
+                        points[j + 1][i + 1],
+                        points[j + 1][i],
+                    );
+                    for (a, b, c) in [(p00, p10, p11), (p00, p11, p01)] {
+                        let area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+                        if sign == 0.0 {
+                            sign = area.signum();
+                        }
+                        assert!(area * sign > 0.0, "{name} v = {v}: folded cell ({i}, {j})");
+                    }
+                    if (i, j) != (0, 0) {
+                        let t = angle(p00);
+                        assert!(
+                            (-1e-9..=theta + 1e-9).contains(&t),
+                            "{name} v = {v}: ({i}, {j}) leaves the wedge"
+                        );
+                    }
+                }
+            }
         }
     }
 }
