@@ -2,15 +2,16 @@
 
 use std::process::{Command, Output};
 
-fn stencilgen(args: &[&str]) -> Output {
+/// Run `stencilgen` with a whitespace-separated argument line.
+fn stencilgen(args: &str) -> Output {
     Command::new(env!("CARGO_BIN_EXE_stencilgen"))
-        .args(args)
+        .args(args.split_whitespace())
         .output()
         .expect("stencilgen runs")
 }
 
 /// The command fails cleanly (an exit status, not a signal or a panic) and says `message`.
-fn fails_with(args: &[&str], message: &str) {
+fn fails_with(args: &str, message: &str) {
     let out = stencilgen(args);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success(), "{args:?} succeeded");
@@ -22,7 +23,7 @@ fn fails_with(args: &[&str], message: &str) {
     assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
 }
 
-fn json(args: &[&str]) -> serde_json::Value {
+fn json(args: &str) -> serde_json::Value {
     let out = stencilgen(args);
     assert!(
         out.status.success(),
@@ -34,7 +35,7 @@ fn json(args: &[&str]) -> serde_json::Value {
 
 #[test]
 fn curve_json_follows_the_contract() {
-    let v = json(&["curve", "--scheme", "four-point", "--n", "3", "--json"]);
+    let v = json("curve --scheme four-point --n 3 --json");
     assert_eq!(v["scheme"], "four-point");
     assert_eq!(v["n"], 3);
     assert_eq!(v["support"], serde_json::json!([-3, 3]));
@@ -50,16 +51,7 @@ fn curve_json_follows_the_contract() {
 
 #[test]
 fn f64_values_are_numbers_with_a_residual() {
-    let v = json(&[
-        "curve",
-        "--scheme",
-        "four-point",
-        "--n",
-        "3",
-        "--derivative",
-        "--f64",
-        "--json",
-    ]);
+    let v = json("curve --scheme four-point --n 3 --derivative --f64 --json");
     let third = v["values"][10].as_f64().expect("a number");
     assert!((third + 584.0 / 540.0).abs() < 1e-12, "phi'(1/3) = {third}");
     assert!(v["residual"].as_f64().expect("residual") < 1e-12);
@@ -67,14 +59,7 @@ fn f64_values_are_numbers_with_a_residual() {
 
 #[test]
 fn vector_schemes_list_their_components() {
-    let v = json(&[
-        "curve",
-        "--scheme",
-        "nonuniform-cubic-bspline",
-        "--n",
-        "2",
-        "--json",
-    ]);
+    let v = json("curve --scheme nonuniform-cubic-bspline --n 2 --json");
     let functions = v["functions"].as_array().expect("functions");
     assert_eq!(functions.len(), 5);
     assert_eq!(functions[2]["name"], "point0");
@@ -82,33 +67,20 @@ fn vector_schemes_list_their_components() {
 
 #[test]
 fn bad_input_is_a_clear_error_not_a_panic() {
-    let cases: [(&[&str], &str); 6] = [
+    let cases: [(&str, &str); 6] = [
         (
-            &["curve", "--scheme", "loop-de-loop", "--n", "3"],
+            "curve --scheme loop-de-loop --n 3",
             "unknown scheme `loop-de-loop`",
         ),
+        ("curve --scheme four-point --n 0", "0 is not in 1..=1024"),
         (
-            &["curve", "--scheme", "four-point", "--n", "0"],
-            "0 is not in 1..=1024",
-        ),
-        (
-            &["curve", "--scheme", "four-point", "--n", "three"],
+            "curve --scheme four-point --n three",
             "invalid value 'three'",
         ),
-        (&["curve", "--scheme", "four-point"], "--n <N>"),
+        ("curve --scheme four-point", "--n <N>"),
+        ("curve --scheme four-point --n 3 --wat", "--wat"),
         (
-            &["curve", "--scheme", "four-point", "--n", "3", "--wat"],
-            "--wat",
-        ),
-        (
-            &[
-                "curve",
-                "--scheme",
-                "nonuniform-cubic-bspline",
-                "--n",
-                "3",
-                "--derivative",
-            ],
+            "curve --scheme nonuniform-cubic-bspline --n 3 --derivative",
             "does not map linear data to linear data",
         ),
     ];
@@ -119,18 +91,7 @@ fn bad_input_is_a_clear_error_not_a_panic() {
 
 #[test]
 fn stencil_json_follows_the_contract() {
-    let v = json(&[
-        "stencil",
-        "--scheme",
-        "catmull-clark",
-        "--valence",
-        "5",
-        "--u",
-        "1/3",
-        "--v",
-        "2/7",
-        "--json",
-    ]);
+    let v = json("stencil --scheme catmull-clark --valence 5 --u 1/3 --v 2/7 --json");
     let weights = v["weights"].as_array().expect("weights");
     assert_eq!(weights.len(), 2 * 5 + 8);
     assert_eq!(v["du"].as_array().expect("du").len(), 18);
@@ -138,96 +99,33 @@ fn stencil_json_follows_the_contract() {
     assert_eq!(v["order"][1], "E1");
     // At the EV the position is the classical limit mask (v^2 V + 4 sum E + sum F)/(v(v+5));
     // exact tangents there are irrational: null, with a note.
-    let v = json(&[
-        "stencil",
-        "--scheme",
-        "catmull-clark",
-        "--valence",
-        "5",
-        "--u",
-        "0",
-        "--v",
-        "0",
-        "--json",
-    ]);
+    let v = json("stencil --scheme catmull-clark --valence 5 --u 0 --v 0 --json");
     assert_eq!(v["weights"][0], "1/2");
     assert_eq!(v["weights"][1], "2/25");
     assert_eq!(v["weights"][6], "1/50");
     assert!(v["du"].is_null());
     assert!(v["note"].as_str().expect("note").contains("irrational"));
-    let v = json(&[
-        "stencil",
-        "--scheme",
-        "catmull-clark",
-        "--valence",
-        "5",
-        "--u",
-        "0",
-        "--v",
-        "0",
-        "--f64",
-        "--json",
-    ]);
+    let v = json("stencil --scheme catmull-clark --valence 5 --u 0 --v 0 --f64 --json");
     assert!(v["du"].as_array().expect("f64 tangents").len() == 18);
 }
 
 #[test]
 fn stencil_bad_input() {
-    let cases: [(&[&str], &str); 4] = [
+    let cases: [(&str, &str); 4] = [
         (
-            &[
-                "stencil",
-                "--scheme",
-                "catmull-clark",
-                "--valence",
-                "5",
-                "--u",
-                "3/2",
-                "--v",
-                "0",
-            ],
+            "stencil --scheme catmull-clark --valence 5 --u 3/2 --v 0",
             "outside the patch",
         ),
         (
-            &[
-                "stencil",
-                "--scheme",
-                "catmull-clark",
-                "--valence",
-                "5",
-                "--u",
-                "1/0",
-                "--v",
-                "0",
-            ],
+            "stencil --scheme catmull-clark --valence 5 --u 1/0 --v 0",
             "denominator is zero",
         ),
         (
-            &[
-                "stencil",
-                "--scheme",
-                "catmull-clark",
-                "--valence",
-                "2",
-                "--u",
-                "0",
-                "--v",
-                "0",
-            ],
+            "stencil --scheme catmull-clark --valence 2 --u 0 --v 0",
             "2 is not in 3..=64",
         ),
         (
-            &[
-                "stencil",
-                "--scheme",
-                "loop",
-                "--valence",
-                "5",
-                "--u",
-                "0",
-                "--v",
-                "0",
-            ],
+            "stencil --scheme loop --valence 5 --u 0 --v 0",
             "unknown scheme `loop`",
         ),
     ];
@@ -268,7 +166,7 @@ fn tables_writes_a_valid_table() {
     );
     let _ = std::fs::remove_file(&path);
     fails_with(
-        &["tables", "--valences", "8..3", "-o", "/tmp/x.subtess"],
+        "tables --valences 8..3 -o /tmp/x.subtess",
         "--valences `8..3`",
     );
 }
