@@ -37,6 +37,14 @@ pub enum MeshError {
         /// The faces involved.
         faces: Vec<usize>,
     },
+    /// A face is not yet a table patch: it needs Catmull–Clark isolation steps first.
+    #[error("face {face} is not an isolated patch: {reason}")]
+    NotIsolated {
+        /// 0-based face.
+        face: usize,
+        /// Why.
+        reason: String,
+    },
     /// The faces around a vertex form more than one fan.
     #[error("vertex {vertex} (OBJ `v` number {}) is non-manifold: its {faces} faces form more than one fan", vertex + 1)]
     NonManifoldVertex {
@@ -74,6 +82,22 @@ pub enum RuntimeError {
     /// The mesh is not one the surface can be built on.
     #[error("invalid mesh: {0}")]
     Mesh(#[from] MeshError),
+    /// A table section's width disagrees with the patch's control-point count.
+    #[error("the table's {key} has {table} weights per point, the face's patch has {patch} control points")]
+    LayoutMismatch {
+        /// The section.
+        key: table_format::SectionKey,
+        /// Its width.
+        table: usize,
+        /// The patch's point count.
+        patch: usize,
+    },
+    /// The mesh pins its one-face boundary corners and the table does not, or the reverse.
+    #[error("the mesh's boundary rule is {} but the stencil table was made for {}; `stencilgen tables --boundary{}` makes a matching table", if *mesh_corners { "edge and corner" } else { "edge only" }, if *mesh_corners { "edge only" } else { "edge and corner" }, if *mesh_corners { " --corners" } else { "" })]
+    BoundaryModeMismatch {
+        /// Whether the mesh pins corners.
+        mesh_corners: bool,
+    },
     /// A file could not be read.
     #[error("{path}: {source}")]
     Io {

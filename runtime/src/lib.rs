@@ -8,6 +8,7 @@
 
 pub mod error;
 pub mod obj;
+pub mod patch;
 pub mod refine;
 pub mod stencil_table;
 pub mod topology;
