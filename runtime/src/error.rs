@@ -98,6 +98,9 @@ pub enum RuntimeError {
         /// Whether the mesh pins corners.
         mesh_corners: bool,
     },
+    /// Something the runtime does not do yet, said plainly.
+    #[error("not supported yet: {0}")]
+    Unsupported(String),
     /// A file could not be read.
     #[error("{path}: {source}")]
     Io {

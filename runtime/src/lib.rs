@@ -6,7 +6,10 @@
 //! assert!(!table.index().entries.is_empty());
 //! ```
 
+pub mod dual_grid;
 pub mod error;
+pub mod isolate;
+pub mod mesh_output;
 pub mod obj;
 pub mod patch;
 pub mod refine;

@@ -1,0 +1,238 @@
+//! The dual-grid watertight tessellator (Schaefer–Warren section 5.5), uniform rate, closed
+//! meshes.
+//!
+//! Every face at rate `n` gets the `n x n` dual points `((2i+1)/2n, (2j+1)/2n)` of its
+//! parameter domain, evaluated once from the table. Three kinds of polygons connect them:
+//!
+//! * face interiors: the `(n-1)^2` quads of the dual grid;
+//! * edges: the strip between the two faces' dual rows nearest the shared edge;
+//! * vertices: the polygon of the surrounding faces' dual points nearest the vertex (a v-gon).
+//!
+//! Each quad and polygon is split into triangles. Every vertex is made exactly once and each
+//! polygon refers to it by index, so the output is watertight by construction; nothing is welded
+//! by distance. Per-face rates, boundaries (the limit boundary curve) and the fast evaluation
+//! path are the next steps; boundary meshes are refused with a clear error until then.
+
+use std::time::Instant;
+
+use table_format::{PointSet, SectionKey, StencilKind};
+
+use crate::patch::{face_patch, FacePatch};
+use crate::stencil_table::StencilTable;
+use crate::topology::{Mesh, NONE};
+use crate::{MeshError, RuntimeError};
+
+/// A triangle mesh with, per vertex, the face and parameters it was evaluated at.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TriangleMesh {
+    /// Limit positions.
+    pub positions: Vec<[f64; 3]>,
+    /// Unit normals (from the tangent stencils).
+    pub normals: Vec<[f64; 3]>,
+    /// Source face and `(u, v)` in that face's own parameters.
+    pub sources: Vec<(u32, f64, f64)>,
+    /// Triangles, counter-clockwise seen from outside (for counter-clockwise input faces).
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl TriangleMesh {
+    /// Whether every edge is shared by exactly two triangles that traverse it in opposite
+    /// directions.
+    pub fn is_watertight(&self) -> bool {
+        let mut directed = std::collections::HashSet::with_capacity(3 * self.triangles.len());
+        for t in &self.triangles {
+            for k in 0..3 {
+                if !directed.insert((t[k], t[(k + 1) % 3])) {
+                    return false;
+                }
+            }
+        }
+        directed.iter().all(|&(a, b)| directed.contains(&(b, a)))
+    }
+
+    /// Euler characteristic V - E + F of the triangle mesh.
+    pub fn euler_characteristic(&self) -> i64 {
+        let mut edges = std::collections::HashSet::with_capacity(3 * self.triangles.len());
+        for t in &self.triangles {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                edges.insert((a.min(b), a.max(b)));
+            }
+        }
+        self.positions.len() as i64 - edges.len() as i64 + self.triangles.len() as i64
+    }
+}
+
+/// Timings of one tessellation.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TessellationTime {
+    /// Seconds spent evaluating and connecting (not gathering patches).
+    pub seconds: f64,
+}
+
+/// The dual point of face-local indices `(i, j)` in the patch's indices.
+fn patch_index(corner: usize, i: usize, j: usize, n: usize) -> (usize, usize) {
+    let last = n - 1;
+    match corner {
+        0 => (i, j),
+        1 => (j, last - i),
+        2 => (last - i, last - j),
+        _ => (last - j, i),
+    }
+}
+
+/// Gather the patch of every face; the first face that is not one is an error.
+pub fn gather_patches(mesh: &Mesh) -> Result<Vec<FacePatch>, MeshError> {
+    (0..mesh.faces()).map(|f| face_patch(mesh, f)).collect()
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// Tessellate a closed, isolated mesh at rate `n` on every face.
+pub fn tessellate_uniform(
+    table: &StencilTable,
+    mesh: &Mesh,
+    patches: &[FacePatch],
+    n: u32,
+) -> Result<(TriangleMesh, TessellationTime), RuntimeError> {
+    if let Some(h) = mesh.twin.iter().position(|&t| t == NONE) {
+        return Err(RuntimeError::Unsupported(format!(
+            "the mesh has a boundary (face {}): the dual-grid tessellator handles closed meshes so far",
+            mesh.face_of[h]
+        )));
+    }
+    let started = Instant::now();
+    let nu = n as usize;
+    let mut out = TriangleMesh::default();
+    let section = |patch: &FacePatch, kind: StencilKind| SectionKey {
+        kind,
+        points: PointSet::Dual,
+        boundary: patch.kind.boundary,
+        faces: patch.kind.faces,
+        sector: patch.kind.sector,
+        n,
+    };
+    // Dual vertices, face by face, in face-local order (j outer).
+    for (f, patch) in patches.iter().enumerate() {
+        let k = patch.points.len();
+        let w = [
+            StencilKind::Position,
+            StencilKind::DerivativeU,
+            StencilKind::DerivativeV,
+        ]
+        .map(|kind| table.weights(&section(patch, kind)));
+        let [pos, du, dv] = w;
+        let (pos, du, dv) = (pos?, du?, dv?);
+        if pos.len() != nu * nu * k {
+            return Err(RuntimeError::LayoutMismatch {
+                key: section(patch, StencilKind::Position),
+                table: pos.len() / (nu * nu),
+                patch: k,
+            });
+        }
+        for j in 0..nu {
+            for i in 0..nu {
+                let (pi, pj) = patch_index(patch.corner, i, j, nu);
+                let row = (pj * nu + pi) * k;
+                let mut p = [[0.0f64; 3]; 3];
+                for (l, &v) in patch.points.iter().enumerate() {
+                    let q = mesh.positions[v as usize];
+                    for (acc, weights) in p.iter_mut().zip([pos, du, dv]) {
+                        let w = f64::from(weights[row + l]);
+                        for c in 0..3 {
+                            acc[c] += w * q[c];
+                        }
+                    }
+                }
+                let normal = cross(p[1], p[2]);
+                let length = (normal.iter().map(|x| x * x).sum::<f64>()).sqrt();
+                out.positions.push(p[0]);
+                out.normals.push(if length > 0.0 {
+                    normal.map(|x| x / length)
+                } else {
+                    [0.0, 0.0, 0.0]
+                });
+                let d = f64::from(2 * n);
+                out.sources.push((
+                    f as u32,
+                    f64::from(2 * i as u32 + 1) / d,
+                    f64::from(2 * j as u32 + 1) / d,
+                ));
+            }
+        }
+    }
+    let vertex = |f: usize, i: usize, j: usize| (f * nu * nu + j * nu + i) as u32;
+    // Face interiors.
+    for f in 0..patches.len() {
+        for j in 0..nu - 1 {
+            for i in 0..nu - 1 {
+                let (a, b, c, d) = (
+                    vertex(f, i, j),
+                    vertex(f, i + 1, j),
+                    vertex(f, i + 1, j + 1),
+                    vertex(f, i, j + 1),
+                );
+                out.triangles.push([a, b, c]);
+                out.triangles.push([a, c, d]);
+            }
+        }
+    }
+    // The dual row of face f nearest its side `side`, in the side's direction.
+    let row = |f: usize, side: usize| -> Vec<u32> {
+        (0..nu)
+            .map(|t| match side {
+                0 => vertex(f, t, 0),
+                1 => vertex(f, nu - 1, t),
+                2 => vertex(f, nu - 1 - t, nu - 1),
+                _ => vertex(f, 0, nu - 1 - t),
+            })
+            .collect()
+    };
+    // Edge strips, each edge once (from its lower half-edge).
+    for h in 0..mesh.face_vertices.len() {
+        let t = mesh.twin[h] as usize;
+        if t < h {
+            continue;
+        }
+        let (f, g) = (mesh.face_of[h] as usize, mesh.face_of[t] as usize);
+        let a = row(f, h - mesh.face_halfedges(f).start);
+        let mut b = row(g, t - mesh.face_halfedges(g).start);
+        b.reverse();
+        for i in 0..nu - 1 {
+            out.triangles.push([b[i], b[i + 1], a[i + 1]]);
+            out.triangles.push([b[i], a[i + 1], a[i]]);
+        }
+    }
+    // Vertex polygons: the corner dual points of the faces around each vertex, in fan order.
+    let corner_point = |f: usize, corner: usize| match corner {
+        0 => vertex(f, 0, 0),
+        1 => vertex(f, nu - 1, 0),
+        2 => vertex(f, nu - 1, nu - 1),
+        _ => vertex(f, 0, nu - 1),
+    };
+    for v in 0..mesh.positions.len() {
+        let polygon: Vec<u32> = mesh
+            .fan(v)
+            .into_iter()
+            .map(|h| {
+                let f = mesh.face_of[h] as usize;
+                corner_point(f, h - mesh.face_halfedges(f).start)
+            })
+            .collect();
+        for i in 1..polygon.len().saturating_sub(1) {
+            out.triangles.push([polygon[0], polygon[i], polygon[i + 1]]);
+        }
+    }
+    Ok((
+        out,
+        TessellationTime {
+            seconds: started.elapsed().as_secs_f64(),
+        },
+    ))
+}
