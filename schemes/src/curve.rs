@@ -59,16 +59,6 @@ impl Translates {
             Translates::Only(b) => k == b,
         }
     }
-
-    /// The finite hull `[min, max]` of the translates, if both ends are finite.
-    pub fn bounds(self) -> (Option<i64>, Option<i64>) {
-        match self {
-            Translates::All => (None, None),
-            Translates::AtMost(b) => (None, Some(b)),
-            Translates::AtLeast(b) => (Some(b), None),
-            Translates::Only(b) => (Some(b), Some(b)),
-        }
-    }
 }
 
 /// One scaling function of a (vector) curve scheme with its refinement relation.

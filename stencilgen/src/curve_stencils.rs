@@ -59,16 +59,15 @@ pub struct CurveStencils<S> {
 }
 
 impl<S: Scalar> CurveStencils<S> {
-    /// The stencil (or tangent mask) of a uniform scheme at `x = numerator / n`: the weights
-    /// `phi(x - k)` of the control points `k` whose basis function is nonzero there, in
-    /// increasing `k`.
+    /// The stencil (or tangent mask) of a uniform scheme at `x = numerator / n`: the nonzero
+    /// weights `phi(x - k)` of the control points `k`, in increasing `k`.
     pub fn mask_at(&self, numerator: i64) -> Vec<(i64, S)> {
         let f = &self.functions[0];
         let n = i64::from(self.n);
         let (lo, hi) = f.support;
         ((numerator - hi * n).div_euclid(n)..=(numerator - lo * n).div_euclid(n))
             .map(|k| (k, f.at(numerator - k * n)))
-            .filter(|(_, w)| !w.is_negligible() || S::EXACT && *w != S::zero())
+            .filter(|(_, w)| !w.is_zero())
             .collect()
     }
 }
