@@ -1,17 +1,18 @@
-//! The dual-grid watertight tessellator (Schaefer–Warren section 5.5), uniform rate, closed
+//! The dual-grid watertight tessellator (Schaefer–Warren section 5.5), per-face rates, closed
 //! meshes.
 //!
 //! Every face at rate `n` gets the `n x n` dual points `((2i+1)/2n, (2j+1)/2n)` of its
 //! parameter domain, evaluated once from the table. Three kinds of polygons connect them:
 //!
 //! * face interiors: the `(n-1)^2` quads of the dual grid;
-//! * edges: the strip between the two faces' dual rows nearest the shared edge;
+//! * edges: the strip between the two faces' dual rows nearest the shared edge, merged by their
+//!   parameter along the edge when the two rates differ;
 //! * vertices: the polygon of the surrounding faces' dual points nearest the vertex (a v-gon).
 //!
 //! Each quad and polygon is split into triangles. Every vertex is made exactly once and each
 //! polygon refers to it by index, so the output is watertight by construction; nothing is welded
-//! by distance. Per-face rates, boundaries (the limit boundary curve) and the fast evaluation
-//! path are the next steps; boundary meshes are refused with a clear error until then.
+//! by distance. Boundaries (the limit boundary curve) and the fast evaluation path are the next
+//! steps; boundary meshes are refused with a clear error until then.
 
 use std::time::Instant;
 
@@ -101,6 +102,25 @@ pub fn tessellate_uniform(
     patches: &[FacePatch],
     n: u32,
 ) -> Result<(TriangleMesh, TessellationTime), RuntimeError> {
+    tessellate(table, mesh, patches, &vec![n; patches.len()])
+}
+
+/// Tessellate a closed, isolated mesh with rate `rates[f]` on face `f` (any rates in the
+/// table, not only powers of two). Across an edge between faces of rates `n_a` and `n_b` the
+/// strip merges the two dual rows by their parameter along the edge: `n_a + n_b - 2` triangles.
+pub fn tessellate(
+    table: &StencilTable,
+    mesh: &Mesh,
+    patches: &[FacePatch],
+    rates: &[u32],
+) -> Result<(TriangleMesh, TessellationTime), RuntimeError> {
+    if rates.len() != patches.len() || rates.contains(&0) {
+        return Err(RuntimeError::Unsupported(format!(
+            "{} rates for {} faces (every face needs a rate of at least 1)",
+            rates.len(),
+            patches.len()
+        )));
+    }
     if let Some(h) = mesh.twin.iter().position(|&t| t == NONE) {
         return Err(RuntimeError::Unsupported(format!(
             "the mesh has a boundary (face {}): the dual-grid tessellator handles closed meshes so far",
@@ -108,9 +128,8 @@ pub fn tessellate_uniform(
         )));
     }
     let started = Instant::now();
-    let nu = n as usize;
     let mut out = TriangleMesh::default();
-    let section = |patch: &FacePatch, kind: StencilKind| SectionKey {
+    let section = |patch: &FacePatch, kind: StencilKind, n: u32| SectionKey {
         kind,
         points: PointSet::Dual,
         boundary: patch.kind.boundary,
@@ -118,20 +137,28 @@ pub fn tessellate_uniform(
         sector: patch.kind.sector,
         n,
     };
+    // First dual vertex of every face.
+    let mut first = Vec::with_capacity(patches.len() + 1);
+    first.push(0usize);
+    for &n in rates {
+        first.push(first[first.len() - 1] + (n * n) as usize);
+    }
     // Dual vertices, face by face, in face-local order (j outer).
     for (f, patch) in patches.iter().enumerate() {
+        let n = rates[f];
+        let nu = n as usize;
         let k = patch.points.len();
         let w = [
             StencilKind::Position,
             StencilKind::DerivativeU,
             StencilKind::DerivativeV,
         ]
-        .map(|kind| table.weights(&section(patch, kind)));
+        .map(|kind| table.weights(&section(patch, kind, n)));
         let [pos, du, dv] = w;
         let (pos, du, dv) = (pos?, du?, dv?);
         if pos.len() != nu * nu * k {
             return Err(RuntimeError::LayoutMismatch {
-                key: section(patch, StencilKind::Position),
+                key: section(patch, StencilKind::Position, n),
                 table: pos.len() / (nu * nu),
                 patch: k,
             });
@@ -167,9 +194,11 @@ pub fn tessellate_uniform(
             }
         }
     }
-    let vertex = |f: usize, i: usize, j: usize| (f * nu * nu + j * nu + i) as u32;
+    let rate = |f: usize| rates[f] as usize;
+    let vertex = |f: usize, i: usize, j: usize| (first[f] + j * rate(f) + i) as u32;
     // Face interiors.
     for f in 0..patches.len() {
+        let nu = rate(f);
         for j in 0..nu - 1 {
             for i in 0..nu - 1 {
                 let (a, b, c, d) = (
@@ -185,6 +214,7 @@ pub fn tessellate_uniform(
     }
     // The dual row of face f nearest its side `side`, in the side's direction.
     let row = |f: usize, side: usize| -> Vec<u32> {
+        let nu = rate(f);
         (0..nu)
             .map(|t| match side {
                 0 => vertex(f, t, 0),
@@ -194,7 +224,8 @@ pub fn tessellate_uniform(
             })
             .collect()
     };
-    // Edge strips, each edge once (from its lower half-edge).
+    // Edge strips, each edge once (from its lower half-edge). Both rows run along the edge;
+    // point t of a row of n points sits at (2t + 1)/2n, so comparing (2t + 1) n_other orders them.
     for h in 0..mesh.face_vertices.len() {
         let t = mesh.twin[h] as usize;
         if t < h {
@@ -204,17 +235,29 @@ pub fn tessellate_uniform(
         let a = row(f, h - mesh.face_halfedges(f).start);
         let mut b = row(g, t - mesh.face_halfedges(g).start);
         b.reverse();
-        for i in 0..nu - 1 {
-            out.triangles.push([b[i], b[i + 1], a[i + 1]]);
-            out.triangles.push([b[i], a[i + 1], a[i]]);
+        let (na, nb) = (a.len(), b.len());
+        let (mut i, mut j) = (0, 0);
+        while i + 1 < na || j + 1 < nb {
+            let advance_a =
+                j + 1 == nb || (i + 1 < na && (2 * (i + 1) + 1) * nb <= (2 * (j + 1) + 1) * na);
+            if advance_a {
+                out.triangles.push([b[j], a[i + 1], a[i]]);
+                i += 1;
+            } else {
+                out.triangles.push([b[j], b[j + 1], a[i]]);
+                j += 1;
+            }
         }
     }
     // Vertex polygons: the corner dual points of the faces around each vertex, in fan order.
-    let corner_point = |f: usize, corner: usize| match corner {
-        0 => vertex(f, 0, 0),
-        1 => vertex(f, nu - 1, 0),
-        2 => vertex(f, nu - 1, nu - 1),
-        _ => vertex(f, 0, nu - 1),
+    let corner_point = |f: usize, corner: usize| {
+        let last = rate(f) - 1;
+        match corner {
+            0 => vertex(f, 0, 0),
+            1 => vertex(f, last, 0),
+            2 => vertex(f, last, last),
+            _ => vertex(f, 0, last),
+        }
     };
     for v in 0..mesh.positions.len() {
         let polygon: Vec<u32> = mesh
