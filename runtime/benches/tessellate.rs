@@ -1,0 +1,68 @@
+//! Per-frame tessellation throughput (evaluation of every dual point with normals, and all
+//! connectivity), topology and patches gathered once, one thread. Mesh: Crane's Spot refined to
+//! 11,712 faces when `../shared/models` exists, else the shipped cube refined to 6,144 faces.
+//!
+//! `cargo bench -p subtess-runtime --bench tessellate`
+#![allow(missing_docs)] // criterion_group! generates an undocumented function
+
+use std::path::Path;
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use runtime::dual_grid::tessellate;
+use runtime::isolate::isolate;
+use runtime::obj::read_obj;
+use runtime::refine::refine;
+use runtime::stencil_table::StencilTable;
+use runtime::topology::Mesh;
+
+fn mesh() -> (String, Mesh) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let spot = root.join("../../shared/models/crane/spot_control_mesh.obj");
+    let (name, path, steps) = if spot.exists() {
+        ("spot", spot, 3)
+    } else {
+        ("cube", root.join("data/cube.obj"), 5)
+    };
+    let obj = read_obj(&path).unwrap_or_else(|e| panic!("{e}"));
+    let mut m = Mesh::from_obj(&obj).unwrap_or_else(|e| panic!("{e}")).0;
+    for _ in 0..steps {
+        m = refine(&m).mesh;
+    }
+    (name.to_owned(), m)
+}
+
+fn bench(c: &mut Criterion) {
+    let table = StencilTable::default_catmull_clark().unwrap_or_else(|e| panic!("{e}"));
+    let (name, m) = mesh();
+    let (isolated, patches, _) = isolate(&m).unwrap_or_else(|e| panic!("{e}"));
+    let mut group = c.benchmark_group(format!(
+        "dual grid, {name}, {} faces, 1 thread",
+        patches.len()
+    ));
+    group.sample_size(10);
+    let mixed: Vec<u32> = (0..patches.len())
+        .map(|f| [3, 5, 8, 12, 7, 16][f % 6])
+        .collect();
+    for (label, rates) in [
+        ("rate 4", vec![4; patches.len()]),
+        ("rate 8", vec![8; patches.len()]),
+        ("rate 16", vec![16; patches.len()]),
+        ("mixed 3..16", mixed),
+    ] {
+        let triangles = tessellate(&table, &isolated, &patches, &rates)
+            .unwrap_or_else(|e| panic!("{e}"))
+            .0
+            .triangles
+            .len();
+        group.throughput(Throughput::Elements(triangles as u64));
+        group.bench_function(label, |b| {
+            b.iter(|| {
+                tessellate(&table, &isolated, &patches, &rates).map(|(t, _)| t.triangles.len())
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
