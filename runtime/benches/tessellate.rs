@@ -1,8 +1,9 @@
 //! Per-frame tessellation throughput (evaluation of every dual point with normals, and all
-//! connectivity), topology and patches gathered once, one thread. Mesh: Crane's Spot refined to
-//! 11,712 faces when `../shared/models` exists, else the shipped cube refined to 6,144 faces.
+//! connectivity), topology and patches gathered once. Mesh: Crane's Spot refined to 11,712
+//! faces when `../shared/models` exists, else the shipped cube refined to 6,144 faces.
 //!
-//! `cargo bench -p subtess-runtime --bench tessellate`
+//! `cargo bench -p subtess-runtime --bench tessellate` (both cores);
+//! `RAYON_NUM_THREADS=1 cargo bench -p subtess-runtime --bench tessellate` (one).
 #![allow(missing_docs)] // criterion_group! generates an undocumented function
 
 use std::path::Path;
@@ -35,8 +36,9 @@ fn bench(c: &mut Criterion) {
     let table = StencilTable::default_catmull_clark().unwrap_or_else(|e| panic!("{e}"));
     let (name, m) = mesh();
     let (isolated, patches, _) = isolate(&m).unwrap_or_else(|e| panic!("{e}"));
+    let threads = rayon::current_num_threads();
     let mut group = c.benchmark_group(format!(
-        "dual grid, {name}, {} faces, 1 thread",
+        "dual grid, {name}, {} faces, {threads} thread(s)",
         patches.len()
     ));
     group.sample_size(10);

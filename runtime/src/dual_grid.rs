@@ -16,6 +16,7 @@
 
 use std::time::Instant;
 
+use rayon::prelude::*;
 use table_format::{PointSet, SectionKey, StencilKind};
 
 use crate::patch::{face_patch, FacePatch};
@@ -143,58 +144,102 @@ pub fn tessellate(
     for &n in rates {
         first.push(first[first.len() - 1] + (n * n) as usize);
     }
-    // Dual vertices, face by face, in face-local order (j outer).
+    // Dual vertices, face by face, in face-local order (j outer): look up every face's
+    // sections first (errors surface here), then evaluate the faces in parallel, each into its
+    // own slice of the preallocated output.
+    let total = first[patches.len()];
+    let mut sections = Vec::with_capacity(patches.len());
     for (f, patch) in patches.iter().enumerate() {
         let n = rates[f];
         let nu = n as usize;
         let k = patch.points.len();
-        let w = [
+        let [pos, du, dv] = [
             StencilKind::Position,
             StencilKind::DerivativeU,
             StencilKind::DerivativeV,
         ]
         .map(|kind| table.weights(&section(patch, kind, n)));
-        let [pos, du, dv] = w;
         let (pos, du, dv) = (pos?, du?, dv?);
-        if pos.len() != nu * nu * k {
+        if pos.len() != nu * nu * k || du.len() != pos.len() || dv.len() != pos.len() {
             return Err(RuntimeError::LayoutMismatch {
                 key: section(patch, StencilKind::Position, n),
                 table: pos.len() / (nu * nu),
                 patch: k,
             });
         }
-        for j in 0..nu {
-            for i in 0..nu {
-                let (pi, pj) = patch_index(patch.corner, i, j, nu);
-                let row = (pj * nu + pi) * k;
-                let mut p = [[0.0f64; 3]; 3];
-                for (l, &v) in patch.points.iter().enumerate() {
-                    let q = mesh.positions[v as usize];
-                    for (acc, weights) in p.iter_mut().zip([pos, du, dv]) {
-                        let w = f64::from(weights[row + l]);
-                        for c in 0..3 {
-                            acc[c] += w * q[c];
-                        }
-                    }
-                }
-                let normal = cross(p[1], p[2]);
-                let length = (normal.iter().map(|x| x * x).sum::<f64>()).sqrt();
-                out.positions.push(p[0]);
-                out.normals.push(if length > 0.0 {
-                    normal.map(|x| x / length)
-                } else {
-                    [0.0, 0.0, 0.0]
-                });
-                let d = f64::from(2 * n);
-                out.sources.push((
-                    f as u32,
-                    f64::from(2 * i as u32 + 1) / d,
-                    f64::from(2 * j as u32 + 1) / d,
-                ));
-            }
+        sections.push((pos, du, dv));
+    }
+    out.positions = vec![[0.0; 3]; total];
+    out.normals = vec![[0.0; 3]; total];
+    out.sources = vec![(0, 0.0, 0.0); total];
+    let mut chunks = Vec::with_capacity(patches.len());
+    {
+        let (mut positions, mut normals, mut sources) = (
+            out.positions.as_mut_slice(),
+            out.normals.as_mut_slice(),
+            out.sources.as_mut_slice(),
+        );
+        for &n in rates {
+            let size = (n * n) as usize;
+            let (p, rest_p) = std::mem::take(&mut positions).split_at_mut(size);
+            let (q, rest_q) = std::mem::take(&mut normals).split_at_mut(size);
+            let (r, rest_r) = std::mem::take(&mut sources).split_at_mut(size);
+            chunks.push((p, q, r));
+            (positions, normals, sources) = (rest_p, rest_q, rest_r);
         }
     }
+    chunks
+        .into_par_iter()
+        .enumerate()
+        .for_each(|(f, (positions, normals, sources))| {
+            let patch = &patches[f];
+            let (pos, du, dv) = sections[f];
+            let n = rates[f];
+            let nu = n as usize;
+            let k = patch.points.len();
+            // The patch's control points, gathered once.
+            let control: Vec<[f64; 3]> = patch
+                .points
+                .iter()
+                .map(|&v| mesh.positions[v as usize])
+                .collect();
+            let d = f64::from(2 * n);
+            for j in 0..nu {
+                for i in 0..nu {
+                    let (pi, pj) = patch_index(patch.corner, i, j, nu);
+                    let row = (pj * nu + pi) * k;
+                    let (wp, wu, wv) = (&pos[row..row + k], &du[row..row + k], &dv[row..row + k]);
+                    let mut p = [[0.0f64; 3]; 3];
+                    for l in 0..k {
+                        let q = control[l];
+                        let (a, b, c) = (f64::from(wp[l]), f64::from(wu[l]), f64::from(wv[l]));
+                        for x in 0..3 {
+                            p[0][x] += a * q[x];
+                            p[1][x] += b * q[x];
+                            p[2][x] += c * q[x];
+                        }
+                    }
+                    let normal = cross(p[1], p[2]);
+                    let length = (normal.iter().map(|x| x * x).sum::<f64>()).sqrt();
+                    let at = j * nu + i;
+                    positions[at] = p[0];
+                    normals[at] = if length > 0.0 {
+                        normal.map(|x| x / length)
+                    } else {
+                        [0.0; 3]
+                    };
+                    sources[at] = (
+                        f as u32,
+                        f64::from(2 * i as u32 + 1) / d,
+                        f64::from(2 * j as u32 + 1) / d,
+                    );
+                }
+            }
+        });
     let rate = |f: usize| rates[f] as usize;
+    let interior: usize = rates.iter().map(|&n| 2 * (n as usize - 1).pow(2)).sum();
+    out.triangles
+        .reserve(interior + 2 * total + 2 * mesh.face_vertices.len());
     let vertex = |f: usize, i: usize, j: usize| (first[f] + j * rate(f) + i) as u32;
     // Face interiors.
     for f in 0..patches.len() {
