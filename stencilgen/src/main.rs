@@ -14,6 +14,7 @@ use schemes::quad::QUAD_SCHEME_NAMES;
 use schemes::{BoundaryMode, CurveScheme, QuadScheme};
 use serde_json::{json, Value};
 use stencilgen::extraordinary_patch::{canonical, Neighbourhood, OUTER_POINTS};
+use stencilgen::patch_stencils::{curve_scheme, quad_scheme};
 use stencilgen::rational::parse_rational;
 use stencilgen::regular_patch::StencilKind;
 use stencilgen::stencil_set::StencilSetSpec;
@@ -176,11 +177,7 @@ fn run(cli: Cli) -> Result<(), StencilError> {
                 Precision::F32
             };
             for name in &schemes {
-                let scheme =
-                    QuadScheme::by_name(name).ok_or_else(|| StencilError::UnknownScheme {
-                        name: name.clone(),
-                        known: QUAD_SCHEME_NAMES.join(", "),
-                    })?;
+                let scheme = quad_scheme(name)?;
                 let path = if schemes.len() > 1 {
                     with_suffix(&output, name)
                 } else {
@@ -209,11 +206,7 @@ fn run(cli: Cli) -> Result<(), StencilError> {
             float,
             json,
         } => {
-            let scheme =
-                QuadScheme::by_name(&scheme).ok_or_else(|| StencilError::UnknownScheme {
-                    name: scheme.clone(),
-                    known: QUAD_SCHEME_NAMES.join(", "),
-                })?;
+            let scheme = quad_scheme(&scheme)?;
             let (u, v) = (parse_rational(&u)?, parse_rational(&v)?);
             let mode = if corners {
                 BoundaryMode::EdgeAndCorner
@@ -244,11 +237,7 @@ fn run(cli: Cli) -> Result<(), StencilError> {
             float,
             json,
         } => {
-            let scheme =
-                CurveScheme::by_name(&scheme).ok_or_else(|| StencilError::UnknownScheme {
-                    name: scheme.clone(),
-                    known: CURVE_SCHEME_NAMES.join(", "),
-                })?;
+            let scheme = curve_scheme(&scheme)?;
             if float {
                 let stencils = curve_stencils::<f64>(&scheme, n, derivative)?;
                 print(&stencils, json, |v| json!(v));

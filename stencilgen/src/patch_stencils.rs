@@ -102,9 +102,22 @@ pub fn patch_stencils<S: Scalar>(
 
 /// The curve scheme whose tensor product is `scheme`'s regular case.
 pub fn regular_curve(scheme: &QuadScheme) -> Result<CurveScheme, StencilError> {
-    CurveScheme::by_name(scheme.regular_curve).ok_or_else(|| StencilError::UnknownScheme {
-        name: scheme.regular_curve.to_owned(),
+    curve_scheme(scheme.regular_curve)
+}
+
+/// A curve scheme from the catalogue, or an error listing the catalogue.
+pub fn curve_scheme(name: &str) -> Result<CurveScheme, StencilError> {
+    CurveScheme::by_name(name).ok_or_else(|| StencilError::UnknownScheme {
+        name: name.to_owned(),
         known: schemes::curve::CURVE_SCHEME_NAMES.join(", "),
+    })
+}
+
+/// A quad scheme from the catalogue, or an error listing the catalogue.
+pub fn quad_scheme(name: &str) -> Result<QuadScheme, StencilError> {
+    QuadScheme::by_name(name).ok_or_else(|| StencilError::UnknownScheme {
+        name: name.to_owned(),
+        known: schemes::quad::QUAD_SCHEME_NAMES.join(", "),
     })
 }
 

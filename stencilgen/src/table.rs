@@ -14,7 +14,7 @@ use table_format::{
 
 use crate::ev_tangents::ev_tangents;
 use crate::extraordinary_patch::LocalMatrices;
-use crate::patch_stencils::PatchStencils;
+use crate::patch_stencils::{quad_scheme, PatchStencils};
 use crate::regular_patch::StencilKind;
 use crate::stencil_set::{stencil_set_with_progress, StencilSetSpec};
 use crate::{Scalar, StencilError};
@@ -35,11 +35,7 @@ pub struct TableSpec {
 impl TableSpec {
     /// The default table `subtess` embeds.
     pub fn default_catmull_clark() -> Result<Self, StencilError> {
-        let scheme =
-            QuadScheme::by_name("catmull-clark").ok_or_else(|| StencilError::UnknownScheme {
-                name: "catmull-clark".to_owned(),
-                known: schemes::quad::QUAD_SCHEME_NAMES.join(", "),
-            })?;
+        let scheme = quad_scheme("catmull-clark")?;
         Ok(TableSpec {
             scheme,
             set: StencilSetSpec::default_catmull_clark(),
