@@ -19,7 +19,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use table_format::{PointSet, SectionKey, StencilKind};
 
-use crate::patch::{face_patch, FacePatch};
+use crate::patch::{dual_index_in_patch, face_patch, FacePatch};
 use crate::stencil_table::StencilTable;
 use crate::topology::{Mesh, NONE};
 use crate::{MeshError, RuntimeError};
@@ -70,17 +70,6 @@ impl TriangleMesh {
 pub struct TessellationTime {
     /// Seconds spent evaluating and connecting (not gathering patches).
     pub seconds: f64,
-}
-
-/// The dual point of face-local indices `(i, j)` in the patch's indices.
-fn patch_index(corner: usize, i: usize, j: usize, n: usize) -> (usize, usize) {
-    let last = n - 1;
-    match corner {
-        0 => (i, j),
-        1 => (j, last - i),
-        2 => (last - i, last - j),
-        _ => (last - j, i),
-    }
 }
 
 /// Gather the patch of every face; the first face that is not one is an error.
@@ -206,7 +195,7 @@ pub fn tessellate(
             let d = f64::from(2 * n);
             for j in 0..nu {
                 for i in 0..nu {
-                    let (pi, pj) = patch_index(patch.corner, i, j, nu);
+                    let (pi, pj) = dual_index_in_patch(patch.corner, i, j, nu);
                     let row = (pj * nu + pi) * k;
                     let (wp, wu, wv) = (&pos[row..row + k], &du[row..row + k], &dv[row..row + k]);
                     let mut p = [[0.0f64; 3]; 3];

@@ -209,6 +209,18 @@ pub fn to_patch(corner: usize, u: f64, v: f64) -> (f64, f64) {
     }
 }
 
+/// The patch indices of the face's dual point `(i, j)` at rate `n` (the rotation of
+/// [`to_patch`] on the dual grid).
+pub fn dual_index_in_patch(corner: usize, i: usize, j: usize, n: usize) -> (usize, usize) {
+    let last = n - 1;
+    match corner {
+        0 => (i, j),
+        1 => (j, last - i),
+        2 => (last - i, last - j),
+        _ => (last - j, i),
+    }
+}
+
 /// The limit positions at the dual points `((2i+1)/2n, (2j+1)/2n)` of the face, in the face's
 /// own parameters, row by row (`j` outer): a direct table evaluation, one weighted sum of the
 /// patch's control points per point.
@@ -244,17 +256,10 @@ pub fn dual_positions(
             patch: k,
         });
     }
-    let last = nu - 1;
     let mut out = Vec::with_capacity(nu * nu);
     for j in 0..nu {
         for i in 0..nu {
-            // The same point in patch indices (the rotation of `to_patch` on the dual grid).
-            let (pi, pj) = match patch.corner {
-                0 => (i, j),
-                1 => (j, last - i),
-                2 => (last - i, last - j),
-                _ => (last - j, i),
-            };
+            let (pi, pj) = dual_index_in_patch(patch.corner, i, j, nu);
             let row = &weights[(pj * nu + pi) * k..][..k];
             let mut p = [0.0; 3];
             for (w, &v) in row.iter().zip(&patch.points) {
