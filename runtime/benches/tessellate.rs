@@ -1,5 +1,5 @@
-//! Per-frame tessellation throughput (evaluation of every dual point with normals, and all
-//! connectivity), topology and patches gathered once. Mesh: Crane's Spot refined to 11,712
+//! Per-frame tessellation throughput: evaluation of every point (positions and normals) and
+//! all connectivity into preallocated buffers; topology, patches and the plan built once. Mesh: Crane's Spot refined to 11,712
 //! faces when `../shared/models` exists, else the shipped cube refined to 6,144 faces.
 //!
 //! `cargo bench -p subtess-runtime --bench tessellate` (both cores);
@@ -9,7 +9,7 @@
 use std::path::Path;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use runtime::dual_grid::tessellate;
+use runtime::dual_grid::DualGrid;
 use runtime::isolate::isolate;
 use runtime::obj::read_obj;
 use runtime::refine::refine;
@@ -51,15 +51,21 @@ fn bench(c: &mut Criterion) {
         ("rate 16", vec![16; patches.len()]),
         ("mixed 3..16", mixed),
     ] {
-        let triangles = tessellate(&table, &isolated, &patches, &rates)
-            .unwrap_or_else(|e| panic!("{e}"))
-            .0
-            .triangles
-            .len();
-        group.throughput(Throughput::Elements(triangles as u64));
+        let grid =
+            DualGrid::new(&table, &isolated, &patches, &rates).unwrap_or_else(|e| panic!("{e}"));
+        let control: Vec<[f32; 3]> = isolated
+            .positions
+            .iter()
+            .map(|p| p.map(|c| c as f32))
+            .collect();
+        let mut positions = vec![[0.0f32; 3]; grid.vertex_count()];
+        let mut normals = positions.clone();
+        let mut triangles = vec![[0u32; 3]; grid.triangle_count()];
+        group.throughput(Throughput::Elements(grid.triangle_count() as u64));
         group.bench_function(label, |b| {
             b.iter(|| {
-                tessellate(&table, &isolated, &patches, &rates).map(|(t, _)| t.triangles.len())
+                grid.evaluate(&control, &mut positions, &mut normals);
+                grid.connect(&mut triangles);
             })
         });
     }

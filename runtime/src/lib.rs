@@ -15,5 +15,6 @@ pub mod patch;
 pub mod refine;
 pub mod stencil_table;
 pub mod topology;
+pub mod triangle_mesh;
 
 pub use error::{MeshError, RuntimeError};

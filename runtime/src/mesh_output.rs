@@ -3,7 +3,7 @@
 use std::io::Write;
 use std::path::Path;
 
-use crate::dual_grid::TriangleMesh;
+use crate::triangle_mesh::TriangleMesh;
 use crate::RuntimeError;
 
 /// Write `mesh` as OBJ (`v`, `vn`, `f a//a b//b c//c`).

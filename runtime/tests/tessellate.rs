@@ -35,10 +35,20 @@ fn check(name: &str, mesh: &Mesh, convex: bool) {
             for (i, p) in expected.iter().enumerate() {
                 let q = out.positions[f * nn + i];
                 assert!(
-                    (0..3).all(|c| (p[c] - q[c]).abs() < 1e-12),
-                    "{name} n = {n} face {f}"
+                    (0..3).all(|c| (p[c] - f64::from(q[c])).abs() < 1e-5),
+                    "{name} n = {n} face {f}: {p:?} vs {q:?}"
                 );
-                assert_eq!(out.sources[f * nn + i].0 as usize, f);
+                let source = out.sources[f * nn + i];
+                assert_eq!(source.face as usize, f);
+                let (u, v) = source.uv();
+                let (ei, ej) = ((i as u32 % n) as f64, (i as u32 / n) as f64);
+                assert_eq!(
+                    (u, v),
+                    (
+                        (2.0 * ei + 1.0) / (2.0 * n as f64),
+                        (2.0 * ej + 1.0) / (2.0 * n as f64)
+                    )
+                );
             }
         }
         if convex {
@@ -46,9 +56,9 @@ fn check(name: &str, mesh: &Mesh, convex: bool) {
                 .positions
                 .iter()
                 .fold([0.0; 3], |a, p| [a[0] + p[0], a[1] + p[1], a[2] + p[2]]);
-            let centre = centre.map(|c| c / out.positions.len() as f64);
+            let centre = centre.map(|c| c / out.positions.len() as f32);
             for (p, normal) in out.positions.iter().zip(&out.normals) {
-                let outward: f64 = (0..3).map(|c| (p[c] - centre[c]) * normal[c]).sum();
+                let outward: f32 = (0..3).map(|c| (p[c] - centre[c]) * normal[c]).sum();
                 assert!(outward > 0.0, "{name} n = {n}: a normal points inwards");
             }
         }
@@ -70,17 +80,6 @@ fn spot_tessellates_watertight() {
         return;
     }
     check("spot", &load(&path), false);
-}
-
-#[test]
-fn boundary_meshes_are_refused_plainly_for_now() {
-    let p = vec![[0.0; 3], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
-    let quad =
-        Mesh::new(p, &[vec![0, 1, 2, 3]], &[], schemes::BoundaryMode::EdgeOnly).expect("valid");
-    let table = StencilTable::default_catmull_clark().expect("embedded table");
-    let (isolated, patches, _) = isolate(&quad).expect("isolates");
-    let e = tessellate_uniform(&table, &isolated, &patches, 2).expect_err("boundary");
-    assert!(e.to_string().contains("closed meshes"), "{e}");
 }
 
 fn spot() -> Option<Mesh> {
@@ -112,5 +111,21 @@ proptest! {
             prop_assert_eq!(out.euler_characteristic(), mesh.euler_characteristic());
             prop_assert_eq!(out.positions.len(), rates.iter().map(|&n| (n * n) as usize).sum::<usize>());
         }
+    }
+}
+
+/// On a refined cube every face away from the eight valence-3 corners is regular and takes the
+/// tensor-product path, whose factors are recovered from (and checked against) the table.
+#[test]
+fn regular_faces_are_evaluated_as_tensor_products() {
+    let mesh = load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("data/cube.obj"));
+    let table = StencilTable::default_catmull_clark().expect("embedded table");
+    let (isolated, patches, _) = isolate(&mesh).expect("isolates");
+    let irregular = patches.iter().filter(|p| p.kind.faces != 4).count();
+    for n in [1, 2, 7, 24] {
+        let grid =
+            runtime::dual_grid::DualGrid::new(&table, &isolated, &patches, &vec![n; patches.len()])
+                .expect("plans");
+        assert_eq!(grid.separable_faces(), patches.len() - irregular, "n = {n}");
     }
 }
