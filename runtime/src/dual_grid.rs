@@ -295,13 +295,6 @@ impl<'t> DualGrid<'t> {
                 rates[f]
             )));
         }
-        if let Some(p) = patches.iter().find(|p| p.points.len() > MAX_PATCH) {
-            return Err(RuntimeError::Unsupported(format!(
-                "a patch of {} control points (valence {}); at most {MAX_PATCH}",
-                p.points.len(),
-                p.kind.faces
-            )));
-        }
         // A one-face boundary vertex is smooth in "edge only" mode and pinned in "edge and
         // corner" mode: its stencils must come from a table made for the mesh's mode.
         let corners = mesh.boundary == schemes::BoundaryMode::EdgeAndCorner;
@@ -336,7 +329,15 @@ impl<'t> DualGrid<'t> {
         let regular = |p: &FacePatch| !p.kind.boundary && p.kind.faces == 4 && p.corner == 0;
         let mut factored = vec![false; MAX_RATE as usize + 1];
         for (patch, &n) in patches.iter().zip(rates) {
+            // A valence beyond the table's is refused here, by the table naming its coverage.
             let s = stencils(table, patch, PointSet::Dual, n)?;
+            if patch.points.len() > MAX_PATCH {
+                return Err(RuntimeError::Unsupported(format!(
+                    "a patch of {} control points (valence {}); at most {MAX_PATCH}",
+                    patch.points.len(),
+                    patch.kind.faces
+                )));
+            }
             if regular(patch) && !factored[n as usize] {
                 factored[n as usize] = true;
                 grid.bases[n as usize] = SeparableBasis::from_stencils(&s, n as usize);

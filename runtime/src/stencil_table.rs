@@ -33,6 +33,16 @@ impl StencilTable {
         })
     }
 
+    /// Validate a table held in memory (copied once into an aligned buffer).
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self, RuntimeError> {
+        let bytes = AlignedBytes::from_slice(bytes);
+        let index = TableIndex::parse(bytes.as_bytes())?;
+        Ok(StencilTable {
+            storage: Storage::Owned(bytes),
+            index,
+        })
+    }
+
     /// Read and validate a table file.
     pub fn read(path: &Path) -> Result<Self, RuntimeError> {
         let bytes = AlignedBytes::read(path).map_err(|source| RuntimeError::Io {

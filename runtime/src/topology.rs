@@ -242,6 +242,25 @@ impl Mesh {
         Ok(())
     }
 
+    /// Number of boundary loops: cycles of boundary half-edges, each followed to the boundary
+    /// half-edge leaving its head (a manifold vertex has at most one).
+    pub fn boundary_loops(&self) -> usize {
+        let mut seen = vec![false; self.face_vertices.len()];
+        let mut loops = 0;
+        for h in 0..self.face_vertices.len() {
+            if self.twin[h] != NONE || seen[h] {
+                continue;
+            }
+            loops += 1;
+            let mut e = h;
+            while !seen[e] {
+                seen[e] = true;
+                e = self.vertex_halfedge[self.head(e) as usize] as usize;
+            }
+        }
+        loops
+    }
+
     /// Euler characteristic V - E + F (unused vertices not counted).
     pub fn euler_characteristic(&self) -> i64 {
         let used = self.vertex_halfedge.iter().filter(|&&h| h != NONE).count() as i64;

@@ -4,8 +4,11 @@
 
 use std::path::{Path, PathBuf};
 
+use runtime::dual_grid::tessellate;
+use runtime::isolate::isolate;
 use runtime::obj::read_obj;
 use runtime::refine::refine;
+use runtime::stencil_table::StencilTable;
 use runtime::topology::Mesh;
 
 fn models() -> Option<PathBuf> {
@@ -82,6 +85,86 @@ fn every_opensubdiv_shape_is_read_or_refused_clearly() {
     }
     println!("{accepted} accepted, {refused} refused");
     assert!(accepted >= 50, "only {accepted} shapes accepted");
+}
+
+/// Every shape the topology accepts tessellates (rate 3, and mixed rates 1..5) into a closed,
+/// consistently oriented surface or, with boundary, one with as many boundary loops as the
+/// input; the Euler characteristic is the input's. Shapes are refused, with the reason, only
+/// when isolation fails.
+#[test]
+fn every_accepted_opensubdiv_shape_tessellates_watertight() {
+    let Some(dir) = models() else { return };
+    let table = StencilTable::default_catmull_clark().expect("embedded table");
+    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir.join("opensubdiv"))
+        .expect("readable")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "obj"))
+        .collect();
+    entries.sort();
+    // Shapes that pin their one-face corners need a table made for that rule.
+    let mut spec = stencilgen::table::TableSpec::default_catmull_clark().expect("spec");
+    spec.set.boundary_mode = schemes::BoundaryMode::EdgeAndCorner;
+    spec.set.rates = (1..=5).collect();
+    let bytes = stencilgen::table::build_table(&spec, &|_, _| {}).expect("corner table");
+    let corner_table = StencilTable::from_bytes(&bytes).expect("valid");
+    let (mut tessellated, mut corners, mut refused) = (0, 0, Vec::new());
+    for path in entries {
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let obj = read_obj(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let Ok((mesh, _)) = Mesh::from_obj(&obj) else {
+            continue;
+        };
+        let (isolated, patches, _) = match isolate(&mesh) {
+            Ok(x) => x,
+            Err(e) => {
+                refused.push(format!("{name}: {e}"));
+                continue;
+            }
+        };
+        let table = if mesh.boundary == schemes::BoundaryMode::EdgeAndCorner {
+            corners += 1;
+            &corner_table
+        } else {
+            &table
+        };
+        let mixed = (0..patches.len()).map(|f| 1 + (f as u32 * 7) % 5).collect();
+        for rates in [vec![3; patches.len()], mixed] {
+            let out = match tessellate(table, &isolated, &patches, &rates) {
+                Ok((out, _)) => out,
+                Err(e @ runtime::RuntimeError::Table(_)) => {
+                    refused.push(format!("{name}: {e}"));
+                    break;
+                }
+                Err(e) => panic!("{name}: {e}"),
+            };
+            if mesh.boundary_loops() == 0 {
+                assert!(out.is_watertight(), "{name}: not watertight");
+            } else {
+                let edges = out
+                    .boundary_edges()
+                    .unwrap_or_else(|| panic!("{name}: non-manifold output"));
+                assert!(!edges.is_empty(), "{name}: lost its boundary");
+            }
+            assert_eq!(
+                out.euler_characteristic(),
+                mesh.euler_characteristic(),
+                "{name}"
+            );
+        }
+        tessellated += 1;
+    }
+    for r in &refused {
+        println!("refused: {r}");
+    }
+    tessellated -= refused.len();
+    println!(
+        "{tessellated} shapes tessellated ({corners} with pinned corners), {} refused",
+        refused.len()
+    );
+    assert!(tessellated >= 45, "only {tessellated} shapes tessellated");
 }
 
 /// The largest distance from each point of `reference` to the nearest point of `ours`, relative
