@@ -75,6 +75,9 @@ struct SeparableBasis {
     dx: [Vec<f32>; 4],
     y: [Vec<f32>; 4],
     dy: [Vec<f32>; 4],
+    /// `x` and `dx` transposed: the four weights of point `i` together.
+    x_rows: Vec<[f32; 4]>,
+    dx_rows: Vec<[f32; 4]>,
 }
 
 /// Grid coordinates `(a, b)` (each in -1..=2) of the regular patch's layout entries
@@ -126,9 +129,17 @@ impl SeparableBasis {
             }
             out
         };
+        let (x, dx) = (column(s.position, true), column(s.du, true));
+        let rows = |f: &[Vec<f32>; 4]| {
+            (0..n)
+                .map(|i| [f[0][i], f[1][i], f[2][i], f[3][i]])
+                .collect()
+        };
         let basis = SeparableBasis {
-            x: column(s.position, true),
-            dx: column(s.du, true),
+            x_rows: rows(&x),
+            dx_rows: rows(&dx),
+            x,
+            dx,
             y: column(s.position, false),
             dy: column(s.dv, false),
         };
@@ -858,8 +869,7 @@ fn weighted_point(s: &Stencils, control: &[[f32; 3]], point: usize) -> ([f32; 3]
 
 /// The tensor-product evaluation of a regular face: per row `j`, contract the 4 x 4 grid with the
 /// row's weights into four points (and their `v` derivatives), then every point of the row is a
-/// 4-term combination of those. Rows are computed as structure-of-arrays over `i` so that the
-/// inner loops vectorize.
+/// 4-term combination of those.
 fn evaluate_separable(
     g: &[[[f32; 3]; 4]; 4],
     basis: &SeparableBasis,
@@ -867,7 +877,6 @@ fn evaluate_separable(
     positions: &mut [[f32; 3]],
     normals: &mut [[f32; 3]],
 ) {
-    const W: usize = MAX_RATE as usize;
     for j in 0..n {
         let y = [basis.y[0][j], basis.y[1][j], basis.y[2][j], basis.y[3][j]];
         let dy = [
@@ -887,34 +896,25 @@ fn evaluate_separable(
                 }
             }
         }
-        let mut p = [[0.0f32; W]; 3];
-        let mut du = [[0.0f32; W]; 3];
-        let mut dv = [[0.0f32; W]; 3];
-        for c in 0..3 {
-            for i in 0..n {
-                let (x0, x1, x2, x3) = (basis.x[0][i], basis.x[1][i], basis.x[2][i], basis.x[3][i]);
-                let (d0, d1, d2, d3) = (
-                    basis.dx[0][i],
-                    basis.dx[1][i],
-                    basis.dx[2][i],
-                    basis.dx[3][i],
-                );
-                p[c][i] = x0 * r[0][c] + x1 * r[1][c] + x2 * r[2][c] + x3 * r[3][c];
-                du[c][i] = d0 * r[0][c] + d1 * r[1][c] + d2 * r[2][c] + d3 * r[3][c];
-                dv[c][i] = x0 * s[0][c] + x1 * s[1][c] + x2 * s[2][c] + x3 * s[3][c];
-            }
-        }
         let row = j * n..(j + 1) * n;
-        for ((i, q), m) in positions[row.clone()]
+        for (((q, m), x), d) in positions[row.clone()]
             .iter_mut()
-            .enumerate()
             .zip(&mut normals[row])
+            .zip(&basis.x_rows)
+            .zip(&basis.dx_rows)
         {
-            *q = [p[0][i], p[1][i], p[2][i]];
-            *m = unit(cross(
-                [du[0][i], du[1][i], du[2][i]],
-                [dv[0][i], dv[1][i], dv[2][i]],
-            ));
+            let mut p = [0.0f32; 3];
+            let mut du = [0.0f32; 3];
+            let mut dv = [0.0f32; 3];
+            for a in 0..4 {
+                for c in 0..3 {
+                    p[c] += x[a] * r[a][c];
+                    du[c] += d[a] * r[a][c];
+                    dv[c] += x[a] * s[a][c];
+                }
+            }
+            *q = p;
+            *m = unit(cross(du, dv));
         }
     }
 }

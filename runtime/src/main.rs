@@ -1,14 +1,16 @@
-//! `subtess`: the runtime's command line: `subtess tessellate MESH -o OUT [--rate N] [--stats]`
-//! and `subtess tables info [FILE]`.
+//! `subtess`: the runtime's command line: `subtess tessellate`, `subtess bench`,
+//! `subtess tables info` (docs/cli.md).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::time::Instant;
 
 use clap::{Parser, Subcommand};
-use runtime::dual_grid::tessellate_uniform;
-use runtime::isolate::isolate;
+use runtime::dual_grid::{tessellate, DualGrid};
+use runtime::isolate::isolate_with_origins;
 use runtime::mesh_output::write_obj;
 use runtime::obj::read_obj;
+use runtime::refine::refine;
 use runtime::stencil_table::StencilTable;
 use runtime::topology::Mesh;
 use runtime::RuntimeError;
@@ -26,22 +28,52 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Tessellate a Catmull-Clark mesh (OBJ) with the dual-grid method, uniform rate.
+    /// Tessellate a Catmull-Clark mesh (OBJ) with the dual-grid method.
     Tessellate {
-        /// Input mesh (OBJ: triangles, quads, n-gons).
+        /// Input mesh (OBJ: triangles, quads, n-gons; closed or with boundary).
         mesh: PathBuf,
         /// Output triangle mesh (.obj).
         #[arg(short = 'o', long = "output")]
         output: PathBuf,
-        /// Dual points per face side, 1..=24 (faces of the isolated mesh).
-        #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=24))]
+        /// Dual points per face side, 1..=24, on every face.
+        #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=24), conflicts_with = "rates")]
         rate: u32,
+        /// Per-face rates: a text file with one rate (1..=24) per input face, in OBJ face
+        /// order, separated by white space; faces made by isolation inherit their input
+        /// face's rate.
+        #[arg(long)]
+        rates: Option<PathBuf>,
         /// A stencil table file instead of the embedded default.
         #[arg(long)]
         table: Option<PathBuf>,
         /// Print statistics as JSON on stdout.
         #[arg(long)]
         stats: bool,
+    },
+    /// Measure per-frame tessellation throughput: the plan (topology, patches, stencil
+    /// lookups) is built once, then every frame evaluates all positions and normals and writes
+    /// all triangles. Prints one JSON object with the median over the frames.
+    Bench {
+        /// Input mesh (OBJ).
+        mesh: PathBuf,
+        /// Dual points per face side on every face.
+        #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=24))]
+        rate: u32,
+        /// Mixed per-face rates instead (3, 5, 8, 12, 7, 16 in turn).
+        #[arg(long, conflicts_with = "rate")]
+        mixed: bool,
+        /// Worker threads (default: one per core).
+        #[arg(long)]
+        threads: Option<usize>,
+        /// Catmull-Clark steps applied to the input first (to reach a given face count).
+        #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=6))]
+        refine: u32,
+        /// Frames to time.
+        #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..))]
+        frames: u32,
+        /// A stencil table file instead of the embedded default.
+        #[arg(long)]
+        table: Option<PathBuf>,
     },
     /// Stencil tables.
     Tables {
@@ -69,56 +101,175 @@ fn main() -> ExitCode {
     }
 }
 
+fn load_table(table: &Option<PathBuf>) -> Result<StencilTable, RuntimeError> {
+    match table {
+        Some(path) => StencilTable::read(path),
+        None => StencilTable::default_catmull_clark(),
+    }
+}
+
+fn load_mesh(path: &Path) -> Result<Mesh, RuntimeError> {
+    let obj = read_obj(path)?;
+    let (mesh, warnings) = Mesh::from_obj(&obj)?;
+    for w in warnings {
+        eprintln!("warning: {}: {w}", path.display());
+    }
+    Ok(mesh)
+}
+
+/// Per-input-face rates from a text file, spread to the isolated faces.
+fn read_rates(path: &Path, input_faces: usize, origin: &[u32]) -> Result<Vec<u32>, RuntimeError> {
+    let text = std::fs::read_to_string(path).map_err(|source| RuntimeError::Io {
+        path: path.display().to_string(),
+        source,
+    })?;
+    let bad = |message: String| RuntimeError::Unsupported(format!("{}: {message}", path.display()));
+    let rates = text
+        .split_whitespace()
+        .enumerate()
+        .map(|(i, word)| match word.parse::<u32>() {
+            Ok(n) if (1..=24).contains(&n) => Ok(n),
+            _ => Err(bad(format!(
+                "rate {} is `{word}`, not an integer in 1..=24",
+                i + 1
+            ))),
+        })
+        .collect::<Result<Vec<u32>, _>>()?;
+    if rates.len() != input_faces {
+        return Err(bad(format!(
+            "{} rates for a mesh of {input_faces} faces",
+            rates.len()
+        )));
+    }
+    Ok(origin.iter().map(|&f| rates[f as usize]).collect())
+}
+
 fn run(cli: Cli) -> Result<(), RuntimeError> {
     match cli.command {
         Command::Tessellate {
             mesh,
             output,
             rate,
+            rates,
             table,
             stats,
         } => {
-            let table = match &table {
-                Some(path) => StencilTable::read(path)?,
-                None => StencilTable::default_catmull_clark()?,
+            let table = load_table(&table)?;
+            let input = load_mesh(&mesh)?;
+            let iso = isolate_with_origins(&input)?;
+            let rates = match &rates {
+                Some(path) => read_rates(path, input.faces(), &iso.origin)?,
+                None => vec![rate; iso.patches.len()],
             };
-            let obj = read_obj(&mesh)?;
-            let (input, warnings) = Mesh::from_obj(&obj)?;
-            for w in warnings {
-                eprintln!("warning: {}: {w}", mesh.display());
-            }
-            let (isolated, patches, steps) = isolate(&input)?;
-            let (triangles, time) = tessellate_uniform(&table, &isolated, &patches, rate)?;
             if output.extension().and_then(|e| e.to_str()) != Some("obj") {
                 return Err(RuntimeError::Unsupported(format!(
                     "output format of {} (OBJ so far; PLY and glTF are next)",
                     output.display()
                 )));
             }
+            let (triangles, time) = tessellate(&table, &iso.mesh, &iso.patches, &rates)?;
             write_obj(&triangles, &output)?;
             if stats {
                 let count = triangles.triangles.len();
-                println!(
-                    "{{\"triangles\":{count},\"vertices\":{},\"seconds\":{},\"triangles_per_second\":{},\"watertight\":{},\"faces\":{},\"isolation_steps\":{steps},\"rate\":{rate}}}",
-                    triangles.positions.len(),
-                    time.seconds,
-                    count as f64 / time.seconds.max(1e-12),
-                    triangles.is_watertight(),
-                    isolated.faces(),
-                );
+                let loops = input.boundary_loops();
+                let stats = serde_json::json!({
+                    "triangles": count,
+                    "vertices": triangles.positions.len(),
+                    "seconds": time.seconds,
+                    "plan_seconds": time.plan_seconds,
+                    "triangles_per_second": count as f64 / time.seconds.max(1e-12),
+                    "watertight": loops == 0 && triangles.is_watertight(),
+                    "boundary_loops": loops,
+                    "input_faces": input.faces(),
+                    "faces": iso.mesh.faces(),
+                    "isolation_steps": iso.steps,
+                    "rate_min": rates.iter().min(),
+                    "rate_max": rates.iter().max(),
+                    "threads": rayon::current_num_threads(),
+                });
+                println!("{stats}");
             }
+            Ok(())
+        }
+        Command::Bench {
+            mesh,
+            rate,
+            mixed,
+            threads,
+            refine: steps,
+            frames,
+            table,
+        } => {
+            let table = load_table(&table)?;
+            let mut input = load_mesh(&mesh)?;
+            for _ in 0..steps {
+                input = refine(&input).mesh;
+            }
+            let iso = isolate_with_origins(&input)?;
+            let faces = iso.patches.len();
+            let rates: Vec<u32> = if mixed {
+                (0..faces).map(|f| [3, 5, 8, 12, 7, 16][f % 6]).collect()
+            } else {
+                vec![rate; faces]
+            };
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads.unwrap_or(0))
+                .build()
+                .map_err(|e| RuntimeError::Unsupported(format!("a pool of threads: {e}")))?;
+            let (grid, control) = pool.install(|| {
+                let grid = DualGrid::new(&table, &iso.mesh, &iso.patches, &rates)?;
+                let control: Vec<[f32; 3]> = iso
+                    .mesh
+                    .positions
+                    .iter()
+                    .map(|p| p.map(|c| c as f32))
+                    .collect();
+                Ok::<_, RuntimeError>((grid, control))
+            })?;
+            let mut positions = vec![[0.0f32; 3]; grid.vertex_count()];
+            let mut normals = positions.clone();
+            let mut triangles = vec![[0u32; 3]; grid.triangle_count()];
+            let mut seconds: Vec<f64> = pool.install(|| {
+                // One untimed frame brings the buffers and the table into memory.
+                grid.evaluate(&control, &mut positions, &mut normals);
+                grid.connect(&mut triangles);
+                (0..frames)
+                    .map(|_| {
+                        let started = Instant::now();
+                        grid.evaluate(&control, &mut positions, &mut normals);
+                        grid.connect(&mut triangles);
+                        started.elapsed().as_secs_f64()
+                    })
+                    .collect()
+            });
+            seconds.sort_by(f64::total_cmp);
+            let median = seconds[seconds.len() / 2];
+            let count = grid.triangle_count();
+            let report = serde_json::json!({
+                "mesh": mesh.display().to_string(),
+                "faces": faces,
+                "rates": if mixed { "mixed 3..16".to_owned() } else { rate.to_string() },
+                "threads": pool.current_num_threads(),
+                "frames": frames,
+                "triangles": count,
+                "vertices": grid.vertex_count(),
+                "separable_faces": grid.separable_faces(),
+                "median_seconds": median,
+                "min_seconds": seconds[0],
+                "max_seconds": seconds[seconds.len() - 1],
+                "triangles_per_second": count as f64 / median.max(1e-12),
+            });
+            println!("{report}");
             Ok(())
         }
         Command::Tables {
             command: TablesCommand::Info { file },
         } => {
-            let (name, table) = match &file {
-                Some(path) => (path.display().to_string(), StencilTable::read(path)?),
-                None => (
-                    "(embedded default)".to_owned(),
-                    StencilTable::default_catmull_clark()?,
-                ),
+            let name = match &file {
+                Some(path) => path.display().to_string(),
+                None => "(embedded default)".to_owned(),
             };
+            let table = load_table(&file)?;
             let index = table.index();
             let weights: u64 = index
                 .entries
