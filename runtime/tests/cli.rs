@@ -1,0 +1,147 @@
+//! The `subtess` command line: `tessellate` with `--stats` (DESIGN.md contract), per-face rates
+//! from a file, `bench`, and clear errors.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn subtess(args: &str) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_subtess"))
+        .args(args.split_whitespace())
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("subtess runs")
+}
+
+fn temp(name: &str) -> PathBuf {
+    std::env::temp_dir().join(format!("subtess-cli-{}-{name}", std::process::id()))
+}
+
+fn json(out: &Output) -> serde_json::Value {
+    let text = String::from_utf8_lossy(&out.stdout);
+    serde_json::from_str(text.trim()).unwrap_or_else(|e| panic!("{e}: {text}"))
+}
+
+#[test]
+fn tessellate_prints_the_stats_contract() {
+    let obj = temp("cube.obj");
+    let out = subtess(&format!(
+        "tessellate data/cube.obj -o {} --rate 5 --stats",
+        obj.display()
+    ));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stats = json(&out);
+    for key in [
+        "triangles",
+        "vertices",
+        "seconds",
+        "triangles_per_second",
+        "watertight",
+    ] {
+        assert!(stats.get(key).is_some(), "{key} missing: {stats}");
+    }
+    assert_eq!(stats["watertight"], true);
+    // The cube isolates in one step to 24 faces: 24 * 25 dual points; triangles by Euler
+    // (a sphere: T = 2V - 4).
+    assert_eq!(stats["faces"], 24);
+    assert_eq!(stats["vertices"], 24 * 25);
+    assert_eq!(stats["triangles"], 2 * 24 * 25 - 4);
+    let text = std::fs::read_to_string(&obj).expect("written");
+    assert_eq!(text.lines().filter(|l| l.starts_with("v ")).count(), 600);
+    assert_eq!(text.lines().filter(|l| l.starts_with("f ")).count(), 1196);
+    let _ = std::fs::remove_file(obj);
+}
+
+#[test]
+fn per_face_rates_from_a_file() {
+    let rates = temp("rates.txt");
+    // The cube has 6 faces; each becomes 4 after isolation.
+    std::fs::write(&rates, "1 2 3\n4 5 24\n").expect("write");
+    let obj = temp("rates.obj");
+    let out = subtess(&format!(
+        "tessellate data/cube.obj -o {} --rates {} --stats",
+        obj.display(),
+        rates.display()
+    ));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stats = json(&out);
+    let points: u64 = [1u64, 2, 3, 4, 5, 24].iter().map(|n| 4 * n * n).sum();
+    assert_eq!(stats["vertices"], points);
+    assert_eq!(stats["watertight"], true);
+    assert_eq!(
+        (stats["rate_min"].as_u64(), stats["rate_max"].as_u64()),
+        (Some(1), Some(24))
+    );
+    for (text, message) in [
+        ("1 2 3 4 5", "5 rates for a mesh of 6 faces"),
+        ("1 2 3 4 5 25", "rate 6 is `25`"),
+        ("1 2 x 4 5 6", "rate 3 is `x`"),
+    ] {
+        std::fs::write(&rates, text).expect("write");
+        let out = subtess(&format!(
+            "tessellate data/cube.obj -o {} --rates {}",
+            obj.display(),
+            rates.display()
+        ));
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            !out.status.success() && stderr.contains(message),
+            "{text}: {stderr}"
+        );
+    }
+    let _ = std::fs::remove_file(rates);
+    let _ = std::fs::remove_file(obj);
+}
+
+#[test]
+fn bench_reports_throughput() {
+    let out = subtess("bench data/cube.obj --refine 2 --rate 4 --threads 1 --frames 3");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report = json(&out);
+    assert_eq!(report["threads"], 1);
+    assert_eq!(report["faces"], 6 * 16);
+    // Closed sphere-like surface: T = 2V - 4 with V = 16 points per face.
+    assert_eq!(report["triangles"], 2 * 96 * 16 - 4);
+    assert!(report["triangles_per_second"]
+        .as_f64()
+        .is_some_and(|t| t > 0.0));
+}
+
+#[test]
+fn bad_input_is_a_clear_error() {
+    let bad = temp("bad.obj");
+    std::fs::write(&bad, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n").expect("write");
+    for (args, message) in [
+        (
+            format!("tessellate {} -o x.obj", bad.display()),
+            "out of range",
+        ),
+        (
+            "tessellate /nonexistent.obj -o x.obj".to_owned(),
+            "/nonexistent.obj",
+        ),
+        (
+            "tessellate data/cube.obj -o x.obj --rate 25".to_owned(),
+            "25",
+        ),
+    ] {
+        let out = subtess(&args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args}");
+        assert!(stderr.contains(message), "{args}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{args}: {stderr}");
+    }
+    assert!(!Path::new(env!("CARGO_MANIFEST_DIR")).join("x.obj").exists());
+    let _ = std::fs::remove_file(bad);
+}
