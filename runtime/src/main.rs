@@ -8,7 +8,7 @@ use std::time::Instant;
 use clap::{Parser, Subcommand};
 use runtime::dual_grid::{tessellate, DualGrid};
 use runtime::isolate::isolate_with_origins;
-use runtime::mesh_output::write_obj;
+use runtime::mesh_output::{write_mesh, MeshFormat};
 use runtime::obj::read_obj;
 use runtime::refine::refine;
 use runtime::stencil_table::StencilTable;
@@ -32,7 +32,7 @@ enum Command {
     Tessellate {
         /// Input mesh (OBJ: triangles, quads, n-gons; closed or with boundary).
         mesh: PathBuf,
-        /// Output triangle mesh (.obj).
+        /// Output triangle mesh: .obj, .ply (with per-vertex face, u, v), .glb or .gltf.
         #[arg(short = 'o', long = "output")]
         output: PathBuf,
         /// Dual points per face side, 1..=24, on every face.
@@ -154,6 +154,7 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
             table,
             stats,
         } => {
+            MeshFormat::from_path(&output)?;
             let table = load_table(&table)?;
             let input = load_mesh(&mesh)?;
             let iso = isolate_with_origins(&input)?;
@@ -161,14 +162,8 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
                 Some(path) => read_rates(path, input.faces(), &iso.origin)?,
                 None => vec![rate; iso.patches.len()],
             };
-            if output.extension().and_then(|e| e.to_str()) != Some("obj") {
-                return Err(RuntimeError::Unsupported(format!(
-                    "output format of {} (OBJ so far; PLY and glTF are next)",
-                    output.display()
-                )));
-            }
             let (triangles, time) = tessellate(&table, &iso.mesh, &iso.patches, &rates)?;
-            write_obj(&triangles, &output)?;
+            write_mesh(&triangles, &output)?;
             if stats {
                 let count = triangles.triangles.len();
                 let loops = input.boundary_loops();

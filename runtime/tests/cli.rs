@@ -100,6 +100,34 @@ fn per_face_rates_from_a_file() {
     let _ = std::fs::remove_file(obj);
 }
 
+/// Every output format from the command line; the format is checked before any work.
+#[test]
+fn output_formats_by_extension() {
+    for (ext, magic) in [
+        ("ply", &b"ply\nformat binary_little_endian 1.0"[..]),
+        ("glb", b"glTF"),
+        ("gltf", b"{"),
+        ("obj", b"# subtess"),
+    ] {
+        let path = temp(&format!("cube.{ext}"));
+        let out = subtess(&format!(
+            "tessellate data/cube.obj -o {} --rate 2",
+            path.display()
+        ));
+        assert!(
+            out.status.success(),
+            "{ext}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let bytes = std::fs::read(&path).expect("written");
+        assert!(bytes.starts_with(magic), "{ext}");
+        let _ = std::fs::remove_file(path);
+    }
+    let out = subtess("tessellate /nonexistent.obj -o out.stl");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && stderr.contains(".ply"), "{stderr}");
+}
+
 #[test]
 fn bench_reports_throughput() {
     let out = subtess("bench data/cube.obj --refine 2 --rate 4 --threads 1 --frames 3");
