@@ -129,3 +129,113 @@ fn regular_faces_are_evaluated_as_tensor_products() {
         assert_eq!(grid.separable_faces(), patches.len() - irregular, "n = {n}");
     }
 }
+
+/// The uniform cubic B-spline basis and its derivative at `t` (closed form).
+fn cubic_bspline(t: f64) -> ([f64; 4], [f64; 4]) {
+    let s = 1.0 - t;
+    (
+        [
+            s * s * s / 6.0,
+            (3.0 * t * t * t - 6.0 * t * t + 4.0) / 6.0,
+            (-3.0 * t * t * t + 3.0 * t * t + 3.0 * t + 1.0) / 6.0,
+            t * t * t / 6.0,
+        ],
+        [
+            -s * s / 2.0,
+            (3.0 * t * t - 4.0 * t) / 2.0,
+            (-3.0 * t * t + 2.0 * t + 1.0) / 2.0,
+            t * t / 2.0,
+        ],
+    )
+}
+
+/// A torus of 12 x 8 quads has only valence-4 vertices: every face is a bicubic B-spline patch
+/// over the 4 x 4 grid of its neighbours (the closed form, independent of the tables), and every
+/// output vertex and normal must be that patch at the vertex's (face, u, v), at any rate.
+#[test]
+fn valence_4_regions_reproduce_the_bicubic_b_spline() {
+    let (m, k) = (12usize, 8usize);
+    let point = |i: usize, j: usize| {
+        let (a, b) = (
+            std::f64::consts::TAU * (i % m) as f64 / m as f64,
+            std::f64::consts::TAU * (j % k) as f64 / k as f64,
+        );
+        // Bumps so that no two patches are congruent.
+        let r = 1.0 + 0.1 * ((3 * i + 7 * j) % 5) as f64;
+        [
+            (3.0 + r * b.cos()) * a.cos(),
+            (3.0 + r * b.cos()) * a.sin(),
+            r * b.sin(),
+        ]
+    };
+    let positions: Vec<[f64; 3]> = (0..k)
+        .flat_map(|j| (0..m).map(move |i| point(i, j)))
+        .collect();
+    let index = |i: usize, j: usize| ((j % k) * m + (i % m)) as i64;
+    let faces: Vec<Vec<i64>> = (0..k)
+        .flat_map(|j| {
+            (0..m).map(move |i| {
+                vec![
+                    index(i, j),
+                    index(i + 1, j),
+                    index(i + 1, j + 1),
+                    index(i, j + 1),
+                ]
+            })
+        })
+        .collect();
+    let mesh = Mesh::new(
+        positions.clone(),
+        &faces,
+        &[],
+        schemes::BoundaryMode::EdgeOnly,
+    )
+    .expect("valid torus");
+    let table = StencilTable::default_catmull_clark().expect("embedded table");
+    let (isolated, patches, steps) = isolate(&mesh).expect("isolates");
+    assert_eq!(steps, 0);
+    for rates in [
+        vec![1; m * k],
+        vec![6; m * k],
+        (0..m * k).map(|f| 1 + (f as u32 * 5) % 24).collect(),
+    ] {
+        let (out, _) = tessellate(&table, &isolated, &patches, &rates).expect("tessellates");
+        assert!(out.is_watertight());
+        assert_eq!(out.euler_characteristic(), 0);
+        for (v, source) in out.sources.iter().enumerate() {
+            let f = source.face as usize;
+            let (fi, fj) = (f % m, f / m);
+            let (u, w) = source.uv();
+            let ((bu, du), (bv, dv)) = (cubic_bspline(u), cubic_bspline(w));
+            let mut p = [0.0; 3];
+            let mut tu = [0.0; 3];
+            let mut tv = [0.0; 3];
+            for a in 0..4 {
+                for b in 0..4 {
+                    let q = positions[index(fi + m + a - 1, fj + k + b - 1) as usize];
+                    for c in 0..3 {
+                        p[c] += bu[a] * bv[b] * q[c];
+                        tu[c] += du[a] * bv[b] * q[c];
+                        tv[c] += bu[a] * dv[b] * q[c];
+                    }
+                }
+            }
+            let got = out.positions[v];
+            assert!(
+                (0..3).all(|c| (p[c] - f64::from(got[c])).abs() < 1e-5),
+                "face {f} at ({u}, {w}): {got:?} vs {p:?}"
+            );
+            let n = [
+                tu[1] * tv[2] - tu[2] * tv[1],
+                tu[2] * tv[0] - tu[0] * tv[2],
+                tu[0] * tv[1] - tu[1] * tv[0],
+            ];
+            let length = n.iter().map(|x| x * x).sum::<f64>().sqrt();
+            let normal = out.normals[v];
+            assert!(
+                (0..3).all(|c| (n[c] / length - f64::from(normal[c])).abs() < 1e-4),
+                "normal of face {f} at ({u}, {w})"
+            );
+        }
+    }
+}
