@@ -2,8 +2,8 @@
 //! all connectivity into preallocated buffers; topology, patches and the plan built once. Mesh: Crane's Spot refined to 11,712
 //! faces when `../shared/models` exists, else the shipped cube refined to 6,144 faces.
 //!
-//! `cargo bench -p subtess-runtime --bench tessellate` (both cores);
-//! `RAYON_NUM_THREADS=1 cargo bench -p subtess-runtime --bench tessellate` (one).
+//! `cargo bench -p subtess-runtime --bench tessellate`: one and two threads (a rayon pool of
+//! each size), rates 4, 8, 16 and mixed.
 #![allow(missing_docs)] // criterion_group! generates an undocumented function
 
 use std::path::Path;
@@ -36,40 +36,47 @@ fn bench(c: &mut Criterion) {
     let table = StencilTable::default_catmull_clark().unwrap_or_else(|e| panic!("{e}"));
     let (name, m) = mesh();
     let (isolated, patches, _) = isolate(&m).unwrap_or_else(|e| panic!("{e}"));
-    let threads = rayon::current_num_threads();
-    let mut group = c.benchmark_group(format!(
-        "dual grid, {name}, {} faces, {threads} thread(s)",
-        patches.len()
-    ));
-    group.sample_size(10);
     let mixed: Vec<u32> = (0..patches.len())
         .map(|f| [3, 5, 8, 12, 7, 16][f % 6])
         .collect();
-    for (label, rates) in [
-        ("rate 4", vec![4; patches.len()]),
-        ("rate 8", vec![8; patches.len()]),
-        ("rate 16", vec![16; patches.len()]),
-        ("mixed 3..16", mixed),
-    ] {
-        let grid =
-            DualGrid::new(&table, &isolated, &patches, &rates).unwrap_or_else(|e| panic!("{e}"));
-        let control: Vec<[f32; 3]> = isolated
-            .positions
-            .iter()
-            .map(|p| p.map(|c| c as f32))
-            .collect();
-        let mut positions = vec![[0.0f32; 3]; grid.vertex_count()];
-        let mut normals = positions.clone();
-        let mut triangles = vec![[0u32; 3]; grid.triangle_count()];
-        group.throughput(Throughput::Elements(grid.triangle_count() as u64));
-        group.bench_function(label, |b| {
-            b.iter(|| {
-                grid.evaluate(&control, &mut positions, &mut normals);
-                grid.connect(&mut triangles);
-            })
-        });
+    let control: Vec<[f32; 3]> = isolated
+        .positions
+        .iter()
+        .map(|p| p.map(|c| c as f32))
+        .collect();
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap_or_else(|e| panic!("{e}"));
+        let mut group = c.benchmark_group(format!(
+            "dual grid, {name}, {} faces, {threads} thread(s)",
+            patches.len()
+        ));
+        group.sample_size(20);
+        for (label, rates) in [
+            ("rate 4", vec![4; patches.len()]),
+            ("rate 8", vec![8; patches.len()]),
+            ("rate 16", vec![16; patches.len()]),
+            ("mixed 3..16", mixed.clone()),
+        ] {
+            let grid = DualGrid::new(&table, &isolated, &patches, &rates)
+                .unwrap_or_else(|e| panic!("{e}"));
+            let mut positions = vec![[0.0f32; 3]; grid.vertex_count()];
+            let mut normals = positions.clone();
+            let mut triangles = vec![[0u32; 3]; grid.triangle_count()];
+            group.throughput(Throughput::Elements(grid.triangle_count() as u64));
+            group.bench_function(label, |b| {
+                pool.install(|| {
+                    b.iter(|| {
+                        grid.evaluate(&control, &mut positions, &mut normals);
+                        grid.connect(&mut triangles);
+                    })
+                })
+            });
+        }
+        group.finish();
     }
-    group.finish();
 }
 
 criterion_group!(benches, bench);
