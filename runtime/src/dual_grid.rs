@@ -428,6 +428,7 @@ impl<'t> DualGrid<'t> {
                 u: i,
                 v: j,
                 denominator: n,
+                subface: 0,
             },
         });
         Ok(())
@@ -570,6 +571,7 @@ impl<'t> DualGrid<'t> {
                         u: 2 * i + 1,
                         v: 2 * j + 1,
                         denominator: 2 * n,
+                        subface: 0,
                     });
                 }
             }

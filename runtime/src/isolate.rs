@@ -9,6 +9,7 @@ use crate::dual_grid::gather_patches;
 use crate::patch::FacePatch;
 use crate::refine::refine;
 use crate::topology::Mesh;
+use crate::triangle_mesh::VertexSource;
 use crate::MeshError;
 
 /// At most this many steps are tried (two always suffice for a valid mesh).
@@ -25,6 +26,47 @@ pub struct Isolation {
     pub steps: usize,
     /// The input face every face of `mesh` lies in.
     pub origin: Vec<u32>,
+    /// For every face of `mesh`, the corner of its parent it was made at, one per step (the
+    /// first for the step from the input mesh).
+    pub corners: Vec<[u8; MAX_STEPS]>,
+    /// Number of sides of every input face.
+    pub input_sides: Vec<u32>,
+}
+
+impl Isolation {
+    /// The input face and its own parameters of a point given on face `source.face` of the
+    /// isolated mesh, exactly. Child `c` of a quad covers the quarter at its corner `c` and runs
+    /// from that corner (`refine.rs`): its `(s, t)` is the parent's
+    /// `(s/2, t/2)`, `(1 - t/2, s/2)`, `(1 - s/2, 1 - t/2)`, `(t/2, 1 - s/2)` for `c = 0..3`, so
+    /// the denominator doubles per step. A non-quad input face has no parameterization of its
+    /// own: the point is left in the parameters of the sub-face (the quad of the first step at
+    /// its corner `subface`), the Ptex / OpenSubdiv convention.
+    pub fn input_source(&self, source: VertexSource) -> VertexSource {
+        let face = source.face as usize;
+        let (mut u, mut v, mut d) = (source.u, source.v, source.denominator);
+        let mut subface = 0;
+        for level in (0..self.steps).rev() {
+            let c = self.corners[face][level];
+            if level == 0 && self.input_sides[self.origin[face] as usize] != 4 {
+                subface = c;
+                break;
+            }
+            (u, v) = match c {
+                0 => (u, v),
+                1 => (2 * d - v, u),
+                2 => (2 * d - u, 2 * d - v),
+                _ => (v, 2 * d - u),
+            };
+            d *= 2;
+        }
+        VertexSource {
+            face: self.origin[face],
+            u,
+            v,
+            denominator: d,
+            subface,
+        }
+    }
 }
 
 /// Refine until every face is a patch; keeps the face ancestry. A refinement step turns face `f`
@@ -33,6 +75,10 @@ pub struct Isolation {
 pub fn isolate_with_origins(mesh: &Mesh) -> Result<Isolation, MeshError> {
     let mut current = mesh.clone();
     let mut origin: Vec<u32> = (0..mesh.faces() as u32).collect();
+    let mut corners = vec![[0u8; MAX_STEPS]; mesh.faces()];
+    let input_sides = (0..mesh.faces())
+        .map(|f| mesh.face(f).len() as u32)
+        .collect();
     for steps in 0..=MAX_STEPS {
         match gather_patches(&current) {
             Ok(patches) => {
@@ -41,10 +87,21 @@ pub fn isolate_with_origins(mesh: &Mesh) -> Result<Isolation, MeshError> {
                     patches,
                     steps,
                     origin,
+                    corners,
+                    input_sides,
                 })
             }
             Err(e) if steps == MAX_STEPS => return Err(e),
             Err(_) => {
+                // Child h of the refined mesh is made at half-edge h of the current one.
+                corners = (0..current.face_vertices.len())
+                    .map(|h| {
+                        let f = current.face_of[h] as usize;
+                        let mut path = corners[f];
+                        path[steps] = (h - current.face_halfedges(f).start) as u8;
+                        path
+                    })
+                    .collect();
                 origin = current
                     .face_of
                     .iter()

@@ -162,7 +162,11 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
                 Some(path) => read_rates(path, input.faces(), &iso.origin)?,
                 None => vec![rate; iso.patches.len()],
             };
-            let (triangles, time) = tessellate(&table, &iso.mesh, &iso.patches, &rates)?;
+            let (mut triangles, time) = tessellate(&table, &iso.mesh, &iso.patches, &rates)?;
+            // Sources in the user's own faces and parameters.
+            for source in &mut triangles.sources {
+                *source = iso.input_source(*source);
+            }
             write_mesh(&triangles, &output)?;
             if stats {
                 let count = triangles.triangles.len();

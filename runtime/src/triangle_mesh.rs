@@ -3,9 +3,12 @@
 
 use std::collections::HashSet;
 
-/// Where an output vertex was evaluated: face `face` of the tessellated mesh at
-/// `(u / denominator, v / denominator)` in that face's own parameters (DESIGN.md conventions).
-/// Dual points at rate `n` have denominator `2n`, points on the boundary curve `n`.
+/// Where an output vertex was evaluated: face `face` at `(u / denominator, v / denominator)` in
+/// that face's own parameters (DESIGN.md conventions). Dual points at rate `n` have denominator
+/// `2n`, points on the boundary curve `n`. As the tessellator makes them, `face` is a face of the
+/// mesh it was given (the isolated mesh); [`crate::isolate::Isolation::input_source`] turns them
+/// into the input mesh's faces, where a non-quad face is parameterized by its sub-faces (the
+/// quads of its first Catmull–Clark step, `subface` = the corner they hold).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct VertexSource {
     /// The face (of the mesh that was tessellated).
@@ -16,6 +19,8 @@ pub struct VertexSource {
     pub v: u32,
     /// The common denominator of `u` and `v`.
     pub denominator: u32,
+    /// For a non-quad input face, which sub-face `(u, v)` is in (0 otherwise).
+    pub subface: u8,
 }
 
 impl VertexSource {

@@ -45,6 +45,7 @@ fn tetrahedron() -> TriangleMesh {
         u,
         v,
         denominator,
+        subface: (face % 3) as u8,
     };
     TriangleMesh {
         positions,
@@ -299,6 +300,7 @@ fn check_ply(mesh: &TriangleMesh, bytes: &[u8], what: &str) {
             scalar("uint", "face"),
             scalar("float", "u"),
             scalar("float", "v"),
+            scalar("uchar", "subface"),
         ]
     );
     assert_eq!(
@@ -309,7 +311,7 @@ fn check_ply(mesh: &TriangleMesh, bytes: &[u8], what: &str) {
             "vertex_indices".into()
         )]
     );
-    // The documented record sizes: 36 bytes a vertex, 13 a triangle (parse_ply checked that
+    // The documented record sizes: 37 bytes a vertex, 13 a triangle (parse_ply checked that
     // the body is exactly the header's elements).
     let record: usize = vertex
         .properties
@@ -320,7 +322,7 @@ fn check_ply(mesh: &TriangleMesh, bytes: &[u8], what: &str) {
         })
         .sum();
     assert_eq!(record, runtime::mesh_output::PLY_VERTEX_BYTES);
-    let header_len = bytes.len() - 36 * mesh.positions.len() - 13 * mesh.triangles.len();
+    let header_len = bytes.len() - 37 * mesh.positions.len() - 13 * mesh.triangles.len();
     assert!(bytes[..header_len].ends_with(b"end_header\n"));
 
     let mut faces = Vec::new();
@@ -337,6 +339,11 @@ fn check_ply(mesh: &TriangleMesh, bytes: &[u8], what: &str) {
         assert_eq!(bits3(&normal), bits3(&mesh.normals[i]), "{what} normal {i}");
         faces.push(u32_of(&row[6].1[0]));
         uvs.push([get(7), get(8)]);
+        assert_eq!(
+            u32_of(&row[9].1[0]),
+            u32::from(mesh.sources[i].subface),
+            "{what} subface {i}"
+        );
     }
     assert_sources(mesh, Some(&faces), &uvs, what);
     for (t, row) in ply.rows[1].iter().enumerate() {
@@ -722,6 +729,7 @@ fn gltf_face_attribute_only_while_exact() {
                 u: 1,
                 v: 2,
                 denominator: 5,
+                subface: 0,
             });
         }
         let doc = check_glb(&m, &written("m.glb", &m, write_glb), "2^24");
