@@ -452,9 +452,12 @@ impl<'t> DualGrid<'t> {
             let h = mesh.vertex_halfedge[v] as usize;
             let f = mesh.face_of[h] as usize;
             let corner = (h - mesh.face_halfedges(f).start) as u32;
-            let (i, j) = [(0, 0), (1, 0), (1, 1), (0, 1)][corner as usize];
+            // The corner of the primal grid at the face's own rate (present in any table that
+            // has the face's dual grid).
+            let n = self.rates[f];
+            let (i, j) = [(0, 0), (n, 0), (n, n), (0, n)][corner as usize];
             *limit = dual_total + self.boundary_points.len() as u32;
-            self.boundary_point(table, &patches[f], f, 1, (i, j))?;
+            self.boundary_point(table, &patches[f], f, n, (i, j))?;
         }
         // Edges, each once: interior ones from their lower half-edge, boundary ones from theirs.
         for h in 0..mesh.face_vertices.len() {
