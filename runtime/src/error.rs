@@ -109,4 +109,12 @@ pub enum RuntimeError {
         /// The cause.
         source: std::io::Error,
     },
+    /// A parameter is outside its domain (a tolerance, a camera, a set of rates).
+    #[error("invalid {name}: {reason}")]
+    InvalidParameter {
+        /// Which parameter.
+        name: &'static str,
+        /// Its value and what it must be.
+        reason: String,
+    },
 }

@@ -12,6 +12,7 @@ pub mod isolate;
 pub mod mesh_output;
 pub mod obj;
 pub mod patch;
+pub mod rates;
 pub mod refine;
 pub mod stencil_table;
 pub mod topology;
