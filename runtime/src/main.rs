@@ -10,6 +10,7 @@ use runtime::dual_grid::{tessellate, DualGrid};
 use runtime::isolate::isolate_with_origins;
 use runtime::mesh_output::{write_mesh, MeshFormat};
 use runtime::obj::read_obj;
+use runtime::rates::{tolerance_rates, view_rates, ViewCamera};
 use runtime::refine::refine;
 use runtime::stencil_table::StencilTable;
 use runtime::topology::Mesh;
@@ -36,13 +37,23 @@ enum Command {
         #[arg(short = 'o', long = "output")]
         output: PathBuf,
         /// Dual points per face side, 1..=24, on every face.
-        #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=24), conflicts_with = "rates")]
+        #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=24), conflicts_with_all = ["rates", "tolerance", "view"])]
         rate: u32,
         /// Per-face rates: a text file with one rate (1..=24) per input face, in OBJ face
         /// order, separated by white space; faces made by isolation inherit their input
         /// face's rate.
-        #[arg(long)]
+        #[arg(long, conflicts_with_all = ["tolerance", "view"])]
         rates: Option<PathBuf>,
+        /// Per face the smallest rate whose tessellation deviates from the limit surface by at
+        /// most T (a distance in the mesh's units), measured on the table's rate-24 grid
+        /// (docs/results.md).
+        #[arg(long, conflicts_with = "view")]
+        tolerance: Option<f64>,
+        /// View-dependent rates: `PX,PY,PZ,TX,TY,TZ,FOV,HEIGHT,EDGE` = camera position, target,
+        /// vertical field of view (degrees), image height (pixels) and the target edge length
+        /// (pixels); per face the projected size over the edge length, in 1..=24.
+        #[arg(long, value_parser = parse_view)]
+        view: Option<ViewCamera>,
         /// A stencil table file instead of the embedded default.
         #[arg(long)]
         table: Option<PathBuf>,
@@ -144,6 +155,28 @@ fn read_rates(path: &Path, input_faces: usize, origin: &[u32]) -> Result<Vec<u32
     Ok(origin.iter().map(|&f| rates[f as usize]).collect())
 }
 
+/// `--view PX,PY,PZ,TX,TY,TZ,FOV,HEIGHT,EDGE`.
+fn parse_view(text: &str) -> Result<ViewCamera, String> {
+    let values = text
+        .split(',')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<Result<Vec<f64>, _>>()
+        .map_err(|e| format!("`{text}`: {e}"))?;
+    match values[..] {
+        [px, py, pz, tx, ty, tz, fov, height, edge] => Ok(ViewCamera {
+            position: [px, py, pz],
+            target: [tx, ty, tz],
+            vertical_fov_degrees: fov,
+            image_height_px: height,
+            target_edge_px: edge,
+        }),
+        _ => Err(format!(
+            "`{text}`: 9 numbers wanted (position x,y,z, target x,y,z, fov degrees, image height px, edge px), got {}",
+            values.len()
+        )),
+    }
+}
+
 fn run(cli: Cli) -> Result<(), RuntimeError> {
     match cli.command {
         Command::Tessellate {
@@ -151,6 +184,8 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
             output,
             rate,
             rates,
+            tolerance,
+            view,
             table,
             stats,
         } => {
@@ -158,9 +193,23 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
             let table = load_table(&table)?;
             let input = load_mesh(&mesh)?;
             let iso = isolate_with_origins(&input)?;
-            let rates = match &rates {
-                Some(path) => read_rates(path, input.faces(), &iso.origin)?,
-                None => vec![rate; iso.patches.len()],
+            let mut unmet = None;
+            let rates = if let Some(path) = &rates {
+                read_rates(path, input.faces(), &iso.origin)?
+            } else if let Some(t) = tolerance {
+                let chosen = tolerance_rates(&table, &iso.mesh, &iso.patches, t)?;
+                if !chosen.unmet.is_empty() {
+                    eprintln!(
+                        "warning: {} faces do not meet the tolerance {t} at rate 24; they get 24",
+                        chosen.unmet.len()
+                    );
+                }
+                unmet = Some(chosen.unmet.len());
+                chosen.rates
+            } else if let Some(camera) = &view {
+                view_rates(&iso.mesh, camera)?
+            } else {
+                vec![rate; iso.patches.len()]
             };
             let (mut triangles, time) = tessellate(&table, &iso.mesh, &iso.patches, &rates)?;
             // Sources in the user's own faces and parameters.
@@ -184,6 +233,8 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
                     "isolation_steps": iso.steps,
                     "rate_min": rates.iter().min(),
                     "rate_max": rates.iter().max(),
+                    "tolerance": tolerance,
+                    "faces_over_tolerance": unmet,
                     "threads": rayon::current_num_threads(),
                 });
                 println!("{stats}");

@@ -173,3 +173,45 @@ fn bad_input_is_a_clear_error() {
     assert!(!Path::new(env!("CARGO_MANIFEST_DIR")).join("x.obj").exists());
     let _ = std::fs::remove_file(bad);
 }
+
+/// `--tolerance`: a tighter tolerance never needs fewer triangles; `--view`: a nearer camera
+/// never fewer; malformed values are refused by the argument parser.
+#[test]
+fn tolerance_and_view_rates() {
+    let obj = temp("rates-cube.obj");
+    let triangles = |args: &str| -> u64 {
+        let out = subtess(&format!(
+            "tessellate data/cube.obj -o {} --stats {args}",
+            obj.display()
+        ));
+        assert!(
+            out.status.success(),
+            "{args}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let stats = json(&out);
+        assert_eq!(stats["watertight"], true, "{args}");
+        stats["triangles"].as_u64().expect("a count")
+    };
+    let tolerances = ["0.05", "0.01", "0.002"].map(|t| triangles(&format!("--tolerance {t}")));
+    assert!(
+        tolerances[0] <= tolerances[1] && tolerances[1] <= tolerances[2],
+        "{tolerances:?}"
+    );
+    assert!(tolerances[0] < tolerances[2], "{tolerances:?}");
+    let far = triangles("--view 0,0,40,0,0,0,45,1080,8");
+    let near = triangles("--view 0,0,4,0,0,0,45,1080,8");
+    assert!(far < near, "{far} vs {near}");
+    for args in [
+        "--view 1,2,3",
+        "--tolerance -1",
+        "--tolerance 0.01 --rate 3",
+    ] {
+        let out = subtess(&format!(
+            "tessellate data/cube.obj -o {} {args}",
+            obj.display()
+        ));
+        assert!(!out.status.success(), "{args}");
+    }
+    let _ = std::fs::remove_file(obj);
+}
