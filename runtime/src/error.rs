@@ -109,4 +109,13 @@ pub enum RuntimeError {
         /// The cause.
         source: std::io::Error,
     },
+    /// An evaluation parameter (a rational `u` or `v`, a face, a corner) is malformed or out
+    /// of range.
+    #[error("bad parameter `{text}`: {reason}")]
+    BadParameter {
+        /// The parameter as given.
+        text: String,
+        /// What is wrong with it.
+        reason: String,
+    },
 }
