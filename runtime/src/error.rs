@@ -109,11 +109,12 @@ pub enum RuntimeError {
         /// The cause.
         source: std::io::Error,
     },
-    /// A parameter is outside its domain (a tolerance, a camera, a set of rates).
+    /// A parameter is malformed or outside its domain (a rational `u` or `v`, a face, a corner,
+    /// a tolerance, a camera, a set of rates).
     #[error("invalid {name}: {reason}")]
     InvalidParameter {
-        /// Which parameter.
-        name: &'static str,
+        /// Which parameter, or its text as given.
+        name: String,
         /// Its value and what it must be.
         reason: String,
     },

@@ -8,6 +8,7 @@
 
 pub mod dual_grid;
 pub mod error;
+pub mod exact_eval;
 pub mod isolate;
 pub mod mesh_output;
 pub mod obj;

@@ -610,7 +610,7 @@ pub fn face_deviation(
     let patch = patches
         .get(face)
         .ok_or_else(|| RuntimeError::InvalidParameter {
-            name: "face",
+            name: "face".to_owned(),
             reason: format!("{face} (the mesh has {} faces)", patches.len()),
         })?;
     let ctx = Context {
@@ -649,7 +649,7 @@ pub fn tolerance_rates_among(
     check_faces(mesh, patches)?;
     if !(tolerance.is_finite() && tolerance > 0.0) {
         return Err(RuntimeError::InvalidParameter {
-            name: "tolerance",
+            name: "tolerance".to_owned(),
             reason: format!("{tolerance} (it must be a positive distance)"),
         });
     }
@@ -660,7 +660,7 @@ pub fn tolerance_rates_among(
         Some(&n) if sorted[0] >= 1 && n <= MAX_SELECTED_RATE => n,
         _ => {
             return Err(RuntimeError::InvalidParameter {
-                name: "candidate rates",
+                name: "candidate rates".to_owned(),
                 reason: format!(
                     "{candidates:?} (they must be 1..={MAX_SELECTED_RATE}, at least one)"
                 ),
@@ -718,7 +718,7 @@ pub fn measure_deviation(
     check_faces(mesh, patches)?;
     if tessellation.triangles.is_empty() {
         return Err(RuntimeError::InvalidParameter {
-            name: "tessellation",
+            name: "tessellation".to_owned(),
             reason: "it has no triangles".to_owned(),
         });
     }
@@ -915,7 +915,7 @@ impl ViewCamera {
     fn check(&self) -> Result<(), RuntimeError> {
         let bad = |reason: String| {
             Err(RuntimeError::InvalidParameter {
-                name: "camera",
+                name: "camera".to_owned(),
                 reason,
             })
         };

@@ -15,6 +15,7 @@
 
 pub mod bivariate;
 pub mod curve;
+pub mod local_matrices;
 pub mod quad;
 
 pub use bivariate::BivariateMask;

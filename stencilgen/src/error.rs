@@ -84,3 +84,12 @@ pub enum StencilError {
         unknowns: usize,
     },
 }
+
+impl From<schemes::local_matrices::UnsupportedNeighbourhood> for StencilError {
+    fn from(e: schemes::local_matrices::UnsupportedNeighbourhood) -> Self {
+        StencilError::UnsupportedScheme {
+            scheme: e.scheme,
+            reason: e.reason,
+        }
+    }
+}

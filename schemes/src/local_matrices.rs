@@ -1,0 +1,556 @@
+//! The neighbourhood of an extraordinary vertex and one subdivision step on it: the local
+//! subdivision matrix `A` and the regular-subpatch picking matrices `R_b` of Schaefer–Warren
+//! section 5.2, as exact rationals. Data only (nothing is solved here): `stencilgen` builds its
+//! scaling-relation systems from them, the runtime's exact evaluator applies them.
+//!
+//! Around a vertex with `f` faces and no other extraordinary vertex nearby, the mesh is `f`
+//! copies of a quadrant of the regular grid: *sector* `s` holds the points `(a, b)` with
+//! `a >= 1, b >= 0` in its own coordinates, its `+a` axis along the edge to `E_{s+1}` and its
+//! `+b` axis along the edge to `E_{s+2}`, which is sector `s + 1`'s `+a` axis. So `(a, b)` in
+//! sector `s` is `(b, -a)` in sector `s + 1` and `(-b, a)` in sector `s - 1` ([`canonical`]).
+//!
+//! * An interior vertex of valence `v` has `f = v` sectors glued cyclically.
+//! * A boundary vertex with `f` faces has sectors `0..f` and one more half-sector `f` holding
+//!   only its axis `(a, 0)`: the boundary runs along sector 0's `+a` axis and sector `f`'s `+a`
+//!   axis; there is nothing beyond (`canonical` returns `None`).
+//!
+//! The patch of sector `s` is the cell `[0,1]^2` of sector `s`, with `u` along `a` and `v` along
+//! `b` and the vertex at `(0,0)`. Its control points ([`patch_layout`], Stam's layout for
+//! interior vertices; drawn in `docs/algorithms/extraordinary-stencils.md`):
+//!
+//! ```text
+//!   V                     the vertex
+//!   E_1 ..= E_e           E_i = sector i-1, (1, 0);      e = v (interior) or f + 1 (boundary)
+//!   F_1 ..= F_f           F_i = sector i-1, (1, 1)       (in the face V, E_i, F_i, E_{i+1})
+//!   O_1 ..= O_7           (2,-1) (2,0) (2,1) (2,2) (1,2) (0,2) (-1,2) in sector-s coordinates,
+//!                         those that exist (a boundary patch lacks the ones beyond the boundary)
+//! ```
+//!
+//! One step of subdivision makes the level-1 points from these; at level 1 (half the spacing)
+//! the same layout around the same vertex gives the `K x K` matrix `A` (`P' = A P`), and the
+//! three regular sub-patches `[1/2,1]x[0,1/2]`, `[1/2,1]^2`, `[0,1/2]x[1/2,1]` of the patch get
+//! `16 x K` matrices `R_b` (the note's `P_b Ā`). Their 16 points are ordered `(p, q)` row by
+//! row, `q` outer, `p, q in -1..=2` relative to the sub-patch's lower-left corner. A sub-patch
+//! on the boundary is a regular boundary patch: its control points beyond the boundary are the
+//! phantom points `P(a, -1) = 2 P(a, 0) - P(a, 1)` (across sector 0's axis; likewise across the
+//! last axis), which makes the bicubic (or tensor-product) patch reproduce the boundary curve
+//! rules exactly.
+
+use std::collections::HashMap;
+
+use crate::{BoundaryMode, QuadScheme};
+use num_bigint::BigInt;
+use num_rational::{BigRational, Rational64};
+use num_traits::Zero;
+
+/// A neighbourhood (or sector) that a scheme has no rules for.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct UnsupportedNeighbourhood {
+    /// The scheme.
+    pub scheme: String,
+    /// Why.
+    pub reason: String,
+}
+
+impl std::fmt::Display for UnsupportedNeighbourhood {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "scheme `{}` cannot be used here: {}",
+            self.scheme, self.reason
+        )
+    }
+}
+
+impl std::error::Error for UnsupportedNeighbourhood {}
+
+/// The combinatorial neighbourhood of the vertex at the patch corner.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Neighbourhood {
+    /// Number of faces around the vertex (the valence, for an interior vertex).
+    pub faces: u32,
+    /// `None` for an interior vertex; the boundary interpolation mode for a boundary vertex.
+    pub boundary: Option<BoundaryMode>,
+}
+
+impl Neighbourhood {
+    /// An interior vertex of valence `v`.
+    pub fn interior(v: u32) -> Self {
+        Neighbourhood {
+            faces: v,
+            boundary: None,
+        }
+    }
+
+    /// A boundary vertex with `faces` faces.
+    pub fn boundary(faces: u32, mode: BoundaryMode) -> Self {
+        Neighbourhood {
+            faces,
+            boundary: Some(mode),
+        }
+    }
+
+    /// Number of edges at the vertex: `v`, or `f + 1` on the boundary.
+    pub fn edges(self) -> u32 {
+        self.faces + u32::from(self.boundary.is_some())
+    }
+
+    /// Whether the vertex is a pinned corner (one face, "edge and corner" mode).
+    pub fn is_corner(self) -> bool {
+        self.faces == 1 && self.boundary == Some(BoundaryMode::EdgeAndCorner)
+    }
+
+    /// Whether the patch at this vertex is a plain tensor-product patch: valence 4, a boundary
+    /// vertex with two faces, or a pinned corner (phantom points in both directions).
+    pub fn is_regular(self) -> bool {
+        match self.boundary {
+            None => self.faces == 4,
+            Some(_) => self.faces == 2 || self.is_corner(),
+        }
+    }
+
+    /// The patches it has: sectors `0..faces` (interior patches are all alike; only sector 0
+    /// is used for them).
+    pub fn sectors(self) -> u32 {
+        if self.boundary.is_some() {
+            self.faces
+        } else {
+            1
+        }
+    }
+
+    /// Check the neighbourhood against what a scheme supports.
+    pub fn validate(
+        self,
+        scheme: &QuadScheme,
+        sector: u32,
+    ) -> Result<(), UnsupportedNeighbourhood> {
+        let unsupported = |reason: String| UnsupportedNeighbourhood {
+            scheme: scheme.name.to_owned(),
+            reason,
+        };
+        match self.boundary {
+            None if self.faces < 3 => Err(unsupported(format!(
+                "an interior vertex needs valence >= 3, not {}",
+                self.faces
+            ))),
+            Some(_) if self.faces == 0 => Err(unsupported(
+                "a boundary vertex needs at least one face".to_owned(),
+            )),
+            Some(_) if scheme.boundary.is_none() => {
+                Err(unsupported("it has no boundary rules".to_owned()))
+            }
+            _ if sector >= self.sectors() => Err(unsupported(format!(
+                "sector {sector} does not exist at a vertex with {} patch(es)",
+                self.sectors()
+            ))),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// A vertex of the neighbourhood, in canonical form.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum GridPoint {
+    /// The vertex at the patch corner.
+    Centre,
+    /// Point `(a, b)`, `a >= 1`, `b >= 0`, of sector `s`.
+    Sector {
+        /// Sector index.
+        s: u32,
+        /// Coordinate along the sector's first edge.
+        a: i64,
+        /// Coordinate along the sector's second edge.
+        b: i64,
+    },
+}
+
+/// The canonical name of point `(a, b)` given in sector `s`'s coordinates, or `None` if it lies
+/// beyond the boundary.
+pub fn canonical(nb: Neighbourhood, s: i64, a: i64, b: i64) -> Option<GridPoint> {
+    let (mut s, mut a, mut b) = (s, a, b);
+    let f = i64::from(nb.faces);
+    loop {
+        if a == 0 && b == 0 {
+            return Some(GridPoint::Centre);
+        }
+        if a >= 1 && b >= 0 {
+            let s = match nb.boundary {
+                None => s.rem_euclid(f),
+                Some(_) if s < f || (s == f && b == 0) => s,
+                Some(_) => return None,
+            };
+            return Some(GridPoint::Sector { s: s as u32, a, b });
+        }
+        if b < 0 {
+            (s, a, b) = (s - 1, -b, a);
+        } else {
+            (s, a, b) = (s + 1, b, -a);
+        }
+        if nb.boundary.is_some() && !(0..=f).contains(&s) {
+            return None;
+        }
+    }
+}
+
+/// The outer points of a patch layout, in the patch sector's coordinates.
+pub const OUTER_POINTS: [(i64, i64); 7] =
+    [(2, -1), (2, 0), (2, 1), (2, 2), (1, 2), (0, 2), (-1, 2)];
+
+/// Lower-left corners, in level-1 sector coordinates, of the three regular sub-patches.
+pub const SUB_PATCH_ORIGINS: [(i64, i64); 3] = [(1, 0), (1, 1), (0, 1)];
+
+/// The control points of the patch of `sector`, in table order.
+pub fn patch_layout(nb: Neighbourhood, sector: u32) -> Vec<GridPoint> {
+    let mut points = vec![GridPoint::Centre];
+    points.extend((0..nb.edges()).map(|s| GridPoint::Sector { s, a: 1, b: 0 }));
+    points.extend((0..nb.faces).map(|s| GridPoint::Sector { s, a: 1, b: 1 }));
+    points.extend(
+        OUTER_POINTS
+            .iter()
+            .filter_map(|&(a, b)| canonical(nb, i64::from(sector), a, b)),
+    );
+    points
+}
+
+/// A linear combination of points.
+type Combination = Vec<(GridPoint, Rational64)>;
+
+fn exists(nb: Neighbourhood, s: i64, a: i64, b: i64) -> GridPoint {
+    canonical(nb, s, a, b)
+        .unwrap_or_else(|| unreachable!("rule reads a point beyond the boundary: ({s}; {a}, {b})"))
+}
+
+/// The level-0 combination that one subdivision step of `scheme` assigns to the level-1 point
+/// `point` (named in level-1 coordinates, which have the same sector structure).
+pub fn refine_point(scheme: &QuadScheme, nb: Neighbourhood, point: GridPoint) -> Combination {
+    let boundary = scheme.boundary;
+    let GridPoint::Sector { s, a, b } = point else {
+        return match (nb.boundary, boundary) {
+            (Some(_), _) if nb.is_corner() => {
+                vec![(GridPoint::Centre, Rational64::from_integer(1))]
+            }
+            (Some(_), Some(rules)) => vec![
+                (GridPoint::Centre, rules.vertex_centre),
+                (GridPoint::Sector { s: 0, a: 1, b: 0 }, rules.vertex_end),
+                (
+                    GridPoint::Sector {
+                        s: nb.faces,
+                        a: 1,
+                        b: 0,
+                    },
+                    rules.vertex_end,
+                ),
+            ],
+            _ => {
+                let (alpha, beta, gamma) = scheme.vertex.weights(nb.faces);
+                let mut c = vec![(GridPoint::Centre, alpha)];
+                c.extend((0..nb.faces).map(|s| (GridPoint::Sector { s, a: 1, b: 0 }, beta)));
+                c.extend((0..nb.faces).map(|s| (GridPoint::Sector { s, a: 1, b: 1 }, gamma)));
+                c
+            }
+        };
+    };
+    let s = i64::from(s);
+    let at = |a: i64, b: i64| canonical(nb, s, a, b);
+    let quarter = Rational64::new(1, 4);
+    let half = Rational64::new(1, 2);
+    match (a.rem_euclid(2), b.rem_euclid(2)) {
+        (0, 0) => {
+            let (x, y) = (a / 2, b / 2);
+            let ring: Vec<Option<GridPoint>> = [
+                (1, 0),
+                (-1, 0),
+                (0, 1),
+                (0, -1),
+                (1, 1),
+                (-1, 1),
+                (1, -1),
+                (-1, -1),
+            ]
+            .iter()
+            .map(|&(dx, dy)| at(x + dx, y + dy))
+            .collect();
+            if ring.iter().all(Option::is_some) {
+                // A regular interior vertex (every vertex but the centre has valence 4).
+                let (alpha, beta, gamma) = scheme.vertex.weights(4);
+                let mut c = vec![(exists(nb, s, x, y), alpha)];
+                c.extend(ring[..4].iter().flatten().map(|&p| (p, beta)));
+                c.extend(ring[4..].iter().flatten().map(|&p| (p, gamma)));
+                c
+            } else {
+                // A regular boundary vertex on an axis: the boundary curve rule along it.
+                let Some(GridPoint::Sector { s, a: x, .. }) = at(x, y) else {
+                    unreachable!("the centre is not refined here")
+                };
+                let rules = boundary
+                    .unwrap_or_else(|| unreachable!("validated: the scheme has boundary rules"));
+                let s = i64::from(s);
+                vec![
+                    (exists(nb, s, x, 0), rules.vertex_centre),
+                    (exists(nb, s, x - 1, 0), rules.vertex_end),
+                    (exists(nb, s, x + 1, 0), rules.vertex_end),
+                ]
+            }
+        }
+        (1, 0) | (0, 1) => {
+            // Edge from (x, y) to (x, y) + d; its side points are offset by o.
+            let (x, y, d, o) = if a.rem_euclid(2) == 1 {
+                ((a - 1) / 2, b / 2, (1, 0), (0, 1))
+            } else {
+                (a / 2, (b - 1) / 2, (0, 1), (1, 0))
+            };
+            let ends = [exists(nb, s, x, y), exists(nb, s, x + d.0, y + d.1)];
+            let sides: Vec<Option<GridPoint>> = [(0, 1), (0, -1), (1, 1), (1, -1)]
+                .iter()
+                .map(|&(along, across)| {
+                    at(
+                        x + along * d.0 + across * o.0,
+                        y + along * d.1 + across * o.1,
+                    )
+                })
+                .collect();
+            if sides.iter().all(Option::is_some) {
+                let mut c: Combination = ends.iter().map(|&p| (p, scheme.edge_end)).collect();
+                c.extend(sides.iter().flatten().map(|&p| (p, scheme.edge_side)));
+                c
+            } else {
+                // A boundary edge: its midpoint.
+                ends.iter().map(|&p| (p, half)).collect()
+            }
+        }
+        _ => {
+            let (x, y) = ((a - 1) / 2, (b - 1) / 2);
+            [(0, 0), (1, 0), (1, 1), (0, 1)]
+                .map(|(dx, dy)| (exists(nb, s, x + dx, y + dy), quarter))
+                .to_vec()
+        }
+    }
+}
+
+/// Point `(a, b)` of sector `s` as a combination of existing points: itself, or a phantom point
+/// extrapolated linearly across the boundary it lies beyond.
+fn with_phantoms(nb: Neighbourhood, s: i64, a: i64, b: i64) -> Combination {
+    if let Some(p) = canonical(nb, s, a, b) {
+        return vec![(p, Rational64::from_integer(1))];
+    }
+    // Beyond sector 0's axis (the line b = 0 of sector 0) reflect in b; beyond the last axis
+    // (the line a = 0 of sector f - 1) reflect in a. A corner patch has both.
+    let (near, far) = if s == 0 && b < 0 {
+        (
+            with_phantoms(nb, s, a, b + 1),
+            with_phantoms(nb, s, a, b + 2),
+        )
+    } else {
+        (
+            with_phantoms(nb, s, a + 1, b),
+            with_phantoms(nb, s, a + 2, b),
+        )
+    };
+    let two = Rational64::from_integer(2);
+    near.into_iter()
+        .map(|(p, w)| (p, w * two))
+        .chain(far.into_iter().map(|(p, w)| (p, -w)))
+        .collect()
+}
+
+/// The local subdivision matrices of one scheme around one neighbourhood, for one sector's patch.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LocalMatrices {
+    /// The neighbourhood.
+    pub neighbourhood: Neighbourhood,
+    /// The sector whose patch this is.
+    pub sector: u32,
+    /// The patch's control points.
+    pub layout: Vec<GridPoint>,
+    /// `A` (K x K): level-1 layout points from level-0 layout points.
+    pub a: Vec<Vec<BigRational>>,
+    /// `R_b` (16 x K), b = 0, 1, 2 for the sub-patches at [`SUB_PATCH_ORIGINS`].
+    pub sub_patches: [Vec<Vec<BigRational>>; 3],
+}
+
+impl LocalMatrices {
+    /// Build `A` and the `R_b` of `scheme` around `nb` for the patch of `sector`.
+    pub fn new(
+        scheme: &QuadScheme,
+        nb: Neighbourhood,
+        sector: u32,
+    ) -> Result<Self, UnsupportedNeighbourhood> {
+        nb.validate(scheme, sector)?;
+        let layout = patch_layout(nb, sector);
+        let index: HashMap<GridPoint, usize> =
+            layout.iter().enumerate().map(|(i, &p)| (p, i)).collect();
+        let row = |combination: Combination| -> Vec<BigRational> {
+            let mut r = vec![BigRational::zero(); layout.len()];
+            for (level1, w1) in combination {
+                for (p, w) in refine_point(scheme, nb, level1) {
+                    let i = *index.get(&p).unwrap_or_else(|| {
+                        unreachable!("a patch point's rule reads only the patch's points: {p:?}")
+                    });
+                    let w = w * w1;
+                    r[i] += BigRational::new(BigInt::from(*w.numer()), BigInt::from(*w.denom()));
+                }
+            }
+            r
+        };
+        let one = Rational64::from_integer(1);
+        let a = layout.iter().map(|&p| row(vec![(p, one)])).collect();
+        let s = i64::from(sector);
+        let sub_patches = SUB_PATCH_ORIGINS.map(|(a0, b0)| {
+            (-1..=2)
+                .flat_map(|q| (-1..=2).map(move |p| (p, q)))
+                .map(|(p, q)| row(with_phantoms(nb, s, a0 + p, b0 + q)))
+                .collect()
+        });
+        Ok(LocalMatrices {
+            neighbourhood: nb,
+            sector,
+            layout,
+            a,
+            sub_patches,
+        })
+    }
+
+    /// For a neighbourhood whose patch is itself a regular (boundary) tensor-product patch
+    /// ([`Neighbourhood::is_regular`]): its 4 x 4 net at level 0 (`16 x K`, points `(p, q)`,
+    /// `p, q in -1..=2`, `q` outer), phantom points beyond the boundary included, so that
+    /// the patch is `psi(u, v) N` on all of `[0,1]^2` without subdividing. `None` otherwise.
+    pub fn regular_net(&self) -> Option<Vec<Vec<BigRational>>> {
+        if !self.neighbourhood.is_regular() {
+            return None;
+        }
+        let index: HashMap<GridPoint, usize> = self
+            .layout
+            .iter()
+            .enumerate()
+            .map(|(i, &p)| (p, i))
+            .collect();
+        let s = i64::from(self.sector);
+        let nb = self.neighbourhood;
+        (-1..=2)
+            .flat_map(|q| (-1..=2).map(move |p| (p, q)))
+            .map(|(p, q)| {
+                let mut r = vec![BigRational::zero(); self.layout.len()];
+                for (point, w) in with_phantoms(nb, s, p, q) {
+                    r[*index.get(&point)?] +=
+                        BigRational::new(BigInt::from(*w.numer()), BigInt::from(*w.denom()));
+                }
+                Some(r)
+            })
+            .collect()
+    }
+
+    /// The number of control points `K`.
+    pub fn size(&self) -> usize {
+        self.a.len()
+    }
+
+    /// A short description for messages: `valence 5`, `boundary, 3 faces, sector 1`.
+    pub fn describe(&self) -> String {
+        match self.neighbourhood.boundary {
+            None => format!("valence {}", self.neighbourhood.faces),
+            Some(mode) => format!(
+                "boundary ({mode:?}), {} faces, sector {}",
+                self.neighbourhood.faces, self.sector
+            ),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use num_traits::One;
+
+    #[test]
+    fn canonical_names_wrap_around_the_vertex() {
+        let nb = Neighbourhood::interior(5);
+        assert_eq!(
+            canonical(nb, 0, 0, 2),
+            Some(GridPoint::Sector { s: 1, a: 2, b: 0 })
+        );
+        assert_eq!(
+            canonical(nb, 0, 2, -1),
+            Some(GridPoint::Sector { s: 4, a: 1, b: 2 })
+        );
+        assert_eq!(
+            canonical(Neighbourhood::interior(3), 0, -1, 0),
+            Some(GridPoint::Sector { s: 2, a: 1, b: 0 })
+        );
+        assert_eq!(
+            canonical(Neighbourhood::interior(6), 2, 0, 0),
+            Some(GridPoint::Centre)
+        );
+    }
+
+    #[test]
+    fn boundary_points_beyond_the_edges_do_not_exist() {
+        let nb = Neighbourhood::boundary(2, BoundaryMode::EdgeOnly);
+        assert_eq!(canonical(nb, 0, 2, -1), None);
+        assert_eq!(
+            canonical(nb, 0, 2, 0),
+            Some(GridPoint::Sector { s: 0, a: 2, b: 0 })
+        );
+        // (0, 2) of sector 1 is the last axis; (-1, 2) of sector 1 is beyond it.
+        assert_eq!(
+            canonical(nb, 1, 0, 2),
+            Some(GridPoint::Sector { s: 2, a: 2, b: 0 })
+        );
+        assert_eq!(canonical(nb, 1, -1, 2), None);
+    }
+
+    #[test]
+    fn interior_layout_has_2v_plus_8_distinct_points() {
+        for v in 3..=8 {
+            let layout = patch_layout(Neighbourhood::interior(v), 0);
+            assert_eq!(layout.len(), 2 * v as usize + 8);
+            let mut sorted = layout.clone();
+            sorted.sort();
+            sorted.dedup();
+            assert_eq!(sorted.len(), layout.len(), "valence {v}");
+        }
+    }
+
+    #[test]
+    fn every_row_is_an_affine_combination() {
+        let cc = QuadScheme::by_name("catmull-clark").expect("catalogued");
+        let sw = QuadScheme::by_name("sw-nonpoly-quad").expect("catalogued");
+        let mut cases: Vec<(QuadScheme, Neighbourhood, u32)> = Vec::new();
+        for v in 3..=8 {
+            cases.push((cc.clone(), Neighbourhood::interior(v), 0));
+            cases.push((sw.clone(), Neighbourhood::interior(v), 0));
+        }
+        for f in 1..=6 {
+            for mode in [BoundaryMode::EdgeOnly, BoundaryMode::EdgeAndCorner] {
+                for s in 0..f {
+                    cases.push((cc.clone(), Neighbourhood::boundary(f, mode), s));
+                }
+            }
+        }
+        for (scheme, nb, s) in cases {
+            let m = LocalMatrices::new(&scheme, nb, s).expect("valid neighbourhood");
+            for row in m.a.iter().chain(m.sub_patches.iter().flatten()) {
+                assert_eq!(
+                    row.iter().sum::<BigRational>(),
+                    BigRational::one(),
+                    "{} {}",
+                    scheme.name,
+                    m.describe()
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn unsupported_neighbourhoods_are_errors() {
+        let sw = QuadScheme::by_name("sw-nonpoly-quad").expect("catalogued");
+        assert!(
+            LocalMatrices::new(&sw, Neighbourhood::boundary(2, BoundaryMode::EdgeOnly), 0).is_err()
+        );
+        let cc = QuadScheme::by_name("catmull-clark").expect("catalogued");
+        assert!(LocalMatrices::new(&cc, Neighbourhood::interior(2), 0).is_err());
+        assert!(
+            LocalMatrices::new(&cc, Neighbourhood::boundary(3, BoundaryMode::EdgeOnly), 3).is_err()
+        );
+    }
+}
