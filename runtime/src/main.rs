@@ -1,4 +1,4 @@
-//! `subtess`: the runtime's command line: `subtess tessellate`, `subtess bench`,
+//! `subtess`: the runtime's command line: `subtess tessellate`, `subtess eval`, `subtess bench`,
 //! `subtess tables info` (docs/cli.md).
 
 use std::path::{Path, PathBuf};
@@ -7,6 +7,7 @@ use std::time::Instant;
 
 use clap::{Parser, Subcommand};
 use runtime::dual_grid::{tessellate, DualGrid};
+use runtime::exact_eval::{evaluate_subface, parse_rational};
 use runtime::isolate::isolate_with_origins;
 use runtime::mesh_output::{write_mesh, MeshFormat};
 use runtime::obj::read_obj;
@@ -85,6 +86,28 @@ enum Command {
         /// A stencil table file instead of the embedded default.
         #[arg(long)]
         table: Option<PathBuf>,
+    },
+    /// Exact limit position and first derivatives of face F at rational (u, v), in the face's
+    /// own parameters (rounded once to f64).
+    Eval {
+        /// Input mesh (OBJ).
+        mesh: PathBuf,
+        /// Subdivision scheme (catmull-clark).
+        #[arg(long, default_value = "catmull-clark")]
+        scheme: String,
+        /// Face number, 0-based, in OBJ order.
+        #[arg(long)]
+        face: usize,
+        /// `U,V`: rationals `p/q`, integers or decimals in [0, 1].
+        #[arg(long)]
+        uv: String,
+        /// For a non-quad face: which sub-face (the quad of the first Catmull-Clark step at
+        /// corner k).
+        #[arg(long, default_value_t = 0)]
+        corner: usize,
+        /// Print JSON `{"position","du","dv"}`.
+        #[arg(long)]
+        json: bool,
     },
     /// Stencil tables.
     Tables {
@@ -310,6 +333,42 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
                 "triangles_per_second": count as f64 / median.max(1e-12),
             });
             println!("{report}");
+            Ok(())
+        }
+        Command::Eval {
+            mesh,
+            scheme,
+            face,
+            uv,
+            corner,
+            json,
+        } => {
+            if scheme != "catmull-clark" {
+                return Err(RuntimeError::Unsupported(format!(
+                    "scheme `{scheme}` in the runtime (catmull-clark so far)"
+                )));
+            }
+            let (u, v) = uv
+                .split_once(',')
+                .ok_or_else(|| RuntimeError::InvalidParameter {
+                    name: format!("--uv `{uv}`"),
+                    reason: "two rationals `U,V` wanted".to_owned(),
+                })?;
+            let (u, v) = (parse_rational(u.trim())?, parse_rational(v.trim())?);
+            let input = load_mesh(&mesh)?;
+            let point = evaluate_subface(&input, face, corner, &u, &v)?;
+            if json {
+                let report = serde_json::json!({
+                    "position": point.position,
+                    "du": point.du,
+                    "dv": point.dv,
+                });
+                println!("{report}");
+            } else {
+                println!("position {:?}", point.position);
+                println!("du       {:?}", point.du);
+                println!("dv       {:?}", point.dv);
+            }
             Ok(())
         }
         Command::Tables {

@@ -215,3 +215,44 @@ fn tolerance_and_view_rates() {
     }
     let _ = std::fs::remove_file(obj);
 }
+
+/// `subtess eval` (DESIGN.md contract): JSON `{"position","du","dv"}`; the centre of the cube's
+/// top face lies on the cube's z axis (symmetry); bad arguments are clear errors.
+#[test]
+fn eval_prints_the_limit_point() {
+    let out = subtess("eval data/cube.obj --scheme catmull-clark --face 1 --uv 1/2,1/2 --json");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let point = json(&out);
+    let p: Vec<f64> = point["position"]
+        .as_array()
+        .expect("position")
+        .iter()
+        .filter_map(|x| x.as_f64())
+        .collect();
+    assert_eq!(p.len(), 3);
+    assert!(point["du"].as_array().is_some_and(|a| a.len() == 3));
+    assert!(point["dv"].as_array().is_some_and(|a| a.len() == 3));
+    // data/cube.obj is [-1, 1]^3, face 1 its top (z = 1).
+    assert!(
+        p[0].abs() < 1e-15 && p[1].abs() < 1e-15 && p[2] > 0.5 && p[2] < 1.0,
+        "{p:?}"
+    );
+    for (args, message) in [
+        ("eval data/cube.obj --face 99 --uv 0,0", "99"),
+        ("eval data/cube.obj --face 0 --uv 1/0,0", "1/0"),
+        ("eval data/cube.obj --face 0 --uv 2,0", "outside"),
+        ("eval data/cube.obj --face 0 --uv 0.5", "two rationals"),
+        ("eval data/cube.obj --scheme loop --face 0 --uv 0,0", "loop"),
+    ] {
+        let out = subtess(args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            !out.status.success() && stderr.contains(message),
+            "{args}: {stderr}"
+        );
+    }
+}

@@ -239,3 +239,74 @@ fn valence_4_regions_reproduce_the_bicubic_b_spline() {
         }
     }
 }
+
+/// Every output vertex is the exact limit surface (`exact_eval`, evaluated on the *input* mesh)
+/// at the source the tessellator reports for it, mapped back through isolation to the input
+/// face's own parameters (or an n-gon's sub-face): positions to f32 accuracy, normals to 1e-4.
+#[test]
+fn output_vertices_are_exact_evaluation_at_their_input_sources() {
+    use num_bigint::BigInt;
+    use num_rational::BigRational;
+    use runtime::exact_eval::ExactEvaluator;
+    use runtime::isolate::isolate_with_origins;
+    let table = StencilTable::default_catmull_clark().expect("embedded table");
+    // A pyramid with a pentagonal base (an n-gon) and a boundary: five triangles around the apex
+    // with one removed.
+    let mut p: Vec<[f64; 3]> = (0..5)
+        .map(|k| {
+            let a = std::f64::consts::TAU * f64::from(k) / 5.0;
+            [a.cos(), a.sin(), 0.0]
+        })
+        .collect();
+    p.push([0.1, 0.2, 1.3]);
+    let faces: Vec<Vec<i64>> = vec![
+        vec![4, 3, 2, 1, 0],
+        vec![0, 1, 5],
+        vec![1, 2, 5],
+        vec![2, 3, 5],
+        vec![3, 4, 5],
+    ];
+    let open_pyramid = Mesh::new(p, &faces, &[], schemes::BoundaryMode::EdgeOnly).expect("valid");
+    let cube = load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("data/cube.obj"));
+    let mut meshes = vec![("cube", cube, 1), ("open pyramid", open_pyramid, 1)];
+    if let Some(spot) = spot() {
+        meshes.push(("spot", spot, 37));
+    }
+    for (name, mesh, stride) in meshes {
+        let iso = isolate_with_origins(&mesh).expect("isolates");
+        let rates: Vec<u32> = (0..iso.patches.len())
+            .map(|f| 1 + (f as u32 * 3) % 5)
+            .collect();
+        let (out, _) = tessellate(&table, &iso.mesh, &iso.patches, &rates).expect("tessellates");
+        let exact = ExactEvaluator::new(&mesh);
+        let size = out
+            .positions
+            .iter()
+            .flatten()
+            .fold(0.0f32, |m, c| m.max(c.abs()));
+        for v in (0..out.positions.len()).step_by(stride) {
+            let s = iso.input_source(out.sources[v]);
+            let r = |x: u32| BigRational::new(BigInt::from(x), BigInt::from(s.denominator));
+            let point = exact
+                .evaluate_subface(s.face as usize, usize::from(s.subface), &r(s.u), &r(s.v))
+                .unwrap_or_else(|e| panic!("{name} vertex {v}: {e}"));
+            let got = out.positions[v];
+            assert!(
+                (0..3).all(|c| (point.position[c] - f64::from(got[c])).abs() < 2e-6 * f64::from(size)),
+                "{name} vertex {v} at {s:?}: {got:?} vs exact {:?}",
+                point.position
+            );
+            let n = [
+                point.du[1] * point.dv[2] - point.du[2] * point.dv[1],
+                point.du[2] * point.dv[0] - point.du[0] * point.dv[2],
+                point.du[0] * point.dv[1] - point.du[1] * point.dv[0],
+            ];
+            let length = n.iter().map(|x| x * x).sum::<f64>().sqrt();
+            let normal = out.normals[v];
+            assert!(
+                (0..3).all(|c| (n[c] / length - f64::from(normal[c])).abs() < 1e-4),
+                "{name} vertex {v} at {s:?}: normal {normal:?} vs exact {n:?}"
+            );
+        }
+    }
+}
