@@ -109,4 +109,17 @@ pub enum RuntimeError {
         /// The cause.
         source: std::io::Error,
     },
+    /// A Bézier patch file (Newell "patches + vertices" or `.bpt`) is malformed.
+    #[error("{path}:{line}: {message}")]
+    PatchFile {
+        /// The file (or a name for text parsed without one).
+        path: String,
+        /// 1-based line (0 when the problem is not on one line, e.g. an empty file).
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// An option of a tessellator is out of range (a threshold, a resolution, a budget).
+    #[error("invalid option: {0}")]
+    InvalidOption(String),
 }
