@@ -208,8 +208,8 @@ fn malformed_bpt_inputs_are_clear_errors() {
             "control point 16 of 16",
         ),
         (format!("1\n3 3\n1 2\n{pts}"), 3, "expected 3"),
-        (format!("2\n3 3\n{pts}"), 18, "patch 2"),
-        (format!("{good}9\n"), 19, "unexpected content"),
+        (format!("2\n3 3\n{pts}"), 19, "patch 2"),
+        (format!("{good}9\n"), 20, "unexpected content"),
     ];
     for (text, line, needle) in cases {
         let (l, m) = patch_error(BezierPatches::parse_bpt(&text, "in.txt"));
