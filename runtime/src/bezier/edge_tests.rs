@@ -106,8 +106,8 @@ pub fn map8p_points(p1: Uv, p2: Uv) -> [Uv; 4] {
 /// Whether a map test splits the edge `p1–p2` (parameters in the unit square), eq. (1)–(3):
 /// every distance `d_k` read from the map ([`DisplacementMap::sample`], bilinear; points
 /// outside the square are clamped to it) is compared with `d12` at the midpoint, and the edge
-/// is split when any difference exceeds `th`. Panics on [`EdgeTest::Flat`] never: that test
-/// needs vertices and is answered `false` here.
+/// is split when any difference exceeds `th`. [`EdgeTest::Flat`] needs vertices, not a map: it
+/// is answered `false` here (use [`flat_test`]).
 pub fn map_test(test: EdgeTest, map: &DisplacementMap, p1: Uv, p2: Uv, th: f64) -> bool {
     let (m, _) = half(p1, p2);
     let d12 = map.sample(m.0, m.1);
