@@ -69,12 +69,12 @@ pub enum RuntimeError {
         /// What is wrong.
         message: String,
     },
-    /// An OBJ file line is malformed.
+    /// A line of an input file (OBJ, Newell patches, `.bpt`) is malformed.
     #[error("{path}:{line}: {message}")]
-    ObjFile {
-        /// The file.
+    ParseFile {
+        /// The file (or a name for text parsed without one).
         path: String,
-        /// 1-based line.
+        /// 1-based line (0 when the problem is not on one line, e.g. an empty file).
         line: usize,
         /// What is wrong.
         message: String,
@@ -118,4 +118,14 @@ pub enum RuntimeError {
         /// Its value and what it must be.
         reason: String,
     },
+}
+
+impl RuntimeError {
+    /// An out-of-range tessellator option (a threshold, a resolution, a budget), said in full.
+    pub fn invalid_option(reason: String) -> Self {
+        RuntimeError::InvalidParameter {
+            name: "option".to_owned(),
+            reason,
+        }
+    }
 }

@@ -6,6 +6,7 @@
 //! assert!(!table.index().entries.is_empty());
 //! ```
 
+pub mod bezier;
 pub mod dual_grid;
 pub mod error;
 pub mod exact_eval;

@@ -145,7 +145,7 @@ pub fn read_obj(path: &Path) -> Result<ObjMesh, RuntimeError> {
         source,
     })?;
     parse_obj(&text).map_err(|e| match e {
-        RuntimeError::Obj { line, message } => RuntimeError::ObjFile {
+        RuntimeError::Obj { line, message } => RuntimeError::ParseFile {
             path: path.display().to_string(),
             line,
             message,
