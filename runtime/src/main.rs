@@ -6,6 +6,7 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use clap::{Parser, Subcommand};
+use runtime::bezier::{tessellate_bezier, BezierOptions, BezierPatches};
 use runtime::dual_grid::{tessellate, DualGrid};
 use runtime::exact_eval::{evaluate_subface, parse_rational};
 use runtime::isolate::isolate_with_origins;
@@ -33,7 +34,8 @@ enum Command {
     /// Tessellate a Catmull-Clark mesh (OBJ) with the dual-grid method.
     Tessellate {
         /// Input mesh (OBJ: triangles, quads, n-gons; closed or with boundary).
-        mesh: PathBuf,
+        #[arg(required_unless_present = "bezier", conflicts_with = "bezier")]
+        mesh: Option<PathBuf>,
         /// Output triangle mesh: .obj, .ply (with per-vertex face, u, v), .glb or .gltf.
         #[arg(short = 'o', long = "output")]
         output: PathBuf,
@@ -61,6 +63,20 @@ enum Command {
         /// Print statistics as JSON on stdout.
         #[arg(long)]
         stats: bool,
+        /// Bicubic Bezier patches instead of a mesh (Newell "patches + vertices" text, or
+        /// `.bpt`), tessellated adaptively by Espino et al.'s displacement-map method
+        /// (docs/espino.md).
+        #[arg(long)]
+        bezier: Option<PathBuf>,
+        /// Bezier edge test: map2p, map4p, map8p or flat.
+        #[arg(long = "test", default_value = "map4p", requires = "bezier")]
+        edge_test: String,
+        /// Bezier split threshold `th` (eq. 1-3), a distance.
+        #[arg(long, requires = "bezier", conflicts_with = "triangles")]
+        threshold: Option<f64>,
+        /// Bezier triangle budget: search the threshold whose output is nearest it.
+        #[arg(long, requires = "bezier")]
+        triangles: Option<usize>,
     },
     /// Measure per-frame tessellation throughput: the plan (topology, patches, stencil
     /// lookups) is built once, then every frame evaluates all positions and normals and writes
@@ -211,8 +227,42 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
             view,
             table,
             stats,
+            bezier,
+            edge_test,
+            threshold,
+            triangles: budget,
         } => {
             MeshFormat::from_path(&output)?;
+            let mesh = match (mesh, bezier) {
+                (_, Some(file)) => {
+                    let patches = BezierPatches::read(&file)?;
+                    let defaults = BezierOptions::default();
+                    let options = BezierOptions {
+                        test: edge_test.parse()?,
+                        threshold: threshold.unwrap_or(defaults.threshold),
+                        target_triangles: budget,
+                        error_samples: if stats { defaults.error_samples } else { 0 },
+                        ..defaults
+                    };
+                    let (triangles, bezier_stats) = tessellate_bezier(&patches, &options)?;
+                    write_mesh(&triangles, &output)?;
+                    if stats {
+                        println!("{}", bezier_stats.to_json());
+                    }
+                    return Ok(());
+                }
+                (Some(_), None) if threshold.is_some() || budget.is_some() => {
+                    return Err(RuntimeError::Unsupported(
+                        "--threshold and --triangles belong to --bezier tessellation".to_owned(),
+                    ))
+                }
+                (Some(mesh), None) => mesh,
+                (None, None) => {
+                    return Err(RuntimeError::Unsupported(
+                        "nothing to tessellate: give a mesh or --bezier FILE".to_owned(),
+                    ))
+                }
+            };
             let table = load_table(&table)?;
             let input = load_mesh(&mesh)?;
             let iso = isolate_with_origins(&input)?;

@@ -256,3 +256,43 @@ fn eval_prints_the_limit_point() {
         );
     }
 }
+
+/// `--bezier`: Espino et al.'s tessellator from the same command, with its own `--stats`.
+#[test]
+fn bezier_patches_from_the_command_line() {
+    let teapot =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/models/bezier/teapot.bpt");
+    if !teapot.exists() {
+        println!("skipping: {} is absent", teapot.display());
+        return;
+    }
+    let out_path = temp("teapot.ply");
+    let out = subtess(&format!(
+        "tessellate --bezier {} -o {} --test map4p --triangles 3000 --stats",
+        teapot.display(),
+        out_path.display()
+    ));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stats = json(&out);
+    let triangles = stats["triangles"].as_u64().expect("a count");
+    assert!((2700..=3300).contains(&triangles), "{triangles}");
+    assert_eq!(
+        stats["vertices_discarded"], 0,
+        "map tests decide before evaluating"
+    );
+    assert!(std::fs::read(&out_path)
+        .expect("written")
+        .starts_with(b"ply"));
+    let _ = std::fs::remove_file(out_path);
+    for args in [
+        "tessellate data/cube.obj -o x.obj --threshold 3",
+        "tessellate -o x.obj",
+    ] {
+        let out = subtess(args);
+        assert!(!out.status.success(), "{args}");
+    }
+}
