@@ -10,6 +10,7 @@ pub mod bezier;
 pub mod dual_grid;
 pub mod error;
 pub mod exact_eval;
+pub mod geometry;
 pub mod isolate;
 pub mod mesh_output;
 pub mod obj;

@@ -565,26 +565,6 @@ fn combine(terms: &[(f64, [f64; 3])]) -> [f64; 3] {
     out
 }
 
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
-    dot(sub(a, b), sub(a, b)).sqrt()
-}
-
 fn check_faces(mesh: &Mesh, patches: &[FacePatch]) -> Result<(), RuntimeError> {
     if patches.len() != mesh.faces() {
         return Err(RuntimeError::Unsupported(format!(
@@ -850,48 +830,8 @@ fn bounds(t: &[[f64; 3]; 3], c: usize) -> (f64, f64) {
     )
 }
 
-/// The distance from `p` to the triangle `t` (closest point by Voronoi regions, Ericson,
-/// *Real-Time Collision Detection*, 5.1.5).
-pub fn point_triangle_distance(p: [f64; 3], t: &[[f64; 3]; 3]) -> f64 {
-    let [a, b, c] = *t;
-    let (ab, ac, ap) = (sub(b, a), sub(c, a), sub(p, a));
-    let (d1, d2) = (dot(ab, ap), dot(ac, ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return distance(p, a);
-    }
-    let bp = sub(p, b);
-    let (d3, d4) = (dot(ab, bp), dot(ac, bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return distance(p, b);
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        let v = d1 / (d1 - d3);
-        return distance(p, combine(&[(1.0 - v, a), (v, b)]));
-    }
-    let cp = sub(p, c);
-    let (d5, d6) = (dot(ab, cp), dot(ac, cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return distance(p, c);
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        let w = d2 / (d2 - d6);
-        return distance(p, combine(&[(1.0 - w, a), (w, c)]));
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return distance(p, combine(&[(1.0 - w, b), (w, c)]));
-    }
-    let denominator = va + vb + vc;
-    if denominator == 0.0 {
-        // Degenerate (zero-area) triangle that no test above caught: its vertices bound it.
-        return distance(p, a).min(distance(p, b)).min(distance(p, c));
-    }
-    let (v, w) = (vb / denominator, vc / denominator);
-    distance(p, combine(&[(1.0 - v - w, a), (v, b), (w, c)]))
-}
+pub use crate::geometry::point_triangle_distance;
+use crate::geometry::{cross, distance, dot, sub};
 
 /// A pinhole camera for view-dependent rates (Schaefer–Warren section 5.5: "projecting each quad
 /// from the base subdivision surface onto the screen, computing its maximal edge length and

@@ -434,7 +434,7 @@ fn map_tests_compare_differences_with_the_threshold_eq_1_and_3() {
 #[test]
 fn point_triangle_distance_is_exact_and_the_grid_finds_the_nearest() {
     let t = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
-    let d = |p: P3| point_triangle_distance(p, t[0], t[1], t[2]);
+    let d = |p: P3| point_triangle_distance(p, &[t[0], t[1], t[2]]);
     assert!((d([0.2, 0.2, 0.5]) - 0.5).abs() < 1e-15, "over the face");
     assert!(
         (d([-1.0, -1.0, 0.0]) - 2f64.sqrt()).abs() < 1e-15,
@@ -464,11 +464,11 @@ fn point_triangle_distance_is_exact_and_the_grid_finds_the_nearest() {
         let p = [3.0 * f - 1.0, (7.0 * f).sin() * 2.0, (13.0 * f).cos()];
         let brute = tris
             .iter()
-            .map(|t| point_triangle_distance(p, t[0], t[1], t[2]))
+            .map(|t| point_triangle_distance(p, &[t[0], t[1], t[2]]))
             .fold(f64::INFINITY, f64::min);
         assert_eq!(grid.nearest_distance(p), brute, "the grid is exact");
         let t = tris[k % tris.len()];
-        let exact = point_triangle_distance(p, t[0], t[1], t[2]);
+        let exact = point_triangle_distance(p, &[t[0], t[1], t[2]]);
         let mut sampled = f64::INFINITY;
         let s = 60;
         for i in 0..=s {

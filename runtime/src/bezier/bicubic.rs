@@ -15,42 +15,8 @@
 //! then takes the limit normal from the next non-vanishing term of the Taylor expansion of
 //! `S_u × S_v` into the patch (first, then second and third derivatives).
 
-/// A point or vector in 3D.
-pub type Point3 = [f64; 3];
-
-/// Difference `a - b`.
-pub(crate) fn sub(a: Point3, b: Point3) -> Point3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-/// Sum `a + b`.
-pub(crate) fn add(a: Point3, b: Point3) -> Point3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-
-/// `s * a`.
-pub(crate) fn scale(s: f64, a: Point3) -> Point3 {
-    [s * a[0], s * a[1], s * a[2]]
-}
-
-/// Dot product.
-pub(crate) fn dot(a: Point3, b: Point3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-/// Cross product.
-pub(crate) fn cross(a: Point3, b: Point3) -> Point3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-/// Euclidean length.
-pub(crate) fn norm(a: Point3) -> f64 {
-    dot(a, a).sqrt()
-}
+pub use crate::geometry::Point3;
+pub(crate) use crate::geometry::{add, cross, dot, norm, scale, sub};
 
 /// The Bernstein polynomials of degree `n` (0..=3) at `t`; entries past `n` are zero.
 ///

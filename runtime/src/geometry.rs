@@ -1,0 +1,117 @@
+//! Small 3D vector helpers and exact point–triangle distances, shared by the error measures of
+//! the tessellators (`rates`, `bezier`).
+
+/// A point or vector in 3D.
+pub type Point3 = [f64; 3];
+
+/// Difference `a - b`.
+pub fn sub(a: Point3, b: Point3) -> Point3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+/// Sum `a + b`.
+pub fn add(a: Point3, b: Point3) -> Point3 {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+/// `s * a`.
+pub fn scale(s: f64, a: Point3) -> Point3 {
+    [s * a[0], s * a[1], s * a[2]]
+}
+
+/// Dot product.
+pub fn dot(a: Point3, b: Point3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// Cross product.
+pub fn cross(a: Point3, b: Point3) -> Point3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// Euclidean distance between two points.
+pub fn distance(a: Point3, b: Point3) -> f64 {
+    norm(sub(a, b))
+}
+
+/// Euclidean length.
+pub fn norm(a: Point3) -> f64 {
+    dot(a, a).sqrt()
+}
+
+/// The closest point to `p` on segment `ab`.
+pub fn closest_point_on_segment(p: Point3, a: Point3, b: Point3) -> Point3 {
+    let ab = sub(b, a);
+    let len2 = dot(ab, ab);
+    if len2 == 0.0 {
+        return a;
+    }
+    let t = (dot(sub(p, a), ab) / len2).clamp(0.0, 1.0);
+    add(a, scale(t, ab))
+}
+
+/// The closest point to `p` on the (closed, solid) triangle `abc`, exactly in the sense of
+/// the Voronoi-region classification (Ericson, *Real-Time Collision Detection*, 5.1.5).
+/// A degenerate triangle (zero area: coincident or collinear corners) is treated as the
+/// union of its three sides.
+pub fn closest_point_on_triangle(p: Point3, a: Point3, b: Point3, c: Point3) -> Point3 {
+    let ab = sub(b, a);
+    let ac = sub(c, a);
+    let n = cross(ab, ac);
+    let longest = dot(ab, ab).max(dot(ac, ac)).max(dot(sub(c, b), sub(c, b)));
+    if dot(n, n) <= 1e-28 * longest * longest {
+        let candidates = [
+            closest_point_on_segment(p, a, b),
+            closest_point_on_segment(p, b, c),
+            closest_point_on_segment(p, c, a),
+        ];
+        let mut best = candidates[0];
+        for q in candidates {
+            if norm(sub(p, q)) < norm(sub(p, best)) {
+                best = q;
+            }
+        }
+        return best;
+    }
+    let ap = sub(p, a);
+    let d1 = dot(ab, ap);
+    let d2 = dot(ac, ap);
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return a;
+    }
+    let bp = sub(p, b);
+    let d3 = dot(ab, bp);
+    let d4 = dot(ac, bp);
+    if d3 >= 0.0 && d4 <= d3 {
+        return b;
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return add(a, scale(d1 / (d1 - d3), ab));
+    }
+    let cp = sub(p, c);
+    let d5 = dot(ab, cp);
+    let d6 = dot(ac, cp);
+    if d6 >= 0.0 && d5 <= d6 {
+        return c;
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return add(a, scale(d2 / (d2 - d6), ac));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0 {
+        return add(b, scale((d4 - d3) / ((d4 - d3) + (d5 - d6)), sub(c, b)));
+    }
+    let denom = 1.0 / (va + vb + vc);
+    add(a, add(scale(vb * denom, ab), scale(vc * denom, ac)))
+}
+
+/// The distance from `p` to the triangle `t` ([`closest_point_on_triangle`]).
+pub fn point_triangle_distance(p: Point3, t: &[Point3; 3]) -> f64 {
+    norm(sub(p, closest_point_on_triangle(p, t[0], t[1], t[2])))
+}
