@@ -1,5 +1,7 @@
-//! Generates the default stencil table into OUT_DIR (see `src/lib.rs` for why it is not
+//! Generates the default stencil tables into OUT_DIR (see `src/lib.rs` for why they are not
 //! checked in).
+
+type Generator = fn() -> Result<Vec<u8>, stencilgen::StencilError>;
 
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
@@ -8,16 +10,25 @@ fn main() {
         eprintln!("OUT_DIR is not set");
         std::process::exit(1);
     };
-    match stencilgen::table::default_table() {
-        Ok(bytes) => {
-            if let Err(e) = std::fs::write(out.join("catmull-clark.subtess"), bytes) {
-                eprintln!("cannot write the default table: {e}");
+    let tables: [(&str, Generator); 2] = [
+        ("catmull-clark.subtess", stencilgen::table::default_table),
+        (
+            "catmull-clark-corners.subtess",
+            stencilgen::table::default_corner_table,
+        ),
+    ];
+    for (name, generate) in tables {
+        match generate() {
+            Ok(bytes) => {
+                if let Err(e) = std::fs::write(out.join(name), bytes) {
+                    eprintln!("cannot write the table {name}: {e}");
+                    std::process::exit(1);
+                }
+            }
+            Err(e) => {
+                eprintln!("cannot generate the table {name}: {e}");
                 std::process::exit(1);
             }
-        }
-        Err(e) => {
-            eprintln!("cannot generate the default table: {e}");
-            std::process::exit(1);
         }
     }
 }

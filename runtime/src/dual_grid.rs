@@ -309,7 +309,7 @@ impl<'t> DualGrid<'t> {
         // A one-face boundary vertex is smooth in "edge only" mode and pinned in "edge and
         // corner" mode: its stencils must come from a table made for the mesh's mode.
         let corners = mesh.boundary == schemes::BoundaryMode::EdgeAndCorner;
-        if table.index().meta.corners != corners
+        if table.pins_corners() != corners
             && patches.iter().any(|p| p.kind.boundary && p.kind.faces == 1)
         {
             return Err(RuntimeError::BoundaryModeMismatch {

@@ -151,10 +151,14 @@ fn main() -> ExitCode {
     }
 }
 
-fn load_table(table: &Option<PathBuf>) -> Result<StencilTable, RuntimeError> {
+/// The table file, or the embedded default for the mesh's boundary rule.
+fn load_table(
+    table: &Option<PathBuf>,
+    mode: schemes::BoundaryMode,
+) -> Result<StencilTable, RuntimeError> {
     match table {
         Some(path) => StencilTable::read(path),
-        None => StencilTable::default_catmull_clark(),
+        None => StencilTable::default_for(mode),
     }
 }
 
@@ -263,8 +267,8 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
                     ))
                 }
             };
-            let table = load_table(&table)?;
             let input = load_mesh(&mesh)?;
+            let table = load_table(&table, input.boundary)?;
             let iso = isolate_with_origins(&input)?;
             let mut unmet = None;
             let rates = if let Some(path) = &rates {
@@ -323,8 +327,8 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
             frames,
             table,
         } => {
-            let table = load_table(&table)?;
             let mut input = load_mesh(&mesh)?;
+            let table = load_table(&table, input.boundary)?;
             for _ in 0..steps {
                 input = refine(&input).mesh;
             }
@@ -428,7 +432,7 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
                 Some(path) => path.display().to_string(),
                 None => "(embedded default)".to_owned(),
             };
-            let table = load_table(&file)?;
+            let table = load_table(&file, schemes::BoundaryMode::EdgeOnly)?;
             let index = table.index();
             let weights: u64 = index
                 .entries

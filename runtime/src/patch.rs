@@ -241,7 +241,7 @@ pub fn dual_positions(
     // A one-face boundary vertex is smooth in "edge only" mode and pinned in "edge and corner"
     // mode: its stencils must come from a table made for the mesh's mode.
     let corners = mesh.boundary == schemes::BoundaryMode::EdgeAndCorner;
-    if patch.kind.boundary && patch.kind.faces == 1 && table.index().meta.corners != corners {
+    if patch.kind.boundary && patch.kind.faces == 1 && table.pins_corners() != corners {
         return Err(RuntimeError::BoundaryModeMismatch {
             mesh_corners: corners,
         });

@@ -15,22 +15,47 @@ enum Storage {
     Owned(AlignedBytes),
 }
 
-/// A validated stencil table.
+/// A validated stencil table, optionally with a pinned-corner table laid over it: the one-face
+/// boundary sections are then read from that one (every other patch is the same whether a
+/// mesh pins its corners or not).
 #[derive(Debug)]
 pub struct StencilTable {
     storage: Storage,
     index: TableIndex,
+    corners: Option<Box<StencilTable>>,
 }
 
 impl StencilTable {
     /// The embedded default Catmull–Clark table (validated: its checksum is verified too).
     pub fn default_catmull_clark() -> Result<Self, RuntimeError> {
-        let bytes = tables::default_catmull_clark();
+        Self::embedded(tables::default_catmull_clark())
+    }
+
+    fn embedded(bytes: &'static [u8]) -> Result<Self, RuntimeError> {
         let index = TableIndex::parse(bytes)?;
         Ok(StencilTable {
             storage: Storage::Embedded(bytes),
             index,
+            corners: None,
         })
+    }
+
+    /// The embedded default table for a mesh's boundary rule: for "edge and corner" meshes, the
+    /// default table with the embedded pinned-corner table laid over it.
+    pub fn default_for(mode: schemes::BoundaryMode) -> Result<Self, RuntimeError> {
+        let mut table = Self::default_catmull_clark()?;
+        if mode == schemes::BoundaryMode::EdgeAndCorner {
+            table.corners = Some(Box::new(Self::embedded(
+                tables::default_catmull_clark_corners(),
+            )?));
+        }
+        Ok(table)
+    }
+
+    /// Whether one-face boundary vertices are pinned corners in this table (its own header, or
+    /// a pinned-corner table laid over it).
+    pub fn pins_corners(&self) -> bool {
+        self.corners.is_some() || self.index.meta.corners
     }
 
     /// Validate a table held in memory (copied once into an aligned buffer).
@@ -40,6 +65,7 @@ impl StencilTable {
         Ok(StencilTable {
             storage: Storage::Owned(bytes),
             index,
+            corners: None,
         })
     }
 
@@ -53,6 +79,7 @@ impl StencilTable {
         Ok(StencilTable {
             storage: Storage::Owned(bytes),
             index,
+            corners: None,
         })
     }
 
@@ -71,6 +98,9 @@ impl StencilTable {
 
     /// The f32 weights of one section: `points x K`, point-major (zero-copy).
     pub fn weights(&self, key: &SectionKey) -> Result<&[f32], RuntimeError> {
+        if let (Some(corners), true) = (&self.corners, key.boundary && key.faces == 1) {
+            return corners.weights(key);
+        }
         Ok(self.index.weights_f32(self.bytes(), key)?)
     }
 }

@@ -296,3 +296,30 @@ fn bezier_patches_from_the_command_line() {
         assert!(!out.status.success(), "{args}");
     }
 }
+
+/// A mesh that pins its corners (`t interpolateboundary 1 0`) tessellates with the embedded
+/// tables, no table file needed.
+#[test]
+fn pinned_corners_work_out_of_the_box() {
+    let shape = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../shared/models/opensubdiv/catmark_edgecorner.obj");
+    if !shape.exists() {
+        println!("skipping: {} is absent", shape.display());
+        return;
+    }
+    let obj = temp("edgecorner.obj");
+    let out = subtess(&format!(
+        "tessellate {} -o {} --rate 3 --stats",
+        shape.display(),
+        obj.display()
+    ));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stats = json(&out);
+    assert!(stats["boundary_loops"].as_u64().is_some_and(|l| l > 0));
+    assert!(stats["triangles"].as_u64().is_some_and(|t| t > 0));
+    let _ = std::fs::remove_file(obj);
+}

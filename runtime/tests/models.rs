@@ -88,8 +88,8 @@ fn every_opensubdiv_shape_is_read_or_refused_clearly() {
 }
 
 /// Every shape the topology accepts tessellates (rate 3, and mixed rates 1..5) into a closed,
-/// consistently oriented surface or, with boundary, one with as many boundary loops as the
-/// input; the Euler characteristic is the input's. Shapes are refused, with the reason, only
+/// consistently oriented surface or, with boundary, one with boundary edges; the Euler
+/// characteristic is the input's. Shapes that pin their corners use the embedded corner table. Shapes are refused, with the reason, only
 /// when isolation fails.
 #[test]
 fn every_accepted_opensubdiv_shape_tessellates_watertight() {
@@ -101,12 +101,10 @@ fn every_accepted_opensubdiv_shape_tessellates_watertight() {
         .filter(|p| p.extension().is_some_and(|e| e == "obj"))
         .collect();
     entries.sort();
-    // Shapes that pin their one-face corners need a table made for that rule.
-    let mut spec = stencilgen::table::TableSpec::default_catmull_clark().expect("spec");
-    spec.set.boundary_mode = schemes::BoundaryMode::EdgeAndCorner;
-    spec.set.rates = (1..=5).collect();
-    let bytes = stencilgen::table::build_table(&spec, &|_, _| {}).expect("corner table");
-    let corner_table = StencilTable::from_bytes(&bytes).expect("valid");
+    // Shapes that pin their one-face corners get the embedded pinned-corner table laid over
+    // the default one.
+    let corner_table =
+        StencilTable::default_for(schemes::BoundaryMode::EdgeAndCorner).expect("embedded tables");
     let (mut tessellated, mut corners, mut refused) = (0, 0, Vec::new());
     for path in entries {
         let name = path

@@ -131,8 +131,13 @@ fn pinned_corners_need_a_corner_table() {
     let path = std::env::temp_dir().join(format!("subtess-corners-{}.subtess", std::process::id()));
     std::fs::write(&path, bytes).expect("write");
     let table = StencilTable::read(&path).expect("valid");
-    check_refinement_invariance("catmark_edgecorner", mesh, &table);
+    check_refinement_invariance("catmark_edgecorner", mesh.clone(), &table);
     let _ = std::fs::remove_file(&path);
+    // The embedded pinned-corner table laid over the default one does the same.
+    let overlay =
+        StencilTable::default_for(schemes::BoundaryMode::EdgeAndCorner).expect("embedded tables");
+    assert!(overlay.pins_corners());
+    check_refinement_invariance("catmark_edgecorner (embedded corner table)", mesh, &overlay);
 }
 
 #[test]

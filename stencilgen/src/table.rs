@@ -45,6 +45,20 @@ impl TableSpec {
     }
 }
 
+impl TableSpec {
+    /// The pinned-corner companion of the default table: only the one-face boundary vertex in
+    /// "edge and corner" mode (OpenSubdiv's `interpolateboundary 1`), every default rate. Every
+    /// other patch is the same in both modes, so the runtime lays this small table over the
+    /// default one for meshes that pin their corners.
+    pub fn default_corners() -> Result<Self, StencilError> {
+        let mut spec = TableSpec::default_catmull_clark()?;
+        spec.set.valences = Vec::new();
+        spec.set.boundary_faces = vec![1];
+        spec.set.boundary_mode = schemes::BoundaryMode::EdgeAndCorner;
+        Ok(spec)
+    }
+}
+
 /// Generate and encode the table of `spec`, reporting `progress(done, total)` grids.
 pub fn build_table(
     spec: &TableSpec,
@@ -71,6 +85,11 @@ pub fn build_table(
 /// The default table's bytes (deterministic: the same bytes on every run).
 pub fn default_table() -> Result<Vec<u8>, StencilError> {
     build_table(&TableSpec::default_catmull_clark()?, &|_, _| {})
+}
+
+/// The embedded pinned-corner companion table ([`TableSpec::default_corners`]), encoded.
+pub fn default_corner_table() -> Result<Vec<u8>, StencilError> {
+    build_table(&TableSpec::default_corners()?, &|_, _| {})
 }
 
 type Section = (SectionKey, u32, Vec<f64>);

@@ -1,4 +1,5 @@
-//! The default stencil tables, embedded.
+//! The default stencil tables, embedded: the Catmull–Clark table and its small pinned-corner
+//! companion.
 //!
 //! The default Catmull–Clark table (interior valences 3..=8, boundary vertices with 1..=6 faces
 //! "edge only", n = 1..=24, primal and dual grids, positions and both derivatives, f32) is about
@@ -18,17 +19,33 @@ static CATMULL_CLARK: &Aligned<[u8]> = &Aligned(*include_bytes!(concat!(
     "/catmull-clark.subtess"
 )));
 
+static CATMULL_CLARK_CORNERS: &Aligned<[u8]> = &Aligned(*include_bytes!(concat!(
+    env!("OUT_DIR"),
+    "/catmull-clark-corners.subtess"
+)));
+
 /// The default Catmull–Clark table's bytes (64-byte aligned).
 pub fn default_catmull_clark() -> &'static [u8] {
     &CATMULL_CLARK.0
+}
+
+/// The pinned-corner companion table's bytes (64-byte aligned): the one-face boundary vertex in
+/// "edge and corner" mode, n = 1..=24 (`stencilgen::table::TableSpec::default_corners`). Laid
+/// over the default table for meshes with `interpolateboundary 1`.
+pub fn default_catmull_clark_corners() -> &'static [u8] {
+    &CATMULL_CLARK_CORNERS.0
 }
 
 #[cfg(test)]
 mod tests {
     #[test]
     fn embedded_table_is_aligned_and_starts_with_the_magic() {
-        let bytes = super::default_catmull_clark();
-        assert_eq!(bytes.as_ptr() as usize % 64, 0);
-        assert_eq!(&bytes[..8], b"SUBTESS\0");
+        for bytes in [
+            super::default_catmull_clark(),
+            super::default_catmull_clark_corners(),
+        ] {
+            assert_eq!(bytes.as_ptr() as usize % 64, 0);
+            assert_eq!(&bytes[..8], b"SUBTESS\0");
+        }
     }
 }

@@ -17,3 +17,21 @@ fn regenerated_default_table_is_byte_identical() {
         table.coverage()
     );
 }
+
+#[test]
+fn regenerated_corner_table_is_byte_identical() {
+    let fresh = stencilgen::table::default_corner_table().expect("the corner table generates");
+    let embedded = tables::default_catmull_clark_corners();
+    assert!(
+        fresh == embedded,
+        "the embedded corner table differs from a fresh generation"
+    );
+    let table = table_format::Table::parse(embedded).expect("the embedded table is valid");
+    assert!(table.meta.corners);
+    println!(
+        "corner table: {} bytes, {} sections; {}",
+        table.size(),
+        table.entries.len(),
+        table.coverage()
+    );
+}
