@@ -1,4 +1,4 @@
-//! Subdivision schemes as data.
+//! Subdivision schemes as data: curves, quad schemes and triangle schemes (Loop, butterfly, √3).
 //!
 //! A subdivision scheme is described here only by the numbers that define it: its masks
 //! (the columns of the subdivision matrix S in `p_{j+1} = S p_j`, Schaefer–Warren eq. (1))
@@ -17,7 +17,9 @@ pub mod bivariate;
 pub mod curve;
 pub mod local_matrices;
 pub mod quad;
+pub mod triangle;
 
 pub use bivariate::BivariateMask;
 pub use curve::{Component, CurveScheme, Term, Translates};
 pub use quad::{BoundaryMode, BoundaryRules, QuadScheme, VertexRule};
+pub use triangle::{LatticeMask, TriangleScheme, TriangleVertexRule, TriangleWeight};

@@ -3,7 +3,8 @@
 //! `stencilgen curve --scheme NAME --n N [--derivative] [--f64] [--json]` prints the values of
 //! a curve scheme's basis function(s) (or their derivatives) on the grid `(1/n) Z`;
 //! `stencilgen stencil --scheme S --valence V --u p/q --v p/q [--f64] [--json]` the stencil of
-//! the patch next to an extraordinary vertex. See `docs/cli.md` for the JSON layouts.
+//! the patch next to an extraordinary vertex; `stencilgen triangle --scheme S --n N` the regular
+//! basis function of a triangle scheme on `(1/n) Z^2`. See `docs/cli.md` for the JSON layouts.
 
 use std::process::ExitCode;
 
@@ -11,7 +12,8 @@ use clap::{Parser, Subcommand};
 use num_rational::BigRational;
 use schemes::curve::CURVE_SCHEME_NAMES;
 use schemes::quad::QUAD_SCHEME_NAMES;
-use schemes::{BoundaryMode, CurveScheme, QuadScheme};
+use schemes::triangle::TRIANGLE_SCHEME_NAMES;
+use schemes::{BoundaryMode, CurveScheme, QuadScheme, TriangleScheme};
 use serde_json::{json, Value};
 use stencilgen::extraordinary_patch::{canonical, Neighbourhood, OUTER_POINTS};
 use stencilgen::patch_stencils::{curve_scheme, quad_scheme};
@@ -20,6 +22,7 @@ use stencilgen::regular_patch::StencilKind;
 use stencilgen::stencil_set::StencilSetSpec;
 use stencilgen::substitution::Substitution;
 use stencilgen::table::{build_table, TableSpec};
+use stencilgen::triangle_system::{triangle_stencils, TriangleStencils};
 use stencilgen::{curve_stencils, CurveStencils, Scalar, StencilError};
 use table_format::Precision;
 
@@ -115,6 +118,25 @@ enum Command {
         #[arg(short = 'o', long = "output")]
         output: std::path::PathBuf,
     },
+    /// Regular basis-function values of a triangle scheme on the grid (1/n)Z^2 (skew lattice
+    /// coordinates; Schaefer-Warren section 5.1).
+    Triangle {
+        /// Triangle scheme name (loop, loop-original, butterfly, sqrt3).
+        #[arg(long)]
+        scheme: String,
+        /// Grid rate: values at the points k/n of the support.
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(stencilgen::triangle_system::MAX_TRIANGLE_RATE)))]
+        n: u32,
+        /// Tangent masks: d/du (along (1,0)) or d/dv (along (0,1)) instead of values.
+        #[arg(long, value_parser = ["u", "v"])]
+        derivative: Option<String>,
+        /// Solve in f64 (SVD least squares) instead of exact rationals.
+        #[arg(long = "f64")]
+        float: bool,
+        /// Print JSON (exact values as "p/q" strings, f64 values as numbers).
+        #[arg(long)]
+        json: bool,
+    },
     /// List the schemes.
     Schemes,
 }
@@ -142,6 +164,53 @@ fn run(cli: Cli) -> Result<(), StencilError> {
             for name in QUAD_SCHEME_NAMES {
                 if let Some(scheme) = QuadScheme::by_name(name) {
                     println!("  {name:<26} {}", scheme.description);
+                }
+            }
+            println!("triangle schemes (stencilgen triangle):");
+            for name in TRIANGLE_SCHEME_NAMES {
+                if let Some(scheme) = TriangleScheme::by_name(name) {
+                    println!("  {name:<26} {}", scheme.description);
+                }
+            }
+            Ok(())
+        }
+        Command::Triangle {
+            scheme,
+            n,
+            derivative,
+            float,
+            json,
+        } => {
+            let scheme =
+                TriangleScheme::by_name(&scheme).ok_or_else(|| StencilError::UnknownScheme {
+                    name: scheme.clone(),
+                    known: TRIANGLE_SCHEME_NAMES.join(", "),
+                })?;
+            let kind = match derivative.as_deref() {
+                Some("u") => StencilKind::DerivativeU,
+                Some("v") => StencilKind::DerivativeV,
+                _ => StencilKind::Position,
+            };
+            let mask = scheme.regular_mask();
+            let out = if float {
+                let s = triangle_stencils::<f64>(&mask, n, kind)?;
+                triangle_json(&s, |v| json!(v))
+            } else {
+                let s = triangle_stencils::<BigRational>(&mask, n, kind)?;
+                triangle_json(&s, |v| json!(v.to_string()))
+            };
+            if json {
+                println!("{out}");
+            } else {
+                let what = match kind {
+                    StencilKind::Position => "phi",
+                    StencilKind::DerivativeU => "d/du phi",
+                    StencilKind::DerivativeV => "d/dv phi",
+                };
+                let points = out["points"].as_array().cloned().unwrap_or_default();
+                let values = out["values"].as_array().cloned().unwrap_or_default();
+                for (p, v) in points.iter().zip(&values) {
+                    println!("{what}({}, {}) = {}", text(&p[0]), text(&p[1]), text(v));
                 }
             }
             Ok(())
@@ -248,6 +317,41 @@ fn run(cli: Cli) -> Result<(), StencilError> {
             Ok(())
         }
     }
+}
+
+/// A JSON string's text, or the value's JSON text.
+fn text(v: &Value) -> String {
+    v.as_str().map_or_else(|| v.to_string(), str::to_owned)
+}
+
+/// `{"scheme","n","dilation","derivative","exact","support","points","values"}` for
+/// `stencilgen triangle` (docs/cli.md): the support polygon's corners and the grid points in
+/// the closed support as `"p/q"` pairs in skew lattice coordinates.
+fn triangle_json<S: Scalar>(s: &TriangleStencils<S>, value: impl Fn(&S) -> Value) -> Value {
+    let n = i64::from(s.n);
+    let d = i64::from(s.dilation) - 1;
+    let rational = |p: i64, q: i64| {
+        BigRational::new(num_bigint::BigInt::from(p), num_bigint::BigInt::from(q)).to_string()
+    };
+    let points = s.points();
+    let mut out = json!({
+        "scheme": s.scheme,
+        "n": s.n,
+        "dilation": s.dilation,
+        "derivative": match s.kind {
+            StencilKind::Position => Value::Null,
+            StencilKind::DerivativeU => json!("u"),
+            StencilKind::DerivativeV => json!("v"),
+        },
+        "exact": S::EXACT,
+        "support": s.hull.iter().map(|&(a, b)| json!([rational(a, d), rational(b, d)])).collect::<Vec<_>>(),
+        "points": points.iter().map(|&(a, b)| json!([rational(a, n), rational(b, n)])).collect::<Vec<_>>(),
+        "values": points.iter().map(|&(a, b)| value(&s.at(a, b))).collect::<Vec<_>>(),
+    });
+    if !S::EXACT {
+        out["residual"] = json!(s.residual);
+    }
+    out
 }
 
 /// A set of positive integers: `a..b` (inclusive), `a,b,c`, or `a`.

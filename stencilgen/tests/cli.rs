@@ -170,3 +170,26 @@ fn tables_writes_a_valid_table() {
         "--valences `8..3`",
     );
 }
+
+#[test]
+fn triangle_json_lists_the_support_grid() {
+    let v = json("triangle --scheme loop --n 2 --json");
+    assert_eq!(v["scheme"], "loop");
+    assert_eq!(v["dilation"], 2);
+    assert_eq!(v["support"].as_array().map(Vec::len), Some(6));
+    let points = v["points"].as_array().expect("points");
+    let values = v["values"].as_array().expect("values");
+    assert_eq!(points.len(), values.len());
+    // Hexagon of radius 4 in half steps: 3 * 4 * 5 + 1 = 61 grid points.
+    assert_eq!(points.len(), 61);
+    let centre = points
+        .iter()
+        .position(|p| p == &serde_json::json!(["0", "0"]))
+        .expect("the origin");
+    // Loop's limit position rule at valence 6: 1/2 at the vertex.
+    assert_eq!(values[centre], "1/2");
+    let f = json("triangle --scheme sqrt3 --n 2 --f64 --json");
+    assert!(f["values"][0].is_number());
+    assert!(f["residual"].as_f64().expect("residual") < 1e-12);
+    fails_with("triangle --scheme loopy --n 2", "unknown scheme `loopy`");
+}
