@@ -11,6 +11,7 @@ pub mod dual_grid;
 pub mod error;
 pub mod exact_eval;
 pub mod isolate;
+pub mod lai_cheng;
 pub mod mesh_output;
 pub mod obj;
 pub mod patch;
