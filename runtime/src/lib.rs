@@ -12,6 +12,7 @@ pub mod error;
 pub mod exact_eval;
 pub mod geometry;
 pub mod isolate;
+pub mod lai_cheng;
 pub mod mesh_output;
 pub mod obj;
 pub mod patch;

@@ -1,0 +1,245 @@
+//! Bicubic Bézier nets of regular (sub-)patches: conversion from the 4 x 4 B-spline net,
+//! midpoint subdivision (de Casteljau at 1/2), and the guaranteed flatness bound that replaces
+//! Lai–Cheng eq. (4)–(8).
+//!
+//! A net is 16 points `b[4 j + i]`, `i` along `u`, `j` along `v` (the layout order of
+//! [`schemes::local_matrices::LocalMatrices`]: `q` outer).
+
+/// A point in space.
+pub type Point = [f64; 3];
+
+/// A bicubic net, `b[4 j + i]`.
+pub type Net = [Point; 16];
+
+pub(crate) fn sub(a: Point, b: Point) -> Point {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+pub(crate) fn norm(a: Point) -> f64 {
+    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+}
+
+pub(crate) fn cross(a: Point, b: Point) -> Point {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// `a` scaled to unit length, or zero when it has none.
+pub(crate) fn unit(a: Point) -> Point {
+    let n = norm(a);
+    if n > 0.0 && n.is_finite() {
+        [a[0] / n, a[1] / n, a[2] / n]
+    } else {
+        [0.0; 3]
+    }
+}
+
+fn lerp(a: Point, b: Point, t: f64) -> Point {
+    std::array::from_fn(|c| a[c] + t * (b[c] - a[c]))
+}
+
+/// Apply a 1D map to the four rows (`along_u`) or the four columns of a net.
+fn map_lines(net: &Net, along_u: bool, f: impl Fn([Point; 4]) -> [Point; 4]) -> Net {
+    let mut out = *net;
+    for line in 0..4 {
+        let at = |k: usize| if along_u { 4 * line + k } else { 4 * k + line };
+        let mapped = f(std::array::from_fn(|k| net[at(k)]));
+        for (k, p) in mapped.into_iter().enumerate() {
+            out[at(k)] = p;
+        }
+    }
+    out
+}
+
+/// The Bézier net of the uniform bicubic B-spline patch with B-spline net `spline` (control
+/// points at `-1..=2` in both directions): per direction `b_0 = (p_0 + 4 p_1 + p_2)/6`,
+/// `b_1 = (2 p_1 + p_2)/3`, `b_2 = (p_1 + 2 p_2)/3`, `b_3 = (p_1 + 4 p_2 + p_3)/6`.
+pub fn bspline_to_bezier(spline: &Net) -> Net {
+    let convert = |p: [Point; 4]| -> [Point; 4] {
+        let w = |a: f64, b: f64, c: f64, d: f64| -> Point {
+            std::array::from_fn(|k| a * p[0][k] + b * p[1][k] + c * p[2][k] + d * p[3][k])
+        };
+        [
+            w(1.0 / 6.0, 4.0 / 6.0, 1.0 / 6.0, 0.0),
+            w(0.0, 2.0 / 3.0, 1.0 / 3.0, 0.0),
+            w(0.0, 1.0 / 3.0, 2.0 / 3.0, 0.0),
+            w(0.0, 1.0 / 6.0, 4.0 / 6.0, 1.0 / 6.0),
+        ]
+    };
+    map_lines(&map_lines(spline, true, convert), false, convert)
+}
+
+/// de Casteljau at `t = 1/2`: the two halves of a cubic Bézier segment.
+fn halve(p: [Point; 4]) -> ([Point; 4], [Point; 4]) {
+    let a = lerp(p[0], p[1], 0.5);
+    let b = lerp(p[1], p[2], 0.5);
+    let c = lerp(p[2], p[3], 0.5);
+    let ab = lerp(a, b, 0.5);
+    let bc = lerp(b, c, 0.5);
+    let m = lerp(ab, bc, 0.5);
+    ([p[0], a, ab, m], [m, bc, c, p[3]])
+}
+
+/// The four quarter nets of a midpoint subdivision of the parameter square (Lai–Cheng
+/// section 2), in the order `[0,1/2]^2`, `[1/2,1] x [0,1/2]`, `[1/2,1]^2`, `[0,1/2] x [1/2,1]`.
+/// Exact subdivision of the polynomial (up to f64 rounding).
+pub fn split(net: &Net) -> [Net; 4] {
+    let left = map_lines(net, true, |p| halve(p).0);
+    let right = map_lines(net, true, |p| halve(p).1);
+    let low = |n: &Net| map_lines(n, false, |p| halve(p).0);
+    let high = |n: &Net| map_lines(n, false, |p| halve(p).1);
+    [low(&left), low(&right), high(&right), high(&left)]
+}
+
+/// The corners `V_1 = S(0,0)`, `V_2 = S(1,0)`, `V_3 = S(1,1)`, `V_4 = S(0,1)` of the patch
+/// (Lai–Cheng section 2), which are limit points.
+pub fn corners(net: &Net) -> [Point; 4] {
+    [net[0], net[3], net[15], net[12]]
+}
+
+/// Unit normals at the four corners, from the net's first differences (zero where degenerate).
+pub fn corner_normals(net: &Net) -> [Point; 4] {
+    let d = |a: usize, b: usize| sub(net[b], net[a]);
+    [
+        unit(cross(d(0, 1), d(0, 4))),
+        unit(cross(d(2, 3), d(3, 7))),
+        unit(cross(d(14, 15), d(11, 15))),
+        unit(cross(d(12, 13), d(8, 12))),
+    ]
+}
+
+/// The longer diagonal `max{D_1, D_2}` of the base quadrilateral (Lai–Cheng section 6).
+pub fn longer_diagonal(v: &[Point; 4]) -> f64 {
+    norm(sub(v[0], v[2])).max(norm(sub(v[1], v[3])))
+}
+
+/// A guaranteed bound on `|S(x) - L(x)|` over the square, where `S` is the patch and `L` is any
+/// interpolant of `S` that is linear on the triangles of a triangulation of the square whose
+/// vertices are points of the square's boundary (the base quadrilateral, or the polygon that
+/// replaces it, Lai–Cheng section 4.2, triangulated in parameter space).
+///
+/// With `Q` the bilinear base quadrilateral (eq. 4) and `d = S - Q`, a bicubic whose Bézier
+/// coefficients are `c_ij = b_ij - Q(i/3, j/3)` (the bilinear's degree-raised coefficients),
+/// `L(x) - S(x) = (sum_k l_k Q(p_k) - Q(x)) + (sum_k l_k d(p_k) - d(x))` (`l_k` barycentric).
+/// The second term is a difference of two points of the convex hull `H` of the `c_ij`. The
+/// first is `w e(x)`, `w = V_1 - V_2 + V_3 - V_4` the twist, `e` the linear interpolation error
+/// of `uv` on the triangle, which is at most `|du dv| / 4 <= 1/4` along the triangle's edges
+/// and has no interior extremum (indefinite Hessian). So
+/// `|S - L| <= max_{i,j, s = +-1} |c_i - c_j + s w / 4|` (a Minkowski sum's extreme points).
+///
+/// This is Lai–Cheng's two-sided test, eq. (8), made direction-free: eq. (8) adds the largest
+/// deviations on the two sides of `Q` along its normal, the width of `H` in one direction; the
+/// bound here is the width of `H` (plus the interpolation term) in the worst direction, so it
+/// bounds the parametric distance and needs no planarity of `Q`.
+pub fn flatness_bound(net: &Net) -> f64 {
+    let [v1, v2, v3, v4] = corners(net);
+    let bilinear = |s: f64, t: f64| -> Point {
+        std::array::from_fn(|k| {
+            (1.0 - s) * (1.0 - t) * v1[k]
+                + s * (1.0 - t) * v2[k]
+                + s * t * v3[k]
+                + (1.0 - s) * t * v4[k]
+        })
+    };
+    let c: [Point; 16] = std::array::from_fn(|n| {
+        let (i, j) = (n % 4, n / 4);
+        sub(net[n], bilinear(i as f64 / 3.0, j as f64 / 3.0))
+    });
+    let w: Point = std::array::from_fn(|k| (v1[k] - v2[k] + v3[k] - v4[k]) / 4.0);
+    let mut best: f64 = 0.0;
+    for (i, ci) in c.iter().enumerate() {
+        for cj in &c[i..] {
+            let d = sub(*ci, *cj);
+            let plus = norm([d[0] + w[0], d[1] + w[1], d[2] + w[2]]);
+            let minus = norm([d[0] - w[0], d[1] - w[1], d[2] - w[2]]);
+            best = best.max(plus).max(minus);
+        }
+    }
+    best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A bicubic evaluated by de Casteljau, for the tests only.
+    fn eval(net: &Net, u: f64, v: f64) -> Point {
+        let curve = |p: [Point; 4], t: f64| {
+            let a = [
+                lerp(p[0], p[1], t),
+                lerp(p[1], p[2], t),
+                lerp(p[2], p[3], t),
+            ];
+            let b = [lerp(a[0], a[1], t), lerp(a[1], a[2], t)];
+            lerp(b[0], b[1], t)
+        };
+        let rows: [Point; 4] =
+            std::array::from_fn(|j| curve(std::array::from_fn(|i| net[4 * j + i]), u));
+        curve(rows, v)
+    }
+
+    fn sample_net() -> Net {
+        std::array::from_fn(|n| {
+            let (i, j) = ((n % 4) as f64, (n / 4) as f64);
+            [
+                i + 0.1 * j * j,
+                j - 0.05 * i * j,
+                0.3 * (i * i - j) + 0.07 * i * j * j,
+            ]
+        })
+    }
+
+    #[test]
+    fn split_reproduces_the_surface() {
+        let net = sample_net();
+        let parts = split(&net);
+        let origins = [(0.0, 0.0), (0.5, 0.0), (0.5, 0.5), (0.0, 0.5)];
+        for (part, (u0, v0)) in parts.iter().zip(origins) {
+            for (s, t) in [(0.0, 0.0), (0.3, 0.7), (1.0, 0.25), (0.6, 1.0)] {
+                let a = eval(part, s, t);
+                let b = eval(&net, u0 + s / 2.0, v0 + t / 2.0);
+                assert!(norm(sub(a, b)) < 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn the_bound_holds_against_the_bilinear_and_its_triangles() {
+        let net = sample_net();
+        let bound = flatness_bound(&net);
+        let [v1, v2, v3, v4] = corners(&net);
+        // The two diagonal triangulations of the square, sampled.
+        let n = 40;
+        let mut worst: f64 = 0.0;
+        for a in 0..=n {
+            for b in 0..=n {
+                let (u, v) = (a as f64 / n as f64, b as f64 / n as f64);
+                let s = eval(&net, u, v);
+                // Split along V1-V3: below the diagonal (V1, V2, V3), above (V1, V3, V4).
+                let l1: Point = if v <= u {
+                    std::array::from_fn(|k| v1[k] + u * (v2[k] - v1[k]) + v * (v3[k] - v2[k]))
+                } else {
+                    std::array::from_fn(|k| v1[k] + u * (v3[k] - v4[k]) + v * (v4[k] - v1[k]))
+                };
+                worst = worst.max(norm(sub(s, l1)));
+            }
+        }
+        assert!(worst <= bound, "{worst} > {bound}");
+        assert!(
+            worst > 0.2 * bound,
+            "the bound is not absurdly loose: {worst} vs {bound}"
+        );
+    }
+
+    #[test]
+    fn an_affine_patch_is_flat() {
+        let net: Net = std::array::from_fn(|n| {
+            let (i, j) = ((n % 4) as f64, (n / 4) as f64);
+            [2.0 * i + j, j, 0.5 * i - j]
+        });
+        assert!(flatness_bound(&bspline_to_bezier(&net)) < 1e-12);
+    }
+}

@@ -1,0 +1,407 @@
+//! Lai–Cheng adaptive tessellation (`runtime::lai_cheng`): the error guarantee measured
+//! independently of the bound (table stencils at rate 24 and exact evaluation, to the output
+//! polygon's own triangles), watertightness by global ids, relative flatness, flat regions.
+//!
+//! Expected values come from the surfaces themselves (exact evaluation, the f32 tables), from
+//! topology (Euler characteristics, edge pairing) or from invariance (scaling by 8 is exact in
+//! floating point), never from the code under test.
+
+use std::path::{Path, PathBuf};
+
+use num_bigint::BigInt;
+use num_rational::BigRational;
+use runtime::exact_eval::ExactEvaluator;
+use runtime::isolate::{isolate_with_origins, Isolation};
+use runtime::lai_cheng::{tessellate_adaptive, AdaptiveMesh, AdaptiveOptions, AdaptivePolygon};
+use runtime::obj::read_obj;
+use runtime::rates::{point_triangle_distance, table_positions};
+use runtime::stencil_table::StencilTable;
+use runtime::topology::Mesh;
+use runtime::RuntimeError;
+use schemes::BoundaryMode;
+use table_format::PointSet;
+
+fn load(path: &Path) -> Mesh {
+    let obj = read_obj(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    Mesh::from_obj(&obj)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .0
+}
+
+fn cube() -> Mesh {
+    load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("data/cube.obj"))
+}
+
+fn spot() -> Option<Mesh> {
+    let path: PathBuf = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../shared/models/crane/spot_control_mesh.obj");
+    if path.is_file() {
+        Some(load(&path))
+    } else {
+        println!("skipping Spot: {} is absent", path.display());
+        None
+    }
+}
+
+fn table() -> StencilTable {
+    StencilTable::default_catmull_clark().expect("embedded table")
+}
+
+fn isolate(mesh: &Mesh) -> Isolation {
+    isolate_with_origins(mesh).expect("isolates")
+}
+
+fn size(mesh: &Mesh) -> f64 {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in &mesh.positions {
+        for c in 0..3 {
+            lo[c] = lo[c].min(p[c]);
+            hi[c] = hi[c].max(p[c]);
+        }
+    }
+    (0..3).map(|c| (hi[c] - lo[c]).powi(2)).sum::<f64>().sqrt()
+}
+
+fn distance_to_polygon(out: &AdaptiveMesh, polygon: &AdaptivePolygon, p: [f64; 3]) -> f64 {
+    polygon
+        .triangles
+        .iter()
+        .map(|t| {
+            let tri = t.map(|i| out.positions[i as usize]);
+            point_triangle_distance(p, &tri)
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+fn contains(polygon: &AdaptivePolygon, u: f64, v: f64) -> bool {
+    let r = &polygon.region;
+    let d = f64::from(r.denominator);
+    let (u0, v0, s) = (
+        f64::from(r.u0) / d,
+        f64::from(r.v0) / d,
+        f64::from(r.size) / d,
+    );
+    let e = 1e-12;
+    u >= u0 - e && u <= u0 + s + e && v >= v0 - e && v <= v0 + s + e
+}
+
+/// The largest measured `distance / bound` ratio and the largest distance, over the table's
+/// primal and dual points at rate 24 of every face, each against every polygon whose parameter
+/// square contains it (its own triangles only). Asserts `distance <= bound + slack`.
+fn check_with_table(iso: &Isolation, out: &AdaptiveMesh, slack: f64) -> (f64, f64) {
+    let table = table();
+    let mut by_face: Vec<Vec<&AdaptivePolygon>> = vec![Vec::new(); iso.mesh.faces()];
+    for p in &out.polygons {
+        by_face[p.region.face as usize].push(p);
+    }
+    let (mut worst_ratio, mut worst): (f64, f64) = (0.0, 0.0);
+    for (f, patch) in iso.patches.iter().enumerate() {
+        for (set, side, offset) in [(PointSet::Primal, 25, 0.0), (PointSet::Dual, 24, 0.5)] {
+            let positions =
+                table_positions(&table, &iso.mesh, patch, set, 24).expect("table positions");
+            for (k, &s) in positions.iter().enumerate() {
+                let (i, j) = (k % side, k / side);
+                let (u, v) = ((i as f64 + offset) / 24.0, (j as f64 + offset) / 24.0);
+                let mut found = false;
+                for polygon in by_face[f].iter().filter(|p| contains(p, u, v)) {
+                    found = true;
+                    let d = distance_to_polygon(out, polygon, s);
+                    assert!(
+                        d <= polygon.region.bound + slack,
+                        "face {f} at ({u}, {v}): distance {d} > bound {} ({:?})",
+                        polygon.region.bound,
+                        polygon.region
+                    );
+                    worst = worst.max(d);
+                    if polygon.region.bound > 0.0 {
+                        worst_ratio = worst_ratio.max(d / polygon.region.bound);
+                    }
+                }
+                assert!(found, "face {f}: ({u}, {v}) is in no polygon");
+            }
+        }
+    }
+    (worst_ratio, worst)
+}
+
+fn rational(numerator: u64, denominator: u64) -> BigRational {
+    BigRational::new(BigInt::from(numerator), BigInt::from(denominator))
+}
+
+/// Exact evaluation at 4 x 4 interior points of every polygon of the faces `faces`: the
+/// distance to the polygon's triangles stays within its bound (to f64 rounding).
+fn check_exactly(iso: &Isolation, out: &AdaptiveMesh, faces: &[u32], scale: f64) -> f64 {
+    let exact = ExactEvaluator::new(&iso.mesh);
+    let mut worst: f64 = 0.0;
+    for polygon in out
+        .polygons
+        .iter()
+        .filter(|p| faces.contains(&p.region.face))
+    {
+        let r = polygon.region;
+        let d = u64::from(r.denominator) * 8;
+        for a in 0..4u64 {
+            for b in 0..4u64 {
+                let u = rational(u64::from(r.u0) * 8 + (2 * a + 1) * u64::from(r.size), d);
+                let v = rational(u64::from(r.v0) * 8 + (2 * b + 1) * u64::from(r.size), d);
+                let s = exact
+                    .evaluate(r.face as usize, &u, &v)
+                    .expect("exact evaluation")
+                    .position;
+                let dist = distance_to_polygon(out, polygon, s);
+                assert!(
+                    dist <= r.bound + 1e-12 * scale,
+                    "face {} at ({u}, {v}): {dist} > {}",
+                    r.face,
+                    r.bound
+                );
+                worst = worst.max(dist);
+            }
+        }
+    }
+    worst
+}
+
+fn options(tolerance: f64) -> AdaptiveOptions {
+    AdaptiveOptions {
+        tolerance,
+        ..Default::default()
+    }
+}
+
+#[test]
+fn the_cube_meets_the_tolerance_everywhere_sampled() {
+    let mesh = cube();
+    let scale = size(&mesh);
+    let iso = isolate(&mesh);
+    for t in [0.02 * scale, 0.004 * scale] {
+        let (out, stats) =
+            tessellate_adaptive(&table(), &iso.mesh, &iso.patches, &options(t)).expect("ok");
+        assert_eq!(stats.leaves_over_tolerance, 0);
+        assert!(stats.max_bound <= t);
+        let (ratio, worst) = check_with_table(&iso, &out, 2e-6 * scale);
+        // Every face of the isolated cube touches a valence-3 vertex: check two exactly.
+        let exact = check_exactly(&iso, &out, &[0, 7], scale);
+        println!(
+            "cube T = {t}: {} polygons, depth {}, measured {worst:.3e} (exact {exact:.3e}), \
+             largest measured/bound {ratio:.3}",
+            stats.polygons, stats.max_depth
+        );
+        assert!(worst <= t && exact <= t);
+    }
+}
+
+#[test]
+fn spot_meets_the_tolerance_everywhere_sampled() {
+    let Some(mesh) = spot() else { return };
+    let scale = size(&mesh);
+    let iso = isolate(&mesh);
+    let t = 0.002 * scale;
+    let (out, stats) =
+        tessellate_adaptive(&table(), &iso.mesh, &iso.patches, &options(t)).expect("ok");
+    assert_eq!(stats.leaves_over_tolerance, 0);
+    let (ratio, worst) = check_with_table(&iso, &out, 2e-6 * scale);
+    // A face at an extraordinary vertex and a regular one, exactly.
+    let ev = out
+        .polygons
+        .iter()
+        .find(|p| p.region.extraordinary)
+        .map_or(0, |p| p.region.face);
+    let regular = out
+        .polygons
+        .iter()
+        .find(|p| p.region.depth > 1 && !p.region.extraordinary)
+        .map_or(1, |p| p.region.face);
+    let exact = check_exactly(&iso, &out, &[ev, regular], scale);
+    println!(
+        "spot T = {t}: {} polygons, {} triangles, depth {}, A/U {:.4}, measured {worst:.3e} \
+         (exact {exact:.3e}), largest measured/bound {ratio:.3}",
+        stats.polygons, stats.triangles, stats.max_depth, stats.au_ratio
+    );
+    assert!(worst <= t + 2e-6 * scale && exact <= t);
+}
+
+/// Global ids make the output closed: every polygon edge and every triangle edge is used once
+/// in each direction, and the Euler characteristic is the input's.
+#[test]
+fn closed_inputs_give_watertight_polygons_and_triangles() {
+    let mut meshes = vec![("cube", cube())];
+    if let Some(s) = spot() {
+        meshes.push(("spot", s));
+    }
+    for (name, mesh) in meshes {
+        let scale = size(&mesh);
+        let iso = isolate(&mesh);
+        for (t, relative) in [(0.05, false), (0.01, false), (0.001, false), (0.02, true)] {
+            let opts = AdaptiveOptions {
+                tolerance: if relative { t } else { t * scale },
+                relative,
+                ..Default::default()
+            };
+            let (out, stats) =
+                tessellate_adaptive(&table(), &iso.mesh, &iso.patches, &opts).expect("ok");
+            assert!(
+                out.is_watertight(),
+                "{name} T = {t}: polygons not watertight"
+            );
+            let triangles = out.to_triangle_mesh();
+            assert!(triangles.is_watertight(), "{name} T = {t}: triangles");
+            assert_eq!(
+                triangles.euler_characteristic(),
+                mesh.euler_characteristic(),
+                "{name} T = {t}"
+            );
+            assert_eq!(stats.triangles, triangles.triangles.len());
+            // A polygon with m vertices gives m - 2 triangles.
+            let expected: usize = out.polygons.iter().map(|p| p.vertices.len() - 2).sum();
+            assert_eq!(stats.triangles, expected);
+        }
+    }
+}
+
+/// Output vertices are limit points at their recorded sources (exact evaluation).
+#[test]
+fn vertices_are_limit_points_at_their_sources() {
+    let mesh = cube();
+    let iso = isolate(&mesh);
+    let (out, _) =
+        tessellate_adaptive(&table(), &iso.mesh, &iso.patches, &options(0.005)).expect("ok");
+    let exact = ExactEvaluator::new(&iso.mesh);
+    for k in (0..out.positions.len()).step_by(7).take(150) {
+        let s = out.sources[k];
+        let d = u64::from(s.denominator);
+        let p = exact
+            .evaluate(
+                s.face as usize,
+                &rational(u64::from(s.u), d),
+                &rational(u64::from(s.v), d),
+            )
+            .expect("exact")
+            .position;
+        let e = (0..3)
+            .map(|c| (p[c] - out.positions[k][c]).abs())
+            .fold(0.0, f64::max);
+        assert!(e < 1e-12, "vertex {k} {s:?}: {e}");
+    }
+}
+
+/// Relative flatness (section 6): every regular leaf's bound is within `T` times its own base
+/// quadrilateral's longer diagonal; the result is invariant under scaling (by 8, exact in f64),
+/// while absolute flatness is not (and is again with `T` scaled too).
+#[test]
+fn relative_flatness_is_scale_invariant_and_bounded_by_the_diagonal() {
+    let mesh = cube();
+    let mut big = mesh.clone();
+    for p in &mut big.positions {
+        *p = p.map(|c| 8.0 * c);
+    }
+    let (iso, iso_big) = (isolate(&mesh), isolate(&big));
+    let t = 0.01;
+    let relative = AdaptiveOptions {
+        tolerance: t,
+        relative: true,
+        ..Default::default()
+    };
+    let run = |iso: &Isolation, o: &AdaptiveOptions| {
+        tessellate_adaptive(&table(), &iso.mesh, &iso.patches, o).expect("ok")
+    };
+    let (small, s_stats) = run(&iso, &relative);
+    let (large, l_stats) = run(&iso_big, &relative);
+    assert_eq!(s_stats.polygons, l_stats.polygons);
+    assert_eq!(small.positions.len(), large.positions.len());
+    for p in &small.polygons {
+        assert!(p.region.bound <= p.region.tolerance);
+        if !p.region.extraordinary {
+            assert!(p.region.bound <= t * p.region.diagonal * (1.0 + 1e-12));
+        }
+    }
+    let (abs_small, _) = run(&iso, &options(0.01));
+    let (abs_large, _) = run(&iso_big, &options(0.01));
+    assert!(abs_large.polygons.len() > abs_small.polygons.len());
+    let (abs_large_scaled, _) = run(&iso_big, &options(0.08));
+    assert_eq!(abs_large_scaled.polygons.len(), abs_small.polygons.len());
+}
+
+fn grid(n: i64, mode: BoundaryMode) -> Mesh {
+    let positions = (0..=n)
+        .flat_map(|j| (0..=n).map(move |i| [i as f64, j as f64, 0.5 * i as f64]))
+        .collect();
+    let faces: Vec<Vec<i64>> = (0..n)
+        .flat_map(|j| {
+            (0..n).map(move |i| {
+                let v = j * (n + 1) + i;
+                vec![v, v + 1, v + n + 2, v + n + 1]
+            })
+        })
+        .collect();
+    Mesh::new(positions, &faces, &[], mode).expect("valid grid")
+}
+
+/// A flat region needs depth 0: a uniform planar grid's limit surface is affine, so every
+/// regular face is one polygon however small the tolerance.
+#[test]
+fn a_flat_region_needs_depth_zero() {
+    let flat = grid(5, BoundaryMode::EdgeAndCorner);
+    let iso = isolate(&flat);
+    let (out, stats) =
+        tessellate_adaptive(&table(), &iso.mesh, &iso.patches, &options(1e-9)).expect("ok");
+    assert_eq!(stats.max_depth, 0);
+    assert_eq!(stats.polygons, iso.mesh.faces());
+    // "Edge only": the corner faces are extraordinary (one-face boundary vertices) and are
+    // subdivided; every other face is still one polygon.
+    let flat = grid(5, BoundaryMode::EdgeOnly);
+    let iso = isolate(&flat);
+    let (out2, _) =
+        tessellate_adaptive(&table(), &iso.mesh, &iso.patches, &options(1e-6)).expect("ok");
+    let mut per_face = vec![0; iso.mesh.faces()];
+    for p in &out2.polygons {
+        per_face[p.region.face as usize] += 1;
+    }
+    let single = per_face.iter().filter(|&&c| c == 1).count();
+    let corner_faces = iso
+        .patches
+        .iter()
+        .filter(|p| p.kind.boundary && p.kind.faces == 1)
+        .count();
+    assert_eq!(single, iso.mesh.faces() - corner_faces);
+    assert!(out.polygons.iter().all(|p| p.region.depth == 0));
+}
+
+#[test]
+fn bad_options_are_refused() {
+    let iso = isolate(&cube());
+    for o in [
+        options(0.0),
+        options(f64::NAN),
+        AdaptiveOptions {
+            max_depth: 99,
+            ..options(0.1)
+        },
+        AdaptiveOptions {
+            min_depth: 5,
+            max_depth: 4,
+            ..options(0.1)
+        },
+    ] {
+        let e = tessellate_adaptive(&table(), &iso.mesh, &iso.patches, &o)
+            .expect_err("invalid options");
+        assert!(matches!(e, RuntimeError::InvalidParameter { .. }), "{e}");
+    }
+}
+
+/// The uniform tessellation (min_depth = max_depth) through the same machinery has
+/// `faces * 4^depth` polygons: the A/U denominator.
+#[test]
+fn uniform_depth_gives_the_uniform_count() {
+    let iso = isolate(&cube());
+    let o = AdaptiveOptions {
+        min_depth: 2,
+        max_depth: 2,
+        ..options(1.0)
+    };
+    let (out, stats) = tessellate_adaptive(&table(), &iso.mesh, &iso.patches, &o).expect("ok");
+    assert_eq!(out.polygons.len(), iso.mesh.faces() * 16);
+    assert_eq!(stats.uniform_polygons, out.polygons.len() as f64);
+    assert!(out.polygons.iter().all(|p| p.vertices.len() == 4));
+}
