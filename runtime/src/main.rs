@@ -10,6 +10,7 @@ use runtime::bezier::{tessellate_bezier, BezierOptions, BezierPatches};
 use runtime::dual_grid::{tessellate, DualGrid};
 use runtime::exact_eval::{evaluate_subface, parse_rational};
 use runtime::isolate::isolate_with_origins;
+use runtime::lai_cheng::{tessellate_adaptive, write_obj_polygons, AdaptiveOptions};
 use runtime::mesh_output::{write_mesh, MeshFormat};
 use runtime::obj::read_obj;
 use runtime::rates::{tolerance_rates, view_rates, ViewCamera};
@@ -29,9 +30,12 @@ struct Cli {
     command: Command,
 }
 
+// Parsed once per run: the size of the largest variant does not matter.
+#[allow(clippy::large_enum_variant)]
 #[derive(Subcommand)]
 enum Command {
-    /// Tessellate a Catmull-Clark mesh (OBJ) with the dual-grid method.
+    /// Tessellate a Catmull-Clark mesh (OBJ) with the dual-grid or the adaptive method, or
+    /// Bezier patches with Espino et al.'s method.
     Tessellate {
         /// Input mesh (OBJ: triangles, quads, n-gons; closed or with boundary).
         #[arg(required_unless_present = "bezier", conflicts_with = "bezier")]
@@ -77,6 +81,17 @@ enum Command {
         /// Bezier triangle budget: search the threshold whose output is nearest it.
         #[arg(long, requires = "bezier")]
         triangles: Option<usize>,
+        /// `dual-grid` (Schaefer-Warren, one rate per face) or `adaptive` (Lai-Cheng: recursive
+        /// subdivision of each face's domain until a guaranteed bound meets `--tolerance`).
+        #[arg(long, default_value = "dual-grid", value_parser = ["dual-grid", "adaptive"])]
+        method: String,
+        /// Adaptive: the tolerance is relative to each square's base quadrilateral's longer
+        /// diagonal (Lai-Cheng section 6) instead of a distance.
+        #[arg(long)]
+        relative: bool,
+        /// Adaptive: write triangles; without it an .obj output holds the polygons (n-gons).
+        #[arg(long)]
+        triangulate: bool,
     },
     /// Measure per-frame tessellation throughput: the plan (topology, patches, stencil
     /// lookups) is built once, then every frame evaluates all positions and normals and writes
@@ -235,6 +250,9 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
             edge_test,
             threshold,
             triangles: budget,
+            method,
+            relative,
+            triangulate,
         } => {
             MeshFormat::from_path(&output)?;
             let mesh = match (mesh, bezier) {
@@ -270,6 +288,42 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
             let input = load_mesh(&mesh)?;
             let table = load_table(&table, input.boundary)?;
             let iso = isolate_with_origins(&input)?;
+            if method == "adaptive" {
+                let tolerance = tolerance.ok_or_else(|| RuntimeError::InvalidParameter {
+                    name: "--method adaptive".to_owned(),
+                    reason: "it needs --tolerance T".to_owned(),
+                })?;
+                let options = AdaptiveOptions {
+                    tolerance,
+                    relative,
+                    triangulate,
+                    ..AdaptiveOptions::default()
+                };
+                let (mut adaptive, adaptive_stats) =
+                    tessellate_adaptive(&table, &iso.mesh, &iso.patches, &options)?;
+                for source in &mut adaptive.sources {
+                    *source = iso.input_source(*source);
+                }
+                let is_obj = MeshFormat::from_path(&output)? == MeshFormat::Obj;
+                if is_obj && !triangulate {
+                    write_obj_polygons(&adaptive, &output)?;
+                } else {
+                    write_mesh(&adaptive.to_triangle_mesh(), &output)?;
+                }
+                if stats {
+                    let mut report = adaptive_stats.to_json();
+                    report["watertight"] =
+                        serde_json::json!(input.boundary_loops() == 0 && adaptive.is_watertight());
+                    println!("{report}");
+                }
+                return Ok(());
+            }
+            if relative || triangulate {
+                return Err(RuntimeError::InvalidParameter {
+                    name: "--relative / --triangulate".to_owned(),
+                    reason: "they belong to --method adaptive".to_owned(),
+                });
+            }
             let mut unmet = None;
             let rates = if let Some(path) = &rates {
                 read_rates(path, input.faces(), &iso.origin)?

@@ -323,3 +323,40 @@ fn pinned_corners_work_out_of_the_box() {
     assert!(stats["triangles"].as_u64().is_some_and(|t| t > 0));
     let _ = std::fs::remove_file(obj);
 }
+
+/// `--method adaptive` (Lai-Cheng): polygons in OBJ, triangles elsewhere, watertight, the bound
+/// under the tolerance; it needs `--tolerance`.
+#[test]
+fn adaptive_method_from_the_command_line() {
+    let obj = temp("adaptive.obj");
+    let out = subtess(&format!(
+        "tessellate data/cube.obj -o {} --method adaptive --tolerance 0.02 --stats",
+        obj.display()
+    ));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stats = json(&out);
+    assert_eq!(stats["watertight"], true);
+    assert_eq!(stats["leaves_over_tolerance"], 0);
+    assert!(stats["max_bound"].as_f64().is_some_and(|b| b <= 0.02));
+    let polygons = stats["polygons"].as_u64().expect("a count");
+    let text = std::fs::read_to_string(&obj).expect("written");
+    assert_eq!(
+        text.lines().filter(|l| l.starts_with("f ")).count() as u64,
+        polygons
+    );
+    for args in [
+        format!(
+            "tessellate data/cube.obj -o {} --method adaptive",
+            obj.display()
+        ),
+        format!("tessellate data/cube.obj -o {} --relative", obj.display()),
+    ] {
+        let out = subtess(&args);
+        assert!(!out.status.success(), "{args}");
+    }
+    let _ = std::fs::remove_file(obj);
+}
