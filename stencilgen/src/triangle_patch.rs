@@ -92,14 +92,17 @@ pub fn sub_triangle_of(y: (i64, i64), n: i64) -> usize {
 }
 
 /// `sum_j psi(y - j) R_b[j]` with `y = Y / n`: the weights of a point of a regular sub-triangle.
+/// Loop's regular basis is rational, so it is always solved (and summed) exactly, then
+/// converted: the f64 path of the regular system solves its orbits densely and is far slower
+/// (Loop `n = 16`: minutes instead of milliseconds).
 fn regular_weights<S: Scalar>(
     matrices: &TriangleLocalMatrices,
-    basis: &TriangleStencils<S>,
+    basis: &TriangleStencils<BigRational>,
     y: (i64, i64),
 ) -> Vec<S> {
     let n = i64::from(basis.n);
     let sub = &matrices.sub_triangles[sub_triangle_of(y, n)];
-    let mut out = vec![S::zero(); matrices.size()];
+    let mut out = vec![BigRational::zero(); matrices.size()];
     for (&(j1, j2), row) in sub.points.iter().zip(&sub.rows) {
         let psi = basis.at(y.0 - n * j1, y.1 - n * j2);
         if psi.is_zero() {
@@ -107,18 +110,18 @@ fn regular_weights<S: Scalar>(
         }
         for (o, r) in out.iter_mut().zip(row) {
             if !r.is_zero() {
-                *o = o.clone() + psi.clone() * S::from_rational(r);
+                *o += &psi * r;
             }
         }
     }
-    out
+    out.iter().map(S::from_rational).collect()
 }
 
-fn regular_basis<S: Scalar>(
+fn regular_basis(
     scheme: &TriangleScheme,
     n: u32,
-) -> Result<TriangleStencils<S>, StencilError> {
-    triangle_stencils::<S>(&scheme.regular_mask(), n, StencilKind::Position)
+) -> Result<TriangleStencils<BigRational>, StencilError> {
+    triangle_stencils::<BigRational>(&scheme.regular_mask(), n, StencilKind::Position)
 }
 
 /// Solve the grid system of the Loop patch around an interior vertex of valence `valence` at
@@ -135,7 +138,7 @@ pub fn triangle_patch_stencils<S: Scalar>(
         });
     }
     let matrices = TriangleLocalMatrices::new(scheme, valence)?;
-    let basis = regular_basis::<S>(scheme, n)?;
+    let basis = regular_basis(scheme, n)?;
     let k = matrices.size();
     let ni = i64::from(n);
     // phi_j(x) = sum_i A[i][j] phi_i(2x).
@@ -210,7 +213,8 @@ pub struct TriangleSubstitution<S> {
     scheme: TriangleScheme,
     /// The local subdivision matrices.
     pub matrices: TriangleLocalMatrices,
-    bases: HashMap<u32, TriangleStencils<S>>,
+    bases: HashMap<u32, TriangleStencils<BigRational>>,
+    field: std::marker::PhantomData<S>,
 }
 
 impl<S: Scalar> TriangleSubstitution<S> {
@@ -220,6 +224,7 @@ impl<S: Scalar> TriangleSubstitution<S> {
             scheme: scheme.clone(),
             matrices: TriangleLocalMatrices::new(scheme, valence)?,
             bases: HashMap::new(),
+            field: std::marker::PhantomData,
         })
     }
 
@@ -260,10 +265,10 @@ impl<S: Scalar> TriangleSubstitution<S> {
         };
         let point = (numerator(&y1), numerator(&y2));
         if !self.bases.contains_key(&n) {
-            let basis = regular_basis::<S>(&self.scheme, n)?;
+            let basis = regular_basis(&self.scheme, n)?;
             self.bases.insert(n, basis);
         }
-        let mut row = regular_weights(&self.matrices, &self.bases[&n], point);
+        let mut row: Vec<S> = regular_weights(&self.matrices, &self.bases[&n], point);
         let size = self.matrices.size();
         for _ in 0..k {
             row = (0..size)

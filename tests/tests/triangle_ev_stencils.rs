@@ -82,6 +82,24 @@ fn grid_system_equals_substitution_exactly() {
 }
 
 #[test]
+fn grid_system_equals_substitution_at_every_rate_up_to_24() {
+    let loop_ = triangle_scheme("loop").expect("catalogued");
+    for v in [3, 5, 8] {
+        let mut sub = TriangleSubstitution::<BigRational>::new(&loop_, v).expect("valid");
+        let rates: Vec<u32> = if v == 5 { (1..=24).collect() } else { vec![24] };
+        for n in rates {
+            let grid = exact(v, n);
+            for (&(i, j), stencil) in grid.points.iter().zip(&grid.stencils) {
+                let by_substitution = sub
+                    .stencil(&q(i, i64::from(n)), &q(j, i64::from(n)))
+                    .expect("in the patch");
+                assert_eq!(stencil, &by_substitution, "v = {v}, ({i}/{n}, {j}/{n})");
+            }
+        }
+    }
+}
+
+#[test]
 fn valence_six_is_the_quartic_box_spline() {
     for n in 1..=6 {
         let s = exact(6, n);
