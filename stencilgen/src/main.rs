@@ -22,7 +22,7 @@ use stencilgen::regular_patch::StencilKind;
 use stencilgen::stencil_set::StencilSetSpec;
 use stencilgen::substitution::Substitution;
 use stencilgen::table::{build_table, TableSpec};
-use stencilgen::triangle_patch::{loop_ev_tangents, TriangleSubstitution};
+use stencilgen::triangle_patch::TriangleSubstitution;
 use stencilgen::triangle_system::{triangle_stencils, TriangleStencils};
 use stencilgen::{curve_stencils, CurveStencils, Scalar, StencilError};
 use table_format::Precision;
@@ -448,9 +448,9 @@ fn write_table(spec: TableSpec, path: &std::path::Path) -> Result<(), StencilErr
 }
 
 /// The Loop EV patch's stencil at `(u, v)` (barycentric: `u, v >= 0`, `u + v <= 1`), by
-/// substitution: `{"scheme","valence","u","v","exact","order","weights","du","dv"}`. The
-/// tangent masks are given at the vertex itself in f64 (subdominant eigenvectors); elsewhere
-/// (and in exact mode at the vertex) they are `null` with the reason in `"note"`.
+/// substitution: `{"scheme","valence","u","v","exact","order","weights","du","dv"}`. At the
+/// vertex itself the tangent masks are irrational in general: `null` in exact mode, with the
+/// reason in `"note"`; `--f64` gives them (subdominant eigenvectors).
 fn triangle_stencil_json<S: Scalar>(
     scheme: &TriangleScheme,
     valence: u32,
@@ -469,18 +469,19 @@ fn triangle_stencil_json<S: Scalar>(
         "exact": S::EXACT,
         "order": substitution.matrices.names(),
         "weights": weights.iter().map(&value).collect::<Vec<_>>(),
-        "du": Value::Null,
-        "dv": Value::Null,
     });
-    let at_vertex = num_traits::Zero::is_zero(u) && num_traits::Zero::is_zero(v);
-    if at_vertex && !S::EXACT {
-        let t = loop_ev_tangents(&substitution.matrices)?;
-        out["du"] = json!(t.du);
-        out["dv"] = json!(t.dv);
-    } else if at_vertex {
-        out["note"] = json!("the tangent masks at the vertex are irrational in general; use --f64");
-    } else {
-        out["note"] = json!("tangent masks of triangle-scheme EV patches away from the vertex are not implemented yet");
+    for (key, kind) in [
+        ("du", StencilKind::DerivativeU),
+        ("dv", StencilKind::DerivativeV),
+    ] {
+        match substitution.stencil_of_kind(u, v, kind) {
+            Ok(mask) => out[key] = mask.iter().map(&value).collect(),
+            Err(e @ StencilError::Irrational { .. }) => {
+                out[key] = Value::Null;
+                out["note"] = json!(e.to_string());
+            }
+            Err(e) => return Err(e),
+        }
     }
     Ok(out)
 }

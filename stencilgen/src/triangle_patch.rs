@@ -46,7 +46,8 @@ pub fn triangle_scheme(name: &str) -> Result<TriangleScheme, StencilError> {
     })
 }
 
-/// Position stencils at every grid point `(i/n, j/n)`, `i + j <= n`, of the Loop EV patch.
+/// Stencils of one kind at the grid points `(i/n, j/n)`, `i + j <= n`, of the Loop EV patch
+/// (derivatives: every point but the vertex itself, see [`loop_ev_tangents`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct TrianglePatchStencils<S> {
     /// The scheme's name.
@@ -55,7 +56,11 @@ pub struct TrianglePatchStencils<S> {
     pub valence: u32,
     /// Grid rate.
     pub n: u32,
-    /// The grid points `(i, j)` (numerators over `n`), `j` outer.
+    /// Positions, or derivatives along the skew axes `u` (towards `E_0`) and `v` (towards
+    /// `E_1`).
+    pub kind: StencilKind,
+    /// The grid points `(i, j)` (numerators over `n`), `j` outer; without `(0, 0)` for
+    /// derivatives.
     pub points: Vec<(i64, i64)>,
     /// `K` weights per point, in the layout order.
     pub stencils: Vec<Vec<S>>,
@@ -120,8 +125,9 @@ fn regular_weights<S: Scalar>(
 fn regular_basis(
     scheme: &TriangleScheme,
     n: u32,
+    kind: StencilKind,
 ) -> Result<TriangleStencils<BigRational>, StencilError> {
-    triangle_stencils::<BigRational>(&scheme.regular_mask(), n, StencilKind::Position)
+    triangle_stencils::<BigRational>(&scheme.regular_mask(), n, kind)
 }
 
 /// Solve the grid system of the Loop patch around an interior vertex of valence `valence` at
@@ -131,6 +137,19 @@ pub fn triangle_patch_stencils<S: Scalar>(
     valence: u32,
     n: u32,
 ) -> Result<TrianglePatchStencils<S>, StencilError> {
+    triangle_patch_stencils_of_kind(scheme, valence, n, StencilKind::Position)
+}
+
+/// [`triangle_patch_stencils`] for positions or derivatives. A derivative picks up a factor 2
+/// per halving (`d/du phi(x) = 2 (d/du phi)(2x) A`, section 4), sums to 0 over the stencil, and
+/// is not a grid unknown at the vertex itself (the characteristic map scales by the
+/// subdominant eigenvalue there, not 1/2; [`loop_ev_tangents`] gives the tangent directions).
+pub fn triangle_patch_stencils_of_kind<S: Scalar>(
+    scheme: &TriangleScheme,
+    valence: u32,
+    n: u32,
+    kind: StencilKind,
+) -> Result<TrianglePatchStencils<S>, StencilError> {
     if n == 0 || n > MAX_TRIANGLE_RATE {
         return Err(StencilError::RateOutOfRange {
             n,
@@ -138,19 +157,23 @@ pub fn triangle_patch_stencils<S: Scalar>(
         });
     }
     let matrices = TriangleLocalMatrices::new(scheme, valence)?;
-    let basis = regular_basis(scheme, n)?;
+    let basis = regular_basis(scheme, n, kind)?;
     let k = matrices.size();
+    let factor = BigRational::from_integer(BigInt::from(kind.doubling_factor()));
     let ni = i64::from(n);
     // phi_j(x) = sum_i A[i][j] phi_i(2x).
     let columns: Vec<Vec<(usize, BigRational)>> = (0..k)
         .map(|j| {
             (0..k)
                 .filter(|&i| !matrices.a[i][j].is_zero())
-                .map(|i| (i, matrices.a[i][j].clone()))
+                .map(|i| (i, &factor * &matrices.a[i][j]))
                 .collect()
         })
         .collect();
-    let points = triangle_grid_points(n);
+    let points: Vec<(i64, i64)> = triangle_grid_points(n)
+        .into_iter()
+        .filter(|&p| p != (0, 0) || kind == StencilKind::Position)
+        .collect();
     let class_of: HashMap<(i64, i64), u32> = points
         .iter()
         .enumerate()
@@ -164,7 +187,10 @@ pub fn triangle_patch_stencils<S: Scalar>(
     for (c, &(i, j)) in points.iter().enumerate() {
         let constants = match next[c] {
             Some(_) => vec![S::zero(); k],
-            None => regular_weights(&matrices, &basis, (2 * i, 2 * j)),
+            None => regular_weights(&matrices, &basis, (2 * i, 2 * j))
+                .into_iter()
+                .map(|w: S| w * S::from_rational(&factor))
+                .collect(),
         };
         for (col, constant) in constants.into_iter().enumerate() {
             let terms: SparseRow = match next[c] {
@@ -188,7 +214,11 @@ pub fn triangle_patch_stencils<S: Scalar>(
             terms: (c * k..(c + 1) * k)
                 .map(|u| (u, BigRational::one()))
                 .collect(),
-            rhs: BigRational::one(),
+            rhs: if kind == StencilKind::Position {
+                BigRational::one()
+            } else {
+                BigRational::zero()
+            },
             label: format!("x = ({i}/{n}, {j}/{n})"),
         });
     }
@@ -200,6 +230,7 @@ pub fn triangle_patch_stencils<S: Scalar>(
         scheme: scheme.name.to_owned(),
         valence,
         n,
+        kind,
         points,
         stencils,
         residual,
@@ -213,7 +244,7 @@ pub struct TriangleSubstitution<S> {
     scheme: TriangleScheme,
     /// The local subdivision matrices.
     pub matrices: TriangleLocalMatrices,
-    bases: HashMap<u32, TriangleStencils<BigRational>>,
+    bases: HashMap<(u32, StencilKind), TriangleStencils<BigRational>>,
     field: std::marker::PhantomData<S>,
 }
 
@@ -233,6 +264,18 @@ impl<S: Scalar> TriangleSubstitution<S> {
     /// The regular basis is solved on the grid of `2x`'s denominator, which must be at most
     /// [`MAX_TRIANGLE_RATE`].
     pub fn stencil(&mut self, u: &BigRational, v: &BigRational) -> Result<Vec<S>, StencilError> {
+        self.stencil_of_kind(u, v, StencilKind::Position)
+    }
+
+    /// [`Self::stencil`] for positions or derivatives along `u` and `v` (a factor 2 per
+    /// halving). At the vertex itself the derivative masks are [`loop_ev_tangents`]' tangent
+    /// directions, irrational in general: f64 only.
+    pub fn stencil_of_kind(
+        &mut self,
+        u: &BigRational,
+        v: &BigRational,
+        kind: StencilKind,
+    ) -> Result<Vec<S>, StencilError> {
         let (zero, one) = (BigRational::zero(), BigRational::one());
         if *u < zero || *v < zero || u + v > one {
             return Err(StencilError::OutOfDomain {
@@ -240,7 +283,25 @@ impl<S: Scalar> TriangleSubstitution<S> {
             });
         }
         if u.is_zero() && v.is_zero() {
-            return self.limit_mask();
+            if kind == StencilKind::Position {
+                return self.limit_mask();
+            }
+            let t = loop_ev_tangents(&self.matrices)?;
+            let mask = if kind == StencilKind::DerivativeU {
+                t.du
+            } else {
+                t.dv
+            };
+            return mask
+                .into_iter()
+                .map(S::from_f64)
+                .collect::<Option<Vec<S>>>()
+                .ok_or_else(|| StencilError::Irrational {
+                    what: format!(
+                        "the tangent mask at the vertex (Loop, valence {})",
+                        self.matrices.valence
+                    ),
+                });
         }
         let half = BigRational::new(BigInt::from(1), BigInt::from(2));
         let two = BigRational::from_integer(BigInt::from(2));
@@ -264,11 +325,17 @@ impl<S: Scalar> TriangleSubstitution<S> {
             i64::try_from(&(t * BigRational::from_integer(d.clone())).to_integer()).unwrap_or(0)
         };
         let point = (numerator(&y1), numerator(&y2));
-        if !self.bases.contains_key(&n) {
-            let basis = regular_basis(&self.scheme, n)?;
-            self.bases.insert(n, basis);
+        if !self.bases.contains_key(&(n, kind)) {
+            let basis = regular_basis(&self.scheme, n, kind)?;
+            self.bases.insert((n, kind), basis);
         }
-        let mut row: Vec<S> = regular_weights(&self.matrices, &self.bases[&n], point);
+        let factor = S::from_rational(&BigRational::from_integer(BigInt::from(
+            kind.doubling_factor(),
+        )));
+        let mut row: Vec<S> = regular_weights(&self.matrices, &self.bases[&(n, kind)], point)
+            .into_iter()
+            .map(|w: S| w * factor.clone())
+            .collect();
         let size = self.matrices.size();
         for _ in 0..k {
             row = (0..size)
@@ -279,6 +346,7 @@ impl<S: Scalar> TriangleSubstitution<S> {
                         .fold(S::zero(), |acc, (w, a)| {
                             acc + w.clone() * S::from_rational(&a[j])
                         })
+                        * factor.clone()
                 })
                 .collect();
         }

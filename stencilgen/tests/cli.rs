@@ -205,6 +205,8 @@ fn loop_stencil_at_an_extraordinary_vertex() {
     assert!(v["du"].is_null() && v["note"].is_string());
     let f = json("stencil --scheme loop --valence 5 --u 0 --v 0 --f64 --json");
     assert_eq!(f["du"].as_array().map(Vec::len), Some(11));
+    let away = json("stencil --scheme loop --valence 5 --u 1/3 --v 1/6 --json");
+    assert_eq!(away["dv"].as_array().map(Vec::len), Some(11));
     let inner = json("stencil --scheme loop --valence 7 --u 1/3 --v 1/5 --f64 --json");
     let sum: f64 = inner["weights"]
         .as_array()

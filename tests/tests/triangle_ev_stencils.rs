@@ -16,11 +16,11 @@ use schemes::triangle_local::{
 use stencilgen::regular_patch::StencilKind;
 use stencilgen::scalar::rational_to_f64;
 use stencilgen::triangle_patch::{
-    loop_ev_tangents, triangle_patch_stencils, triangle_scheme, TrianglePatchStencils,
-    TriangleSubstitution,
+    loop_ev_tangents, triangle_patch_stencils, triangle_patch_stencils_of_kind, triangle_scheme,
+    TrianglePatchStencils, TriangleSubstitution,
 };
 use stencilgen::triangle_system::triangle_stencils;
-use subtess_tests::box_spline::loop_basis;
+use subtess_tests::box_spline::{box_spline, loop_basis};
 use subtess_tests::bspline::q;
 
 fn exact(v: u32, n: u32) -> TrianglePatchStencils<BigRational> {
@@ -242,5 +242,86 @@ fn valence_six_tangents_are_the_box_spline_derivatives() {
     assert_eq!(apply_map(r, (1, 0)), (0, 1));
     for k in 0..6 {
         assert!((t.du[1 + k] - t.dv[1 + (k + 1) % 6]).abs() < 1e-12);
+    }
+}
+
+fn exact_kind(v: u32, n: u32, kind: StencilKind) -> TrianglePatchStencils<BigRational> {
+    let loop_ = triangle_scheme("loop").expect("catalogued");
+    triangle_patch_stencils_of_kind::<BigRational>(&loop_, v, n, kind).expect("solvable")
+}
+
+const DERIVATIVES: [StencilKind; 2] = [StencilKind::DerivativeU, StencilKind::DerivativeV];
+
+#[test]
+fn derivative_grid_equals_substitution_and_sums_to_zero() {
+    let loop_ = triangle_scheme("loop").expect("catalogued");
+    for v in 3..=8 {
+        let mut sub = TriangleSubstitution::<BigRational>::new(&loop_, v).expect("valid");
+        for kind in DERIVATIVES {
+            for n in [1, 2, 3, 5, 7] {
+                let grid = exact_kind(v, n, kind);
+                assert!(!grid.points.contains(&(0, 0)));
+                for (&(i, j), stencil) in grid.points.iter().zip(&grid.stencils) {
+                    let by_substitution = sub
+                        .stencil_of_kind(&q(i, i64::from(n)), &q(j, i64::from(n)), kind)
+                        .expect("in the patch");
+                    assert_eq!(
+                        stencil, &by_substitution,
+                        "{kind:?} v = {v}, ({i}/{n}, {j}/{n})"
+                    );
+                    assert!(stencil.iter().sum::<BigRational>().is_zero());
+                }
+            }
+        }
+        // At the vertex exact mode refuses (irrational in general).
+        assert!(sub
+            .stencil_of_kind(&q(0, 1), &q(0, 1), StencilKind::DerivativeU)
+            .is_err());
+    }
+}
+
+#[test]
+fn valence_six_derivatives_are_the_box_spline_differences() {
+    // d/du M_222(z) = M_122(z) - M_122(z - xi_1), d/dv = M_212(z) - M_212(z - xi_2),
+    // z = x - p + (2, 0) for the control point at p.
+    for n in 1..=4 {
+        for kind in DERIVATIVES {
+            let s = exact_kind(6, n, kind);
+            for (&(i, j), stencil) in s.points.iter().zip(&s.stencils) {
+                let mut expected = vec![BigRational::zero(); 12];
+                for (k, (a, b)) in unfolded_positions(6) {
+                    let z = (
+                        q(i, i64::from(n)) - q(a - 2, 1),
+                        q(j, i64::from(n)) - q(b, 1),
+                    );
+                    let (c, d) = match kind {
+                        StencilKind::DerivativeU => ([1, 2, 2], (1, 0)),
+                        _ => ([2, 1, 2], (0, 1)),
+                    };
+                    expected[k] +=
+                        box_spline(c, &z) - box_spline(c, &(&z.0 - q(d.0, 1), &z.1 - q(d.1, 1)));
+                }
+                assert_eq!(stencil, &expected, "{kind:?} ({i}/{n}, {j}/{n})");
+            }
+        }
+    }
+}
+
+#[test]
+fn derivative_mirror_symmetry() {
+    for v in [3, 5, 8u32] {
+        let du = exact_kind(v, 5, StencilKind::DerivativeU);
+        let dv = exact_kind(v, 5, StencilKind::DerivativeV);
+        for &(i, j) in &du.points {
+            let a = du.at(i, j).expect("grid point");
+            let b = dv.at(j, i).expect("grid point");
+            for p in 0..a.len() {
+                assert_eq!(
+                    a[p],
+                    b[mirror(v as usize, p)],
+                    "v = {v} ({i}, {j}) point {p}"
+                );
+            }
+        }
     }
 }
