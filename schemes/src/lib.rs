@@ -18,6 +18,7 @@ pub mod curve;
 pub mod local_matrices;
 pub mod quad;
 pub mod triangle;
+pub mod triangle_local;
 
 pub use bivariate::BivariateMask;
 pub use curve::{Component, CurveScheme, Term, Translates};

@@ -45,24 +45,7 @@ pub fn ev_tangents(matrices: &LocalMatrices) -> Result<EvTangents, StencilError>
         n: 0,
         detail: format!("{}: {what}", matrices.describe()),
     };
-    // A bounded Schur iteration, so that a matrix it cannot settle is an error, not a hang.
-    let schur = nalgebra::linalg::Schur::try_new(a1.clone(), 1e-14, 100_000)
-        .ok_or_else(|| failure("the eigenvalue iteration did not converge"))?;
-    let mut eigenvalues: Vec<f64> = schur
-        .complex_eigenvalues()
-        .iter()
-        .filter(|z| (z.norm() - 1.0).abs() > 1e-9)
-        .map(|z| z.re)
-        .collect();
-    eigenvalues.sort_by(|x, y| y.total_cmp(x));
-    let (&l1, &l2) = (
-        eigenvalues
-            .first()
-            .ok_or_else(|| failure("no subdominant eigenvalue"))?,
-        eigenvalues
-            .get(1)
-            .ok_or_else(|| failure("no second subdominant eigenvalue"))?,
-    );
+    let (l1, l2) = subdominant_eigenvalues(&a1).map_err(|e| failure(&e))?;
     // Left eigenvectors spanning the tangent plane: the null spaces of A1^T - lambda I.
     let mut basis: Vec<Vec<f64>> = left_null_space(&a1, l1);
     if (l1 - l2).abs() > 1e-9 {
@@ -121,8 +104,26 @@ pub fn ev_tangents(matrices: &LocalMatrices) -> Result<EvTangents, StencilError>
     })
 }
 
+/// The two largest eigenvalues of `a1` whose modulus is not 1 (real parts), by a bounded
+/// Schur iteration so that a matrix it cannot settle is an error, not a hang.
+pub(crate) fn subdominant_eigenvalues(a1: &DMatrix<f64>) -> Result<(f64, f64), String> {
+    let schur = nalgebra::linalg::Schur::try_new(a1.clone(), 1e-14, 100_000)
+        .ok_or_else(|| "the eigenvalue iteration did not converge".to_owned())?;
+    let mut eigenvalues: Vec<f64> = schur
+        .complex_eigenvalues()
+        .iter()
+        .filter(|z| (z.norm() - 1.0).abs() > 1e-9)
+        .map(|z| z.re)
+        .collect();
+    eigenvalues.sort_by(|x, y| y.total_cmp(x));
+    match eigenvalues.as_slice() {
+        [l1, l2, ..] => Ok((*l1, *l2)),
+        _ => Err("no pair of subdominant eigenvalues".to_owned()),
+    }
+}
+
 /// An orthonormal basis of the left null space of `a - lambda I` (singular values below 1e-8).
-fn left_null_space(a: &DMatrix<f64>, lambda: f64) -> Vec<Vec<f64>> {
+pub(crate) fn left_null_space(a: &DMatrix<f64>, lambda: f64) -> Vec<Vec<f64>> {
     let n = a.nrows();
     let m = a.transpose() - DMatrix::identity(n, n) * lambda;
     let svd = m.svd(false, true);

@@ -3,7 +3,7 @@
 //! `stencilgen curve --scheme NAME --n N [--derivative] [--f64] [--json]` prints the values of
 //! a curve scheme's basis function(s) (or their derivatives) on the grid `(1/n) Z`;
 //! `stencilgen stencil --scheme S --valence V --u p/q --v p/q [--f64] [--json]` the stencil of
-//! the patch next to an extraordinary vertex; `stencilgen triangle --scheme S --n N` the regular
+//! the patch next to an extraordinary vertex (quad schemes, and Loop); `stencilgen triangle --scheme S --n N` the regular
 //! basis function of a triangle scheme on `(1/n) Z^2`. See `docs/cli.md` for the JSON layouts.
 
 use std::process::ExitCode;
@@ -22,6 +22,7 @@ use stencilgen::regular_patch::StencilKind;
 use stencilgen::stencil_set::StencilSetSpec;
 use stencilgen::substitution::Substitution;
 use stencilgen::table::{build_table, TableSpec};
+use stencilgen::triangle_patch::TriangleSubstitution;
 use stencilgen::triangle_system::{triangle_stencils, TriangleStencils};
 use stencilgen::{curve_stencils, CurveStencils, Scalar, StencilError};
 use table_format::Precision;
@@ -59,7 +60,8 @@ enum Command {
     },
     /// Stencil of the patch next to an extraordinary vertex at a rational (u, v).
     Stencil {
-        /// Quad scheme name (catmull-clark, sw-nonpoly-quad).
+        /// Quad scheme name (catmull-clark, sw-nonpoly-quad), or `loop` (interior vertices;
+        /// (u, v) barycentric on the triangle V, E0, E1).
         #[arg(long)]
         scheme: String,
         /// Valence of the (interior) extraordinary vertex at (0, 0).
@@ -275,8 +277,30 @@ fn run(cli: Cli) -> Result<(), StencilError> {
             float,
             json,
         } => {
-            let scheme = quad_scheme(&scheme)?;
             let (u, v) = (parse_rational(&u)?, parse_rational(&v)?);
+            if let Some(triangle) = TriangleScheme::by_name(&scheme) {
+                let Some(valence) = valence.filter(|_| boundary.is_none()) else {
+                    return Err(StencilError::UnsupportedScheme {
+                        scheme,
+                        reason: "triangle schemes have no boundary rules yet; give --valence"
+                            .to_owned(),
+                    });
+                };
+                let out = if float {
+                    triangle_stencil_json::<f64>(&triangle, valence, &u, &v, |x| json!(x))?
+                } else {
+                    triangle_stencil_json::<BigRational>(&triangle, valence, &u, &v, |x| {
+                        json!(x.to_string())
+                    })?
+                };
+                if json {
+                    println!("{out}");
+                } else {
+                    println!("{}", serde_json::to_string_pretty(&out).unwrap_or_default());
+                }
+                return Ok(());
+            }
+            let scheme = quad_scheme(&scheme)?;
             let mode = if corners {
                 BoundaryMode::EdgeAndCorner
             } else {
@@ -421,6 +445,45 @@ fn write_table(spec: TableSpec, path: &std::path::Path) -> Result<(), StencilErr
         started.elapsed()
     );
     Ok(())
+}
+
+/// The Loop EV patch's stencil at `(u, v)` (barycentric: `u, v >= 0`, `u + v <= 1`), by
+/// substitution: `{"scheme","valence","u","v","exact","order","weights","du","dv"}`. At the
+/// vertex itself the tangent masks are irrational in general: `null` in exact mode, with the
+/// reason in `"note"`; `--f64` gives them (subdominant eigenvectors).
+fn triangle_stencil_json<S: Scalar>(
+    scheme: &TriangleScheme,
+    valence: u32,
+    u: &BigRational,
+    v: &BigRational,
+    value: impl Fn(&S) -> Value,
+) -> Result<Value, StencilError> {
+    let mut substitution = TriangleSubstitution::<S>::new(scheme, valence)?;
+    let weights = substitution.stencil(u, v)?;
+    let mut out = json!({
+        "scheme": scheme.name,
+        "valence": valence,
+        "boundary": false,
+        "u": u.to_string(),
+        "v": v.to_string(),
+        "exact": S::EXACT,
+        "order": substitution.matrices.names(),
+        "weights": weights.iter().map(&value).collect::<Vec<_>>(),
+    });
+    for (key, kind) in [
+        ("du", StencilKind::DerivativeU),
+        ("dv", StencilKind::DerivativeV),
+    ] {
+        match substitution.stencil_of_kind(u, v, kind) {
+            Ok(mask) => out[key] = mask.iter().map(&value).collect(),
+            Err(e @ StencilError::Irrational { .. }) => {
+                out[key] = Value::Null;
+                out["note"] = json!(e.to_string());
+            }
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(out)
 }
 
 /// `{"weights","du","dv"}` (DESIGN.md / issue contract) plus what they mean: the scheme,

@@ -125,8 +125,8 @@ fn stencil_bad_input() {
             "2 is not in 3..=64",
         ),
         (
-            "stencil --scheme loop --valence 5 --u 0 --v 0",
-            "unknown scheme `loop`",
+            "stencil --scheme no-such-scheme --valence 5 --u 0 --v 0",
+            "unknown scheme `no-such-scheme`",
         ),
     ];
     for (args, message) in cases {
@@ -192,4 +192,41 @@ fn triangle_json_lists_the_support_grid() {
     assert!(f["values"][0].is_number());
     assert!(f["residual"].as_f64().expect("residual") < 1e-12);
     fails_with("triangle --scheme loopy --n 2", "unknown scheme `loopy`");
+}
+
+#[test]
+fn loop_stencil_at_an_extraordinary_vertex() {
+    // Loop's limit rule with Warren's beta = 3/40 at valence 5: chi = 1/(3/(8 beta) + 5) = 1/10.
+    let v = json("stencil --scheme loop --valence 5 --u 0 --v 0 --json");
+    assert_eq!(v["order"].as_array().map(Vec::len), Some(11));
+    assert_eq!(v["weights"][0], "1/2");
+    assert_eq!(v["weights"][1], "1/10");
+    assert_eq!(v["weights"][6], "0");
+    assert!(v["du"].is_null() && v["note"].is_string());
+    let f = json("stencil --scheme loop --valence 5 --u 0 --v 0 --f64 --json");
+    assert_eq!(f["du"].as_array().map(Vec::len), Some(11));
+    let away = json("stencil --scheme loop --valence 5 --u 1/3 --v 1/6 --json");
+    assert_eq!(away["dv"].as_array().map(Vec::len), Some(11));
+    let inner = json("stencil --scheme loop --valence 7 --u 1/3 --v 1/5 --f64 --json");
+    let sum: f64 = inner["weights"]
+        .as_array()
+        .map(|w| w.iter().filter_map(serde_json::Value::as_f64).sum())
+        .unwrap_or(0.0);
+    assert!((sum - 1.0).abs() < 1e-12);
+    fails_with(
+        "stencil --scheme loop --valence 5 --u 2/3 --v 2/3",
+        "outside the patch",
+    );
+    fails_with(
+        "stencil --scheme loop-original --valence 5 --u 1/3 --v 0",
+        "irrational",
+    );
+    fails_with(
+        "stencil --scheme butterfly --valence 5 --u 1/3 --v 0",
+        "Loop only",
+    );
+    fails_with(
+        "stencil --scheme loop --boundary 3 --u 1/3 --v 0",
+        "boundary",
+    );
 }

@@ -1,0 +1,474 @@
+//! Stencils of the Loop patch next to an interior extraordinary vertex (Schaefer–Warren
+//! sections 5.2–5.3 on the triangular lattice of section 5.1), by the grid system and by
+//! substitution, and the limit tangents at the vertex.
+//!
+//! Let `phi(x)` be the row of the `K = v + 6` basis functions of the layout of
+//! [`schemes::triangle_local`] at `x = (u, v)` in the patch `u, v >= 0`, `u + v <= 1`. One step
+//! of subdivision does not change the surface, so
+//!
+//! * `phi(x) = phi(2x) A` when `2x` is in the patch again (`u + v <= 1/2`);
+//! * otherwise `y = 2x` (level-1 skew coordinates) lies in a regular sub-triangle `b`, and
+//!   `phi(x) = sum_j psi(y - j) R_b[j]` over its twelve level-1 points `j`, with `psi` the
+//!   regular (box-spline) basis function of [`crate::triangle_system`];
+//! * the partition of unity `sum_j phi_j(x) = 1`.
+//!
+//! At the grid points `(i/n, j/n)`, `i + j <= n`, this is a [`ScalingSystem`] whose classes are
+//! the grid points (`x -> 2x` maps the grid into itself): triangular except at `x = 0`, where
+//! `phi(0) = phi(0) A`, `sum phi(0) = 1` is the limit-position mask. [`TriangleSubstitution`]
+//! unrolls the same relations at any rational point without forming a system (the independent
+//! cross-check). [`loop_ev_tangents`] gives the tangent masks at the vertex from the
+//! subdominant left eigenvectors of `A` (f64: they are irrational for most valences).
+
+use std::collections::HashMap;
+
+use nalgebra::DMatrix;
+use num_bigint::BigInt;
+use num_integer::Integer;
+use num_rational::BigRational;
+use num_traits::{One, Zero};
+use schemes::triangle_local::TriangleLocalMatrices;
+use schemes::TriangleScheme;
+
+use crate::ev_tangents::{left_null_space, subdominant_eigenvalues};
+use crate::exact_solve::solve_dense;
+use crate::regular_patch::StencilKind;
+use crate::scalar::rational_to_f64;
+use crate::scaling_system::{NormalizationRow, Relation, ScalingSystem, SparseRow};
+use crate::solve::{solve_system, Solution};
+use crate::triangle_system::{triangle_stencils, TriangleStencils, MAX_TRIANGLE_RATE};
+use crate::{Scalar, StencilError};
+
+/// A triangle scheme from the catalogue, or an error listing the catalogue.
+pub fn triangle_scheme(name: &str) -> Result<TriangleScheme, StencilError> {
+    TriangleScheme::by_name(name).ok_or_else(|| StencilError::UnknownScheme {
+        name: name.to_owned(),
+        known: schemes::triangle::TRIANGLE_SCHEME_NAMES.join(", "),
+    })
+}
+
+/// Stencils of one kind at the grid points `(i/n, j/n)`, `i + j <= n`, of the Loop EV patch
+/// (derivatives: every point but the vertex itself, see [`loop_ev_tangents`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TrianglePatchStencils<S> {
+    /// The scheme's name.
+    pub scheme: String,
+    /// The valence of the vertex at `(0, 0)`.
+    pub valence: u32,
+    /// Grid rate.
+    pub n: u32,
+    /// Positions, or derivatives along the skew axes `u` (towards `E_0`) and `v` (towards
+    /// `E_1`).
+    pub kind: StencilKind,
+    /// The grid points `(i, j)` (numerators over `n`), `j` outer; without `(0, 0)` for
+    /// derivatives.
+    pub points: Vec<(i64, i64)>,
+    /// `K` weights per point, in the layout order.
+    pub stencils: Vec<Vec<S>>,
+    /// Largest residual over the system.
+    pub residual: f64,
+}
+
+impl<S: Scalar> TrianglePatchStencils<S> {
+    /// The stencil at `(i/n, j/n)`, if that is a grid point of the patch.
+    pub fn at(&self, i: i64, j: i64) -> Option<&[S]> {
+        let k = self.points.iter().position(|&p| p == (i, j))?;
+        Some(&self.stencils[k])
+    }
+}
+
+/// The grid points `(i, j)`, `i + j <= n`, `j` outer.
+pub fn triangle_grid_points(n: u32) -> Vec<(i64, i64)> {
+    let n = i64::from(n);
+    (0..=n)
+        .flat_map(|j| (0..=n - j).map(move |i| (i, j)))
+        .collect()
+}
+
+/// The regular sub-triangle holding `y = (y_1/n, y_2/n)` (level-1 coordinates,
+/// `y_1 + y_2 >= n`, inside the level-0 patch): the index into `SUB_TRIANGLES`.
+pub fn sub_triangle_of(y: (i64, i64), n: i64) -> usize {
+    if y.0 >= n {
+        0
+    } else if y.1 >= n {
+        2
+    } else {
+        1
+    }
+}
+
+/// `sum_j psi(y - j) R_b[j]` with `y = Y / n`: the weights of a point of a regular sub-triangle.
+/// Loop's regular basis is rational, so it is always solved (and summed) exactly, then
+/// converted: the f64 path of the regular system solves its orbits densely and is far slower
+/// (Loop `n = 16`: minutes instead of milliseconds).
+fn regular_weights<S: Scalar>(
+    matrices: &TriangleLocalMatrices,
+    basis: &TriangleStencils<BigRational>,
+    y: (i64, i64),
+) -> Vec<S> {
+    let n = i64::from(basis.n);
+    let sub = &matrices.sub_triangles[sub_triangle_of(y, n)];
+    let mut out = vec![BigRational::zero(); matrices.size()];
+    for (&(j1, j2), row) in sub.points.iter().zip(&sub.rows) {
+        let psi = basis.at(y.0 - n * j1, y.1 - n * j2);
+        if psi.is_zero() {
+            continue;
+        }
+        for (o, r) in out.iter_mut().zip(row) {
+            if !r.is_zero() {
+                *o += &psi * r;
+            }
+        }
+    }
+    out.iter().map(S::from_rational).collect()
+}
+
+fn regular_basis(
+    scheme: &TriangleScheme,
+    n: u32,
+    kind: StencilKind,
+) -> Result<TriangleStencils<BigRational>, StencilError> {
+    triangle_stencils::<BigRational>(&scheme.regular_mask(), n, kind)
+}
+
+/// Solve the grid system of the Loop patch around an interior vertex of valence `valence` at
+/// rate `n` (`1..=`[`MAX_TRIANGLE_RATE`]), positions.
+pub fn triangle_patch_stencils<S: Scalar>(
+    scheme: &TriangleScheme,
+    valence: u32,
+    n: u32,
+) -> Result<TrianglePatchStencils<S>, StencilError> {
+    triangle_patch_stencils_of_kind(scheme, valence, n, StencilKind::Position)
+}
+
+/// [`triangle_patch_stencils`] for positions or derivatives. A derivative picks up a factor 2
+/// per halving (`d/du phi(x) = 2 (d/du phi)(2x) A`, section 4), sums to 0 over the stencil, and
+/// is not a grid unknown at the vertex itself (the characteristic map scales by the
+/// subdominant eigenvalue there, not 1/2; [`loop_ev_tangents`] gives the tangent directions).
+pub fn triangle_patch_stencils_of_kind<S: Scalar>(
+    scheme: &TriangleScheme,
+    valence: u32,
+    n: u32,
+    kind: StencilKind,
+) -> Result<TrianglePatchStencils<S>, StencilError> {
+    if n == 0 || n > MAX_TRIANGLE_RATE {
+        return Err(StencilError::RateOutOfRange {
+            n,
+            max: MAX_TRIANGLE_RATE,
+        });
+    }
+    let matrices = TriangleLocalMatrices::new(scheme, valence)?;
+    let basis = regular_basis(scheme, n, kind)?;
+    let k = matrices.size();
+    let factor = BigRational::from_integer(BigInt::from(kind.doubling_factor()));
+    let ni = i64::from(n);
+    // phi_j(x) = sum_i A[i][j] phi_i(2x).
+    let columns: Vec<Vec<(usize, BigRational)>> = (0..k)
+        .map(|j| {
+            (0..k)
+                .filter(|&i| !matrices.a[i][j].is_zero())
+                .map(|i| (i, &factor * &matrices.a[i][j]))
+                .collect()
+        })
+        .collect();
+    let points: Vec<(i64, i64)> = triangle_grid_points(n)
+        .into_iter()
+        .filter(|&p| p != (0, 0) || kind == StencilKind::Position)
+        .collect();
+    let class_of: HashMap<(i64, i64), u32> = points
+        .iter()
+        .enumerate()
+        .map(|(c, &p)| (p, c as u32))
+        .collect();
+    let next: Vec<Option<u32>> = points
+        .iter()
+        .map(|&(i, j)| (2 * (i + j) <= ni).then(|| class_of[&(2 * i, 2 * j)]))
+        .collect();
+    let mut system = ScalingSystem::<S>::new(next.clone());
+    for (c, &(i, j)) in points.iter().enumerate() {
+        let constants = match next[c] {
+            Some(_) => vec![S::zero(); k],
+            None => regular_weights(&matrices, &basis, (2 * i, 2 * j))
+                .into_iter()
+                .map(|w: S| w * S::from_rational(&factor))
+                .collect(),
+        };
+        for (col, constant) in constants.into_iter().enumerate() {
+            let terms: SparseRow = match next[c] {
+                Some(target) => {
+                    let base = target as usize * k;
+                    columns[col]
+                        .iter()
+                        .map(|(r, w)| (base + r, w.clone()))
+                        .collect()
+                }
+                None => Vec::new(),
+            };
+            system.push_unknown(
+                c as u32,
+                Relation { terms, constant },
+                format!("phi_{col}({i}/{n}, {j}/{n})"),
+            );
+        }
+        system.normalization.push(NormalizationRow {
+            class: c as u32,
+            terms: (c * k..(c + 1) * k)
+                .map(|u| (u, BigRational::one()))
+                .collect(),
+            rhs: if kind == StencilKind::Position {
+                BigRational::one()
+            } else {
+                BigRational::zero()
+            },
+            label: format!("x = ({i}/{n}, {j}/{n})"),
+        });
+    }
+    let Solution { values, residual } = solve_system::<S>(&system, scheme.name, n)?;
+    let stencils = (0..points.len())
+        .map(|c| values[c * k..(c + 1) * k].to_vec())
+        .collect();
+    Ok(TrianglePatchStencils {
+        scheme: scheme.name.to_owned(),
+        valence,
+        n,
+        kind,
+        points,
+        stencils,
+        residual,
+    })
+}
+
+/// Evaluates Loop EV-patch stencils by substitution at any rational `(u, v)`; caches the
+/// regular basis per denominator.
+#[derive(Debug)]
+pub struct TriangleSubstitution<S> {
+    scheme: TriangleScheme,
+    /// The local subdivision matrices.
+    pub matrices: TriangleLocalMatrices,
+    bases: HashMap<(u32, StencilKind), TriangleStencils<BigRational>>,
+    field: std::marker::PhantomData<S>,
+}
+
+impl<S: Scalar> TriangleSubstitution<S> {
+    /// Prepare for a Loop scheme around an interior vertex of valence `valence`.
+    pub fn new(scheme: &TriangleScheme, valence: u32) -> Result<Self, StencilError> {
+        Ok(TriangleSubstitution {
+            scheme: scheme.clone(),
+            matrices: TriangleLocalMatrices::new(scheme, valence)?,
+            bases: HashMap::new(),
+            field: std::marker::PhantomData,
+        })
+    }
+
+    /// The `K` position weights at `(u, v)`, `u, v >= 0`, `u + v <= 1`: double `x` `k` times
+    /// until `u + v > 1/2`, take the regular sub-triangle's weights at `2x`, apply `A` `k` times.
+    /// The regular basis is solved on the grid of `2x`'s denominator, which must be at most
+    /// [`MAX_TRIANGLE_RATE`].
+    pub fn stencil(&mut self, u: &BigRational, v: &BigRational) -> Result<Vec<S>, StencilError> {
+        self.stencil_of_kind(u, v, StencilKind::Position)
+    }
+
+    /// [`Self::stencil`] for positions or derivatives along `u` and `v` (a factor 2 per
+    /// halving). At the vertex itself the derivative masks are [`loop_ev_tangents`]' tangent
+    /// directions, irrational in general: f64 only.
+    pub fn stencil_of_kind(
+        &mut self,
+        u: &BigRational,
+        v: &BigRational,
+        kind: StencilKind,
+    ) -> Result<Vec<S>, StencilError> {
+        let (zero, one) = (BigRational::zero(), BigRational::one());
+        if *u < zero || *v < zero || u + v > one {
+            return Err(StencilError::OutOfDomain {
+                what: format!("(u, v) = ({u}, {v}) is outside the patch u, v >= 0, u + v <= 1"),
+            });
+        }
+        if u.is_zero() && v.is_zero() {
+            if kind == StencilKind::Position {
+                return self.limit_mask();
+            }
+            let t = loop_ev_tangents(&self.matrices)?;
+            let mask = if kind == StencilKind::DerivativeU {
+                t.du
+            } else {
+                t.dv
+            };
+            return mask
+                .into_iter()
+                .map(S::from_f64)
+                .collect::<Option<Vec<S>>>()
+                .ok_or_else(|| StencilError::Irrational {
+                    what: format!(
+                        "the tangent mask at the vertex (Loop, valence {})",
+                        self.matrices.valence
+                    ),
+                });
+        }
+        let half = BigRational::new(BigInt::from(1), BigInt::from(2));
+        let two = BigRational::from_integer(BigInt::from(2));
+        let (mut x, mut y, mut k) = (u.clone(), v.clone(), 0u32);
+        while &x + &y <= half {
+            x *= &two;
+            y *= &two;
+            k += 1;
+        }
+        let (y1, y2) = (&x * &two, &y * &two);
+        let d = y1.denom().lcm(y2.denom());
+        let n = u32::try_from(&d)
+            .ok()
+            .filter(|&n| n <= MAX_TRIANGLE_RATE)
+            .ok_or_else(|| StencilError::OutOfDomain {
+                what: format!(
+                    "the denominator of ({u}, {v}) doubled is {d}; the regular basis is solved for denominators up to {MAX_TRIANGLE_RATE}"
+                ),
+            })?;
+        let numerator = |t: &BigRational| {
+            i64::try_from(&(t * BigRational::from_integer(d.clone())).to_integer()).unwrap_or(0)
+        };
+        let point = (numerator(&y1), numerator(&y2));
+        if !self.bases.contains_key(&(n, kind)) {
+            let basis = regular_basis(&self.scheme, n, kind)?;
+            self.bases.insert((n, kind), basis);
+        }
+        let factor = S::from_rational(&BigRational::from_integer(BigInt::from(
+            kind.doubling_factor(),
+        )));
+        let mut row: Vec<S> = regular_weights(&self.matrices, &self.bases[&(n, kind)], point)
+            .into_iter()
+            .map(|w: S| w * factor.clone())
+            .collect();
+        let size = self.matrices.size();
+        for _ in 0..k {
+            row = (0..size)
+                .map(|j| {
+                    row.iter()
+                        .zip(&self.matrices.a)
+                        .filter(|(_, a)| !a[j].is_zero())
+                        .fold(S::zero(), |acc, (w, a)| {
+                            acc + w.clone() * S::from_rational(&a[j])
+                        })
+                        * factor.clone()
+                })
+                .collect();
+        }
+        Ok(row)
+    }
+
+    /// The limit-position mask at the vertex: `phi(0) = phi(0) A`, `sum phi(0) = 1`.
+    fn limit_mask(&self) -> Result<Vec<S>, StencilError> {
+        let size = self.matrices.size();
+        let mut rows: Vec<(Vec<BigRational>, BigRational)> = (0..size)
+            .map(|j| {
+                let mut row: Vec<BigRational> =
+                    (0..size).map(|i| self.matrices.a[i][j].clone()).collect();
+                row[j] -= BigRational::one();
+                (row, BigRational::zero())
+            })
+            .collect();
+        rows.push((vec![BigRational::one(); size], BigRational::one()));
+        let mask = solve_dense(rows, size).map_err(|e| StencilError::Inconsistent {
+            scheme: self.scheme.name.to_owned(),
+            n: 1,
+            detail: format!("limit mask at valence {}: {e:?}", self.matrices.valence),
+        })?;
+        Ok(mask.iter().map(S::from_rational).collect())
+    }
+}
+
+/// The subdominant eigenvalue and the tangent masks at the extraordinary vertex of a Loop
+/// patch (f64, `K` weights each, zero beyond the 1-ring).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoopEvTangents {
+    /// The subdominant eigenvalue of `A` (`3/8 + cos(2 pi / v) / 4` for Loop).
+    pub lambda: f64,
+    /// Tangent mask in the direction of `E_0` (the patch's `u`).
+    pub du: Vec<f64>,
+    /// Tangent mask in the direction of `E_1` (the patch's `v`).
+    pub dv: Vec<f64>,
+}
+
+/// Tangent masks at the vertex from the subdominant left eigenvectors of the 1-ring block of
+/// `A` (`V, E_0..E_{v-1}`, invariant under subdivision), as [`crate::ev_tangents`] does for
+/// quads. The normalization is fixed on the reference net `V = 0`,
+/// `E_i = (cos 2 pi i/v, sin 2 pi i/v)`: the `u` mask maps it to `E_0`, the `v` mask to `E_1`.
+/// At valence 6 the net is the equilateral lattice and the masks are the box spline's
+/// derivatives along the skew axes `(1, 0)` and `(0, 1)` at the vertex.
+pub fn loop_ev_tangents(matrices: &TriangleLocalMatrices) -> Result<LoopEvTangents, StencilError> {
+    let v = matrices.valence as usize;
+    let ring = 1 + v;
+    let a1 = DMatrix::from_fn(ring, ring, |i, j| rational_to_f64(&matrices.a[i][j]));
+    let failure = |what: &str| StencilError::Inconsistent {
+        scheme: "tangents at the extraordinary vertex".to_owned(),
+        n: 0,
+        detail: format!("{} valence {v}: {what}", matrices.scheme),
+    };
+    let (l1, l2) = subdominant_eigenvalues(&a1).map_err(|e| failure(&e))?;
+    let mut basis = left_null_space(&a1, l1);
+    if (l1 - l2).abs() > 1e-9 {
+        basis.truncate(1);
+        basis.extend(left_null_space(&a1, l2).into_iter().take(1));
+    }
+    if basis.len() != 2 {
+        return Err(failure(
+            "the tangent plane is not spanned by two eigenvectors",
+        ));
+    }
+    let edge = |i: usize| {
+        let t = 2.0 * std::f64::consts::PI * (i % v) as f64 / v as f64;
+        [t.cos(), t.sin()]
+    };
+    let image = |w: &[f64]| {
+        (0..v).fold([0.0, 0.0], |acc, i| {
+            let e = edge(i);
+            [acc[0] + w[1 + i] * e[0], acc[1] + w[1 + i] * e[1]]
+        })
+    };
+    let (g0, g1) = (image(&basis[0]), image(&basis[1]));
+    let det = g0[0] * g1[1] - g0[1] * g1[0];
+    if det.abs() < 1e-12 {
+        return Err(failure(
+            "the eigenvectors do not span the reference net's plane",
+        ));
+    }
+    let mask = |target: [f64; 2]| -> Vec<f64> {
+        let c0 = (target[0] * g1[1] - target[1] * g1[0]) / det;
+        let c1 = (g0[0] * target[1] - g0[1] * target[0]) / det;
+        let mut m: Vec<f64> = basis[0]
+            .iter()
+            .zip(&basis[1])
+            .map(|(a, b)| c0 * a + c1 * b)
+            .collect();
+        m.resize(matrices.size(), 0.0);
+        m
+    };
+    Ok(LoopEvTangents {
+        lambda: l1,
+        du: mask(edge(0)),
+        dv: mask(edge(1)),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn loop_subdominant_eigenvalue_is_the_closed_form() {
+        let loop_ = triangle_scheme("loop").expect("catalogued");
+        for v in 3..=8u32 {
+            let m = TriangleLocalMatrices::new(&loop_, v).expect("valid");
+            let t = loop_ev_tangents(&m).expect("tangents");
+            let expected = 0.375 + 0.25 * (2.0 * std::f64::consts::PI / f64::from(v)).cos();
+            assert!((t.lambda - expected).abs() < 1e-12, "v = {v}: {}", t.lambda);
+        }
+    }
+
+    #[test]
+    fn points_outside_the_patch_are_errors() {
+        let loop_ = triangle_scheme("loop").expect("catalogued");
+        let mut s = TriangleSubstitution::<BigRational>::new(&loop_, 5).expect("valid");
+        let q = |p: i64, r: i64| BigRational::new(p.into(), r.into());
+        assert!(s.stencil(&q(2, 3), &q(2, 3)).is_err());
+        assert!(s.stencil(&q(-1, 3), &q(0, 1)).is_err());
+        assert!(triangle_patch_stencils::<f64>(&loop_, 5, 0).is_err());
+    }
+}
