@@ -163,6 +163,46 @@ fn check_exactly(iso: &Isolation, out: &AdaptiveMesh, faces: &[u32], scale: f64)
     worst
 }
 
+/// Exact evaluation at 8 x 8 interior points of every polygon at an extraordinary vertex of
+/// the faces `faces`: asserts the distance to the polygon's triangles is within its bound and
+/// returns the largest distance / bound.
+fn check_extraordinary_exactly(
+    iso: &Isolation,
+    out: &AdaptiveMesh,
+    faces: &[u32],
+    scale: f64,
+) -> f64 {
+    let exact = ExactEvaluator::new(&iso.mesh);
+    let mut worst: f64 = 0.0;
+    for polygon in out
+        .polygons
+        .iter()
+        .filter(|p| p.region.extraordinary && faces.contains(&p.region.face))
+    {
+        let r = polygon.region;
+        let d = u64::from(r.denominator) * 16;
+        for a in 0..8u64 {
+            for b in 0..8u64 {
+                let u = rational(u64::from(r.u0) * 16 + (2 * a + 1) * u64::from(r.size), d);
+                let v = rational(u64::from(r.v0) * 16 + (2 * b + 1) * u64::from(r.size), d);
+                let s = exact
+                    .evaluate(r.face as usize, &u, &v)
+                    .expect("exact evaluation")
+                    .position;
+                let dist = distance_to_polygon(out, polygon, s);
+                assert!(
+                    dist <= r.bound + 1e-12 * scale,
+                    "face {} at ({u}, {v}): {dist} > {}",
+                    r.face,
+                    r.bound
+                );
+                worst = worst.max(dist / r.bound);
+            }
+        }
+    }
+    worst
+}
+
 fn options(tolerance: f64) -> AdaptiveOptions {
     AdaptiveOptions {
         tolerance,
@@ -218,6 +258,47 @@ fn spot_meets_the_tolerance_everywhere_sampled() {
         "spot T = {t}: {} polygons, {} triangles, depth {}, A/U {:.4}, measured {worst:.3e} \
          (exact {exact:.3e}), largest measured/bound {ratio:.3}",
         stats.polygons, stats.triangles, stats.max_depth, stats.au_ratio
+    );
+    assert!(worst <= t + 2e-6 * scale && exact <= t);
+}
+
+/// The extraordinary bound (hull of the Bézier nets of three levels of regular quarters and the
+/// innermost layout) on the penguin, whose extraordinary vertices reach valence 8: every
+/// polygon of the four faces with the deepest extraordinary squares, exactly at 4 x 4 points,
+/// and every face at the table's points, within its polygon's bound.
+#[test]
+fn the_penguin_meets_the_extraordinary_bound() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../shared/models/odedstein/penguin_control_mesh.obj");
+    if !path.is_file() {
+        println!("skipping the penguin: {} is absent", path.display());
+        return;
+    }
+    let mesh = load(&path);
+    let scale = size(&mesh);
+    let iso = isolate(&mesh);
+    let t = 0.003 * scale;
+    let (out, stats) =
+        tessellate_adaptive(&table(), &iso.mesh, &iso.patches, &options(t)).expect("ok");
+    assert_eq!(stats.leaves_over_tolerance, 0);
+    assert!(stats.max_bound <= t);
+    let (ratio, worst) = check_with_table(&iso, &out, 2e-6 * scale);
+    let mut ev: Vec<(u32, u32)> = out
+        .polygons
+        .iter()
+        .filter(|p| p.region.extraordinary)
+        .map(|p| (p.region.depth, p.region.face))
+        .collect();
+    ev.sort_unstable_by(|a, b| b.cmp(a));
+    let faces: Vec<u32> = ev.iter().take(4).map(|&(_, f)| f).collect();
+    assert_eq!(faces.len(), 4, "the penguin has extraordinary vertices");
+    let exact = check_exactly(&iso, &out, &faces, scale);
+    let ev_ratio = check_extraordinary_exactly(&iso, &out, &faces, scale);
+    println!(
+        "penguin T = {t}: {} polygons, {} extraordinary, deepest EV square {}, measured \
+         {worst:.3e} (exact {exact:.3e}), largest measured/bound {ratio:.3}, at the EV \
+         squares (exact, 8 x 8) {ev_ratio:.3}",
+        stats.polygons, stats.extraordinary_leaves, ev[0].0
     );
     assert!(worst <= t + 2e-6 * scale && exact <= t);
 }

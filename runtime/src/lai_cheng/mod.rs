@@ -17,7 +17,9 @@
 //!   square at the EV, the counterpart of section 4.1's `m_eps` (the patch within an
 //!   `eps`-sphere): with non-negative subdivision rules, the surface over `[0, 2^-k]^2`, its
 //!   boundary points and so any polygon through them lie in the convex hull of `A^k P`, so
-//!   `|S - L| <= diam(A^k P)`, which decays like `lambda^k` (the subdominant eigenvalue).
+//!   `|S - L| <= diam(A^k P)`, which decays like `lambda^k` (the subdominant eigenvalue); and
+//!   in the tighter hull of `ev_enclosure` (the Bézier nets of the regular quarters of three
+//!   levels and the innermost layout): the bound is the smaller of the two diameters.
 //! * **Globalization** (section 5): every marked point gets one id, keyed by its exact place in
 //!   a shared parameterization (a mesh vertex; a canonical half-edge and the dyadic parameter
 //!   along it; a face and its dyadic `(u, v)`). Each leaf square becomes the polygon through
@@ -125,7 +127,7 @@ pub struct PolygonRegion {
     /// Whether this is the square at an extraordinary vertex (the sphere bound).
     pub extraordinary: bool,
     /// The guaranteed bound on `|S - L|` over the square for any triangulation `L` of the
-    /// polygon in parameter space ([`bezier_net::flatness_bound`], or the hull diameter).
+    /// polygon in parameter space ([`bezier_net::flatness_bound`], or the EV hull diameter).
     pub bound: f64,
     /// The absolute tolerance the square had to meet (`tolerance`, or `tolerance` times a
     /// diagonal in relative mode).
@@ -393,7 +395,7 @@ impl FaceWork<'_> {
                 root_diagonal = diagonal;
             }
             let bound = if ops.nonnegative {
-                diameter(&points)
+                diameter(&points).min(diameter(&ev_enclosure(ops, &nets, &points)))
             } else {
                 f64::INFINITY
             };
@@ -423,6 +425,30 @@ impl FaceWork<'_> {
             depth += 1;
         }
     }
+}
+
+/// Levels of the extraordinary enclosure ([`ev_enclosure`]).
+const EV_ENCLOSURE_LEVELS: usize = 3;
+
+/// Points whose convex hull contains the surface over the extraordinary square with layout
+/// `points` (`nets`: its three regular quarters, `ops.sub_patch(b, points)`): the Bézier nets
+/// of the regular quarters of [`EV_ENCLOSURE_LEVELS`] levels and the layout `A^levels P` of the
+/// innermost square. Each regular quarter lies in the hull of its own Bézier net (Bernstein
+/// polynomials are non-negative and sum to one), the innermost square in the hull of its layout
+/// (`A >= 0`, the extraordinary bound's condition), and the squares tile the extraordinary one.
+/// The hull is inside that of `points` when the quarters' operators are non-negative too, and
+/// shrinks towards the surface piece itself as the levels grow.
+fn ev_enclosure(ops: &Operators, nets: &[Net; 3], points: &[Point]) -> Vec<Point> {
+    let mut out: Vec<Point> = nets.iter().flat_map(|n| n.iter().copied()).collect();
+    let mut layout = ops.a.apply(points);
+    for _ in 1..EV_ENCLOSURE_LEVELS {
+        for b in 0..3 {
+            out.extend_from_slice(&ops.sub_patch(b, &layout));
+        }
+        layout = ops.a.apply(&layout);
+    }
+    out.extend_from_slice(&layout);
+    out
 }
 
 /// The largest distance between two of the points (the diameter of their convex hull).
