@@ -30,69 +30,11 @@ struct Cli {
     command: Command,
 }
 
-// Parsed once per run: the size of the largest variant does not matter.
-#[allow(clippy::large_enum_variant)]
 #[derive(Subcommand)]
 enum Command {
     /// Tessellate a Catmull-Clark mesh (OBJ) with the dual-grid or the adaptive method, or
     /// Bezier patches with Espino et al.'s method.
-    Tessellate {
-        /// Input mesh (OBJ: triangles, quads, n-gons; closed or with boundary).
-        #[arg(required_unless_present = "bezier", conflicts_with = "bezier")]
-        mesh: Option<PathBuf>,
-        /// Output triangle mesh: .obj, .ply (with per-vertex face, u, v), .glb or .gltf.
-        #[arg(short = 'o', long = "output")]
-        output: PathBuf,
-        /// Dual points per face side, 1..=24, on every face.
-        #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=24), conflicts_with_all = ["rates", "tolerance", "view"])]
-        rate: u32,
-        /// Per-face rates: a text file with one rate (1..=24) per input face, in OBJ face
-        /// order, separated by white space; faces made by isolation inherit their input
-        /// face's rate.
-        #[arg(long, conflicts_with_all = ["tolerance", "view"])]
-        rates: Option<PathBuf>,
-        /// Per face the smallest rate whose tessellation deviates from the limit surface by at
-        /// most T (a distance in the mesh's units), measured on the table's rate-24 grid
-        /// (docs/results.md).
-        #[arg(long, conflicts_with = "view")]
-        tolerance: Option<f64>,
-        /// View-dependent rates: `PX,PY,PZ,TX,TY,TZ,FOV,HEIGHT,EDGE` = camera position, target,
-        /// vertical field of view (degrees), image height (pixels) and the target edge length
-        /// (pixels); per face the projected size over the edge length, in 1..=24.
-        #[arg(long, value_parser = parse_view)]
-        view: Option<ViewCamera>,
-        /// A stencil table file instead of the embedded default.
-        #[arg(long)]
-        table: Option<PathBuf>,
-        /// Print statistics as JSON on stdout.
-        #[arg(long)]
-        stats: bool,
-        /// Bicubic Bezier patches instead of a mesh (Newell "patches + vertices" text, or
-        /// `.bpt`), tessellated adaptively by Espino et al.'s displacement-map method
-        /// (docs/espino.md).
-        #[arg(long)]
-        bezier: Option<PathBuf>,
-        /// Bezier edge test: map2p, map4p, map8p or flat.
-        #[arg(long = "test", default_value = "map4p", requires = "bezier")]
-        edge_test: String,
-        /// Bezier split threshold `th` (eq. 1-3), a distance.
-        #[arg(long, requires = "bezier", conflicts_with = "triangles")]
-        threshold: Option<f64>,
-        /// Bezier triangle budget: search the threshold whose output is nearest it.
-        #[arg(long, requires = "bezier")]
-        triangles: Option<usize>,
-        /// `dual-grid` (Schaefer-Warren, one rate per face) or `adaptive` (Lai-Cheng: recursive
-        /// subdivision of each face's domain until a guaranteed bound meets `--tolerance`).
-        #[arg(long, default_value = "dual-grid", value_parser = ["dual-grid", "adaptive"])]
-        method: String,
-        /// Adaptive: the tolerance is relative to each square's base quadrilateral's longer
-        /// diagonal (Lai-Cheng section 6) instead of a distance.
-        #[arg(long)]
-        relative: bool,
-        /// Adaptive: write triangles; without it an .obj output holds the polygons (n-gons).
-        #[arg(long)]
-        triangulate: bool,
-    },
+    Tessellate(Box<TessellateArgs>),
     /// Measure per-frame tessellation throughput: the plan (topology, patches, stencil
     /// lookups) is built once, then every frame evaluates all positions and normals and writes
     /// all triangles. Prints one JSON object with the median over the frames.
@@ -145,6 +87,66 @@ enum Command {
         #[command(subcommand)]
         command: TablesCommand,
     },
+}
+
+/// `subtess tessellate`'s arguments.
+#[derive(clap::Args)]
+struct TessellateArgs {
+    /// Input mesh (OBJ: triangles, quads, n-gons; closed or with boundary).
+    #[arg(required_unless_present = "bezier", conflicts_with = "bezier")]
+    mesh: Option<PathBuf>,
+    /// Output triangle mesh: .obj, .ply (with per-vertex face, u, v), .glb or .gltf.
+    #[arg(short = 'o', long = "output")]
+    output: PathBuf,
+    /// Dual points per face side, 1..=24, on every face.
+    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=24), conflicts_with_all = ["rates", "tolerance", "view"])]
+    rate: u32,
+    /// Per-face rates: a text file with one rate (1..=24) per input face, in OBJ face
+    /// order, separated by white space; faces made by isolation inherit their input
+    /// face's rate.
+    #[arg(long, conflicts_with_all = ["tolerance", "view"])]
+    rates: Option<PathBuf>,
+    /// A distance T in the mesh's units. Dual grid: per face the smallest rate whose
+    /// tessellation deviates from the limit surface by at most T, measured on the table's
+    /// rate-24 grid (docs/results.md). Adaptive: the guaranteed bound every polygon meets.
+    #[arg(long, conflicts_with = "view")]
+    tolerance: Option<f64>,
+    /// View-dependent rates: `PX,PY,PZ,TX,TY,TZ,FOV,HEIGHT,EDGE` = camera position, target,
+    /// vertical field of view (degrees), image height (pixels) and the target edge length
+    /// (pixels); per face the projected size over the edge length, in 1..=24.
+    #[arg(long, value_parser = parse_view)]
+    view: Option<ViewCamera>,
+    /// A stencil table file instead of the embedded default.
+    #[arg(long)]
+    table: Option<PathBuf>,
+    /// Print statistics as JSON on stdout.
+    #[arg(long)]
+    stats: bool,
+    /// Bicubic Bezier patches instead of a mesh (Newell "patches + vertices" text, or
+    /// `.bpt`), tessellated adaptively by Espino et al.'s displacement-map method
+    /// (docs/espino.md).
+    #[arg(long)]
+    bezier: Option<PathBuf>,
+    /// Bezier edge test: map2p, map4p, map8p or flat.
+    #[arg(long = "test", default_value = "map4p", requires = "bezier")]
+    edge_test: String,
+    /// Bezier split threshold `th` (eq. 1-3), a distance.
+    #[arg(long, requires = "bezier", conflicts_with = "triangles")]
+    threshold: Option<f64>,
+    /// Bezier triangle budget: search the threshold whose output is nearest it.
+    #[arg(long, requires = "bezier")]
+    triangles: Option<usize>,
+    /// `dual-grid` (Schaefer-Warren, one rate per face) or `adaptive` (Lai-Cheng: recursive
+    /// subdivision of each face's domain until a guaranteed bound meets `--tolerance`).
+    #[arg(long, default_value = "dual-grid", value_parser = ["dual-grid", "adaptive"])]
+    method: String,
+    /// Adaptive: the tolerance is relative to each square's base quadrilateral's longer
+    /// diagonal (Lai-Cheng section 6) instead of a distance.
+    #[arg(long)]
+    relative: bool,
+    /// Adaptive: write triangles; without it an .obj output holds the polygons (n-gons).
+    #[arg(long)]
+    triangulate: bool,
 }
 
 #[derive(Subcommand)]
@@ -237,23 +239,24 @@ fn parse_view(text: &str) -> Result<ViewCamera, String> {
 
 fn run(cli: Cli) -> Result<(), RuntimeError> {
     match cli.command {
-        Command::Tessellate {
-            mesh,
-            output,
-            rate,
-            rates,
-            tolerance,
-            view,
-            table,
-            stats,
-            bezier,
-            edge_test,
-            threshold,
-            triangles: budget,
-            method,
-            relative,
-            triangulate,
-        } => {
+        Command::Tessellate(args) => {
+            let TessellateArgs {
+                mesh,
+                output,
+                rate,
+                rates,
+                tolerance,
+                view,
+                table,
+                stats,
+                bezier,
+                edge_test,
+                threshold,
+                triangles: budget,
+                method,
+                relative,
+                triangulate,
+            } = *args;
             MeshFormat::from_path(&output)?;
             let mesh = match (mesh, bezier) {
                 (_, Some(file)) => {
