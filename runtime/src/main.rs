@@ -9,7 +9,7 @@ use clap::{Parser, Subcommand};
 use runtime::bezier::{tessellate_bezier, BezierOptions, BezierPatches};
 use runtime::dual_grid::{tessellate, DualGrid};
 use runtime::exact_eval::{evaluate_subface, parse_rational};
-use runtime::isolate::isolate_with_origins;
+use runtime::isolate::{isolate_with_origins, Isolation};
 use runtime::lai_cheng::{tessellate_adaptive, write_obj_polygons, AdaptiveOptions};
 use runtime::mesh_output::{write_mesh, MeshFormat};
 use runtime::obj::read_obj;
@@ -237,144 +237,148 @@ fn parse_view(text: &str) -> Result<ViewCamera, String> {
     }
 }
 
+/// `subtess tessellate`: Bezier patches (Espino et al.), or a mesh by the dual grid or the
+/// adaptive method (Lai-Cheng).
+fn tessellate_command(args: TessellateArgs) -> Result<(), RuntimeError> {
+    MeshFormat::from_path(&args.output)?;
+    let mesh = match (&args.mesh, &args.bezier) {
+        (_, Some(file)) => return bezier_command(file, &args),
+        (Some(_), None) if args.threshold.is_some() || args.triangles.is_some() => {
+            return Err(RuntimeError::Unsupported(
+                "--threshold and --triangles belong to --bezier tessellation".to_owned(),
+            ))
+        }
+        (Some(mesh), None) => mesh,
+        (None, None) => {
+            return Err(RuntimeError::Unsupported(
+                "nothing to tessellate: give a mesh or --bezier FILE".to_owned(),
+            ))
+        }
+    };
+    let input = load_mesh(mesh)?;
+    let table = load_table(&args.table, input.boundary)?;
+    let iso = isolate_with_origins(&input)?;
+    if args.method == "adaptive" {
+        return adaptive_command(&args, &input, &table, &iso);
+    }
+    if args.relative || args.triangulate {
+        return Err(RuntimeError::InvalidParameter {
+            name: "--relative / --triangulate".to_owned(),
+            reason: "they belong to --method adaptive".to_owned(),
+        });
+    }
+    let mut unmet = None;
+    let rates = if let Some(path) = &args.rates {
+        read_rates(path, input.faces(), &iso.origin)?
+    } else if let Some(t) = args.tolerance {
+        let chosen = tolerance_rates(&table, &iso.mesh, &iso.patches, t)?;
+        if !chosen.unmet.is_empty() {
+            eprintln!(
+                "warning: {} faces do not meet the tolerance {t} at rate 24; they get 24",
+                chosen.unmet.len()
+            );
+        }
+        unmet = Some(chosen.unmet.len());
+        chosen.rates
+    } else if let Some(camera) = &args.view {
+        view_rates(&iso.mesh, camera)?
+    } else {
+        vec![args.rate; iso.patches.len()]
+    };
+    let (mut triangles, time) = tessellate(&table, &iso.mesh, &iso.patches, &rates)?;
+    // Sources in the user's own faces and parameters.
+    for source in &mut triangles.sources {
+        *source = iso.input_source(*source);
+    }
+    write_mesh(&triangles, &args.output)?;
+    if args.stats {
+        let count = triangles.triangles.len();
+        let loops = input.boundary_loops();
+        let stats = serde_json::json!({
+            "triangles": count,
+            "vertices": triangles.positions.len(),
+            "seconds": time.seconds,
+            "plan_seconds": time.plan_seconds,
+            "triangles_per_second": count as f64 / time.seconds.max(1e-12),
+            "watertight": loops == 0 && triangles.is_watertight(),
+            "boundary_loops": loops,
+            "input_faces": input.faces(),
+            "faces": iso.mesh.faces(),
+            "isolation_steps": iso.steps,
+            "rate_min": rates.iter().min(),
+            "rate_max": rates.iter().max(),
+            "tolerance": args.tolerance,
+            "faces_over_tolerance": unmet,
+            "threads": rayon::current_num_threads(),
+        });
+        println!("{stats}");
+    }
+    Ok(())
+}
+
+/// `subtess tessellate --bezier FILE`.
+fn bezier_command(file: &Path, args: &TessellateArgs) -> Result<(), RuntimeError> {
+    let patches = BezierPatches::read(file)?;
+    let defaults = BezierOptions::default();
+    let options = BezierOptions {
+        test: args.edge_test.parse()?,
+        threshold: args.threshold.unwrap_or(defaults.threshold),
+        target_triangles: args.triangles,
+        error_samples: if args.stats {
+            defaults.error_samples
+        } else {
+            0
+        },
+        ..defaults
+    };
+    let (triangles, stats) = tessellate_bezier(&patches, &options)?;
+    write_mesh(&triangles, &args.output)?;
+    if args.stats {
+        println!("{}", stats.to_json());
+    }
+    Ok(())
+}
+
+/// `subtess tessellate MESH --method adaptive --tolerance T`.
+fn adaptive_command(
+    args: &TessellateArgs,
+    input: &Mesh,
+    table: &StencilTable,
+    iso: &Isolation,
+) -> Result<(), RuntimeError> {
+    let tolerance = args
+        .tolerance
+        .ok_or_else(|| RuntimeError::InvalidParameter {
+            name: "--method adaptive".to_owned(),
+            reason: "it needs --tolerance T".to_owned(),
+        })?;
+    let options = AdaptiveOptions {
+        tolerance,
+        relative: args.relative,
+        triangulate: args.triangulate,
+        ..AdaptiveOptions::default()
+    };
+    let (mut adaptive, stats) = tessellate_adaptive(table, &iso.mesh, &iso.patches, &options)?;
+    for source in &mut adaptive.sources {
+        *source = iso.input_source(*source);
+    }
+    if MeshFormat::from_path(&args.output)? == MeshFormat::Obj && !args.triangulate {
+        write_obj_polygons(&adaptive, &args.output)?;
+    } else {
+        write_mesh(&adaptive.to_triangle_mesh(), &args.output)?;
+    }
+    if args.stats {
+        let mut report = stats.to_json();
+        report["watertight"] =
+            serde_json::json!(input.boundary_loops() == 0 && adaptive.is_watertight());
+        println!("{report}");
+    }
+    Ok(())
+}
+
 fn run(cli: Cli) -> Result<(), RuntimeError> {
     match cli.command {
-        Command::Tessellate(args) => {
-            let TessellateArgs {
-                mesh,
-                output,
-                rate,
-                rates,
-                tolerance,
-                view,
-                table,
-                stats,
-                bezier,
-                edge_test,
-                threshold,
-                triangles: budget,
-                method,
-                relative,
-                triangulate,
-            } = *args;
-            MeshFormat::from_path(&output)?;
-            let mesh = match (mesh, bezier) {
-                (_, Some(file)) => {
-                    let patches = BezierPatches::read(&file)?;
-                    let defaults = BezierOptions::default();
-                    let options = BezierOptions {
-                        test: edge_test.parse()?,
-                        threshold: threshold.unwrap_or(defaults.threshold),
-                        target_triangles: budget,
-                        error_samples: if stats { defaults.error_samples } else { 0 },
-                        ..defaults
-                    };
-                    let (triangles, bezier_stats) = tessellate_bezier(&patches, &options)?;
-                    write_mesh(&triangles, &output)?;
-                    if stats {
-                        println!("{}", bezier_stats.to_json());
-                    }
-                    return Ok(());
-                }
-                (Some(_), None) if threshold.is_some() || budget.is_some() => {
-                    return Err(RuntimeError::Unsupported(
-                        "--threshold and --triangles belong to --bezier tessellation".to_owned(),
-                    ))
-                }
-                (Some(mesh), None) => mesh,
-                (None, None) => {
-                    return Err(RuntimeError::Unsupported(
-                        "nothing to tessellate: give a mesh or --bezier FILE".to_owned(),
-                    ))
-                }
-            };
-            let input = load_mesh(&mesh)?;
-            let table = load_table(&table, input.boundary)?;
-            let iso = isolate_with_origins(&input)?;
-            if method == "adaptive" {
-                let tolerance = tolerance.ok_or_else(|| RuntimeError::InvalidParameter {
-                    name: "--method adaptive".to_owned(),
-                    reason: "it needs --tolerance T".to_owned(),
-                })?;
-                let options = AdaptiveOptions {
-                    tolerance,
-                    relative,
-                    triangulate,
-                    ..AdaptiveOptions::default()
-                };
-                let (mut adaptive, adaptive_stats) =
-                    tessellate_adaptive(&table, &iso.mesh, &iso.patches, &options)?;
-                for source in &mut adaptive.sources {
-                    *source = iso.input_source(*source);
-                }
-                let is_obj = MeshFormat::from_path(&output)? == MeshFormat::Obj;
-                if is_obj && !triangulate {
-                    write_obj_polygons(&adaptive, &output)?;
-                } else {
-                    write_mesh(&adaptive.to_triangle_mesh(), &output)?;
-                }
-                if stats {
-                    let mut report = adaptive_stats.to_json();
-                    report["watertight"] =
-                        serde_json::json!(input.boundary_loops() == 0 && adaptive.is_watertight());
-                    println!("{report}");
-                }
-                return Ok(());
-            }
-            if relative || triangulate {
-                return Err(RuntimeError::InvalidParameter {
-                    name: "--relative / --triangulate".to_owned(),
-                    reason: "they belong to --method adaptive".to_owned(),
-                });
-            }
-            let mut unmet = None;
-            let rates = if let Some(path) = &rates {
-                read_rates(path, input.faces(), &iso.origin)?
-            } else if let Some(t) = tolerance {
-                let chosen = tolerance_rates(&table, &iso.mesh, &iso.patches, t)?;
-                if !chosen.unmet.is_empty() {
-                    eprintln!(
-                        "warning: {} faces do not meet the tolerance {t} at rate 24; they get 24",
-                        chosen.unmet.len()
-                    );
-                }
-                unmet = Some(chosen.unmet.len());
-                chosen.rates
-            } else if let Some(camera) = &view {
-                view_rates(&iso.mesh, camera)?
-            } else {
-                vec![rate; iso.patches.len()]
-            };
-            let (mut triangles, time) = tessellate(&table, &iso.mesh, &iso.patches, &rates)?;
-            // Sources in the user's own faces and parameters.
-            for source in &mut triangles.sources {
-                *source = iso.input_source(*source);
-            }
-            write_mesh(&triangles, &output)?;
-            if stats {
-                let count = triangles.triangles.len();
-                let loops = input.boundary_loops();
-                let stats = serde_json::json!({
-                    "triangles": count,
-                    "vertices": triangles.positions.len(),
-                    "seconds": time.seconds,
-                    "plan_seconds": time.plan_seconds,
-                    "triangles_per_second": count as f64 / time.seconds.max(1e-12),
-                    "watertight": loops == 0 && triangles.is_watertight(),
-                    "boundary_loops": loops,
-                    "input_faces": input.faces(),
-                    "faces": iso.mesh.faces(),
-                    "isolation_steps": iso.steps,
-                    "rate_min": rates.iter().min(),
-                    "rate_max": rates.iter().max(),
-                    "tolerance": tolerance,
-                    "faces_over_tolerance": unmet,
-                    "threads": rayon::current_num_threads(),
-                });
-                println!("{stats}");
-            }
-            Ok(())
-        }
+        Command::Tessellate(args) => tessellate_command(*args),
         Command::Bench {
             mesh,
             rate,
