@@ -142,6 +142,14 @@ impl<S: Scalar> TriangleBoundarySubstitution<S> {
         })
     }
 
+    /// Switch to the patch of sector `sector` next to a boundary vertex with `faces`
+    /// triangles, keeping the cached regular basis (it does not depend on the patch, and
+    /// solving it exactly is what costs: one system per denominator and kind).
+    pub fn select_patch(&mut self, faces: u32, sector: u32) -> Result<(), StencilError> {
+        self.matrices = TriangleLocalMatrices::boundary(&self.scheme, faces, sector)?;
+        Ok(())
+    }
+
     /// The `K` position weights at `(u, v)`, `u, v >= 0`, `u + v <= 1`, in the layout order
     /// of [`schemes::triangle_local::triangle_boundary_layout`].
     pub fn stencil(&mut self, u: &BigRational, v: &BigRational) -> Result<Vec<S>, StencilError> {
