@@ -31,6 +31,7 @@ pub mod ev_tangents;
 pub mod exact_solve;
 pub mod extraordinary_patch;
 pub mod float_solve;
+pub mod loop_basis;
 pub mod orbit_block;
 pub mod orbits;
 pub mod patch_stencils;
@@ -45,6 +46,7 @@ pub mod table;
 pub mod triangle_boundary;
 pub mod triangle_patch;
 pub mod triangle_system;
+pub mod triangle_table;
 
 pub use curve_stencils::{curve_stencils, BasisFunction, CurveStencils};
 pub use error::StencilError;
