@@ -13,7 +13,7 @@
 //! * `phi(x) = phi(2x) A` while `u + v <= 1/2`;
 //! * otherwise `y = 2x` lies in a regular sub-triangle `b` and
 //!   `phi(x) = sum_j psi(y - j) R_b[j]` (the quartic box spline `psi` of
-//!   [`crate::triangle_system`] over the sub-triangle's twelve level-1 points `j`);
+//!   [`crate::loop_basis`] over the sub-triangle's twelve level-1 points `j`);
 //! * at `x = 0`: `phi(0) = phi(0) A`, `sum phi(0) = 1` (the limit-position mask).
 //!
 //! A derivative picks up a factor 2 per halving (section 4). [`TriangleBoundarySubstitution`]
@@ -50,10 +50,10 @@ use schemes::TriangleScheme;
 
 use crate::ev_tangents::left_null_space;
 use crate::exact_solve::solve_dense;
+use crate::loop_basis::LoopRegularBasis;
 use crate::regular_patch::StencilKind;
 use crate::scalar::rational_to_f64;
 use crate::triangle_patch::sub_triangle_of;
-use crate::triangle_system::{triangle_stencils, TriangleStencils, MAX_TRIANGLE_RATE};
 use crate::{Scalar, StencilError};
 
 /// `(faces, sector)` of boundary matrices, or an error saying they are not.
@@ -69,29 +69,29 @@ fn boundary_of(matrices: &TriangleLocalMatrices) -> Result<(u32, u32), StencilEr
     }
 }
 
-/// `sum_j psi(y - j) R_b[j]` with `y = Y / n` (level-1 sector coordinates): the weights of a
-/// point of a regular sub-triangle over the layout. Summed exactly (Loop's regular basis is
-/// rational), then converted.
+/// `sum_j psi(y - j) R_b[j]` with `y = Y / d` (level-1 sector coordinates): the weights of a
+/// point of a regular sub-triangle over the layout, `psi` from the exact quartic pieces of
+/// [`LoopRegularBasis`] (any denominator).
 fn sub_triangle_weights<S: Scalar>(
     matrices: &TriangleLocalMatrices,
-    basis: &TriangleStencils<BigRational>,
+    basis: &LoopRegularBasis,
     y: (i64, i64),
+    d: i64,
 ) -> Vec<S> {
-    let n = i64::from(basis.n);
-    let sub = &matrices.sub_triangles[sub_triangle_of(y, n)];
-    let mut out = vec![BigRational::zero(); matrices.size()];
+    let sub = &matrices.sub_triangles[sub_triangle_of(y, d)];
+    let mut out = vec![S::zero(); matrices.size()];
     for (&(j1, j2), row) in sub.points.iter().zip(&sub.rows) {
-        let psi = basis.at(y.0 - n * j1, y.1 - n * j2);
-        if psi.is_zero() {
+        let psi: S = basis.at(y.0 - d * j1, y.1 - d * j2, d);
+        if S::EXACT && psi.is_negligible() {
             continue;
         }
         for (o, r) in out.iter_mut().zip(row) {
             if !r.is_zero() {
-                *o += &psi * r;
+                *o = o.clone() + psi.clone() * S::from_rational(r);
             }
         }
     }
-    out.iter().map(S::from_rational).collect()
+    out
 }
 
 /// The limit-position mask at `V`: the left fixed vector of `A` (`phi(0) = phi(0) A`) with
@@ -120,13 +120,13 @@ pub fn boundary_limit_mask(
 }
 
 /// Evaluates stencils of the Loop patch next to a boundary vertex by substitution at any
-/// rational `(u, v)`; caches the regular basis per denominator and kind.
+/// rational `(u, v)`; caches the regular basis per kind.
 #[derive(Debug)]
 pub struct TriangleBoundarySubstitution<S> {
     scheme: TriangleScheme,
     /// The local subdivision matrices ([`TriangleLocalMatrices::boundary`]).
     pub matrices: TriangleLocalMatrices,
-    bases: HashMap<(u32, StencilKind), TriangleStencils<BigRational>>,
+    bases: HashMap<StencilKind, LoopRegularBasis>,
     field: std::marker::PhantomData<S>,
 }
 
@@ -143,8 +143,7 @@ impl<S: Scalar> TriangleBoundarySubstitution<S> {
     }
 
     /// Switch to the patch of sector `sector` next to a boundary vertex with `faces`
-    /// triangles, keeping the cached regular basis (it does not depend on the patch, and
-    /// solving it exactly is what costs: one system per denominator and kind).
+    /// triangles, keeping the cached regular basis (it does not depend on the patch).
     pub fn select_patch(&mut self, faces: u32, sector: u32) -> Result<(), StencilError> {
         self.matrices = TriangleLocalMatrices::boundary(&self.scheme, faces, sector)?;
         Ok(())
@@ -159,7 +158,7 @@ impl<S: Scalar> TriangleBoundarySubstitution<S> {
     /// [`Self::stencil`] for positions or derivatives along `u` (towards `E_s`) and `v`
     /// (towards `E_{s+1}`): double `x` `j` times until `u + v > 1/2`, take the regular
     /// sub-triangle's weights at `2x`, apply `A` `j` times (times 2 per step for a
-    /// derivative). The denominator of that `2x` must be at most [`MAX_TRIANGLE_RATE`]. At
+    /// derivative). Any denominator that fits 64 bits works ([`LoopRegularBasis`]). At
     /// `V` the position is [`boundary_limit_mask`] and the derivatives are
     /// [`loop_boundary_tangents`]' masks, irrational in general: f64 only.
     pub fn stencil_of_kind(
@@ -208,35 +207,28 @@ impl<S: Scalar> TriangleBoundarySubstitution<S> {
         }
         let (y1, y2) = (&x * &two, &y * &two);
         let d = y1.denom().lcm(y2.denom());
-        let n = u32::try_from(&d)
-            .ok()
-            .filter(|&n| n <= MAX_TRIANGLE_RATE)
-            .ok_or_else(|| StencilError::OutOfDomain {
-                what: format!(
-                    "the denominator of ({u}, {v}) doubled is {d}; the regular basis is solved for denominators up to {MAX_TRIANGLE_RATE}"
-                ),
-            })?;
-        // Both numerators are at most 2n after the scaling by d = n, so they fit an i64.
         let numerator = |t: &BigRational| {
             i64::try_from(&(t * BigRational::from_integer(d.clone())).to_integer())
         };
-        let (Ok(p1), Ok(p2)) = (numerator(&y1), numerator(&y2)) else {
-            return Err(StencilError::OutOfDomain {
-                what: format!("(u, v) = ({u}, {v}): numerators out of range"),
-            });
+        let too_big = || StencilError::OutOfDomain {
+            what: format!("the denominator of ({u}, {v}) does not fit in 64 bits"),
         };
-        if !self.bases.contains_key(&(n, kind)) {
-            let basis = triangle_stencils::<BigRational>(&self.scheme.regular_mask(), n, kind)?;
-            self.bases.insert((n, kind), basis);
+        let point = (
+            numerator(&y1).map_err(|_| too_big())?,
+            numerator(&y2).map_err(|_| too_big())?,
+        );
+        let d = i64::try_from(&d).map_err(|_| too_big())?;
+        if !self.bases.contains_key(&kind) {
+            let basis = LoopRegularBasis::new(&self.scheme, kind)?;
+            self.bases.insert(kind, basis);
         }
         let factor = S::from_rational(&BigRational::from_integer(BigInt::from(
             kind.doubling_factor(),
         )));
-        let mut row: Vec<S> =
-            sub_triangle_weights(&self.matrices, &self.bases[&(n, kind)], (p1, p2))
-                .into_iter()
-                .map(|w: S| w * factor.clone())
-                .collect();
+        let mut row: Vec<S> = sub_triangle_weights(&self.matrices, &self.bases[&kind], point, d)
+            .into_iter()
+            .map(|w: S| w * factor.clone())
+            .collect();
         let size = self.matrices.size();
         for _ in 0..steps {
             // phi_j(x) = f sum_i phi_i(2x) A[i][j].
@@ -424,7 +416,8 @@ mod tests {
         let mut s = TriangleBoundarySubstitution::<BigRational>::new(&loop_, 3, 1).expect("valid");
         assert!(s.stencil(&q(2, 3), &q(2, 3)).is_err());
         assert!(s.stencil(&q(-1, 3), &q(0, 1)).is_err());
-        assert!(s.stencil(&q(1, 100), &q(0, 1)).is_err());
+        let too_fine = BigRational::new(1.into(), BigInt::from(3).pow(50));
+        assert!(s.stencil(&too_fine, &q(0, 1)).is_err());
         assert!(s
             .stencil_of_kind(&q(0, 1), &q(0, 1), StencilKind::DerivativeU)
             .is_err());
