@@ -1,4 +1,5 @@
-//! Loop subdivision around an interior extraordinary vertex of valence `v`: the patch layout,
+//! Loop subdivision around an interior extraordinary vertex of valence `v`, or next to a
+//! boundary vertex ("Boundary vertices" below): the patch layout,
 //! the local subdivision matrix `A` and the picking matrices of the three regular
 //! sub-triangles (Schaefer–Warren section 5.2, on the triangular lattice of section 5.1), as
 //! exact rationals. Data only: `stencilgen::triangle_patch` solves with them.
@@ -27,6 +28,45 @@
 //! vertex it holds the three regular triangles [`SUB_TRIANGLES`] (all corners of valence 6),
 //! on which the surface is the quartic box spline of the twelve level-1 points of the corners'
 //! 1-rings ([`SubTriangle`]), each a row of level-0 weights.
+//!
+//! **Boundary vertices** ([`TriangleLocalMatrices::boundary`]). A boundary vertex `V` with `k`
+//! triangles has neighbours `E_0, ..., E_k` counter-clockwise, `E_0` and `E_k` on the
+//! boundary, and sectors `0..k` (sector `i` is the triangle `V, E_i, E_{i+1}`), not glued: a
+//! point on the ray towards `E_k` is named in "sector `k`" with `b = 0`, and everything below
+//! sector 0's `a` axis or beyond ray `k` is outside the mesh ([`canonical_boundary_point`]).
+//! Loop's boundary rules (Hoppe et al. 1994, OpenSubdiv's "smooth boundary"): a boundary edge
+//! point is the midpoint of its ends; a boundary vertex is `1/8 B_- + 3/4 V + 1/8 B_+` over
+//! its two boundary neighbours, `V` included whatever `k` is; interior points use the rules of
+//! the interior case (all interior vertices other than `V` have valence 6). The patch of
+//! sector `s` is `V, E_s, E_{s+1}` (`V` at `(0,0)`, `E_s` at `(1,0)`, `E_{s+1}` at `(0,1)`);
+//! its layout (a contract: the runtime gathers control points in this order) is
+//!
+//! ```text
+//!   V, E_0, ..., E_k,
+//!   then of O_0..O_4 = (2,-1) (2,0) (1,1) (0,2) (-1,2) (sector-s coordinates) those inside:
+//!   sector s-1 (1,1) [iff s >= 1], ray s (2,0), sector s (1,1), ray s+1 (2,0),
+//!   sector s+1 (1,1) [iff s+1 <= k-1]
+//! ```
+//!
+//! so `K = 1 + (k+1) + 3 + [s >= 1] + [s <= k-2]` ([`triangle_boundary_layout`]). Refining
+//! every layout point reads only layout points (`E_s`, `E_{s+1}` are regular: valence 6 inside,
+//! 3 triangles on the boundary), which gives `A`. The sub-triangles' points are in sector-`s`
+//! level-1 coordinates.
+//!
+//! *Phantoms.* The three sub-triangles have regular corners, but their twelve-point nets can
+//! reach outside the mesh. A net point `p` outside lies across a boundary edge `(c, m)` whose
+//! interior triangle is `(c, m, r)`; its phantom is `p = c + m - r`. With phantoms the regular
+//! rules reproduce the boundary rules: at a boundary edge `3/8 c + 3/8 m + 1/8 r +
+//! 1/8 (c + m - r) = (c + m)/2`; at a boundary vertex `b` with boundary neighbours `b_-, b_+`
+//! and interior ones `c, d`, `5/8 b + 1/16 (b_- + b_+ + c + d + (b_- + b - d) + (b + b_+ - c))
+//! = 1/8 b_- + 3/4 b + 1/8 b_+`. And the regular rules applied to a phantom-extended net give,
+//! at the next level's phantom positions, exactly the phantom formula of the next level's
+//! points (a few lines of algebra using only the edge rules and the vertex rule of the
+//! regular boundary vertex next to the phantom; `docs/algorithms/triangle-schemes.md`). So
+//! the phantom-extended net subdivides like a regular net forever: a triangle with regular
+//! corners is the box spline of its phantom-extended twelve-point net, even when one of the
+//! net's points is the irregular `V` (its own vertex rule is never used). The row of an
+//! outside point is therefore `R[c] + R[m] - R[r]`.
 
 use std::collections::HashMap;
 
