@@ -33,9 +33,11 @@
 //! the *cross-boundary* mode is the one of `mu_1 = 3/8 + cos(pi/k)/4` (for `k = 1`, which
 //! has no interior neighbour, the curve's second difference `E_0 - 2V + E_1`, eigenvalue
 //! `1/4`). So `mu_1 < 1/2` for `k <= 2`, `= 1/2` at the regular `k = 3`, `> 1/2` for
-//! `k >= 4`, and `mu_2 = 3/8 + cos(2 pi/k)/4` reaches `1/2` at `k = 6` and exceeds it for
-//! `k >= 7`: from `k = 6` on, the boundary tangent's eigenvalue is no longer the second
-//! largest, and the surface is not tangent-plane continuous at `V` (measured in
+//! `k >= 4`, and `mu_2 = 3/8 + cos(2 pi/k)/4` reaches `1/2` at `k = 6` (a Jordan block with
+//! the boundary tangent: the normals still converge to the plane of `E_k - E_0` and the
+//! `mu_1` mode, but only like `1/j` after `j` halvings) and exceeds it for `k >= 7`: there the
+//! two largest subdominant modes are both cross modes, whose plane does not contain the
+//! boundary curve's tangent, and the surface has no tangent plane at `V` (measured in
 //! `docs/algorithms/triangle-schemes.md`).
 
 use std::collections::HashMap;
@@ -290,10 +292,11 @@ fn eigenvalues(m: &DMatrix<f64>) -> Result<Vec<f64>, String> {
 /// line): the `u` mask maps the net to `E_s`'s position, the `v` mask to `E_{s+1}`'s. So
 /// `du x dv` points to the same side as the patch `V, E_s, E_{s+1}`. At `k = 3` the net is
 /// the lattice and the masks are the box spline's derivatives along the skew axes at `V`
-/// (phantoms expanded). For `k >= 6` the pair `(1/2, mu_1)` is not the subdominant pair of
-/// `A` (`mu_2 >= 1/2`) and the limit surface has no tangent plane at `V`: the masks are still
-/// the plane of the boundary tangent and the dominant cross mode, which the surface's normals
-/// do not converge to (see the module docs).
+/// (phantoms expanded). At `k = 6` the normals converge to this plane only like `1/j`
+/// (`mu_2 = 1/2`, a Jordan block). For `k >= 7` the pair `(1/2, mu_1)` is not the subdominant
+/// pair of `A` (`mu_2 > 1/2`) and the limit surface has no tangent plane at `V`: the masks are
+/// still the plane of the boundary tangent and the dominant cross mode, which the surface's
+/// normals do not converge to (see the module docs).
 pub fn loop_boundary_tangents(
     matrices: &TriangleLocalMatrices,
 ) -> Result<LoopBoundaryTangents, StencilError> {
