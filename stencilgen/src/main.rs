@@ -255,10 +255,11 @@ fn run(cli: Cli) -> Result<(), StencilError> {
                     output.clone()
                 };
                 if let Some(triangle) = TriangleScheme::by_name(name) {
-                    if boundary {
+                    if corners {
                         return Err(StencilError::UnsupportedScheme {
                             scheme: name.clone(),
-                            reason: "triangle tables have no boundary patches yet".to_owned(),
+                            reason: "pinned corners are implemented for quad schemes only"
+                                .to_owned(),
                         });
                     }
                     if exact {
@@ -270,6 +271,7 @@ fn run(cli: Cli) -> Result<(), StencilError> {
                     let spec = TriangleTableSpec {
                         scheme: triangle,
                         valences: set.valences.clone(),
+                        boundary_faces: set.boundary_faces.clone(),
                         rates: set.rates.clone(),
                         precision,
                     };

@@ -26,7 +26,7 @@ use num_bigint::BigInt;
 use num_integer::Integer;
 use num_rational::BigRational;
 use num_traits::{One, Zero};
-use schemes::triangle_local::TriangleLocalMatrices;
+use schemes::triangle_local::{TriangleLocalMatrices, TriangleNeighbourhood};
 use schemes::TriangleScheme;
 
 use crate::ev_tangents::{left_null_space, subdominant_eigenvalues};
@@ -426,6 +426,12 @@ pub struct LoopEvTangents {
 /// At valence 6 the net is the equilateral lattice and the masks are the box spline's
 /// derivatives along the skew axes `(1, 0)` and `(0, 1)` at the vertex.
 pub fn loop_ev_tangents(matrices: &TriangleLocalMatrices) -> Result<LoopEvTangents, StencilError> {
+    if let TriangleNeighbourhood::Boundary { faces, .. } = matrices.neighbourhood {
+        return Err(StencilError::UnsupportedScheme {
+            scheme: matrices.scheme.clone(),
+            reason: format!("a boundary vertex ({faces} triangles) has no rotational symmetry; its tangents are triangle_boundary::loop_boundary_tangents"),
+        });
+    }
     let v = matrices.valence as usize;
     let ring = 1 + v;
     let a1 = DMatrix::from_fn(ring, ring, |i, j| rational_to_f64(&matrices.a[i][j]));
