@@ -349,7 +349,7 @@ fn contract_points(n: u32) -> [Vec<(BigRational, BigRational)>; 2] {
 fn loop_table_sections_are_the_substitution_stencils_at_the_contract_points() {
     // The table's f64 grid system (on 1/3n for the centroids) against exact substitution,
     // point by point in the documented order, interior and boundary patches.
-    use stencilgen::triangle_boundary::{loop_boundary_tangents, TriangleBoundarySubstitution};
+    use stencilgen::triangle_boundary::loop_boundary_tangents;
     use stencilgen::triangle_table::{build_triangle_table, TriangleTableSpec};
     use table_format::{AlignedBytes, PointSet, Precision, SectionKey, StencilKind as Kind, Table};
     let loop_ = triangle_scheme("loop").expect("catalogued");
@@ -378,7 +378,7 @@ fn loop_table_sections_are_the_substitution_stencils_at_the_contract_points() {
         let m = TriangleLocalMatrices::boundary(&loop_, 2, sector).expect("valid");
         let t = loop_boundary_tangents(&m).expect("tangents");
         let mut sub =
-            TriangleBoundarySubstitution::<BigRational>::new(&loop_, 2, sector).expect("valid");
+            TriangleSubstitution::<BigRational>::boundary(&loop_, 2, sector).expect("valid");
         let eval: Evaluator =
             Box::new(move |x, y, kind| sub.stencil_of_kind(x, y, kind).expect("inside"));
         patches.push(((true, 2, sector), eval, (t.du, t.dv)));
