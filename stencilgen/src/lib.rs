@@ -31,6 +31,7 @@ pub mod ev_tangents;
 pub mod exact_solve;
 pub mod extraordinary_patch;
 pub mod float_solve;
+pub mod loop_basis;
 pub mod orbit_block;
 pub mod orbits;
 pub mod patch_stencils;

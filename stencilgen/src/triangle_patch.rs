@@ -31,11 +31,12 @@ use schemes::TriangleScheme;
 
 use crate::ev_tangents::{left_null_space, subdominant_eigenvalues};
 use crate::exact_solve::solve_dense;
+use crate::loop_basis::LoopRegularBasis;
 use crate::regular_patch::StencilKind;
 use crate::scalar::rational_to_f64;
 use crate::scaling_system::{NormalizationRow, Relation, ScalingSystem, SparseRow};
 use crate::solve::{solve_system, Solution};
-use crate::triangle_system::{triangle_stencils, TriangleStencils, MAX_TRIANGLE_RATE};
+use crate::triangle_system::MAX_TRIANGLE_RATE;
 use crate::{Scalar, StencilError};
 
 /// A triangle scheme from the catalogue, or an error listing the catalogue.
@@ -96,38 +97,28 @@ pub fn sub_triangle_of(y: (i64, i64), n: i64) -> usize {
     }
 }
 
-/// `sum_j psi(y - j) R_b[j]` with `y = Y / n`: the weights of a point of a regular sub-triangle.
-/// Loop's regular basis is rational, so it is always solved (and summed) exactly, then
-/// converted: the f64 path of the regular system solves its orbits densely and is far slower
-/// (Loop `n = 16`: minutes instead of milliseconds).
+/// `sum_j psi(y - j) R_b[j]` with `y = Y / d` (level-1 coordinates): the weights of a point of
+/// a regular sub-triangle, with `psi` from the exact quartic pieces of [`LoopRegularBasis`].
 fn regular_weights<S: Scalar>(
     matrices: &TriangleLocalMatrices,
-    basis: &TriangleStencils<BigRational>,
+    basis: &LoopRegularBasis,
     y: (i64, i64),
+    d: i64,
 ) -> Vec<S> {
-    let n = i64::from(basis.n);
-    let sub = &matrices.sub_triangles[sub_triangle_of(y, n)];
-    let mut out = vec![BigRational::zero(); matrices.size()];
+    let sub = &matrices.sub_triangles[sub_triangle_of(y, d)];
+    let mut out = vec![S::zero(); matrices.size()];
     for (&(j1, j2), row) in sub.points.iter().zip(&sub.rows) {
-        let psi = basis.at(y.0 - n * j1, y.1 - n * j2);
-        if psi.is_zero() {
+        let psi: S = basis.at(y.0 - d * j1, y.1 - d * j2, d);
+        if psi.is_negligible() && S::EXACT {
             continue;
         }
         for (o, r) in out.iter_mut().zip(row) {
             if !r.is_zero() {
-                *o += &psi * r;
+                *o = o.clone() + psi.clone() * S::from_rational(r);
             }
         }
     }
-    out.iter().map(S::from_rational).collect()
-}
-
-fn regular_basis(
-    scheme: &TriangleScheme,
-    n: u32,
-    kind: StencilKind,
-) -> Result<TriangleStencils<BigRational>, StencilError> {
-    triangle_stencils::<BigRational>(&scheme.regular_mask(), n, kind)
+    out
 }
 
 /// Solve the grid system of the Loop patch around an interior vertex of valence `valence` at
@@ -157,10 +148,34 @@ pub fn triangle_patch_stencils_of_kind<S: Scalar>(
         });
     }
     let matrices = TriangleLocalMatrices::new(scheme, valence)?;
-    let basis = regular_basis(scheme, n, kind)?;
+    let basis = LoopRegularBasis::new(scheme, kind)?;
+    patch_stencils_at(&matrices, &basis, &triangle_grid_points(n), n)
+}
+
+/// The grid system of a Loop patch (any [`TriangleLocalMatrices`]: interior or boundary) at
+/// the points `(i/d, j/d)` of `points` (`i, j >= 0`, `i + j <= d`), closed under `x -> 2x`
+/// inside the patch, so that every relation `phi(x) = phi(2x) A` has its right-hand side among
+/// the unknowns. The primal grid of rate `n` is `d = n`; the dual points (triangle centroids)
+/// of rate `n` live on `d = 3n`. Derivatives leave out `(0, 0)` (see
+/// [`triangle_patch_stencils_of_kind`]).
+pub fn patch_stencils_at<S: Scalar>(
+    matrices: &TriangleLocalMatrices,
+    basis: &LoopRegularBasis,
+    points: &[(i64, i64)],
+    d: u32,
+) -> Result<TrianglePatchStencils<S>, StencilError> {
+    let kind = basis.kind;
     let k = matrices.size();
     let factor = BigRational::from_integer(BigInt::from(kind.doubling_factor()));
-    let ni = i64::from(n);
+    let di = i64::from(d);
+    if let Some(p) = points.iter().find(|&&(i, j)| i < 0 || j < 0 || i + j > di) {
+        return Err(StencilError::OutOfDomain {
+            what: format!(
+                "({}/{d}, {}/{d}) is outside the patch u, v >= 0, u + v <= 1",
+                p.0, p.1
+            ),
+        });
+    }
     // phi_j(x) = sum_i A[i][j] phi_i(2x).
     let columns: Vec<Vec<(usize, BigRational)>> = (0..k)
         .map(|j| {
@@ -170,24 +185,34 @@ pub fn triangle_patch_stencils_of_kind<S: Scalar>(
                 .collect()
         })
         .collect();
-    let points: Vec<(i64, i64)> = triangle_grid_points(n)
-        .into_iter()
-        .filter(|&p| p != (0, 0) || kind == StencilKind::Position)
-        .collect();
-    let class_of: HashMap<(i64, i64), u32> = points
+    let mut all: Vec<(i64, i64)> = Vec::with_capacity(points.len());
+    let mut class_of: HashMap<(i64, i64), u32> = HashMap::new();
+    for &p in points {
+        let mut p = p;
+        loop {
+            if p == (0, 0) && kind != StencilKind::Position {
+                break;
+            }
+            if class_of.contains_key(&p) {
+                break;
+            }
+            class_of.insert(p, all.len() as u32);
+            all.push(p);
+            if 2 * (p.0 + p.1) > di {
+                break;
+            }
+            p = (2 * p.0, 2 * p.1);
+        }
+    }
+    let next: Vec<Option<u32>> = all
         .iter()
-        .enumerate()
-        .map(|(c, &p)| (p, c as u32))
-        .collect();
-    let next: Vec<Option<u32>> = points
-        .iter()
-        .map(|&(i, j)| (2 * (i + j) <= ni).then(|| class_of[&(2 * i, 2 * j)]))
+        .map(|&(i, j)| (2 * (i + j) <= di).then(|| class_of[&(2 * i, 2 * j)]))
         .collect();
     let mut system = ScalingSystem::<S>::new(next.clone());
-    for (c, &(i, j)) in points.iter().enumerate() {
+    for (c, &(i, j)) in all.iter().enumerate() {
         let constants = match next[c] {
             Some(_) => vec![S::zero(); k],
-            None => regular_weights(&matrices, &basis, (2 * i, 2 * j))
+            None => regular_weights(matrices, basis, (2 * i, 2 * j), di)
                 .into_iter()
                 .map(|w: S| w * S::from_rational(&factor))
                 .collect(),
@@ -206,7 +231,7 @@ pub fn triangle_patch_stencils_of_kind<S: Scalar>(
             system.push_unknown(
                 c as u32,
                 Relation { terms, constant },
-                format!("phi_{col}({i}/{n}, {j}/{n})"),
+                format!("phi_{col}({i}/{d}, {j}/{d})"),
             );
         }
         system.normalization.push(NormalizationRow {
@@ -219,32 +244,41 @@ pub fn triangle_patch_stencils_of_kind<S: Scalar>(
             } else {
                 BigRational::zero()
             },
-            label: format!("x = ({i}/{n}, {j}/{n})"),
+            label: format!("x = ({i}/{d}, {j}/{d})"),
         });
     }
-    let Solution { values, residual } = solve_system::<S>(&system, scheme.name, n)?;
-    let stencils = (0..points.len())
-        .map(|c| values[c * k..(c + 1) * k].to_vec())
+    let Solution { values, residual } = solve_system::<S>(&system, &matrices.scheme, d)?;
+    let wanted: Vec<(i64, i64)> = points
+        .iter()
+        .copied()
+        .filter(|&p| p != (0, 0) || kind == StencilKind::Position)
+        .collect();
+    let stencils = wanted
+        .iter()
+        .map(|p| {
+            let c = class_of[p] as usize;
+            values[c * k..(c + 1) * k].to_vec()
+        })
         .collect();
     Ok(TrianglePatchStencils {
-        scheme: scheme.name.to_owned(),
-        valence,
-        n,
+        scheme: matrices.scheme.clone(),
+        valence: matrices.valence,
+        n: d,
         kind,
-        points,
+        points: wanted,
         stencils,
         residual,
     })
 }
 
 /// Evaluates Loop EV-patch stencils by substitution at any rational `(u, v)`; caches the
-/// regular basis per denominator.
+/// regular basis per kind.
 #[derive(Debug)]
 pub struct TriangleSubstitution<S> {
     scheme: TriangleScheme,
     /// The local subdivision matrices.
     pub matrices: TriangleLocalMatrices,
-    bases: HashMap<(u32, StencilKind), TriangleStencils<BigRational>>,
+    bases: HashMap<StencilKind, LoopRegularBasis>,
     field: std::marker::PhantomData<S>,
 }
 
@@ -261,8 +295,8 @@ impl<S: Scalar> TriangleSubstitution<S> {
 
     /// The `K` position weights at `(u, v)`, `u, v >= 0`, `u + v <= 1`: double `x` `k` times
     /// until `u + v > 1/2`, take the regular sub-triangle's weights at `2x`, apply `A` `k` times.
-    /// The regular basis is solved on the grid of `2x`'s denominator, which must be at most
-    /// [`MAX_TRIANGLE_RATE`].
+    /// The regular basis comes from its exact quartic pieces ([`LoopRegularBasis`]), so any
+    /// denominator works.
     pub fn stencil(&mut self, u: &BigRational, v: &BigRational) -> Result<Vec<S>, StencilError> {
         self.stencil_of_kind(u, v, StencilKind::Position)
     }
@@ -313,26 +347,25 @@ impl<S: Scalar> TriangleSubstitution<S> {
         }
         let (y1, y2) = (&x * &two, &y * &two);
         let d = y1.denom().lcm(y2.denom());
-        let n = u32::try_from(&d)
-            .ok()
-            .filter(|&n| n <= MAX_TRIANGLE_RATE)
-            .ok_or_else(|| StencilError::OutOfDomain {
-                what: format!(
-                    "the denominator of ({u}, {v}) doubled is {d}; the regular basis is solved for denominators up to {MAX_TRIANGLE_RATE}"
-                ),
-            })?;
         let numerator = |t: &BigRational| {
-            i64::try_from(&(t * BigRational::from_integer(d.clone())).to_integer()).unwrap_or(0)
+            i64::try_from(&(t * BigRational::from_integer(d.clone())).to_integer())
         };
-        let point = (numerator(&y1), numerator(&y2));
-        if !self.bases.contains_key(&(n, kind)) {
-            let basis = regular_basis(&self.scheme, n, kind)?;
-            self.bases.insert((n, kind), basis);
+        let too_big = || StencilError::OutOfDomain {
+            what: format!("the denominator of ({u}, {v}) does not fit in 64 bits"),
+        };
+        let point = (
+            numerator(&y1).map_err(|_| too_big())?,
+            numerator(&y2).map_err(|_| too_big())?,
+        );
+        let d = i64::try_from(&d).map_err(|_| too_big())?;
+        if !self.bases.contains_key(&kind) {
+            let basis = LoopRegularBasis::new(&self.scheme, kind)?;
+            self.bases.insert(kind, basis);
         }
         let factor = S::from_rational(&BigRational::from_integer(BigInt::from(
             kind.doubling_factor(),
         )));
-        let mut row: Vec<S> = regular_weights(&self.matrices, &self.bases[&(n, kind)], point)
+        let mut row: Vec<S> = regular_weights(&self.matrices, &self.bases[&kind], point, d)
             .into_iter()
             .map(|w: S| w * factor.clone())
             .collect();

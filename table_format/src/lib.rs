@@ -26,7 +26,7 @@ use thiserror::Error;
 /// The first eight bytes of every table.
 pub const MAGIC: [u8; 8] = *b"SUBTESS\0";
 /// The format version this crate reads and writes.
-pub const VERSION: u32 = 1;
+pub const VERSION: u32 = 2;
 /// Size of the fixed header.
 pub const HEADER_SIZE: usize = 64;
 /// Size of one section-index entry.
@@ -130,6 +130,15 @@ pub enum TableError {
         /// The length the shape implies.
         expected: u64,
     },
+    /// A section's point set is for the other kind of patch (triangle point sets in a quad
+    /// scheme's table or the reverse).
+    #[error("section {key} uses a point set that does not belong to {scheme} patches")]
+    WrongPointSet {
+        /// The section.
+        key: SectionKey,
+        /// The table's scheme.
+        scheme: &'static str,
+    },
     /// Two index entries describe the same section.
     #[error("section {key} appears twice in the index")]
     DuplicateSection {
@@ -167,6 +176,8 @@ pub enum SchemeId {
     CatmullClark = 1,
     /// Schaefer–Warren's non-polynomial quad scheme.
     SwNonpolyQuad = 2,
+    /// Loop with Warren's rational weights (a triangle scheme: triangle point sets).
+    Loop = 3,
 }
 
 impl SchemeId {
@@ -175,20 +186,31 @@ impl SchemeId {
         match self {
             SchemeId::CatmullClark => "catmull-clark",
             SchemeId::SwNonpolyQuad => "sw-nonpoly-quad",
+            SchemeId::Loop => "loop",
         }
+    }
+
+    /// Whether the scheme subdivides triangles (its sections use the triangle point sets).
+    pub fn is_triangle(self) -> bool {
+        matches!(self, SchemeId::Loop)
     }
 
     /// From the catalogue name.
     pub fn from_name(name: &str) -> Option<Self> {
-        [SchemeId::CatmullClark, SchemeId::SwNonpolyQuad]
-            .into_iter()
-            .find(|s| s.name() == name)
+        [
+            SchemeId::CatmullClark,
+            SchemeId::SwNonpolyQuad,
+            SchemeId::Loop,
+        ]
+        .into_iter()
+        .find(|s| s.name() == name)
     }
 
     fn from_u32(v: u32) -> Option<Self> {
         match v {
             1 => Some(SchemeId::CatmullClark),
             2 => Some(SchemeId::SwNonpolyQuad),
+            3 => Some(SchemeId::Loop),
             _ => None,
         }
     }
@@ -230,6 +252,16 @@ pub enum PointSet {
     Primal = 0,
     /// `((2i+1)/2n, (2j+1)/2n)`, `0 <= i, j < n`, `j` outer: `n^2` points.
     Dual = 1,
+    /// Triangle patches: `(i/n, j/n)`, `i + j <= n`, `j` outer, `i` inner: `(n+1)(n+2)/2`
+    /// points.
+    TrianglePrimal = 2,
+    /// Triangle patches: the centroids of the `n^2` small triangles, row by row (`j` outer),
+    /// each row `up(0,j), down(0,j), up(1,j), .., up(n-1-j, j)`, where `up(i,j)` is the
+    /// triangle `(i,j), (i+1,j), (i,j+1)` with centroid `((3i+1)/3n, (3j+1)/3n)` and
+    /// `down(i,j)` the triangle `(i+1,j), (i,j+1), (i+1,j+1)` with centroid
+    /// `((3i+2)/3n, (3j+2)/3n)`: `2(n-j)-1` points in row `j`, the first `2n-1` being the
+    /// zigzag along the edge `v = 0`.
+    TriangleDual = 3,
 }
 
 impl PointSet {
@@ -238,8 +270,14 @@ impl PointSet {
         let n = u64::from(n);
         match self {
             PointSet::Primal => (n + 1) * (n + 1),
-            PointSet::Dual => n * n,
+            PointSet::Dual | PointSet::TriangleDual => n * n,
+            PointSet::TrianglePrimal => (n + 1) * (n + 2) / 2,
         }
+    }
+
+    /// Whether the point set belongs to triangle patches.
+    pub fn is_triangle(self) -> bool {
+        matches!(self, PointSet::TrianglePrimal | PointSet::TriangleDual)
     }
 }
 
@@ -270,6 +308,8 @@ impl fmt::Display for SectionKey {
         let grid = match self.points {
             PointSet::Primal => "primal",
             PointSet::Dual => "dual",
+            PointSet::TrianglePrimal => "triangle primal",
+            PointSet::TriangleDual => "triangle dual",
         };
         if self.boundary {
             write!(
@@ -335,6 +375,15 @@ pub fn encode(
         if pair[0].0 == pair[1].0 {
             return Err(TableError::DuplicateSection { key: pair[0].0 });
         }
+    }
+    if let Some((key, _, _)) = sorted
+        .iter()
+        .find(|(key, _, _)| key.points.is_triangle() != meta.scheme.is_triangle())
+    {
+        return Err(TableError::WrongPointSet {
+            key: *key,
+            scheme: meta.scheme.name(),
+        });
     }
     let bytes_per = meta.precision as u64;
     let index_offset = HEADER_SIZE as u64;
@@ -595,6 +644,8 @@ impl TableIndex {
             let points = match e[1] {
                 0 => PointSet::Primal,
                 1 => PointSet::Dual,
+                2 => PointSet::TrianglePrimal,
+                3 => PointSet::TriangleDual,
                 p => {
                     return Err(TableError::BadField {
                         field: "section point set",
@@ -620,6 +671,12 @@ impl TableIndex {
                 sector: u32_at(e, 8),
                 n: u32_at(e, 12),
             };
+            if points.is_triangle() != scheme.is_triangle() {
+                return Err(TableError::WrongPointSet {
+                    key,
+                    scheme: scheme.name(),
+                });
+            }
             let entry = SectionEntry {
                 key,
                 points: u32_at(e, 16),

@@ -77,7 +77,7 @@ fn wrong_magic() {
 
 #[test]
 fn newer_and_older_versions() {
-    for v in [0u32, 2, 99] {
+    for v in [0u32, VERSION - 1, VERSION + 1, 99] {
         let mut b = sample();
         b[8..12].copy_from_slice(&v.to_le_bytes());
         assert_eq!(
@@ -209,6 +209,33 @@ fn duplicate_sections_are_refused_by_the_writer() {
     assert!(matches!(e, TableError::DuplicateSection { .. }));
     let e = encode(meta, &[(k, 2, vec![1.0])]).expect_err("wrong length");
     assert!(matches!(e, TableError::Encode(_)));
+}
+
+#[test]
+fn triangle_point_sets_count_and_belong_to_triangle_schemes() {
+    for n in 1..=24u64 {
+        // (n+1)(n+2)/2 grid points i + j <= n; n^2 small triangles.
+        let grid = (0..=n).map(|j| n - j + 1).sum::<u64>();
+        let small = (0..n).map(|j| 2 * (n - j) - 1).sum::<u64>();
+        assert_eq!(PointSet::TrianglePrimal.count(n as u32), grid);
+        assert_eq!(PointSet::TriangleDual.count(n as u32), small);
+    }
+    let loop_ = TableMeta {
+        scheme: SchemeId::Loop,
+        precision: Precision::F32,
+        corners: false,
+    };
+    let tri = key(StencilKind::Position, PointSet::TrianglePrimal, 6, 1);
+    let bytes = encode(loop_, &[(tri, 12, vec![0.5; 36])]).expect("valid");
+    parse(&bytes).expect("a Loop table with triangle sections");
+    let quad = key(StencilKind::Position, PointSet::Primal, 6, 1);
+    let e = encode(loop_, &[(quad, 1, vec![1.0; 4])]).expect_err("quad grid in a Loop table");
+    assert!(matches!(e, TableError::WrongPointSet { .. }));
+    // The reader refuses it too: relabel the valid file's scheme as Catmull–Clark.
+    let mut b = bytes.clone();
+    b[52..56].copy_from_slice(&(SchemeId::CatmullClark as u32).to_le_bytes());
+    reseal(&mut b);
+    assert!(matches!(parse(&b), Err(TableError::WrongPointSet { .. })));
 }
 
 proptest! {

@@ -234,3 +234,34 @@ fn sqrt3_edge_midpoint_stencil_has_the_papers_normalization_2256() {
         }
     }
 }
+
+#[test]
+fn loop_quartic_pieces_equal_the_box_spline_at_denominators_beyond_the_grids() {
+    // LoopRegularBasis interpolates the rate-4 grid; the box spline comes from its definition.
+    // Denominators 3n of the dual points up to n = 24, and odd ones no grid here was solved at.
+    let scheme = TriangleScheme::by_name("loop").expect("catalogued");
+    let basis = stencilgen::loop_basis::LoopRegularBasis::new(&scheme, StencilKind::Position)
+        .expect("polynomial");
+    let du = stencilgen::loop_basis::LoopRegularBasis::new(&scheme, StencilKind::DerivativeU)
+        .expect("polynomial");
+    let mut checked = 0;
+    for d in [29i64, 48, 72] {
+        // A sparse sweep of the support [-2, 2]^2 (every 7th numerator, offset per row).
+        for k2 in (-2 * d..=2 * d).step_by(7) {
+            for k1 in (-2 * d + (k2.rem_euclid(5))..=2 * d).step_by(11) {
+                let x = (q(k1, d), q(k2, d));
+                let value: BigRational = basis.at(k1, k2, d);
+                assert_eq!(value, loop_basis(&x), "psi at ({k1}, {k2})/{d}");
+                let shifted = (&x.0 + q(2, 1), x.1.clone());
+                let expected_u = box_spline([1, 2, 2], &shifted)
+                    - box_spline([1, 2, 2], &(&shifted.0 - q(1, 1), shifted.1.clone()));
+                let slope: BigRational = du.at(k1, k2, d);
+                assert_eq!(slope, expected_u, "d/du psi at ({k1}, {k2})/{d}");
+                let float: f64 = basis.at(k1, k2, d);
+                assert!((float - rational_to_f64(&value)).abs() < 1e-14);
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 300, "{checked} points");
+}
