@@ -263,15 +263,12 @@ fn stencils<'t>(
     ]
     .map(|kind| table.weights(&section(patch, kind, points, n)));
     let (position, du, dv) = (position?, du?, dv?);
-    let side = match points {
-        PointSet::Dual => n as usize,
-        PointSet::Primal => n as usize + 1,
-    };
+    let count = points.count(n) as usize;
     let k = patch.points.len();
-    if position.len() != side * side * k || du.len() != position.len() || dv.len() != du.len() {
+    if position.len() != count * k || du.len() != position.len() || dv.len() != du.len() {
         return Err(RuntimeError::LayoutMismatch {
             key: section(patch, StencilKind::Position, points, n),
-            table: position.len() / (side * side),
+            table: position.len() / count.max(1),
             patch: k,
         });
     }

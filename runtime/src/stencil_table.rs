@@ -104,3 +104,18 @@ impl StencilTable {
         Ok(self.index.weights_f32(self.bytes(), key)?)
     }
 }
+
+impl crate::triangle_dual_grid::TriangleStencils for StencilTable {
+    /// Triangle sections of a triangle-scheme (Loop) table; a quad table is refused by name
+    /// rather than read at the wrong layout.
+    fn triangle_weights(&self, key: &SectionKey) -> Result<&[f32], RuntimeError> {
+        let scheme = self.index.meta.scheme;
+        if !scheme.is_triangle() {
+            return Err(RuntimeError::Unsupported(format!(
+                "the stencil table is for {}, a quad scheme; triangle meshes need a Loop table",
+                scheme.name()
+            )));
+        }
+        self.weights(key)
+    }
+}

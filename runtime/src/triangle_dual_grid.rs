@@ -36,7 +36,7 @@
 use std::ops::Range;
 use std::time::Instant;
 
-use table_format::StencilKind;
+use table_format::{PointSet, SectionKey, StencilKind};
 
 use crate::dual_grid::{
     evaluate_points, for_each_range, merge_rows, weighted_point, PointPlan, Stencils,
@@ -56,70 +56,12 @@ const MAX_TRIANGLE_PATCH: usize = 32;
 /// The largest rate the evaluator takes.
 pub const MAX_TRIANGLE_RATE: u32 = 64;
 
-/// Which grid of a triangle patch a section covers (`table_format`'s triangle point sets).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum TriangleGrid {
-    /// `(i/n, j/n)`, `i + j <= n`: `(n+1)(n+2)/2` points ([`primal_index`]).
-    Primal,
-    /// The centroids of the `n^2` small triangles ([`dual_index`]).
-    Dual,
-}
-
-impl TriangleGrid {
-    /// Number of points at rate `n`.
-    pub fn count(self, n: u32) -> usize {
-        let n = n as usize;
-        match self {
-            TriangleGrid::Primal => (n + 1) * (n + 2) / 2,
-            TriangleGrid::Dual => n * n,
-        }
-    }
-}
-
-/// One section of a triangle-scheme table: one kind of stencil on one grid of one patch.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct TriangleSection {
-    /// Position or derivative (in the patch's own `(u, v)`).
-    pub kind: StencilKind,
-    /// Primal or dual grid.
-    pub grid: TriangleGrid,
-    /// Whether the patch vertex is on the boundary.
-    pub boundary: bool,
-    /// Its valence (interior) or number of triangles (boundary).
-    pub faces: u32,
-    /// Which of a boundary vertex's triangles (0 for interior).
-    pub sector: u32,
-    /// Grid rate.
-    pub n: u32,
-}
-
-impl std::fmt::Display for TriangleSection {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let grid = match self.grid {
-            TriangleGrid::Primal => "primal",
-            TriangleGrid::Dual => "dual",
-        };
-        if self.boundary {
-            write!(
-                f,
-                "{:?} on the triangle {grid} grid, n = {}, boundary vertex with {} triangles, sector {}",
-                self.kind, self.n, self.faces, self.sector
-            )
-        } else {
-            write!(
-                f,
-                "{:?} on the triangle {grid} grid, n = {}, valence {}",
-                self.kind, self.n, self.faces
-            )
-        }
-    }
-}
-
 /// Where the triangle tessellator gets its stencils: `points x K` f32 weights, point-major, of
-/// one section (a Loop stencil table).
+/// one section on a triangle point set ([`PointSet::TrianglePrimal`], [`PointSet::TriangleDual`]);
+/// a Loop [`crate::stencil_table::StencilTable`], or any other source of the same layout.
 pub trait TriangleStencils: Sync {
     /// The weights of `key`, or an error naming what the source covers.
-    fn triangle_weights(&self, key: &TriangleSection) -> Result<&[f32], RuntimeError>;
+    fn triangle_weights(&self, key: &SectionKey) -> Result<&[f32], RuntimeError>;
 }
 
 /// How one triangle's points are evaluated: its table stencils on both grids, its control
@@ -275,10 +217,10 @@ pub struct TriangleDualGrid<'t> {
     boundary: bool,
 }
 
-fn section(patch: &TrianglePatch, kind: StencilKind, grid: TriangleGrid, n: u32) -> TriangleSection {
-    TriangleSection {
+fn section(patch: &TrianglePatch, kind: StencilKind, points: PointSet, n: u32) -> SectionKey {
+    SectionKey {
         kind,
-        grid,
+        points,
         boundary: patch.kind.boundary,
         faces: patch.kind.faces,
         sector: patch.kind.sector,
@@ -289,7 +231,7 @@ fn section(patch: &TrianglePatch, kind: StencilKind, grid: TriangleGrid, n: u32)
 fn stencils<'t>(
     table: &'t dyn TriangleStencils,
     patch: &TrianglePatch,
-    grid: TriangleGrid,
+    grid: PointSet,
     n: u32,
 ) -> Result<Stencils<'t>, RuntimeError> {
     let [position, du, dv] = [
@@ -300,14 +242,13 @@ fn stencils<'t>(
     .map(|kind| table.triangle_weights(&section(patch, kind, grid, n)));
     let (position, du, dv) = (position?, du?, dv?);
     let k = patch.points.len();
-    let expected = grid.count(n) * k;
-    if position.len() != expected || du.len() != expected || dv.len() != expected {
-        return Err(RuntimeError::Unsupported(format!(
-            "the table's {} has {} weights, but {} points x {k} control points = {expected}",
-            section(patch, StencilKind::Position, grid, n),
-            position.len(),
-            grid.count(n)
-        )));
+    let count = grid.count(n) as usize;
+    if position.len() != count * k || du.len() != position.len() || dv.len() != du.len() {
+        return Err(RuntimeError::LayoutMismatch {
+            key: section(patch, StencilKind::Position, grid, n),
+            table: position.len() / count.max(1),
+            patch: k,
+        });
     }
     Ok(Stencils { position, du, dv })
 }
@@ -388,8 +329,8 @@ impl<'t> TriangleDualGrid<'t> {
                 )));
             }
             // A valence beyond the table's is refused here, by the table naming its coverage.
-            let dual = stencils(table, patch, TriangleGrid::Dual, n)?;
-            let primal = stencils(table, patch, TriangleGrid::Primal, n)?;
+            let dual = stencils(table, patch, PointSet::TriangleDual, n)?;
+            let primal = stencils(table, patch, PointSet::TrianglePrimal, n)?;
             let maps = &mut grid.maps[n as usize];
             if maps.is_none() {
                 *maps = Some([0, 1, 2].map(|corner| point_map(n, corner)));
@@ -427,7 +368,7 @@ impl<'t> TriangleDualGrid<'t> {
         (i, j): (u32, u32),
     ) -> Result<u32, RuntimeError> {
         let n = self.rates[f];
-        let s = stencils(table, patch, TriangleGrid::Primal, n)?;
+        let s = stencils(table, patch, PointSet::TrianglePrimal, n)?;
         let (pi, pj) = primal_in_patch(patch.corner, n, i, j);
         let k = patch.points.len();
         let at = primal_index(n, pi, pj);

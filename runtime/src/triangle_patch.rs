@@ -195,8 +195,12 @@ fn beyond(mesh: &Mesh, e: u32, v: u32) -> Result<u32, String> {
         match (ring.len(), ring.first(), ring.last()) {
             (4, Some(&a), Some(&b)) if a == v => Ok(b),
             (4, Some(&a), Some(&b)) if b == v => Ok(a),
-            _ => Err(format!(
-                "boundary vertex {e} next to the patch vertex is not regular along the boundary"
+            (4, _, _) => Err(format!(
+                "its boundary corners {v} and {e} are joined by an interior edge, a neighbourhood no Loop table layout covers"
+            )),
+            (faces, _, _) => Err(format!(
+                "boundary vertex {e} next to the patch vertex has {} triangles, not 3",
+                faces.saturating_sub(1)
             )),
         }
     } else {

@@ -1,0 +1,626 @@
+//! Loop (triangle) meshes end to end: isolation, patches, the triangle dual-grid plan, and its
+//! output's topology and parameters.
+//!
+//! Without weights from a Loop table, the geometry-free properties are checked with *flat*
+//! stencils ([`FlatStencils`]): every point of a patch is the linear interpolation of the
+//! patch's own triangle (`V`, and the two corners after it), which is what a table's layout
+//! would give for the piecewise-linear surface. With them:
+//!
+//! * the output is an oriented 2-manifold (it builds a valid [`Mesh`]: every edge in at most two
+//!   triangles, traversed both ways, every vertex a single fan) with the input's Euler
+//!   characteristic and number of boundary loops, for random per-face rates;
+//! * every output vertex lies on its input triangle at its exact source: tessellating the
+//!   isolated mesh with its vertices placed linearly (input vertices where they are, edge points
+//!   at the input edges' midpoints) puts every vertex at `(1-u-v) v0 + u v1 + v v2` of its
+//!   source, and every normal along the input triangle's normal — which checks the rotations
+//!   into the patches, the patch corners' order and the exact child parameters.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use proptest::prelude::*;
+use runtime::loop_isolate::{isolate_loop, LoopIsolation};
+use runtime::loop_refine::loop_refine;
+use runtime::obj::read_obj;
+use runtime::topology::Mesh;
+use runtime::triangle_dual_grid::{TriangleDualGrid, TriangleStencils};
+use runtime::triangle_mesh::TriangleMesh;
+use runtime::{MeshError, RuntimeError};
+use schemes::BoundaryMode;
+use table_format::{PointSet, SectionKey, StencilKind};
+
+/// The largest rate the flat stencils cover.
+const MAX_N: u32 = 12;
+
+/// Stencils of the piecewise-linear surface in the Loop tables' layout: a patch's point
+/// `(u, v)` is `(1-u-v) V + u A + v B`, where `A`, `B` are the patch's `(1,0)` and `(0,1)`
+/// corners: layout entries 1 and 2 of an interior patch (`E_0`, `E_1`), `1 + s` and `2 + s` of a
+/// boundary patch in sector `s` (`E_s`, `E_{s+1}`).
+struct FlatStencils {
+    sections: HashMap<SectionKey, Vec<f32>>,
+}
+
+/// The points of a triangle point set at rate `n`, in table order.
+fn grid_points(points: PointSet, n: u32) -> Vec<(f64, f64)> {
+    let n_f = f64::from(n);
+    let mut out = Vec::new();
+    match points {
+        PointSet::TrianglePrimal => {
+            for j in 0..=n {
+                for i in 0..=n - j {
+                    out.push((f64::from(i) / n_f, f64::from(j) / n_f));
+                }
+            }
+        }
+        _ => {
+            for j in 0..n {
+                for i in 0..n - j {
+                    let at = |shift: u32| {
+                        (
+                            f64::from(3 * i + shift) / (3.0 * n_f),
+                            f64::from(3 * j + shift) / (3.0 * n_f),
+                        )
+                    };
+                    out.push(at(1));
+                    if i + j + 1 < n {
+                        out.push(at(2));
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+impl FlatStencils {
+    fn new() -> Self {
+        let mut patches = Vec::new();
+        for valence in 3..=12u32 {
+            patches.push((false, valence, 0u32, valence as usize + 6, 1usize));
+        }
+        for k in 1..=6u32 {
+            for s in 0..k {
+                let size = 1 + (k + 1) + 3 + u32::from(s >= 1) + u32::from(s + 2 <= k);
+                patches.push((true, k, s, size as usize, 1 + s as usize));
+            }
+        }
+        let mut sections = HashMap::new();
+        for (boundary, faces, sector, size, a) in patches {
+            for n in 1..=MAX_N {
+                for points in [PointSet::TrianglePrimal, PointSet::TriangleDual] {
+                    for kind in [
+                        StencilKind::Position,
+                        StencilKind::DerivativeU,
+                        StencilKind::DerivativeV,
+                    ] {
+                        let mut w = Vec::new();
+                        for (u, v) in grid_points(points, n) {
+                            let mut row = vec![0.0f32; size];
+                            let (c, cu, cv) = match kind {
+                                StencilKind::Position => (1.0 - u - v, u, v),
+                                StencilKind::DerivativeU => (-1.0, 1.0, 0.0),
+                                StencilKind::DerivativeV => (-1.0, 0.0, 1.0),
+                            };
+                            row[0] = c as f32;
+                            row[a] = cu as f32;
+                            row[a + 1] = cv as f32;
+                            w.extend(row);
+                        }
+                        let key = SectionKey {
+                            kind,
+                            points,
+                            boundary,
+                            faces,
+                            sector,
+                            n,
+                        };
+                        sections.insert(key, w);
+                    }
+                }
+            }
+        }
+        FlatStencils { sections }
+    }
+}
+
+impl TriangleStencils for FlatStencils {
+    fn triangle_weights(&self, key: &SectionKey) -> Result<&[f32], RuntimeError> {
+        self.sections
+            .get(key)
+            .map(Vec::as_slice)
+            .ok_or_else(|| RuntimeError::Unsupported(format!("flat stencils lack {key}")))
+    }
+}
+
+fn mesh(positions: Vec<[f64; 3]>, faces: &[[i64; 3]]) -> Mesh {
+    let faces: Vec<Vec<i64>> = faces.iter().map(|f| f.to_vec()).collect();
+    Mesh::new(positions, &faces, &[], BoundaryMode::EdgeOnly).expect("a valid test mesh")
+}
+
+fn tetrahedron() -> Mesh {
+    mesh(
+        vec![
+            [1.0, 1.0, 1.0],
+            [1.0, -1.0, -1.0],
+            [-1.0, 1.0, -1.0],
+            [-1.0, -1.0, 1.0],
+        ],
+        &[[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]],
+    )
+}
+
+fn octahedron() -> Mesh {
+    let p = vec![
+        [1.0, 0.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, -1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, -1.0],
+    ];
+    mesh(
+        p,
+        &[
+            [0, 2, 4],
+            [2, 1, 4],
+            [1, 3, 4],
+            [3, 0, 4],
+            [2, 0, 5],
+            [1, 2, 5],
+            [3, 1, 5],
+            [0, 3, 5],
+        ],
+    )
+}
+
+fn icosahedron() -> Mesh {
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let p = vec![
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
+    ];
+    mesh(
+        p,
+        &[
+            [0, 11, 5],
+            [0, 5, 1],
+            [0, 1, 7],
+            [0, 7, 10],
+            [0, 10, 11],
+            [1, 5, 9],
+            [5, 11, 4],
+            [11, 10, 2],
+            [10, 7, 6],
+            [7, 1, 8],
+            [3, 9, 4],
+            [3, 4, 2],
+            [3, 2, 6],
+            [3, 6, 8],
+            [3, 8, 9],
+            [4, 9, 5],
+            [2, 4, 11],
+            [6, 2, 10],
+            [8, 6, 7],
+            [9, 8, 1],
+        ],
+    )
+}
+
+fn single_triangle() -> Mesh {
+    mesh(
+        vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.2, 0.9, 0.3]],
+        &[[0, 1, 2]],
+    )
+}
+
+/// A disc of two rings around a centre on the hexagonal lattice: the centre and the inner ring
+/// regular, the rim on the boundary with two or three triangles.
+fn disc() -> Mesh {
+    let lattice = |a: i64, b: i64| [a as f64 + 0.5 * b as f64, 0.75f64.sqrt() * b as f64, 0.0];
+    let mut points = Vec::new();
+    let mut index = HashMap::new();
+    for b in -2i64..=2 {
+        for a in -2i64..=2 {
+            if (a + b).abs() <= 2 {
+                index.insert((a, b), points.len() as i64);
+                points.push(lattice(a, b));
+            }
+        }
+    }
+    let mut faces = Vec::new();
+    let at = |a: i64, b: i64| index.get(&(a, b)).copied();
+    for b in -3i64..=2 {
+        for a in -3i64..=2 {
+            // Up triangle (a,b),(a+1,b),(a,b+1) and down (a+1,b),(a+1,b+1),(a,b+1).
+            if let (Some(v), Some(x), Some(y)) = (at(a, b), at(a + 1, b), at(a, b + 1)) {
+                faces.push([v, x, y]);
+            }
+            if let (Some(x), Some(z), Some(y)) = (at(a + 1, b), at(a + 1, b + 1), at(a, b + 1)) {
+                faces.push([x, z, y]);
+            }
+        }
+    }
+    faces.sort_unstable();
+    mesh(points, &faces)
+}
+
+/// A torus of `m x n` lattice cells, each split into two triangles the same way: every vertex
+/// interior of valence 6 (regular).
+fn torus(m: usize, n: usize) -> Mesh {
+    let (big, small) = (3.0, 1.0);
+    let mut p = Vec::new();
+    for j in 0..n {
+        for i in 0..m {
+            let (a, b) = (
+                std::f64::consts::TAU * i as f64 / m as f64,
+                std::f64::consts::TAU * j as f64 / n as f64,
+            );
+            let r = big + small * b.cos();
+            p.push([r * a.cos(), r * a.sin(), small * b.sin()]);
+        }
+    }
+    let at = |i: usize, j: usize| ((j % n) * m + i % m) as i64;
+    let mut faces = Vec::new();
+    for j in 0..n {
+        for i in 0..m {
+            faces.push([at(i, j), at(i + 1, j), at(i, j + 1)]);
+            faces.push([at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]);
+        }
+    }
+    mesh(p, &faces)
+}
+
+fn models() -> Option<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/models");
+    if dir.is_dir() {
+        Some(dir)
+    } else {
+        println!(
+            "skipping: {} is absent (it ships beside the repository, not in it)",
+            dir.display()
+        );
+        None
+    }
+}
+
+fn load(path: &Path) -> Mesh {
+    let obj = read_obj(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    Mesh::from_obj(&obj)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .0
+}
+
+/// Tessellate with flat stencils at per-input-face rates; sources in the input's triangles.
+fn tessellate_flat(
+    stencils: &FlatStencils,
+    iso: &LoopIsolation,
+    positions: &[[f64; 3]],
+    input_rates: &[u32],
+) -> TriangleMesh {
+    let rates: Vec<u32> = iso
+        .origin
+        .iter()
+        .map(|&f| input_rates[f as usize])
+        .collect();
+    let grid = TriangleDualGrid::new(stencils, &iso.mesh, &iso.patches, &rates)
+        .unwrap_or_else(|e| panic!("plan: {e}"));
+    let mut placed = iso.mesh.clone();
+    placed.positions = positions.to_vec();
+    let mut out = grid.tessellate(&placed);
+    for s in &mut out.sources {
+        *s = iso.input_source(*s);
+    }
+    assert_eq!(out.positions.len(), grid.vertex_count());
+    assert_eq!(out.triangles.len(), grid.triangle_count());
+    out
+}
+
+/// The output is an oriented manifold with the input's Euler characteristic and boundary loops.
+fn check_topology(input: &Mesh, out: &TriangleMesh, label: &str) {
+    let triangles: Vec<Vec<i64>> = out
+        .triangles
+        .iter()
+        .map(|t| t.iter().map(|&v| i64::from(v)).collect())
+        .collect();
+    let positions = out.positions.iter().map(|p| p.map(f64::from)).collect();
+    let surface = Mesh::new(positions, &triangles, &[], BoundaryMode::EdgeOnly)
+        .unwrap_or_else(|e| panic!("{label}: the output is not an oriented manifold: {e}"));
+    let used = surface
+        .vertex_halfedge
+        .iter()
+        .filter(|&&h| h != runtime::topology::NONE)
+        .count();
+    assert_eq!(used, out.positions.len(), "{label}: unused output vertices");
+    assert_eq!(
+        surface.euler_characteristic(),
+        input.euler_characteristic(),
+        "{label}: Euler characteristic"
+    );
+    assert_eq!(
+        surface.boundary_loops(),
+        input.boundary_loops(),
+        "{label}: boundary loops"
+    );
+    assert_eq!(
+        out.is_watertight(),
+        input.boundary_loops() == 0,
+        "{label}: watertight"
+    );
+}
+
+/// The isolated mesh's vertices placed linearly on the input: input vertices where they are,
+/// edge points at their edge's midpoint, step by step (from the refinement's own edge lists).
+fn linear_positions(input: &Mesh, iso: &LoopIsolation) -> Vec<[f64; 3]> {
+    let mut current = input.clone();
+    let mut linear = input.positions.clone();
+    for _ in 0..iso.steps {
+        let refinement = loop_refine(&current).expect("refines");
+        for [a, b] in refinement.edges {
+            let (p, q) = (linear[a as usize], linear[b as usize]);
+            linear.push([0, 1, 2].map(|c| 0.5 * (p[c] + q[c])));
+        }
+        current = refinement.mesh;
+    }
+    linear
+}
+
+/// Every output vertex at its source on its input triangle, every normal along the triangle's.
+fn check_on_input(input: &Mesh, out: &TriangleMesh, label: &str) {
+    let scale = input
+        .positions
+        .iter()
+        .flat_map(|p| p.iter().map(|c| c.abs()))
+        .fold(1.0f64, f64::max);
+    for ((p, normal), s) in out.positions.iter().zip(&out.normals).zip(&out.sources) {
+        let corners = input.face(s.face as usize);
+        let [a, b, c] = [0, 1, 2].map(|k| input.positions[corners[k] as usize]);
+        let (u, v) = s.uv();
+        assert!(u >= 0.0 && v >= 0.0 && u + v <= 1.0, "{label}: source {s:?}");
+        for k in 0..3 {
+            let expected = (1.0 - u - v) * a[k] + u * b[k] + v * c[k];
+            assert!(
+                (f64::from(p[k]) - expected).abs() <= 1e-5 * scale,
+                "{label}: vertex at {s:?} is {p:?}, its source on the input is at {k}: {expected}"
+            );
+        }
+        let (e1, e2) = (
+            [0, 1, 2].map(|k| b[k] - a[k]),
+            [0, 1, 2].map(|k| c[k] - a[k]),
+        );
+        let n = [
+            e1[1] * e2[2] - e1[2] * e2[1],
+            e1[2] * e2[0] - e1[0] * e2[2],
+            e1[0] * e2[1] - e1[1] * e2[0],
+        ];
+        let length = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        let cosine = (0..3).map(|k| f64::from(normal[k]) * n[k]).sum::<f64>() / length;
+        assert!(
+            cosine > 1.0 - 1e-5,
+            "{label}: normal {normal:?} at {s:?} is not the input triangle's {n:?}"
+        );
+    }
+}
+
+fn small_meshes() -> Vec<(&'static str, Mesh)> {
+    vec![
+        ("tetrahedron", tetrahedron()),
+        ("octahedron", octahedron()),
+        ("icosahedron", icosahedron()),
+        ("disc", disc()),
+        ("torus", torus(6, 5)),
+    ]
+}
+
+#[test]
+fn the_small_meshes_have_the_expected_topology() {
+    for (name, m) in small_meshes() {
+        let expected = match name {
+            "tetrahedron" | "octahedron" | "icosahedron" => (2, 0),
+            "torus" => (0, 0),
+            _ => (1, 1),
+        };
+        assert_eq!(
+            (m.euler_characteristic(), m.boundary_loops()),
+            expected,
+            "{name}"
+        );
+    }
+    // The disc has 19 vertices, 24 triangles.
+    assert_eq!((disc().positions.len(), disc().faces()), (19, 24));
+}
+
+#[test]
+fn isolation_refines_exactly_when_a_triangle_needs_it() {
+    for (name, m) in small_meshes() {
+        let iso = isolate_loop(&m).unwrap_or_else(|e| panic!("{name}: {e}"));
+        // The torus (all valence 6) and the disc (its only irregular vertices are rim corners
+        // with two triangles, never two in one triangle) are table patches as given.
+        let patches_as_given = name == "torus" || name == "disc";
+        assert_eq!(iso.steps, usize::from(!patches_as_given), "{name}");
+        assert_eq!(iso.mesh.faces(), m.faces() * 4usize.pow(iso.steps as u32));
+    }
+}
+
+#[test]
+fn uniform_and_mixed_rates_give_manifolds_on_the_input() {
+    let stencils = FlatStencils::new();
+    for (name, m) in small_meshes() {
+        let iso = isolate_loop(&m).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let linear = linear_positions(&m, &iso);
+        for rates in [
+            vec![1; m.faces()],
+            vec![2; m.faces()],
+            vec![5; m.faces()],
+            (0..m.faces()).map(|f| 1 + (f as u32 * 7) % 12).collect(),
+        ] {
+            let label = format!("{name}, rates {:?}", &rates[..rates.len().min(6)]);
+            let out = tessellate_flat(&stencils, &iso, &linear, &rates);
+            check_topology(&m, &out, &label);
+            check_on_input(&m, &out, &label);
+        }
+    }
+}
+
+/// Closed meshes: `3n^2 - 3n + 3` triangles per tessellated triangle at uniform rate `n`
+/// (`3(n-1)(n-2)` in its hexagons, `3 (2n - 2)` in its half of three edge strips, 3 in its
+/// share of the vertex fans).
+#[test]
+fn a_closed_mesh_at_uniform_rate_has_the_counted_triangles() {
+    let stencils = FlatStencils::new();
+    let m = icosahedron();
+    let iso = isolate_loop(&m).expect("isolates");
+    for n in 1..=6u32 {
+        let out = tessellate_flat(&stencils, &iso, &iso.mesh.positions, &vec![n; m.faces()]);
+        let per_face = (3 * n * n - 3 * n + 3) as usize;
+        assert_eq!(out.triangles.len(), per_face * iso.mesh.faces(), "n = {n}");
+    }
+}
+
+/// A boundary corner with one triangle is refused by name (module docs of `loop_isolate`): a
+/// single triangle has three.
+#[test]
+fn a_one_triangle_corner_is_refused_by_name() {
+    let e = isolate_loop(&single_triangle()).expect_err("three one-triangle corners");
+    assert!(e.to_string().contains("vertex 0 (OBJ `v` number 1)"), "{e}");
+    // A triangle glued to the disc's rim makes an ear too.
+    let mut m = disc();
+    let rim = (0..m.positions.len())
+        .find(|&v| m.is_boundary_vertex(v))
+        .expect("a rim");
+    let h = m.vertex_halfedge[rim] as usize;
+    let (a, b) = (m.face_vertices[h], m.head(h));
+    m.positions.push([0.0, 0.0, 5.0]);
+    let apex = (m.positions.len() - 1) as i64;
+    let mut faces: Vec<Vec<i64>> = (0..m.faces())
+        .map(|f| m.face(f).iter().map(|&v| i64::from(v)).collect())
+        .collect();
+    faces.push(vec![i64::from(b), i64::from(a), apex]);
+    let eared = Mesh::new(m.positions.clone(), &faces, &[], BoundaryMode::EdgeOnly).expect("valid");
+    let e = isolate_loop(&eared).expect_err("an ear");
+    assert!(e.to_string().contains(&format!("vertex {apex}")), "{e}");
+}
+
+#[test]
+fn non_triangles_and_non_manifold_input_are_named() {
+    let p = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [2.0, 0.0, 0.0],
+    ];
+    let quad = Mesh::new(
+        p.clone(),
+        &[vec![1, 4, 2], vec![0, 1, 2, 3]],
+        &[],
+        BoundaryMode::EdgeOnly,
+    )
+    .expect("valid");
+    let e = isolate_loop(&quad).expect_err("a quad");
+    assert!(
+        matches!(
+            e,
+            RuntimeError::Mesh(MeshError::NotTriangle {
+                face: 1,
+                vertices: 4
+            })
+        ),
+        "{e}"
+    );
+    // Two triangles sharing only a vertex: refused by the topology, naming the vertex.
+    let bowtie = Mesh::new(
+        vec![
+            [0.0; 3],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, -1.0, 0.0],
+        ],
+        &[vec![0, 1, 2], vec![0, 3, 4]],
+        &[],
+        BoundaryMode::EdgeOnly,
+    )
+    .expect_err("bowtie");
+    assert!(bowtie.to_string().contains("vertex 0"), "{bowtie}");
+}
+
+#[test]
+fn the_models_tessellate_to_manifolds_on_the_input() {
+    let Some(dir) = models() else { return };
+    let stencils = FlatStencils::new();
+    for (file, euler, loops) in [
+        ("crane/spot_triangulated.obj", 2, 0),
+        ("odedstein/hand_lowres.obj", 1, 1),
+    ] {
+        let m = load(&dir.join(file));
+        assert_eq!(
+            (m.euler_characteristic(), m.boundary_loops()),
+            (euler, loops),
+            "{file}"
+        );
+        let iso = isolate_loop(&m).unwrap_or_else(|e| panic!("{file}: {e}"));
+        let linear = linear_positions(&m, &iso);
+        let rates: Vec<u32> = (0..m.faces()).map(|f| 1 + (f as u32 * 5) % 7).collect();
+        let out = tessellate_flat(&stencils, &iso, &linear, &rates);
+        check_topology(&m, &out, file);
+        check_on_input(&m, &out, file);
+    }
+}
+
+#[test]
+fn the_hand_has_one_boundary_loop_of_16_edges_with_2_3_and_4_triangles() {
+    let Some(dir) = models() else { return };
+    let m = load(&dir.join("odedstein/hand_lowres.obj"));
+    let boundary: Vec<usize> = (0..m.positions.len())
+        .filter(|&v| m.is_boundary_vertex(v))
+        .collect();
+    assert_eq!(boundary.len(), 16);
+    let mut ks: Vec<usize> = boundary.iter().map(|&v| m.fan(v).len()).collect();
+    ks.sort_unstable();
+    ks.dedup();
+    assert_eq!(ks, vec![2, 3, 4]);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+    /// Random per-face rates on the small meshes.
+    #[test]
+    fn random_rates_on_small_meshes(which in 0usize..5, seed in proptest::collection::vec(1u32..=12, 80)) {
+        let stencils = FlatStencils::new();
+        let (name, m) = small_meshes().swap_remove(which);
+        let iso = isolate_loop(&m).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let rates: Vec<u32> = (0..m.faces()).map(|f| seed[f % seed.len()]).collect();
+        let linear = linear_positions(&m, &iso);
+        let out = tessellate_flat(&stencils, &iso, &linear, &rates);
+        check_topology(&m, &out, name);
+        check_on_input(&m, &out, name);
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 2, ..ProptestConfig::default() })]
+
+    /// Random per-face rates 1..=12 on Spot (closed, genus 0) and the hand (one boundary loop).
+    #[test]
+    fn random_rates_on_the_models(hand in any::<bool>(), seed in proptest::collection::vec(1u32..=12, 1..400)) {
+        let Some(dir) = models() else { return Ok(()) };
+        let stencils = FlatStencils::new();
+        let file = if hand { "odedstein/hand_lowres.obj" } else { "crane/spot_triangulated.obj" };
+        let m = load(&dir.join(file));
+        let iso = isolate_loop(&m).unwrap_or_else(|e| panic!("{file}: {e}"));
+        let rates: Vec<u32> = (0..m.faces()).map(|f| seed[(f * 31 + f / 7) % seed.len()]).collect();
+        let out = tessellate_flat(&stencils, &iso, &iso.mesh.positions, &rates);
+        check_topology(&m, &out, file);
+    }
+}
