@@ -10,11 +10,15 @@ fn main() {
         eprintln!("OUT_DIR is not set");
         std::process::exit(1);
     };
-    let tables: [(&str, Generator); 2] = [
+    let tables: [(&str, Generator); 3] = [
         ("catmull-clark.subtess", stencilgen::table::default_table),
         (
             "catmull-clark-corners.subtess",
             stencilgen::table::default_corner_table,
+        ),
+        (
+            "loop.subtess",
+            stencilgen::triangle_table::default_loop_table,
         ),
     ];
     for (name, generate) in tables {

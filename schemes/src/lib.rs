@@ -16,6 +16,7 @@
 pub mod bivariate;
 pub mod curve;
 pub mod local_matrices;
+pub mod loop_regular;
 pub mod quad;
 pub mod triangle;
 pub mod triangle_local;

@@ -45,6 +45,7 @@ pub mod substitution;
 pub mod table;
 pub mod triangle_patch;
 pub mod triangle_system;
+pub mod triangle_table;
 
 pub use curve_stencils::{curve_stencils, BasisFunction, CurveStencils};
 pub use error::StencilError;

@@ -64,15 +64,21 @@ impl LoopRegularBasis {
     pub fn at<S: Scalar>(&self, x: i64, y: i64, d: i64) -> S {
         let (a, b) = (x.div_euclid(d), y.div_euclid(d));
         let (s, t) = (x - a * d, y - b * d);
-        // Barycentric coordinates (numerators over d) and the map from the principal lattice
-        // point (i, j, k) to its numerators over 4.
-        let (lambda, corner): ([i64; 3], fn(i64, i64, i64, i64, i64) -> (i64, i64)) = if s + t <= d
-        {
-            ([d - s - t, s, t], |a, b, _i, j, k| (4 * a + j, 4 * b + k))
+        // Barycentric coordinates (numerators over d) in the up triangle (a,b),(a+1,b),(a,b+1)
+        // or the down triangle (a+1,b),(a,b+1),(a+1,b+1).
+        let up = s + t <= d;
+        let lambda = if up {
+            [d - s - t, s, t]
         } else {
-            ([d - t, d - s, s + t - d], |a, b, i, j, k| {
+            [d - t, d - s, s + t - d]
+        };
+        // The principal-lattice point (i, j, k) / 4 of that triangle, as numerators over 4.
+        let corner = |i: i64, j: i64, k: i64| {
+            if up {
+                (4 * a + j, 4 * b + k)
+            } else {
                 (4 * a + i + k, 4 * b + j + k)
-            })
+            }
         };
         let ratio = |p: i64, q: i64| S::from_rational(&BigRational::new(p.into(), q.into()));
         // l_i(lambda / d) for i = 0..=4, per barycentric coordinate.
@@ -91,7 +97,7 @@ impl LoopRegularBasis {
         for i in 0..=DEGREE {
             for j in 0..=DEGREE - i {
                 let k = DEGREE - i - j;
-                let (p, q) = corner(a, b, i, j, k);
+                let (p, q) = corner(i, j, k);
                 let value = self.value::<S>(p, q);
                 if value.is_negligible() && S::EXACT {
                     continue;

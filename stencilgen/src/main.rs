@@ -24,6 +24,7 @@ use stencilgen::substitution::Substitution;
 use stencilgen::table::{build_table, TableSpec};
 use stencilgen::triangle_patch::TriangleSubstitution;
 use stencilgen::triangle_system::{triangle_stencils, TriangleStencils};
+use stencilgen::triangle_table::{build_triangle_table, TriangleTableSpec};
 use stencilgen::{curve_stencils, CurveStencils, Scalar, StencilError};
 use table_format::Precision;
 
@@ -91,8 +92,8 @@ enum Command {
     },
     /// Write a versioned binary stencil table (docs/table-format.md).
     Tables {
-        /// Quad schemes, comma separated (one file each; with several, the scheme name is
-        /// appended to the file stem).
+        /// Schemes, comma separated: quad schemes, or `loop` (one file each; with several, the
+        /// scheme name is appended to the file stem).
         #[arg(long, default_value = "catmull-clark", value_delimiter = ',')]
         schemes: Vec<String>,
         /// Interior valences: a range `3..8` (inclusive) or a list `3,5,6`.
@@ -248,12 +249,36 @@ fn run(cli: Cli) -> Result<(), StencilError> {
                 Precision::F32
             };
             for name in &schemes {
-                let scheme = quad_scheme(name)?;
                 let path = if schemes.len() > 1 {
                     with_suffix(&output, name)
                 } else {
                     output.clone()
                 };
+                if let Some(triangle) = TriangleScheme::by_name(name) {
+                    if boundary {
+                        return Err(StencilError::UnsupportedScheme {
+                            scheme: name.clone(),
+                            reason: "triangle tables have no boundary patches yet".to_owned(),
+                        });
+                    }
+                    if exact {
+                        return Err(StencilError::UnsupportedScheme {
+                            scheme: name.clone(),
+                            reason: "triangle tables are generated from the f64 path (the tests check it against exact substitution within 1e-12)".to_owned(),
+                        });
+                    }
+                    let spec = TriangleTableSpec {
+                        scheme: triangle,
+                        valences: set.valences.clone(),
+                        rates: set.rates.clone(),
+                        precision,
+                    };
+                    let started = std::time::Instant::now();
+                    let bytes = build_triangle_table(&spec)?;
+                    write_bytes(&path, &bytes, started)?;
+                    continue;
+                }
+                let scheme = quad_scheme(name)?;
                 write_table(
                     TableSpec {
                         scheme,
@@ -433,7 +458,15 @@ fn write_table(spec: TableSpec, path: &std::path::Path) -> Result<(), StencilErr
         bar.set_position(done as u64);
     })?;
     bar.finish_and_clear();
-    std::fs::write(path, &bytes).map_err(|e| StencilError::Io {
+    write_bytes(path, &bytes, started)
+}
+
+fn write_bytes(
+    path: &std::path::Path,
+    bytes: &[u8],
+    started: std::time::Instant,
+) -> Result<(), StencilError> {
+    std::fs::write(path, bytes).map_err(|e| StencilError::Io {
         path: path.display().to_string(),
         message: e.to_string(),
     })?;

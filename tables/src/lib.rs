@@ -1,5 +1,5 @@
-//! The default stencil tables, embedded: the Catmull–Clark table and its small pinned-corner
-//! companion.
+//! The default stencil tables, embedded: the Catmull–Clark table, its small pinned-corner
+//! companion, and the Loop table.
 //!
 //! The default Catmull–Clark table (interior valences 3..=8, boundary vertices with 1..=6 faces
 //! "edge only", n = 1..=24, primal and dual grids, positions and both derivatives, f32) is about
@@ -24,6 +24,8 @@ static CATMULL_CLARK_CORNERS: &Aligned<[u8]> = &Aligned(*include_bytes!(concat!(
     "/catmull-clark-corners.subtess"
 )));
 
+static LOOP: &Aligned<[u8]> = &Aligned(*include_bytes!(concat!(env!("OUT_DIR"), "/loop.subtess")));
+
 /// The default Catmull–Clark table's bytes (64-byte aligned).
 pub fn default_catmull_clark() -> &'static [u8] {
     &CATMULL_CLARK.0
@@ -36,6 +38,13 @@ pub fn default_catmull_clark_corners() -> &'static [u8] {
     &CATMULL_CLARK_CORNERS.0
 }
 
+/// The default Loop table's bytes (64-byte aligned): interior valences 3..=12 (6 is the
+/// regular patch), n = 1..=24, triangle primal and dual grids, positions and both derivatives,
+/// f32 (`stencilgen::triangle_table::TriangleTableSpec::default_loop`; about 13 MB).
+pub fn default_loop() -> &'static [u8] {
+    &LOOP.0
+}
+
 #[cfg(test)]
 mod tests {
     #[test]
@@ -43,6 +52,7 @@ mod tests {
         for bytes in [
             super::default_catmull_clark(),
             super::default_catmull_clark_corners(),
+            super::default_loop(),
         ] {
             assert_eq!(bytes.as_ptr() as usize % 64, 0);
             assert_eq!(&bytes[..8], b"SUBTESS\0");

@@ -35,3 +35,21 @@ fn regenerated_corner_table_is_byte_identical() {
         table.coverage()
     );
 }
+
+#[test]
+fn regenerated_loop_table_is_byte_identical() {
+    let fresh = stencilgen::triangle_table::default_loop_table().expect("the Loop table generates");
+    let embedded = tables::default_loop();
+    assert!(
+        fresh == embedded,
+        "the embedded Loop table differs from a fresh generation"
+    );
+    let table = table_format::Table::parse(embedded).expect("the embedded table is valid");
+    assert_eq!(table.meta.scheme, table_format::SchemeId::Loop);
+    println!(
+        "Loop table: {} bytes, {} sections; {}",
+        table.size(),
+        table.entries.len(),
+        table.coverage()
+    );
+}

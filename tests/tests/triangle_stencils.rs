@@ -265,3 +265,36 @@ fn loop_quartic_pieces_equal_the_box_spline_at_denominators_beyond_the_grids() {
     }
     assert!(checked > 300, "{checked} points");
 }
+
+#[test]
+fn regular_loop_patch_from_subdivision_is_the_box_spline() {
+    // schemes::loop_regular interpolates limit points of two subdivision steps; the oracle is
+    // the box spline from its definition: the weight of net point p at x is psi(x - p).
+    use schemes::loop_regular::{RegularDerivative, RegularLoopPatch, REGULAR_NET};
+    let patch = RegularLoopPatch::new();
+    for (nu, nv, d) in [
+        (0, 0, 1),
+        (1, 0, 3),
+        (1, 1, 3),
+        (2, 5, 9),
+        (7, 3, 17),
+        (10, 31, 72),
+        (1, 70, 72),
+    ] {
+        let (u, v) = (q(nu, d), q(nv, d));
+        let w = patch.weights(&u, &v, RegularDerivative::Position);
+        let du = patch.weights(&u, &v, RegularDerivative::U);
+        let dv = patch.weights(&u, &v, RegularDerivative::V);
+        for (c, &(p1, p2)) in REGULAR_NET.iter().enumerate() {
+            let x = (&u - q(p1, 1), &v - q(p2, 1));
+            assert_eq!(w[c], loop_basis(&x), "({nu}, {nv})/{d}, point {c}");
+            // Box-spline derivative formula, centred by (2, 0) as in loop_tangents_are_...
+            let s = (&x.0 + q(2, 1), x.1.clone());
+            let less = |e: (i64, i64)| (&s.0 - q(e.0, 1), &s.1 - q(e.1, 1));
+            let eu = box_spline([1, 2, 2], &s) - box_spline([1, 2, 2], &less((1, 0)));
+            let ev = box_spline([2, 1, 2], &s) - box_spline([2, 1, 2], &less((0, 1)));
+            assert_eq!(du[c], eu, "d/du ({nu}, {nv})/{d}, point {c}");
+            assert_eq!(dv[c], ev, "d/dv ({nu}, {nv})/{d}, point {c}");
+        }
+    }
+}
