@@ -31,6 +31,11 @@ impl StencilTable {
         Self::embedded(tables::default_catmull_clark())
     }
 
+    /// The embedded default Loop table (Warren's weights; validated, checksum included).
+    pub fn default_loop() -> Result<Self, RuntimeError> {
+        Self::embedded(tables::default_loop())
+    }
+
     fn embedded(bytes: &'static [u8]) -> Result<Self, RuntimeError> {
         let index = TableIndex::parse(bytes)?;
         Ok(StencilTable {
