@@ -871,7 +871,11 @@ pub(crate) fn evaluate_points(
 
 /// Position and unit normal of table point `point` (row of the stencils) from the patch's
 /// control points.
-pub(crate) fn weighted_point(s: &Stencils, control: &[[f32; 3]], point: usize) -> ([f32; 3], [f32; 3]) {
+pub(crate) fn weighted_point(
+    s: &Stencils,
+    control: &[[f32; 3]],
+    point: usize,
+) -> ([f32; 3], [f32; 3]) {
     let k = control.len();
     let rows = point * k..(point + 1) * k;
     let (wp, wu, wv) = (&s.position[rows.clone()], &s.du[rows.clone()], &s.dv[rows]);

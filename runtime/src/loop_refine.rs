@@ -97,7 +97,10 @@ pub fn loop_refine(mesh: &Mesh) -> Result<LoopRefinement, MeshError> {
             let sum = ring
                 .iter()
                 .fold([0.0; 3], |acc, &e| add(acc, p[e as usize]));
-            add(scale(1.0 - ring.len() as f64 * beta, p[v]), scale(beta, sum))
+            add(
+                scale(1.0 - ring.len() as f64 * beta, p[v]),
+                scale(beta, sum),
+            )
         })
         .collect();
     positions.extend(edge_points);

@@ -206,6 +206,8 @@ pub struct TriangleDualGrid<'t> {
     /// interior points.
     points: Vec<PointPlan<'t>>,
     strips: Vec<TriangleStrip>,
+    /// The output vertex of every mesh vertex's limit point ([`NONE`] for unused vertices).
+    limit_points: Vec<u32>,
     /// Vertex polygons, concatenated, each fanned from its first entry (the limit point).
     polygons: Vec<u32>,
     polygon_offsets: Vec<u32>,
@@ -312,6 +314,7 @@ impl<'t> TriangleDualGrid<'t> {
             control: Vec::new(),
             points: Vec::new(),
             strips: Vec::new(),
+            limit_points: Vec::new(),
             polygons: Vec::new(),
             polygon_offsets: vec![0],
             face_triangles: Vec::new(),
@@ -453,7 +456,8 @@ impl<'t> TriangleDualGrid<'t> {
                 let g = mesh.face_of[t] as usize;
                 // Reversed, so that both rows run along h.
                 let right = self.zigzag(g, t - mesh.face_halfedges(g).start, true);
-                self.strips.push(TriangleStrip::Interior { left: row, right });
+                self.strips
+                    .push(TriangleStrip::Interior { left: row, right });
             }
         }
         // Vertex polygons: the limit point, then the corner dual points in fan order, closed
@@ -478,6 +482,7 @@ impl<'t> TriangleDualGrid<'t> {
             self.polygon_offsets.push(self.polygons.len() as u32);
         }
         self.vertex_count = self.first[self.rates.len()] as usize + self.points.len();
+        self.limit_points = limit_point;
         let prefix = |counts: &mut dyn Iterator<Item = usize>| -> Vec<usize> {
             let mut total = 0;
             counts
@@ -487,12 +492,8 @@ impl<'t> TriangleDualGrid<'t> {
                 })
                 .collect()
         };
-        self.face_triangles = prefix(
-            &mut self
-                .rates
-                .iter()
-                .map(|&n| 6 * interior_points(n) as usize),
-        );
+        self.face_triangles =
+            prefix(&mut self.rates.iter().map(|&n| 6 * interior_points(n) as usize));
         self.strip_triangles = prefix(&mut self.strips.iter().map(TriangleStrip::triangles));
         self.polygon_triangles = prefix(
             &mut self
@@ -518,6 +519,15 @@ impl<'t> TriangleDualGrid<'t> {
         .iter()
         .map(|v| v.last().copied().unwrap_or(0))
         .sum()
+    }
+
+    /// The output vertex holding mesh vertex `vertex`'s limit point (`None` for a vertex no
+    /// triangle uses).
+    pub fn limit_point(&self, vertex: usize) -> Option<u32> {
+        self.limit_points
+            .get(vertex)
+            .copied()
+            .filter(|&v| v != NONE)
     }
 
     /// Whether the mesh has a boundary (its output then has boundary loops).

@@ -110,8 +110,7 @@ pub fn triangle_patch(mesh: &Mesh, face: usize) -> Result<TrianglePatch, MeshErr
     if boundary(corner) {
         boundary_patch(mesh, h0, centre).map_err(not_isolated)
     } else {
-        interior_patch(mesh, face, centre, corners[(corner + 1) % 3], corner)
-            .map_err(not_isolated)
+        interior_patch(mesh, face, centre, corners[(corner + 1) % 3], corner).map_err(not_isolated)
     }
     .map(|(kind, points)| TrianglePatch {
         kind,
@@ -128,7 +127,9 @@ pub fn gather_triangle_patches(mesh: &Mesh) -> Result<Vec<TrianglePatch>, MeshEr
 /// The one-ring of interior vertex `e` of valence 6, from `from` counter-clockwise.
 fn regular_ring(mesh: &Mesh, e: u32, from: u32) -> Result<Vec<u32>, String> {
     if mesh.is_boundary_vertex(e as usize) {
-        return Err(format!("vertex {e} next to the patch vertex is on the boundary"));
+        return Err(format!(
+            "vertex {e} next to the patch vertex is on the boundary"
+        ));
     }
     let ring = neighbours(mesh, e as usize);
     if ring.len() != 6 {

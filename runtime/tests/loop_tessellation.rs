@@ -385,7 +385,10 @@ fn check_on_input(input: &Mesh, out: &TriangleMesh, label: &str) {
         let corners = input.face(s.face as usize);
         let [a, b, c] = [0, 1, 2].map(|k| input.positions[corners[k] as usize]);
         let (u, v) = s.uv();
-        assert!(u >= 0.0 && v >= 0.0 && u + v <= 1.0, "{label}: source {s:?}");
+        assert!(
+            u >= 0.0 && v >= 0.0 && u + v <= 1.0,
+            "{label}: source {s:?}"
+        );
         for k in 0..3 {
             let expected = (1.0 - u - v) * a[k] + u * b[k] + v * c[k];
             assert!(
@@ -622,5 +625,219 @@ proptest! {
         let rates: Vec<u32> = (0..m.faces()).map(|f| seed[(f * 31 + f / 7) % seed.len()]).collect();
         let out = tessellate_flat(&stencils, &iso, &iso.mesh.positions, &rates);
         check_topology(&m, &out, file);
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// With the default Loop table: the surface itself.
+
+mod with_the_table {
+    use super::*;
+    use num_bigint::BigInt;
+    use num_rational::BigRational;
+    use num_traits::ToPrimitive;
+    use runtime::stencil_table::StencilTable;
+    use subtess_tests::box_spline::{box_spline, DIRECTIONS};
+
+    fn table() -> StencilTable {
+        StencilTable::default_loop().unwrap_or_else(|e| panic!("the embedded Loop table: {e}"))
+    }
+
+    fn rational(p: i64, q: i64) -> BigRational {
+        BigRational::new(BigInt::from(p), BigInt::from(q))
+    }
+
+    /// `M_{222}` with direction `drop` removed once (`None`: none), centred like Loop's basis
+    /// (`x + (2, 0)`), by exact box-spline recurrences (`subtess_tests::box_spline`).
+    fn centred(drop: Option<usize>, x: &(BigRational, BigRational)) -> BigRational {
+        let mut c = [2u32, 2, 2];
+        if let Some(j) = drop {
+            c[j] -= 1;
+        }
+        box_spline(c, &(&x.0 + rational(2, 1), x.1.clone()))
+    }
+
+    /// Weights of the control points of lattice points `(a, b)` near `x` in the value and the
+    /// derivatives along `DIRECTIONS[0]`, `[1]`, `[2]` of the regular Loop surface over the
+    /// lattice: the quartic box spline `sum_p P_p M_{222}(x - p + (2,0))`, with the box-spline
+    /// derivative identity `D_xi M_Xi(x) = M_{Xi \ xi}(x) - M_{Xi \ xi}(x - xi)`.
+    fn box_spline_weights(x: &(BigRational, BigRational)) -> Vec<((i64, i64), [f64; 4])> {
+        let (fa, fb) = (
+            x.0.floor().to_integer().to_i64().expect("small"),
+            x.1.floor().to_integer().to_i64().expect("small"),
+        );
+        let mut out = Vec::new();
+        for b in fb - 2..=fb + 3 {
+            for a in fa - 2..=fa + 3 {
+                let d = (&x.0 - rational(a, 1), &x.1 - rational(b, 1));
+                // The support is the hexagon max(|a|, |b|, |a + b|) <= 2 around p.
+                let (da, db) = (d.0.to_f64().expect("finite"), d.1.to_f64().expect("finite"));
+                if da.abs().max(db.abs()).max((da + db).abs()) > 3.0 {
+                    continue;
+                }
+                let mut w = [centred(None, &d).to_f64().expect("finite"), 0.0, 0.0, 0.0];
+                for (j, xi) in DIRECTIONS.iter().enumerate() {
+                    let shifted = (&d.0 - rational(xi.0, 1), &d.1 - rational(xi.1, 1));
+                    w[j + 1] = (centred(Some(j), &d) - centred(Some(j), &shifted))
+                        .to_f64()
+                        .expect("finite");
+                }
+                out.push(((a, b), w));
+            }
+        }
+        out
+    }
+
+    fn combine(
+        weights: &[((i64, i64), [f64; 4])],
+        control: impl Fn(i64, i64) -> [f64; 3],
+    ) -> [[f64; 3]; 4] {
+        let mut out = [[0.0; 3]; 4];
+        for &((a, b), w) in weights {
+            let p = control(a, b);
+            for (o, w) in out.iter_mut().zip(w) {
+                for c in 0..3 {
+                    o[c] += w * p[c];
+                }
+            }
+        }
+        out
+    }
+
+    fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    }
+
+    /// On a torus whose every vertex has valence 6, every output vertex is the quartic box
+    /// spline at its exact source, and every normal its normal.
+    #[test]
+    fn a_regular_torus_is_the_quartic_box_spline_at_every_output_vertex() {
+        let table = table();
+        let (m, n) = (6usize, 5usize);
+        let t = torus(m, n);
+        let iso = isolate_loop(&t).expect("isolates");
+        assert_eq!(iso.steps, 0);
+        let rates: Vec<u32> = (0..t.faces()).map(|f| 1 + (f as u32 * 5) % 4).collect();
+        let grid = TriangleDualGrid::new(&table, &iso.mesh, &iso.patches, &rates).expect("plan");
+        let out = grid.tessellate(&iso.mesh);
+        let control = |a: i64, b: i64| {
+            t.positions[(b.rem_euclid(n as i64) as usize) * m + a.rem_euclid(m as i64) as usize]
+        };
+        let mut cache: HashMap<(BigRational, BigRational, bool), Vec<((i64, i64), [f64; 4])>> =
+            HashMap::new();
+        for ((p, normal), s) in out.positions.iter().zip(&out.normals).zip(&out.sources) {
+            // Face 2(j m + i) is the up triangle at lattice (i, j), the next one the down.
+            let (cell, down) = (s.face as usize / 2, s.face % 2 == 1);
+            let (i, j) = ((cell % m) as i64, (cell / m) as i64);
+            let d = i64::from(s.denominator);
+            let (u, v) = (rational(i64::from(s.u), d), rational(i64::from(s.v), d));
+            // Lattice offsets from the triangle's lattice point (i, j), on which the weights
+            // depend only through (u, v) and the orientation (up: (u, v); down: (1 - v, u + v)).
+            let local = if down {
+                (rational(1, 1) - &v, &u + &v)
+            } else {
+                (u.clone(), v.clone())
+            };
+            let weights = cache
+                .entry((u, v, down))
+                .or_insert_with(|| box_spline_weights(&local));
+            // The box spline reproduces linear functions: the lattice coordinates themselves
+            // come back, a check on the reference.
+            let linear = combine(weights, |a, b| [a as f64, b as f64, 0.0]);
+            assert!((linear[0][0] - local.0.to_f64().expect("finite")).abs() < 1e-12);
+            assert!((linear[0][1] - local.1.to_f64().expect("finite")).abs() < 1e-12);
+            let value = combine(weights, |a, b| control(a + i, b + j));
+            // d/du, d/dv of the face: up (xi_1, xi_2); down (xi_2, -xi_3).
+            let (du, dv) = if down {
+                (value[2], value[3].map(|c| -c))
+            } else {
+                (value[1], value[2])
+            };
+            for c in 0..3 {
+                assert!(
+                    (f64::from(p[c]) - value[0][c]).abs() <= 1e-5 * 4.0,
+                    "vertex at {s:?}: {p:?}, box spline {:?}",
+                    value[0]
+                );
+            }
+            let expected = cross(du, dv);
+            let length = expected.iter().map(|c| c * c).sum::<f64>().sqrt();
+            let cosine = (0..3)
+                .map(|c| f64::from(normal[c]) * expected[c])
+                .sum::<f64>()
+                / length;
+            assert!(
+                cosine > 1.0 - 1e-6,
+                "normal at {s:?}: {normal:?} vs {expected:?}"
+            );
+        }
+    }
+
+    /// Loop's closed-form limit position (Loop 1987; chi = 1 / (3 / (8 beta) + v)):
+    /// `(1 - v chi) V + chi sum E_i`, Warren's `beta` (3/16 at valence 3, 3/(8v) above).
+    fn limit_position(mesh: &Mesh, v: usize) -> [f64; 3] {
+        let fan = mesh.fan(v);
+        let valence = fan.len() as f64;
+        let beta = if fan.len() == 3 {
+            3.0 / 16.0
+        } else {
+            3.0 / (8.0 * valence)
+        };
+        let chi = 1.0 / (3.0 / (8.0 * beta) + valence);
+        let mut out = mesh.positions[v].map(|c| (1.0 - valence * chi) * c);
+        for h in fan {
+            let e = mesh.positions[mesh.head(h) as usize];
+            for c in 0..3 {
+                out[c] += chi * e[c];
+            }
+        }
+        out
+    }
+
+    fn check_limit_points(mesh: &Mesh, label: &str) {
+        let table = table();
+        let iso = isolate_loop(mesh).unwrap_or_else(|e| panic!("{label}: {e}"));
+        let rates: Vec<u32> = (0..iso.mesh.faces()).map(|f| 1 + f as u32 % 5).collect();
+        let grid = TriangleDualGrid::new(&table, &iso.mesh, &iso.patches, &rates).expect("plan");
+        let out = grid.tessellate(&iso.mesh);
+        let scale = iso
+            .mesh
+            .positions
+            .iter()
+            .flat_map(|p| p.iter().map(|c| c.abs()))
+            .fold(0.0f64, f64::max);
+        let mut valences = std::collections::BTreeSet::new();
+        for v in 0..iso.mesh.positions.len() {
+            let at = grid.limit_point(v).expect("used") as usize;
+            valences.insert(iso.mesh.fan(v).len());
+            let expected = limit_position(&iso.mesh, v);
+            for c in 0..3 {
+                assert!(
+                    (f64::from(out.positions[at][c]) - expected[c]).abs() <= 1e-5 * scale,
+                    "{label}: vertex {v} (valence {}): {:?} vs {expected:?}",
+                    iso.mesh.fan(v).len(),
+                    out.positions[at]
+                );
+            }
+        }
+        println!("{label}: valences {valences:?}");
+    }
+
+    #[test]
+    fn interior_limit_points_are_loops_closed_form() {
+        for (name, m) in [
+            ("tetrahedron", tetrahedron()),
+            ("octahedron", octahedron()),
+            ("icosahedron", icosahedron()),
+        ] {
+            check_limit_points(&m, name);
+        }
+        if let Some(dir) = models() {
+            check_limit_points(&load(&dir.join("crane/spot_triangulated.obj")), "spot");
+        }
     }
 }
