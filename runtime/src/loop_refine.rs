@@ -108,8 +108,8 @@ pub fn loop_refine(mesh: &Mesh) -> Result<LoopRefinement, MeshError> {
     for f in 0..mesh.faces() {
         let hs: Vec<usize> = mesh.face_halfedges(f).collect();
         let e = |i: usize| (nv + edge_of[hs[i % 3]] as usize) as i64;
-        for i in 0..3 {
-            let c = i64::from(mesh.face_vertices[hs[i]]);
+        for (i, &h) in hs.iter().enumerate() {
+            let c = i64::from(mesh.face_vertices[h]);
             faces.push(vec![c, e(i), e(i + 2)]);
         }
         faces.push(vec![e(0), e(1), e(2)]);

@@ -407,7 +407,7 @@ impl<'t> TriangleDualGrid<'t> {
         // one (its primal (0,0), where the derivative rows are the tangent masks), else from
         // the first triangle of its fan at the matching corner.
         let mut limit_point = vec![NONE; mesh.positions.len()];
-        for v in 0..mesh.positions.len() {
+        for (v, limit) in limit_point.iter_mut().enumerate() {
             let fan = mesh.fan(v);
             let Some(&h0) = fan.first() else { continue };
             let corner_of = |h: usize| {
@@ -425,7 +425,7 @@ impl<'t> TriangleDualGrid<'t> {
             let (f, c) = corner_of(h);
             let n = self.rates[f];
             let ij = [(0, 0), (n, 0), (0, n)][c];
-            limit_point[v] = self.point(table, &patches[f], f, ij)?;
+            *limit = self.point(table, &patches[f], f, ij)?;
         }
         // Edges, each once: interior ones from their lower half-edge, boundary ones from theirs.
         for h in 0..mesh.face_vertices.len() {

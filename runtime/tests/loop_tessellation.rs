@@ -657,11 +657,14 @@ mod with_the_table {
         box_spline(c, &(&x.0 + rational(2, 1), x.1.clone()))
     }
 
+    /// Lattice points `(a, b)` with their weights in a value and its three derivatives.
+    type Weights = Vec<((i64, i64), [f64; 4])>;
+
     /// Weights of the control points of lattice points `(a, b)` near `x` in the value and the
     /// derivatives along `DIRECTIONS[0]`, `[1]`, `[2]` of the regular Loop surface over the
     /// lattice: the quartic box spline `sum_p P_p M_{222}(x - p + (2,0))`, with the box-spline
     /// derivative identity `D_xi M_Xi(x) = M_{Xi \ xi}(x) - M_{Xi \ xi}(x - xi)`.
-    fn box_spline_weights(x: &(BigRational, BigRational)) -> Vec<((i64, i64), [f64; 4])> {
+    fn box_spline_weights(x: &(BigRational, BigRational)) -> Weights {
         let (fa, fb) = (
             x.0.floor().to_integer().to_i64().expect("small"),
             x.1.floor().to_integer().to_i64().expect("small"),
@@ -727,8 +730,7 @@ mod with_the_table {
         let control = |a: i64, b: i64| {
             t.positions[(b.rem_euclid(n as i64) as usize) * m + a.rem_euclid(m as i64) as usize]
         };
-        let mut cache: HashMap<(BigRational, BigRational, bool), Vec<((i64, i64), [f64; 4])>> =
-            HashMap::new();
+        let mut cache: HashMap<(BigRational, BigRational, bool), Weights> = HashMap::new();
         for ((p, normal), s) in out.positions.iter().zip(&out.normals).zip(&out.sources) {
             // Face 2(j m + i) is the up triangle at lattice (i, j), the next one the down.
             let (cell, down) = (s.face as usize / 2, s.face % 2 == 1);
