@@ -39,7 +39,7 @@ use std::time::Instant;
 use table_format::{PointSet, SectionKey, StencilKind};
 
 use crate::dual_grid::{
-    evaluate_points, for_each_range, merge_rows, weighted_point, PointPlan, Stencils,
+    cross, evaluate_points, for_each_range, merge_rows, unit, weighted_point, PointPlan, Stencils,
     TessellationTime,
 };
 use crate::topology::{Mesh, NONE};
@@ -612,6 +612,21 @@ impl<'t> TriangleDualGrid<'t> {
             *l = control[v as usize];
         }
         let local = &local[..points.len()];
+        if points.len() == REGULAR_POINTS {
+            // The regular patch, most of any isolated mesh: fixed-length dot products over
+            // coordinate columns, which the compiler unrolls and vectorizes.
+            let mut columns = [[0.0f32; REGULAR_POINTS]; 3];
+            for (l, p) in local.iter().enumerate() {
+                for c in 0..3 {
+                    columns[c][l] = p[c];
+                }
+            }
+            for (at, &row) in map.iter().enumerate() {
+                let stencils = if at < n * n { &plan.dual } else { &plan.primal };
+                (positions[at], normals[at]) = regular_point(stencils, &columns, row as usize);
+            }
+            return;
+        }
         for (at, &row) in map.iter().enumerate() {
             let stencils = if at < n * n { &plan.dual } else { &plan.primal };
             (positions[at], normals[at]) = weighted_point(stencils, local, row as usize);
@@ -692,6 +707,35 @@ impl<'t> TriangleDualGrid<'t> {
         self.connect(&mut out.triangles);
         out
     }
+}
+
+/// Control points of the regular patch (valence 6): `V`, six neighbours, five outer points.
+const REGULAR_POINTS: usize = 12;
+
+/// [`weighted_point`] for the regular patch, from the control points' coordinate columns.
+fn regular_point(
+    s: &Stencils,
+    columns: &[[f32; REGULAR_POINTS]; 3],
+    point: usize,
+) -> ([f32; 3], [f32; 3]) {
+    let rows = point * REGULAR_POINTS..(point + 1) * REGULAR_POINTS;
+    let weights = |w: &[f32]| -> [f32; REGULAR_POINTS] {
+        let mut out = [0.0; REGULAR_POINTS];
+        out.copy_from_slice(w);
+        out
+    };
+    let (wp, wu, wv) = (
+        weights(&s.position[rows.clone()]),
+        weights(&s.du[rows.clone()]),
+        weights(&s.dv[rows]),
+    );
+    let dot = |w: &[f32; REGULAR_POINTS], x: &[f32; REGULAR_POINTS]| -> f32 {
+        w.iter().zip(x).map(|(a, b)| a * b).sum()
+    };
+    let p = columns.map(|x| dot(&wp, &x));
+    let du = columns.map(|x| dot(&wu, &x));
+    let dv = columns.map(|x| dot(&wv, &x));
+    (p, unit(cross(du, dv)))
 }
 
 /// Tessellate an isolated triangle mesh (closed or with boundary) with rate `rates[f]` on
