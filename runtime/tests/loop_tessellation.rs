@@ -925,8 +925,8 @@ mod boundary_with_the_table {
             let mut expected = [0.0; 3];
             for (k, p) in [p0, p1, p2, p3].into_iter().enumerate() {
                 let w = cubic(&t + BigRational::from_integer(BigInt::from(1 - k as i64)));
-                for c in 0..3 {
-                    expected[c] += w * m.positions[p][c];
+                for (e, x) in expected.iter_mut().zip(m.positions[p]) {
+                    *e += w * x;
                 }
             }
             let got = out.positions[a as usize];
