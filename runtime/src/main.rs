@@ -166,6 +166,9 @@ enum TablesCommand {
     Info {
         /// A table file written by `stencilgen tables`.
         file: Option<PathBuf>,
+        /// Without a file: which embedded default (catmull-clark or loop).
+        #[arg(long, default_value = "catmull-clark", conflicts_with = "file")]
+        scheme: String,
     },
 }
 
@@ -633,13 +636,16 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
             Ok(())
         }
         Command::Tables {
-            command: TablesCommand::Info { file },
+            command: TablesCommand::Info { file, scheme },
         } => {
             let name = match &file {
                 Some(path) => path.display().to_string(),
-                None => "(embedded default)".to_owned(),
+                None => format!("(embedded default, {scheme})"),
             };
-            let table = load_table(&file, schemes::BoundaryMode::EdgeOnly)?;
+            let table = match parse_scheme(&scheme)? {
+                Scheme::Loop if file.is_none() => StencilTable::default_loop()?,
+                _ => load_table(&file, schemes::BoundaryMode::EdgeOnly)?,
+            };
             let index = table.index();
             let weights: u64 = index
                 .entries
