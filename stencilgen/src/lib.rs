@@ -43,6 +43,7 @@ pub mod solve;
 pub mod stencil_set;
 pub mod substitution;
 pub mod table;
+pub mod triangle_boundary;
 pub mod triangle_patch;
 pub mod triangle_system;
 pub mod triangle_table;
