@@ -851,6 +851,8 @@ mod boundary_with_the_table {
     use num_traits::ToPrimitive;
     use runtime::stencil_table::StencilTable;
     use runtime::topology::NONE;
+    use stencilgen::regular_patch::StencilKind as OracleKind;
+    use stencilgen::triangle_boundary::TriangleBoundarySubstitution;
     use subtess_tests::bspline::uniform_bspline;
 
     /// The centred uniform cubic B-spline `N(x) = B_3(x + 2)` (support `[-2, 2]`) at the
@@ -861,38 +863,121 @@ mod boundary_with_the_table {
             .expect("finite")
     }
 
-    /// Tessellate with the default table; `None` (after checking that the refusal is the
-    /// table's coverage error) while the table has no boundary sections.
-    fn tessellate_with_boundary(m: &Mesh, label: &str) -> Option<TriangleMesh> {
+    /// The points of a triangle point set at rate `n`, in table order, as rationals.
+    fn rational_points(points: PointSet, n: u32) -> Vec<(BigRational, BigRational)> {
+        let q = |p: u32, d: u32| BigRational::new(BigInt::from(p), BigInt::from(d));
+        let mut out = Vec::new();
+        for j in 0..=n {
+            for i in 0..=n - j {
+                match points {
+                    PointSet::TrianglePrimal => out.push((q(i, n), q(j, n))),
+                    _ if i + j < n => {
+                        out.push((q(3 * i + 1, 3 * n), q(3 * j + 1, 3 * n)));
+                        if i + j + 1 < n {
+                            out.push((q(3 * i + 2, 3 * n), q(3 * j + 2, 3 * n)));
+                        }
+                    }
+                    _ => {}
+                }
+            }
+        }
+        out
+    }
+
+    /// The default table, with the boundary sections a mesh needs computed here by the
+    /// stencil generator's substitution for boundary patches (`stencilgen::triangle_boundary`,
+    /// f64; the oracle the tables are built from) while the default table has none.
+    struct WithBoundary {
+        table: StencilTable,
+        boundary: HashMap<SectionKey, Vec<f32>>,
+    }
+
+    impl WithBoundary {
+        fn new(iso: &LoopIsolation, rates: &[u32]) -> Self {
+            let scheme = schemes::TriangleScheme::by_name("loop").expect("loop");
+            let mut boundary = HashMap::new();
+            for (patch, &n) in iso.patches.iter().zip(rates) {
+                if !patch.kind.boundary {
+                    continue;
+                }
+                let (k, s) = (patch.kind.faces, patch.kind.sector);
+                let mut substitution =
+                    TriangleBoundarySubstitution::<f64>::new(&scheme, k, s).expect("a patch");
+                for points in [PointSet::TrianglePrimal, PointSet::TriangleDual] {
+                    for (kind, oracle) in [
+                        (StencilKind::Position, OracleKind::Position),
+                        (StencilKind::DerivativeU, OracleKind::DerivativeU),
+                        (StencilKind::DerivativeV, OracleKind::DerivativeV),
+                    ] {
+                        let key = SectionKey {
+                            kind,
+                            points,
+                            boundary: true,
+                            faces: k,
+                            sector: s,
+                            n,
+                        };
+                        if boundary.contains_key(&key) {
+                            continue;
+                        }
+                        let mut weights = Vec::new();
+                        for (u, v) in rational_points(points, n) {
+                            let row = substitution
+                                .stencil_of_kind(&u, &v, oracle)
+                                .unwrap_or_else(|e| panic!("{key}: {e}"));
+                            weights.extend(row.iter().map(|&w| w as f32));
+                        }
+                        boundary.insert(key, weights);
+                    }
+                }
+            }
+            WithBoundary {
+                table: StencilTable::default_loop().expect("embedded"),
+                boundary,
+            }
+        }
+    }
+
+    impl TriangleStencils for WithBoundary {
+        fn triangle_weights(&self, key: &SectionKey) -> Result<&[f32], RuntimeError> {
+            match self.boundary.get(key) {
+                Some(w) => Ok(w),
+                None => self.table.triangle_weights(key),
+            }
+        }
+    }
+
+    /// Tessellate with the default table, or, while it has no boundary sections (the refusal
+    /// must then be its coverage error), with [`WithBoundary`].
+    fn tessellate_with_boundary(m: &Mesh, label: &str) -> TriangleMesh {
         let table = StencilTable::default_loop().expect("embedded");
         let iso = isolate_loop(m).unwrap_or_else(|e| panic!("{label}: {e}"));
         let rates: Vec<u32> = (0..iso.mesh.faces()).map(|f| 1 + f as u32 % 6).collect();
-        match TriangleDualGrid::new(&table, &iso.mesh, &iso.patches, &rates) {
-            Ok(grid) => {
-                let mut out = grid.tessellate(&iso.mesh);
-                for s in &mut out.sources {
-                    *s = iso.input_source(*s);
-                }
-                Some(out)
-            }
+        let mut out = match TriangleDualGrid::new(&table, &iso.mesh, &iso.patches, &rates) {
+            Ok(grid) => grid.tessellate(&iso.mesh),
             Err(e) => {
                 let text = e.to_string();
                 assert!(
                     text.contains("boundary vertex") && text.contains("covers"),
                     "{label}: {text}"
                 );
-                println!("{label}: the default Loop table has no boundary sections yet: {text}");
-                None
+                println!("{label}: the default Loop table has no boundary sections yet; they are computed by stencilgen's substitution here");
+                let stencils = WithBoundary::new(&iso, &rates);
+                TriangleDualGrid::new(&stencils, &iso.mesh, &iso.patches, &rates)
+                    .unwrap_or_else(|e| panic!("{label}: {e}"))
+                    .tessellate(&iso.mesh)
             }
+        };
+        for s in &mut out.sources {
+            *s = iso.input_source(*s);
         }
+        out
     }
 
     /// Every output vertex on the output's boundary is the uniform cubic B-spline of the input's
     /// boundary polygon at its source (limit points included: `(E_0 + 4V + E_k)/6`).
     fn check_boundary_curve(m: &Mesh, label: &str) {
-        let Some(out) = tessellate_with_boundary(m, label) else {
-            return;
-        };
+        let out = tessellate_with_boundary(m, label);
         check_topology(m, &out, label);
         let edges = out.boundary_edges().expect("oriented");
         let scale = m
@@ -908,12 +993,22 @@ mod boundary_with_the_table {
             // The face's side the source lies on, and the parameter along it.
             let sides = [(v == 0, u), (u + v == d, v), (u == 0, d - v)];
             let halfedges: Vec<usize> = m.face_halfedges(face).collect();
-            let Some((h, t)) = (0..3)
-                .filter(|&k| sides[k].0 && m.twin[halfedges[k]] == NONE)
-                .map(|k| {
-                    let t = BigRational::new(BigInt::from(sides[k].1), BigInt::from(d));
-                    (halfedges[k], t)
-                })
+            // A corner (a vertex's limit point) is `t = 0` on the boundary edge leaving it.
+            let corner = [(0, 0), (d, 0), (0, d)].iter().position(|&c| c == (u, v));
+            let corner_edge = corner.map(|c| {
+                let h = m.vertex_halfedge[m.face_vertices[halfedges[c]] as usize] as usize;
+                (h, BigRational::from_integer(BigInt::from(0)))
+            });
+            let Some((h, t)) = corner_edge
+                .into_iter()
+                .chain(
+                    (0..3)
+                        .filter(|&k| sides[k].0 && m.twin[halfedges[k]] == NONE)
+                        .map(|k| {
+                            let t = BigRational::new(BigInt::from(sides[k].1), BigInt::from(d));
+                            (halfedges[k], t)
+                        }),
+                )
                 .next()
             else {
                 panic!("{label}: boundary output vertex {a} at {s:?} is not on a boundary edge");
@@ -939,6 +1034,92 @@ mod boundary_with_the_table {
             checked += 1;
         }
         assert_eq!(checked, edges.len());
+    }
+
+    /// The limit position at the point `t = i/n` along side `side` of triangle `f` (from its
+    /// corner `side` to the next), from the triangle's own patch: the patch at face corner `r`
+    /// has `(u', v') = (w_{r+1}, w_{r+2})` of the face's barycentric weights `w`.
+    fn on_side(
+        stencils: &dyn TriangleStencils,
+        mesh: &Mesh,
+        patch: &runtime::triangle_patch::TrianglePatch,
+        side: usize,
+        i: u32,
+        n: u32,
+    ) -> [f64; 3] {
+        let mut w = [0u32; 3];
+        w[side] = n - i;
+        w[(side + 1) % 3] = i;
+        let r = patch.corner;
+        let (pu, pv) = (w[(r + 1) % 3], w[(r + 2) % 3]);
+        // Row pv of the primal grid starts after rows of n + 1, n, .. points.
+        let at = (0..pv).map(|j| (n + 1 - j) as usize).sum::<usize>() + pu as usize;
+        let key = SectionKey {
+            kind: StencilKind::Position,
+            points: PointSet::TrianglePrimal,
+            boundary: patch.kind.boundary,
+            faces: patch.kind.faces,
+            sector: patch.kind.sector,
+            n,
+        };
+        let weights = stencils.triangle_weights(&key).expect("covered");
+        let k = patch.points.len();
+        let mut out = [0.0; 3];
+        for (weight, &v) in weights[at * k..(at + 1) * k].iter().zip(&patch.points) {
+            for (o, x) in out.iter_mut().zip(mesh.positions[v as usize]) {
+                *o += f64::from(*weight) * x;
+            }
+        }
+        out
+    }
+
+    /// Two triangles sharing an edge evaluate the same limit curve on it, each from its own
+    /// patch (different patch kinds, corners, sectors and layouts): a control point gathered in
+    /// the wrong order shows up as a mismatch.
+    fn check_edges_agree(m: &Mesh, label: &str) {
+        let n = 4;
+        let iso = isolate_loop(m).unwrap_or_else(|e| panic!("{label}: {e}"));
+        let stencils = WithBoundary::new(&iso, &vec![n; iso.mesh.faces()]);
+        let mesh = &iso.mesh;
+        let scale = mesh
+            .positions
+            .iter()
+            .flat_map(|p| p.iter().map(|c| c.abs()))
+            .fold(1.0f64, f64::max);
+        let mut compared = 0;
+        for h in 0..mesh.face_vertices.len() {
+            let t = mesh.twin[h];
+            if t == NONE || (t as usize) < h {
+                continue;
+            }
+            let (f, g) = (mesh.face_of[h] as usize, mesh.face_of[t as usize] as usize);
+            let side_f = h - mesh.face_halfedges(f).start;
+            let side_g = t as usize - mesh.face_halfedges(g).start;
+            for i in 0..=n {
+                // The twin runs the other way: its parameter n - i is the same point.
+                let a = on_side(&stencils, mesh, &iso.patches[f], side_f, i, n);
+                let b = on_side(&stencils, mesh, &iso.patches[g], side_g, n - i, n);
+                for c in 0..3 {
+                    assert!(
+                        (a[c] - b[c]).abs() <= 1e-5 * scale,
+                        "{label}: edge {h} ({:?} vs {:?}), point {i}/{n}: {a:?} vs {b:?}",
+                        iso.patches[f].kind,
+                        iso.patches[g].kind
+                    );
+                }
+                compared += 1;
+            }
+        }
+        assert!(compared > 0);
+    }
+
+    #[test]
+    fn neighbouring_triangles_agree_on_their_shared_edges() {
+        check_edges_agree(&disc(), "disc");
+        check_edges_agree(&icosahedron(), "icosahedron");
+        if let Some(dir) = models() {
+            check_edges_agree(&load(&dir.join("odedstein/hand_lowres.obj")), "hand");
+        }
     }
 
     #[test]
