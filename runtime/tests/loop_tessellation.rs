@@ -829,6 +829,40 @@ mod with_the_table {
         println!("{label}: valences {valences:?}");
     }
 
+    /// On convex, centred solids every normal points outwards, and every output triangle turns
+    /// the same way as the surface (its geometric normal along its vertices' normals).
+    #[test]
+    fn normals_point_outwards_and_triangles_agree_with_them() {
+        let table = table();
+        for (name, m) in [("octahedron", octahedron()), ("icosahedron", icosahedron())] {
+            let iso = isolate_loop(&m).expect("isolates");
+            let rates: Vec<u32> = (0..iso.mesh.faces()).map(|f| 1 + f as u32 % 7).collect();
+            let grid =
+                TriangleDualGrid::new(&table, &iso.mesh, &iso.patches, &rates).expect("plan");
+            let out = grid.tessellate(&iso.mesh);
+            for (p, n) in out.positions.iter().zip(&out.normals) {
+                let outward: f32 = (0..3).map(|c| p[c] * n[c]).sum();
+                assert!(outward > 0.0, "{name}: normal {n:?} at {p:?}");
+            }
+            for t in &out.triangles {
+                let [a, b, c] = t.map(|v| out.positions[v as usize].map(f64::from));
+                let e1 = [0, 1, 2].map(|k| b[k] - a[k]);
+                let e2 = [0, 1, 2].map(|k| c[k] - a[k]);
+                let g = cross(e1, e2);
+                let n: [f64; 3] = [0, 1, 2].map(|k| {
+                    t.iter()
+                        .map(|&v| f64::from(out.normals[v as usize][k]))
+                        .sum()
+                });
+                let along: f64 = (0..3).map(|k| g[k] * n[k]).sum();
+                assert!(
+                    along > 0.0,
+                    "{name}: triangle {t:?} turns against the surface"
+                );
+            }
+        }
+    }
+
     #[test]
     fn interior_limit_points_are_loops_closed_form() {
         for (name, m) in [
