@@ -255,10 +255,11 @@ fn run(cli: Cli) -> Result<(), StencilError> {
                     output.clone()
                 };
                 if let Some(triangle) = TriangleScheme::by_name(name) {
-                    if boundary {
+                    if corners {
                         return Err(StencilError::UnsupportedScheme {
                             scheme: name.clone(),
-                            reason: "triangle tables have no boundary patches yet".to_owned(),
+                            reason: "pinned corners are implemented for quad schemes only"
+                                .to_owned(),
                         });
                     }
                     if exact {
@@ -270,6 +271,7 @@ fn run(cli: Cli) -> Result<(), StencilError> {
                     let spec = TriangleTableSpec {
                         scheme: triangle,
                         valences: set.valences.clone(),
+                        boundary_faces: set.boundary_faces.clone(),
                         rates: set.rates.clone(),
                         precision,
                     };
@@ -304,17 +306,27 @@ fn run(cli: Cli) -> Result<(), StencilError> {
         } => {
             let (u, v) = (parse_rational(&u)?, parse_rational(&v)?);
             if let Some(triangle) = TriangleScheme::by_name(&scheme) {
-                let Some(valence) = valence.filter(|_| boundary.is_none()) else {
+                if corners {
                     return Err(StencilError::UnsupportedScheme {
                         scheme,
-                        reason: "triangle schemes have no boundary rules yet; give --valence"
-                            .to_owned(),
+                        reason: "pinned corners are implemented for quad schemes only".to_owned(),
                     });
+                }
+                let patch = match (valence, boundary) {
+                    (Some(v), None) => TrianglePatchChoice::Interior(v),
+                    (None, Some(faces)) => TrianglePatchChoice::Boundary(faces, sector),
+                    _ => {
+                        return Err(StencilError::UnsupportedScheme {
+                            scheme,
+                            reason: "give either --valence V or --boundary FACES [--sector S]"
+                                .to_owned(),
+                        })
+                    }
                 };
                 let out = if float {
-                    triangle_stencil_json::<f64>(&triangle, valence, &u, &v, |x| json!(x))?
+                    triangle_stencil_json::<f64>(&triangle, patch, &u, &v, |x| json!(x))?
                 } else {
-                    triangle_stencil_json::<BigRational>(&triangle, valence, &u, &v, |x| {
+                    triangle_stencil_json::<BigRational>(&triangle, patch, &u, &v, |x| {
                         json!(x.to_string())
                     })?
                 };
@@ -484,25 +496,48 @@ fn write_bytes(
 /// substitution: `{"scheme","valence","u","v","exact","order","weights","du","dv"}`. At the
 /// vertex itself the tangent masks are irrational in general: `null` in exact mode, with the
 /// reason in `"note"`; `--f64` gives them (subdominant eigenvectors).
+/// Which Loop patch `stencilgen stencil` prints.
+#[derive(Clone, Copy, Debug)]
+enum TrianglePatchChoice {
+    /// Next to an interior vertex of this valence.
+    Interior(u32),
+    /// Sector `.1` next to a boundary vertex with `.0` triangles.
+    Boundary(u32, u32),
+}
+
 fn triangle_stencil_json<S: Scalar>(
     scheme: &TriangleScheme,
-    valence: u32,
+    patch: TrianglePatchChoice,
     u: &BigRational,
     v: &BigRational,
     value: impl Fn(&S) -> Value,
 ) -> Result<Value, StencilError> {
-    let mut substitution = TriangleSubstitution::<S>::new(scheme, valence)?;
+    let mut substitution = match patch {
+        TrianglePatchChoice::Interior(valence) => TriangleSubstitution::<S>::new(scheme, valence)?,
+        TrianglePatchChoice::Boundary(faces, sector) => {
+            TriangleSubstitution::<S>::boundary(scheme, faces, sector)?
+        }
+    };
     let weights = substitution.stencil(u, v)?;
     let mut out = json!({
         "scheme": scheme.name,
-        "valence": valence,
-        "boundary": false,
         "u": u.to_string(),
         "v": v.to_string(),
         "exact": S::EXACT,
         "order": substitution.matrices.names(),
         "weights": weights.iter().map(&value).collect::<Vec<_>>(),
     });
+    match patch {
+        TrianglePatchChoice::Interior(valence) => {
+            out["valence"] = json!(valence);
+            out["boundary"] = json!(false);
+        }
+        TrianglePatchChoice::Boundary(faces, sector) => {
+            out["faces"] = json!(faces);
+            out["sector"] = json!(sector);
+            out["boundary"] = json!(true);
+        }
+    }
     for (key, kind) in [
         ("du", StencilKind::DerivativeU),
         ("dv", StencilKind::DerivativeV),

@@ -16,12 +16,12 @@
 //!   [`crate::loop_basis`] over the sub-triangle's twelve level-1 points `j`);
 //! * at `x = 0`: `phi(0) = phi(0) A`, `sum phi(0) = 1` (the limit-position mask).
 //!
-//! A derivative picks up a factor 2 per halving (section 4). [`TriangleBoundarySubstitution`]
-//! unrolls these at any rational point, exactly or in f64 (one generic implementation over
-//! [`Scalar`]); the grid system of [`crate::triangle_patch`] solves the same relations on a
-//! grid. [`boundary_limit_mask`] solves for the left fixed vector of `A`;
-//! [`loop_boundary_tangents`] gives the tangent masks at `V` from the eigen-structure of the
-//! 1-ring block of `A` (f64).
+//! A derivative picks up a factor 2 per halving (section 4). These are the relations of the
+//! interior patch, so the same code serves both: [`crate::triangle_patch::TriangleSubstitution::boundary`]
+//! unrolls them at any rational point (exactly or in f64), `patch_stencils_at` solves them on a
+//! grid, and `TriangleSubstitution::limit_mask` is the left fixed vector of `A`. This module
+//! adds what is particular to the boundary: [`loop_boundary_tangents`], the tangent masks at
+//! `V` from the eigen-structure of the 1-ring block of `A` (f64).
 //!
 //! **The 1-ring block.** `V, E_0, ..., E_k` is invariant under subdivision. Its boundary rows
 //! (`V' = 1/8 E_0 + 3/4 V + 1/8 E_k`, `E_0' = (V + E_0)/2`, `E_k' = (V + E_k)/2`) read only
@@ -40,23 +40,12 @@
 //! boundary curve's tangent, and the surface has no tangent plane at `V` (measured in
 //! `docs/algorithms/triangle-schemes.md`).
 
-use std::collections::HashMap;
-
 use nalgebra::DMatrix;
-use num_bigint::BigInt;
-use num_integer::Integer;
-use num_rational::BigRational;
-use num_traits::{One, Zero};
 use schemes::triangle_local::{TriangleLocalMatrices, TriangleNeighbourhood};
-use schemes::TriangleScheme;
 
 use crate::ev_tangents::left_null_space;
-use crate::exact_solve::solve_dense;
-use crate::loop_basis::LoopRegularBasis;
-use crate::regular_patch::StencilKind;
 use crate::scalar::rational_to_f64;
-use crate::triangle_patch::sub_triangle_of;
-use crate::{Scalar, StencilError};
+use crate::StencilError;
 
 /// `(faces, sector)` of boundary matrices, or an error saying they are not.
 fn boundary_of(matrices: &TriangleLocalMatrices) -> Result<(u32, u32), StencilError> {
@@ -68,185 +57,6 @@ fn boundary_of(matrices: &TriangleLocalMatrices) -> Result<(u32, u32), StencilEr
                 "these are the matrices of an interior vertex of valence {valence}; use triangle_patch for them"
             ),
         }),
-    }
-}
-
-/// `sum_j psi(y - j) R_b[j]` with `y = Y / d` (level-1 sector coordinates): the weights of a
-/// point of a regular sub-triangle over the layout, `psi` from the exact quartic pieces of
-/// [`LoopRegularBasis`] (any denominator).
-fn sub_triangle_weights<S: Scalar>(
-    matrices: &TriangleLocalMatrices,
-    basis: &LoopRegularBasis,
-    y: (i64, i64),
-    d: i64,
-) -> Vec<S> {
-    let sub = &matrices.sub_triangles[sub_triangle_of(y, d)];
-    let mut out = vec![S::zero(); matrices.size()];
-    for (&(j1, j2), row) in sub.points.iter().zip(&sub.rows) {
-        let psi: S = basis.at(y.0 - d * j1, y.1 - d * j2, d);
-        if S::EXACT && psi.is_negligible() {
-            continue;
-        }
-        for (o, r) in out.iter_mut().zip(row) {
-            if !r.is_zero() {
-                *o = o.clone() + psi.clone() * S::from_rational(r);
-            }
-        }
-    }
-    out
-}
-
-/// The limit-position mask at `V`: the left fixed vector of `A` (`phi(0) = phi(0) A`) with
-/// weights summing to 1, solved exactly. For Loop's boundary rules it is the cubic B-spline
-/// curve's limit `(E_0 + 4 V + E_k) / 6` (the boundary rows read only boundary points).
-pub fn boundary_limit_mask(
-    matrices: &TriangleLocalMatrices,
-) -> Result<Vec<BigRational>, StencilError> {
-    let size = matrices.size();
-    let mut rows: Vec<(Vec<BigRational>, BigRational)> = (0..size)
-        .map(|j| {
-            let mut row: Vec<BigRational> = (0..size).map(|i| matrices.a[i][j].clone()).collect();
-            row[j] -= BigRational::one();
-            (row, BigRational::zero())
-        })
-        .collect();
-    rows.push((vec![BigRational::one(); size], BigRational::one()));
-    solve_dense(rows, size).map_err(|e| StencilError::Inconsistent {
-        scheme: matrices.scheme.clone(),
-        n: 1,
-        detail: format!(
-            "limit mask next to a boundary vertex ({:?}): {e:?}",
-            matrices.neighbourhood
-        ),
-    })
-}
-
-/// Evaluates stencils of the Loop patch next to a boundary vertex by substitution at any
-/// rational `(u, v)`; caches the regular basis per kind.
-#[derive(Debug)]
-pub struct TriangleBoundarySubstitution<S> {
-    scheme: TriangleScheme,
-    /// The local subdivision matrices ([`TriangleLocalMatrices::boundary`]).
-    pub matrices: TriangleLocalMatrices,
-    bases: HashMap<StencilKind, LoopRegularBasis>,
-    field: std::marker::PhantomData<S>,
-}
-
-impl<S: Scalar> TriangleBoundarySubstitution<S> {
-    /// Prepare for the patch of sector `sector` next to a boundary vertex with `faces`
-    /// triangles (`faces >= 1`, `sector < faces`), Loop's boundary rules.
-    pub fn new(scheme: &TriangleScheme, faces: u32, sector: u32) -> Result<Self, StencilError> {
-        Ok(TriangleBoundarySubstitution {
-            scheme: scheme.clone(),
-            matrices: TriangleLocalMatrices::boundary(scheme, faces, sector)?,
-            bases: HashMap::new(),
-            field: std::marker::PhantomData,
-        })
-    }
-
-    /// Switch to the patch of sector `sector` next to a boundary vertex with `faces`
-    /// triangles, keeping the cached regular basis (it does not depend on the patch).
-    pub fn select_patch(&mut self, faces: u32, sector: u32) -> Result<(), StencilError> {
-        self.matrices = TriangleLocalMatrices::boundary(&self.scheme, faces, sector)?;
-        Ok(())
-    }
-
-    /// The `K` position weights at `(u, v)`, `u, v >= 0`, `u + v <= 1`, in the layout order
-    /// of [`schemes::triangle_local::triangle_boundary_layout`].
-    pub fn stencil(&mut self, u: &BigRational, v: &BigRational) -> Result<Vec<S>, StencilError> {
-        self.stencil_of_kind(u, v, StencilKind::Position)
-    }
-
-    /// [`Self::stencil`] for positions or derivatives along `u` (towards `E_s`) and `v`
-    /// (towards `E_{s+1}`): double `x` `j` times until `u + v > 1/2`, take the regular
-    /// sub-triangle's weights at `2x`, apply `A` `j` times (times 2 per step for a
-    /// derivative). Any denominator that fits 64 bits works ([`LoopRegularBasis`]). At
-    /// `V` the position is [`boundary_limit_mask`] and the derivatives are
-    /// [`loop_boundary_tangents`]' masks, irrational in general: f64 only.
-    pub fn stencil_of_kind(
-        &mut self,
-        u: &BigRational,
-        v: &BigRational,
-        kind: StencilKind,
-    ) -> Result<Vec<S>, StencilError> {
-        let (zero, one) = (BigRational::zero(), BigRational::one());
-        if *u < zero || *v < zero || u + v > one {
-            return Err(StencilError::OutOfDomain {
-                what: format!("(u, v) = ({u}, {v}) is outside the patch u, v >= 0, u + v <= 1"),
-            });
-        }
-        if u.is_zero() && v.is_zero() {
-            if kind == StencilKind::Position {
-                return Ok(boundary_limit_mask(&self.matrices)?
-                    .iter()
-                    .map(S::from_rational)
-                    .collect());
-            }
-            let t = loop_boundary_tangents(&self.matrices)?;
-            let mask = if kind == StencilKind::DerivativeU {
-                t.du
-            } else {
-                t.dv
-            };
-            return mask
-                .into_iter()
-                .map(S::from_f64)
-                .collect::<Option<Vec<S>>>()
-                .ok_or_else(|| StencilError::Irrational {
-                    what: format!(
-                        "the tangent mask at a boundary vertex ({:?})",
-                        self.matrices.neighbourhood
-                    ),
-                });
-        }
-        let half = BigRational::new(BigInt::from(1), BigInt::from(2));
-        let two = BigRational::from_integer(BigInt::from(2));
-        let (mut x, mut y, mut steps) = (u.clone(), v.clone(), 0u32);
-        while &x + &y <= half {
-            x *= &two;
-            y *= &two;
-            steps += 1;
-        }
-        let (y1, y2) = (&x * &two, &y * &two);
-        let d = y1.denom().lcm(y2.denom());
-        let numerator = |t: &BigRational| {
-            i64::try_from(&(t * BigRational::from_integer(d.clone())).to_integer())
-        };
-        let too_big = || StencilError::OutOfDomain {
-            what: format!("the denominator of ({u}, {v}) does not fit in 64 bits"),
-        };
-        let point = (
-            numerator(&y1).map_err(|_| too_big())?,
-            numerator(&y2).map_err(|_| too_big())?,
-        );
-        let d = i64::try_from(&d).map_err(|_| too_big())?;
-        if !self.bases.contains_key(&kind) {
-            let basis = LoopRegularBasis::new(&self.scheme, kind)?;
-            self.bases.insert(kind, basis);
-        }
-        let factor = S::from_rational(&BigRational::from_integer(BigInt::from(
-            kind.doubling_factor(),
-        )));
-        let mut row: Vec<S> = sub_triangle_weights(&self.matrices, &self.bases[&kind], point, d)
-            .into_iter()
-            .map(|w: S| w * factor.clone())
-            .collect();
-        let size = self.matrices.size();
-        for _ in 0..steps {
-            // phi_j(x) = f sum_i phi_i(2x) A[i][j].
-            row = (0..size)
-                .map(|j| {
-                    row.iter()
-                        .zip(&self.matrices.a)
-                        .filter(|(_, a)| !a[j].is_zero())
-                        .fold(S::zero(), |acc, (w, a)| {
-                            acc + w.clone() * S::from_rational(&a[j])
-                        })
-                        * factor.clone()
-                })
-                .collect();
-        }
-        Ok(row)
     }
 }
 
@@ -389,7 +199,10 @@ pub fn loop_boundary_tangents(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::triangle_patch::triangle_scheme;
+    use crate::regular_patch::StencilKind;
+    use crate::triangle_patch::{triangle_scheme, TriangleSubstitution};
+    use num_bigint::BigInt;
+    use num_rational::BigRational;
 
     fn q(p: i64, r: i64) -> BigRational {
         BigRational::new(p.into(), r.into())
@@ -416,7 +229,7 @@ mod tests {
     #[test]
     fn bad_input_is_an_error() {
         let loop_ = triangle_scheme("loop").expect("catalogued");
-        let mut s = TriangleBoundarySubstitution::<BigRational>::new(&loop_, 3, 1).expect("valid");
+        let mut s = TriangleSubstitution::<BigRational>::boundary(&loop_, 3, 1).expect("valid");
         assert!(s.stencil(&q(2, 3), &q(2, 3)).is_err());
         assert!(s.stencil(&q(-1, 3), &q(0, 1)).is_err());
         let too_fine = BigRational::new(1.into(), BigInt::from(3).pow(50));
@@ -424,7 +237,7 @@ mod tests {
         assert!(s
             .stencil_of_kind(&q(0, 1), &q(0, 1), StencilKind::DerivativeU)
             .is_err());
-        assert!(TriangleBoundarySubstitution::<f64>::new(&loop_, 3, 3).is_err());
+        assert!(TriangleSubstitution::<f64>::boundary(&loop_, 3, 3).is_err());
         let interior = TriangleLocalMatrices::new(&loop_, 5).expect("valid");
         assert!(loop_boundary_tangents(&interior).is_err());
     }

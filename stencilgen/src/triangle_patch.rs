@@ -26,7 +26,7 @@ use num_bigint::BigInt;
 use num_integer::Integer;
 use num_rational::BigRational;
 use num_traits::{One, Zero};
-use schemes::triangle_local::TriangleLocalMatrices;
+use schemes::triangle_local::{TriangleLocalMatrices, TriangleNeighbourhood};
 use schemes::TriangleScheme;
 
 use crate::ev_tangents::{left_null_space, subdominant_eigenvalues};
@@ -36,6 +36,7 @@ use crate::regular_patch::StencilKind;
 use crate::scalar::rational_to_f64;
 use crate::scaling_system::{NormalizationRow, Relation, ScalingSystem, SparseRow};
 use crate::solve::{solve_system, Solution};
+use crate::triangle_boundary::loop_boundary_tangents;
 use crate::triangle_system::MAX_TRIANGLE_RATE;
 use crate::{Scalar, StencilError};
 
@@ -271,7 +272,8 @@ pub fn patch_stencils_at<S: Scalar>(
     })
 }
 
-/// Evaluates Loop EV-patch stencils by substitution at any rational `(u, v)`; caches the
+/// Evaluates Loop patch stencils (next to an interior vertex, or a boundary vertex with
+/// [`TriangleSubstitution::boundary`]) by substitution at any rational `(u, v)`; caches the
 /// regular basis per kind.
 #[derive(Debug)]
 pub struct TriangleSubstitution<S> {
@@ -291,6 +293,28 @@ impl<S: Scalar> TriangleSubstitution<S> {
             bases: HashMap::new(),
             field: std::marker::PhantomData,
         })
+    }
+
+    /// Prepare for the patch of sector `sector` next to a boundary vertex with `faces`
+    /// triangles (Loop's boundary rules, [`TriangleLocalMatrices::boundary`]).
+    pub fn boundary(
+        scheme: &TriangleScheme,
+        faces: u32,
+        sector: u32,
+    ) -> Result<Self, StencilError> {
+        Ok(TriangleSubstitution {
+            scheme: scheme.clone(),
+            matrices: TriangleLocalMatrices::boundary(scheme, faces, sector)?,
+            bases: HashMap::new(),
+            field: std::marker::PhantomData,
+        })
+    }
+
+    /// Switch to another boundary patch, keeping the cached regular basis (it does not depend
+    /// on the patch).
+    pub fn select_boundary_patch(&mut self, faces: u32, sector: u32) -> Result<(), StencilError> {
+        self.matrices = TriangleLocalMatrices::boundary(&self.scheme, faces, sector)?;
+        Ok(())
     }
 
     /// The `K` position weights at `(u, v)`, `u, v >= 0`, `u + v <= 1`: double `x` `k` times
@@ -320,11 +344,20 @@ impl<S: Scalar> TriangleSubstitution<S> {
             if kind == StencilKind::Position {
                 return self.limit_mask();
             }
-            let t = loop_ev_tangents(&self.matrices)?;
+            let (du, dv) = match self.matrices.neighbourhood {
+                TriangleNeighbourhood::Interior { .. } => {
+                    let t = loop_ev_tangents(&self.matrices)?;
+                    (t.du, t.dv)
+                }
+                TriangleNeighbourhood::Boundary { .. } => {
+                    let t = loop_boundary_tangents(&self.matrices)?;
+                    (t.du, t.dv)
+                }
+            };
             let mask = if kind == StencilKind::DerivativeU {
-                t.du
+                du
             } else {
-                t.dv
+                dv
             };
             return mask
                 .into_iter()
@@ -332,8 +365,8 @@ impl<S: Scalar> TriangleSubstitution<S> {
                 .collect::<Option<Vec<S>>>()
                 .ok_or_else(|| StencilError::Irrational {
                     what: format!(
-                        "the tangent mask at the vertex (Loop, valence {})",
-                        self.matrices.valence
+                        "the tangent mask at the vertex (Loop, {:?})",
+                        self.matrices.neighbourhood
                     ),
                 });
         }
@@ -386,8 +419,10 @@ impl<S: Scalar> TriangleSubstitution<S> {
         Ok(row)
     }
 
-    /// The limit-position mask at the vertex: `phi(0) = phi(0) A`, `sum phi(0) = 1`.
-    fn limit_mask(&self) -> Result<Vec<S>, StencilError> {
+    /// The limit-position mask at the vertex: `phi(0) = phi(0) A`, `sum phi(0) = 1`, solved
+    /// exactly (Loop: `(1 - v chi) V + chi sum E_i`, `chi = 1 / (3 / (8 beta) + v)`, in the
+    /// interior; the boundary curve's `(E_0 + 4 V + E_k) / 6` at a boundary vertex).
+    pub fn limit_mask(&self) -> Result<Vec<S>, StencilError> {
         let size = self.matrices.size();
         let mut rows: Vec<(Vec<BigRational>, BigRational)> = (0..size)
             .map(|j| {
@@ -401,7 +436,7 @@ impl<S: Scalar> TriangleSubstitution<S> {
         let mask = solve_dense(rows, size).map_err(|e| StencilError::Inconsistent {
             scheme: self.scheme.name.to_owned(),
             n: 1,
-            detail: format!("limit mask at valence {}: {e:?}", self.matrices.valence),
+            detail: format!("limit mask, {:?}: {e:?}", self.matrices.neighbourhood),
         })?;
         Ok(mask.iter().map(S::from_rational).collect())
     }
@@ -426,6 +461,12 @@ pub struct LoopEvTangents {
 /// At valence 6 the net is the equilateral lattice and the masks are the box spline's
 /// derivatives along the skew axes `(1, 0)` and `(0, 1)` at the vertex.
 pub fn loop_ev_tangents(matrices: &TriangleLocalMatrices) -> Result<LoopEvTangents, StencilError> {
+    if let TriangleNeighbourhood::Boundary { faces, .. } = matrices.neighbourhood {
+        return Err(StencilError::UnsupportedScheme {
+            scheme: matrices.scheme.clone(),
+            reason: format!("a boundary vertex ({faces} triangles) has no rotational symmetry; its tangents are triangle_boundary::loop_boundary_tangents"),
+        });
+    }
     let v = matrices.valence as usize;
     let ring = 1 + v;
     let a1 = DMatrix::from_fn(ring, ring, |i, j| rational_to_f64(&matrices.a[i][j]));

@@ -1,12 +1,13 @@
 //! Loop stencil tables (`docs/table-format.md`, triangle point sets).
 //!
-//! Each Loop patch (interior vertex of valence `v`, `v = 6` being the regular patch) and rate
+//! Each Loop patch (interior vertex of valence `v`, `v = 6` being the regular patch; each
+//! sector of a boundary vertex with `k` triangles, `k = 3` being the regular boundary) and rate
 //! `n` becomes six sections: positions, d/du and d/dv on the triangle primal grid
 //! `(i/n, j/n)`, `i + j <= n`, and on the `n^2` centroids of the grid's small triangles (the
 //! dual points of section 5.5), in the order [`triangle_dual_points`] gives. Every point's
 //! weights come from the scaling-relation grid system of [`crate::triangle_patch`] (the
 //! centroids live on the grid `1/3n`); the tangent rows at the vertex itself are
-//! [`loop_ev_tangents`]' masks. The default table is generated from the f64 path, which agrees
+//! [`loop_ev_tangents`]' or [`loop_boundary_tangents`]' masks. The default table is generated from the f64 path, which agrees
 //! with exact arithmetic within 1e-12 (checked by the tests against the exact path).
 
 use rayon::prelude::*;
@@ -18,6 +19,7 @@ use table_format::{
 
 use crate::loop_basis::LoopRegularBasis;
 use crate::regular_patch::StencilKind;
+use crate::triangle_boundary::loop_boundary_tangents;
 use crate::triangle_patch::{
     loop_ev_tangents, patch_stencils_at, triangle_grid_points, triangle_scheme,
 };
@@ -31,6 +33,8 @@ pub struct TriangleTableSpec {
     pub scheme: TriangleScheme,
     /// Interior valences (6 is the regular patch).
     pub valences: Vec<u32>,
+    /// Triangle counts of the boundary vertices (3 is the regular boundary; every sector).
+    pub boundary_faces: Vec<u32>,
     /// Grid rates.
     pub rates: Vec<u32>,
     /// Stored precision.
@@ -38,11 +42,13 @@ pub struct TriangleTableSpec {
 }
 
 impl TriangleTableSpec {
-    /// The Loop table `subtess` embeds: interior valences 3..=12, n = 1..=24, f32.
+    /// The Loop table `subtess` embeds: interior valences 3..=12, boundary vertices with
+    /// 1..=6 triangles, n = 1..=24, f32.
     pub fn default_loop() -> Result<Self, StencilError> {
         Ok(TriangleTableSpec {
             scheme: triangle_scheme("loop")?,
             valences: (3..=12).collect(),
+            boundary_faces: (1..=6).collect(),
             rates: (1..=MAX_TRIANGLE_RATE).collect(),
             precision: Precision::F32,
         })
@@ -145,15 +151,20 @@ pub fn build_triangle_table(spec: &TriangleTableSpec) -> Result<Vec<u8>, Stencil
         .iter()
         .map(|&(kind, _)| LoopRegularBasis::new(&spec.scheme, kind))
         .collect::<Result<Vec<_>, _>>()?;
-    let patches = spec
-        .valences
-        .iter()
-        .map(|&v| {
-            let m = TriangleLocalMatrices::new(&spec.scheme, v)?;
-            let t = loop_ev_tangents(&m)?;
-            Ok((v, m, t))
-        })
-        .collect::<Result<Vec<_>, StencilError>>()?;
+    // (boundary, faces, sector), the local matrices, the tangent masks at the vertex.
+    let mut patches = Vec::new();
+    for &v in &spec.valences {
+        let m = TriangleLocalMatrices::new(&spec.scheme, v)?;
+        let t = loop_ev_tangents(&m)?;
+        patches.push(((false, v, 0), m, (t.du, t.dv)));
+    }
+    for &faces in &spec.boundary_faces {
+        for sector in 0..faces {
+            let m = TriangleLocalMatrices::boundary(&spec.scheme, faces, sector)?;
+            let t = loop_boundary_tangents(&m)?;
+            patches.push(((true, faces, sector), m, (t.du, t.dv)));
+        }
+    }
     let jobs: Vec<(usize, usize, u32)> = (0..patches.len())
         .flat_map(|p| (0..kinds.len()).map(move |k| (p, k)))
         .flat_map(|(p, k)| spec.rates.iter().map(move |&n| (p, k, n)))
@@ -161,18 +172,18 @@ pub fn build_triangle_table(spec: &TriangleTableSpec) -> Result<Vec<u8>, Stencil
     let sections = jobs
         .into_par_iter()
         .map(|(p, k, n)| {
-            let (valence, matrices, tangents) = &patches[p];
+            let ((boundary, faces, sector), matrices, (du, dv)) = &patches[p];
             let tangent = match kinds[k].0 {
                 StencilKind::Position => None,
-                StencilKind::DerivativeU => Some(tangents.du.as_slice()),
-                StencilKind::DerivativeV => Some(tangents.dv.as_slice()),
+                StencilKind::DerivativeU => Some(du.as_slice()),
+                StencilKind::DerivativeV => Some(dv.as_slice()),
             };
             let key = SectionKey {
                 kind: kinds[k].1,
                 points: PointSet::TrianglePrimal,
-                boundary: false,
-                faces: *valence,
-                sector: 0,
+                boundary: *boundary,
+                faces: *faces,
+                sector: *sector,
                 n,
             };
             patch_sections(matrices, &bases[k], key, tangent)

@@ -226,7 +226,44 @@ fn loop_stencil_at_an_extraordinary_vertex() {
         "Loop only",
     );
     fails_with(
-        "stencil --scheme loop --boundary 3 --u 1/3 --v 0",
-        "boundary",
+        "stencil --scheme loop --boundary 3 --valence 5 --u 1/3 --v 0",
+        "cannot be used with",
     );
+    fails_with(
+        "stencil --scheme loop --boundary 2 --sector 2 --u 1/3 --v 0",
+        "sectors 0..2",
+    );
+}
+
+#[test]
+fn loop_stencil_next_to_a_boundary_vertex() {
+    // At the vertex: the cubic B-spline curve's limit (E_0 + 4 V + E_k) / 6, whatever k is.
+    let at = json("stencil --scheme loop --boundary 4 --sector 2 --u 0 --v 0 --json");
+    let order: Vec<&str> = at["order"]
+        .as_array()
+        .map(|o| o.iter().filter_map(serde_json::Value::as_str).collect())
+        .unwrap_or_default();
+    assert_eq!(&order[..6], ["V", "E0", "E1", "E2", "E3", "E4"]);
+    assert_eq!(at["weights"][0], "2/3");
+    assert_eq!(at["weights"][1], "1/6");
+    assert_eq!(at["weights"][5], "1/6");
+    assert_eq!(at["weights"][3], "0");
+    assert_eq!((at["faces"].as_u64(), at["sector"].as_u64()), (Some(4), Some(2)));
+    // Along the boundary edge of sector 0 only boundary points count: V, E0 and the point
+    // beyond E0 (O1), the cubic B-spline at t = 1/2 between V and E0: 1/48, 23/48, 23/48, 1/48
+    // with the fourth point (E_k) at the other end.
+    let edge = json("stencil --scheme loop --boundary 2 --sector 0 --u 1/2 --v 0 --json");
+    let names: Vec<&str> = edge["order"]
+        .as_array()
+        .map(|o| o.iter().filter_map(serde_json::Value::as_str).collect())
+        .unwrap_or_default();
+    let weight = |name: &str| {
+        let i = names.iter().position(|n| *n == name).expect("named");
+        edge["weights"][i].as_str().map(str::to_owned).unwrap_or_default()
+    };
+    assert_eq!(weight("V"), "23/48");
+    assert_eq!(weight("E0"), "23/48");
+    assert_eq!(weight("E2"), "1/48");
+    assert_eq!(weight("O1"), "1/48");
+    assert_eq!(weight("E1"), "0");
 }

@@ -39,8 +39,9 @@ pub fn default_catmull_clark_corners() -> &'static [u8] {
 }
 
 /// The default Loop table's bytes (64-byte aligned): interior valences 3..=12 (6 is the
-/// regular patch), n = 1..=24, triangle primal and dual grids, positions and both derivatives,
-/// f32 (`stencilgen::triangle_table::TriangleTableSpec::default_loop`; about 13 MB).
+/// regular patch), boundary vertices with 1..=6 triangles (every sector), n = 1..=24, triangle
+/// primal and dual grids, positions and both derivatives, f32
+/// (`stencilgen::triangle_table::TriangleTableSpec::default_loop`; 32.6 MiB).
 pub fn default_loop() -> &'static [u8] {
     &LOOP.0
 }

@@ -22,26 +22,29 @@ use schemes::triangle_local::{TriangleLocalMatrices, TrianglePoint};
 use stencilgen::loop_basis::LoopRegularBasis;
 use stencilgen::regular_patch::StencilKind;
 use stencilgen::scalar::rational_to_f64;
-use stencilgen::triangle_boundary::{loop_boundary_tangents, TriangleBoundarySubstitution};
-use stencilgen::triangle_patch::{patch_stencils_at, triangle_grid_points, triangle_scheme};
+use stencilgen::triangle_boundary::loop_boundary_tangents;
+use stencilgen::triangle_patch::{
+    patch_stencils_at, triangle_grid_points, triangle_scheme, TriangleSubstitution,
+};
 use subtess_tests::box_spline::{box_spline, loop_basis};
 use subtess_tests::bspline::{q, uniform_bspline, uniform_bspline_derivative};
 
-type Exact = TriangleBoundarySubstitution<BigRational>;
+type Exact = TriangleSubstitution<BigRational>;
 
 fn exact(k: u32, s: u32) -> Exact {
     let loop_ = triangle_scheme("loop").expect("catalogued");
-    Exact::new(&loop_, k, s).expect("valid boundary patch")
+    Exact::boundary(&loop_, k, s).expect("valid boundary patch")
 }
 
 /// Switch `sub` to sector `s` of `k` triangles (keeping its cached regular basis).
-fn select<S: stencilgen::Scalar>(sub: &mut TriangleBoundarySubstitution<S>, k: u32, s: u32) {
-    sub.select_patch(k, s).expect("valid boundary patch");
+fn select<S: stencilgen::Scalar>(sub: &mut TriangleSubstitution<S>, k: u32, s: u32) {
+    sub.select_boundary_patch(k, s)
+        .expect("valid boundary patch");
 }
 
-fn float(k: u32, s: u32) -> TriangleBoundarySubstitution<f64> {
+fn float(k: u32, s: u32) -> TriangleSubstitution<f64> {
     let loop_ = triangle_scheme("loop").expect("catalogued");
-    TriangleBoundarySubstitution::<f64>::new(&loop_, k, s).expect("valid boundary patch")
+    TriangleSubstitution::<f64>::boundary(&loop_, k, s).expect("valid boundary patch")
 }
 
 fn ray(s: u32, a: i64) -> TrianglePoint {

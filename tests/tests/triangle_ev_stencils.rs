@@ -326,39 +326,66 @@ fn derivative_mirror_symmetry() {
     }
 }
 
+/// The table's contract points for rate `n`: the primal grid and the centroids in zigzag rows,
+/// written out from docs/table-format.md.
+fn contract_points(n: u32) -> [Vec<(BigRational, BigRational)>; 2] {
+    let ni = i64::from(n);
+    let mut dual = Vec::new();
+    for j in 0..ni {
+        for i in 0..ni - j {
+            dual.push((q(3 * i + 1, 3 * ni), q(3 * j + 1, 3 * ni)));
+            if i + j + 2 <= ni {
+                dual.push((q(3 * i + 2, 3 * ni), q(3 * j + 2, 3 * ni)));
+            }
+        }
+    }
+    let primal = (0..=ni)
+        .flat_map(|j| (0..=ni - j).map(move |i| (q(i, ni), q(j, ni))))
+        .collect();
+    [primal, dual]
+}
+
 #[test]
 fn loop_table_sections_are_the_substitution_stencils_at_the_contract_points() {
     // The table's f64 grid system (on 1/3n for the centroids) against exact substitution,
-    // point by point in the documented order (table_format::PointSet::TriangleDual).
+    // point by point in the documented order, interior and boundary patches.
+    use stencilgen::triangle_boundary::loop_boundary_tangents;
     use stencilgen::triangle_table::{build_triangle_table, TriangleTableSpec};
     use table_format::{AlignedBytes, PointSet, Precision, SectionKey, StencilKind as Kind, Table};
     let loop_ = triangle_scheme("loop").expect("catalogued");
+    let rates = [1u32, 2, 5];
     let spec = TriangleTableSpec {
         scheme: loop_.clone(),
         valences: vec![3, 7],
-        rates: vec![1, 2, 5],
+        boundary_faces: vec![2],
+        rates: rates.to_vec(),
         precision: Precision::F64,
     };
     let bytes = AlignedBytes::from_slice(&build_triangle_table(&spec).expect("builds"));
     let table = Table::parse(bytes.as_bytes()).expect("valid");
+    type Evaluator = Box<dyn FnMut(&BigRational, &BigRational, StencilKind) -> Vec<BigRational>>;
+    // (boundary, faces, sector), exact substitution, the tangent masks at the vertex.
+    type Case = ((bool, u32, u32), Evaluator, (Vec<f64>, Vec<f64>));
+    let mut patches: Vec<Case> = Vec::new();
     for v in [3u32, 7] {
         let mut sub = TriangleSubstitution::<BigRational>::new(&loop_, v).expect("valid");
-        let tangents = loop_ev_tangents(&sub.matrices).expect("tangents");
-        for n in [1u32, 2, 5] {
-            let ni = i64::from(n);
-            // Centroids in zigzag rows, written out from the contract.
-            let mut dual = Vec::new();
-            for j in 0..ni {
-                for i in 0..ni - j {
-                    dual.push((q(3 * i + 1, 3 * ni), q(3 * j + 1, 3 * ni)));
-                    if i + j + 2 <= ni {
-                        dual.push((q(3 * i + 2, 3 * ni), q(3 * j + 2, 3 * ni)));
-                    }
-                }
-            }
-            let primal: Vec<_> = (0..=ni)
-                .flat_map(|j| (0..=ni - j).map(move |i| (q(i, ni), q(j, ni))))
-                .collect();
+        let t = loop_ev_tangents(&sub.matrices).expect("tangents");
+        let eval: Evaluator =
+            Box::new(move |x, y, kind| sub.stencil_of_kind(x, y, kind).expect("inside"));
+        patches.push(((false, v, 0), eval, (t.du, t.dv)));
+    }
+    for sector in 0..2 {
+        let m = TriangleLocalMatrices::boundary(&loop_, 2, sector).expect("valid");
+        let t = loop_boundary_tangents(&m).expect("tangents");
+        let mut sub =
+            TriangleSubstitution::<BigRational>::boundary(&loop_, 2, sector).expect("valid");
+        let eval: Evaluator =
+            Box::new(move |x, y, kind| sub.stencil_of_kind(x, y, kind).expect("inside"));
+        patches.push(((true, 2, sector), eval, (t.du, t.dv)));
+    }
+    for ((boundary, faces, sector), mut eval, (du, dv)) in patches {
+        for n in rates {
+            let [primal, dual] = contract_points(n);
             for (kind, stencil_kind) in [
                 (Kind::Position, StencilKind::Position),
                 (Kind::DerivativeU, StencilKind::DerivativeU),
@@ -371,26 +398,23 @@ fn loop_table_sections_are_the_substitution_stencils_at_the_contract_points() {
                     let key = SectionKey {
                         kind,
                         points: set,
-                        boundary: false,
-                        faces: v,
-                        sector: 0,
+                        boundary,
+                        faces,
+                        sector,
                         n,
                     };
                     let w = table.weights_f64(&key).expect("present");
-                    let k = v as usize + 6;
+                    let k = w.len() / points.len();
                     assert_eq!(w.len(), points.len() * k);
                     for (p, (x, y)) in points.iter().enumerate() {
                         let row = &w[p * k..(p + 1) * k];
                         if x.is_zero() && y.is_zero() && kind != Kind::Position {
-                            let t = if kind == Kind::DerivativeU {
-                                &tangents.du
-                            } else {
-                                &tangents.dv
-                            };
+                            let t = if kind == Kind::DerivativeU { &du } else { &dv };
                             assert_eq!(row, t.as_slice());
                             continue;
                         }
-                        let exact = sub.stencil_of_kind(x, y, stencil_kind).expect("inside");
+                        let exact = eval(x, y, stencil_kind);
+                        assert_eq!(exact.len(), k);
                         for (a, b) in row.iter().zip(&exact) {
                             assert!((a - rational_to_f64(b)).abs() < 1e-12, "{key} point {p}");
                         }
