@@ -885,8 +885,6 @@ mod boundary_with_the_table {
     use num_traits::ToPrimitive;
     use runtime::stencil_table::StencilTable;
     use runtime::topology::NONE;
-    use stencilgen::regular_patch::StencilKind as OracleKind;
-    use stencilgen::triangle_boundary::TriangleBoundarySubstitution;
     use subtess_tests::bspline::uniform_bspline;
 
     /// The centred uniform cubic B-spline `N(x) = B_3(x + 2)` (support `[-2, 2]`) at the
@@ -897,111 +895,15 @@ mod boundary_with_the_table {
             .expect("finite")
     }
 
-    /// The points of a triangle point set at rate `n`, in table order, as rationals.
-    fn rational_points(points: PointSet, n: u32) -> Vec<(BigRational, BigRational)> {
-        let q = |p: u32, d: u32| BigRational::new(BigInt::from(p), BigInt::from(d));
-        let mut out = Vec::new();
-        for j in 0..=n {
-            for i in 0..=n - j {
-                match points {
-                    PointSet::TrianglePrimal => out.push((q(i, n), q(j, n))),
-                    _ if i + j < n => {
-                        out.push((q(3 * i + 1, 3 * n), q(3 * j + 1, 3 * n)));
-                        if i + j + 1 < n {
-                            out.push((q(3 * i + 2, 3 * n), q(3 * j + 2, 3 * n)));
-                        }
-                    }
-                    _ => {}
-                }
-            }
-        }
-        out
-    }
-
-    /// The default table, with the boundary sections a mesh needs computed here by the
-    /// stencil generator's substitution for boundary patches (`stencilgen::triangle_boundary`,
-    /// f64; the oracle the tables are built from) while the default table has none.
-    struct WithBoundary {
-        table: StencilTable,
-        boundary: HashMap<SectionKey, Vec<f32>>,
-    }
-
-    impl WithBoundary {
-        fn new(iso: &LoopIsolation, rates: &[u32]) -> Self {
-            let scheme = schemes::TriangleScheme::by_name("loop").expect("loop");
-            let mut boundary = HashMap::new();
-            for (patch, &n) in iso.patches.iter().zip(rates) {
-                if !patch.kind.boundary {
-                    continue;
-                }
-                let (k, s) = (patch.kind.faces, patch.kind.sector);
-                let mut substitution =
-                    TriangleBoundarySubstitution::<f64>::new(&scheme, k, s).expect("a patch");
-                for points in [PointSet::TrianglePrimal, PointSet::TriangleDual] {
-                    for (kind, oracle) in [
-                        (StencilKind::Position, OracleKind::Position),
-                        (StencilKind::DerivativeU, OracleKind::DerivativeU),
-                        (StencilKind::DerivativeV, OracleKind::DerivativeV),
-                    ] {
-                        let key = SectionKey {
-                            kind,
-                            points,
-                            boundary: true,
-                            faces: k,
-                            sector: s,
-                            n,
-                        };
-                        if boundary.contains_key(&key) {
-                            continue;
-                        }
-                        let mut weights = Vec::new();
-                        for (u, v) in rational_points(points, n) {
-                            let row = substitution
-                                .stencil_of_kind(&u, &v, oracle)
-                                .unwrap_or_else(|e| panic!("{key}: {e}"));
-                            weights.extend(row.iter().map(|&w| w as f32));
-                        }
-                        boundary.insert(key, weights);
-                    }
-                }
-            }
-            WithBoundary {
-                table: StencilTable::default_loop().expect("embedded"),
-                boundary,
-            }
-        }
-    }
-
-    impl TriangleStencils for WithBoundary {
-        fn triangle_weights(&self, key: &SectionKey) -> Result<&[f32], RuntimeError> {
-            match self.boundary.get(key) {
-                Some(w) => Ok(w),
-                None => self.table.triangle_weights(key),
-            }
-        }
-    }
-
-    /// Tessellate with the default table, or, while it has no boundary sections (the refusal
-    /// must then be its coverage error), with [`WithBoundary`].
+    /// Tessellate with the default table (boundary sections included) at mixed rates; sources
+    /// in the input's triangles.
     fn tessellate_with_boundary(m: &Mesh, label: &str) -> TriangleMesh {
         let table = StencilTable::default_loop().expect("embedded");
         let iso = isolate_loop(m).unwrap_or_else(|e| panic!("{label}: {e}"));
         let rates: Vec<u32> = (0..iso.mesh.faces()).map(|f| 1 + f as u32 % 6).collect();
-        let mut out = match TriangleDualGrid::new(&table, &iso.mesh, &iso.patches, &rates) {
-            Ok(grid) => grid.tessellate(&iso.mesh),
-            Err(e) => {
-                let text = e.to_string();
-                assert!(
-                    text.contains("boundary vertex") && text.contains("covers"),
-                    "{label}: {text}"
-                );
-                println!("{label}: the default Loop table has no boundary sections yet; they are computed by stencilgen's substitution here");
-                let stencils = WithBoundary::new(&iso, &rates);
-                TriangleDualGrid::new(&stencils, &iso.mesh, &iso.patches, &rates)
-                    .unwrap_or_else(|e| panic!("{label}: {e}"))
-                    .tessellate(&iso.mesh)
-            }
-        };
+        let mut out = TriangleDualGrid::new(&table, &iso.mesh, &iso.patches, &rates)
+            .unwrap_or_else(|e| panic!("{label}: {e}"))
+            .tessellate(&iso.mesh);
         for s in &mut out.sources {
             *s = iso.input_source(*s);
         }
@@ -1113,7 +1015,7 @@ mod boundary_with_the_table {
     fn check_edges_agree(m: &Mesh, label: &str) {
         let n = 4;
         let iso = isolate_loop(m).unwrap_or_else(|e| panic!("{label}: {e}"));
-        let stencils = WithBoundary::new(&iso, &vec![n; iso.mesh.faces()]);
+        let stencils = StencilTable::default_loop().expect("embedded");
         let mesh = &iso.mesh;
         let scale = mesh
             .positions
