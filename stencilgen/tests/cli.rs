@@ -248,7 +248,10 @@ fn loop_stencil_next_to_a_boundary_vertex() {
     assert_eq!(at["weights"][1], "1/6");
     assert_eq!(at["weights"][5], "1/6");
     assert_eq!(at["weights"][3], "0");
-    assert_eq!((at["faces"].as_u64(), at["sector"].as_u64()), (Some(4), Some(2)));
+    assert_eq!(
+        (at["faces"].as_u64(), at["sector"].as_u64()),
+        (Some(4), Some(2))
+    );
     // Along the boundary edge of sector 0 only boundary points count: V, E0 and the point
     // beyond E0 (O1), the cubic B-spline at t = 1/2 between V and E0: 1/48, 23/48, 23/48, 1/48
     // with the fourth point (E_k) at the other end.
@@ -259,7 +262,10 @@ fn loop_stencil_next_to_a_boundary_vertex() {
         .unwrap_or_default();
     let weight = |name: &str| {
         let i = names.iter().position(|n| *n == name).expect("named");
-        edge["weights"][i].as_str().map(str::to_owned).unwrap_or_default()
+        edge["weights"][i]
+            .as_str()
+            .map(str::to_owned)
+            .unwrap_or_default()
     };
     assert_eq!(weight("V"), "23/48");
     assert_eq!(weight("E0"), "23/48");
