@@ -4,6 +4,10 @@
 //!
 //! `cargo bench -p subtess-runtime --bench tessellate`: one and two threads (a rayon pool of
 //! each size), rates 4, 8, 16 and mixed.
+//!
+//! Loop (the triangle dual grid): Crane's triangulated Spot (5,856 triangles, 23,424 after the
+//! one isolating Loop step) when `../shared/models` exists, else an icosahedron refined to
+//! 5,120 triangles; the same threads and rates.
 #![allow(missing_docs)] // criterion_group! generates an undocumented function
 
 use std::path::Path;
@@ -11,10 +15,13 @@ use std::path::Path;
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use runtime::dual_grid::DualGrid;
 use runtime::isolate::isolate;
+use runtime::loop_isolate::isolate_loop;
+use runtime::loop_refine::loop_refine;
 use runtime::obj::read_obj;
 use runtime::refine::refine;
 use runtime::stencil_table::StencilTable;
 use runtime::topology::Mesh;
+use runtime::triangle_dual_grid::TriangleDualGrid;
 
 fn mesh() -> (String, Mesh) {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -79,5 +86,108 @@ fn bench(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, bench);
+/// Spot triangulated, or an icosahedron refined four times by Loop.
+fn triangle_mesh() -> (String, Mesh) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let spot = root.join("../../shared/models/crane/spot_triangulated.obj");
+    if spot.exists() {
+        let obj = read_obj(&spot).unwrap_or_else(|e| panic!("{e}"));
+        let m = Mesh::from_obj(&obj).unwrap_or_else(|e| panic!("{e}")).0;
+        return ("spot triangulated".to_owned(), m);
+    }
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let p = vec![
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
+    ];
+    let faces: Vec<Vec<i64>> = [
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ]
+    .iter()
+    .map(|f| f.to_vec())
+    .collect();
+    let mut m = Mesh::new(p, &faces, &[], schemes::BoundaryMode::EdgeOnly)
+        .unwrap_or_else(|e| panic!("{e}"));
+    for _ in 0..4 {
+        m = loop_refine(&m).unwrap_or_else(|e| panic!("{e}")).mesh;
+    }
+    ("icosahedron".to_owned(), m)
+}
+
+fn bench_loop(c: &mut Criterion) {
+    let table = StencilTable::default_loop().unwrap_or_else(|e| panic!("{e}"));
+    let (name, m) = triangle_mesh();
+    let iso = isolate_loop(&m).unwrap_or_else(|e| panic!("{e}"));
+    let faces = iso.patches.len();
+    let mixed: Vec<u32> = (0..faces).map(|f| [3, 5, 8, 12, 7, 16][f % 6]).collect();
+    let control: Vec<[f32; 3]> = iso
+        .mesh
+        .positions
+        .iter()
+        .map(|p| p.map(|c| c as f32))
+        .collect();
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap_or_else(|e| panic!("{e}"));
+        let mut group = c.benchmark_group(format!(
+            "loop dual grid, {name}, {faces} triangles, {threads} thread(s)"
+        ));
+        group.sample_size(20);
+        for (label, rates) in [
+            ("rate 4", vec![4; faces]),
+            ("rate 8", vec![8; faces]),
+            ("rate 16", vec![16; faces]),
+            ("mixed 3..16", mixed.clone()),
+        ] {
+            let grid = TriangleDualGrid::new(&table, &iso.mesh, &iso.patches, &rates)
+                .unwrap_or_else(|e| panic!("{e}"));
+            let mut positions = vec![[0.0f32; 3]; grid.vertex_count()];
+            let mut normals = positions.clone();
+            let mut triangles = vec![[0u32; 3]; grid.triangle_count()];
+            group.throughput(Throughput::Elements(grid.triangle_count() as u64));
+            group.bench_function(label, |b| {
+                pool.install(|| {
+                    b.iter(|| {
+                        grid.evaluate(&control, &mut positions, &mut normals);
+                        grid.connect(&mut triangles);
+                    })
+                })
+            });
+        }
+        group.finish();
+    }
+}
+
+criterion_group!(benches, bench, bench_loop);
 criterion_main!(benches);

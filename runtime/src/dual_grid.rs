@@ -39,7 +39,7 @@ use crate::{MeshError, RuntimeError};
 
 /// The largest patch (control points) the evaluator takes: an interior vertex of valence `v`
 /// has `2v + 8`, a boundary vertex with `k` faces `2k + 8`.
-const MAX_PATCH: usize = 40;
+pub(crate) const MAX_PATCH: usize = 40;
 
 /// The largest rate of the tables the evaluator takes.
 pub const MAX_RATE: u32 = 64;
@@ -60,10 +60,10 @@ pub fn gather_patches(mesh: &Mesh) -> Result<Vec<FacePatch>, MeshError> {
 
 /// The three stencils of one point set of one patch: `points x K` weights each, point-major.
 #[derive(Clone, Copy, Debug)]
-struct Stencils<'t> {
-    position: &'t [f32],
-    du: &'t [f32],
-    dv: &'t [f32],
+pub(crate) struct Stencils<'t> {
+    pub(crate) position: &'t [f32],
+    pub(crate) du: &'t [f32],
+    pub(crate) dv: &'t [f32],
 }
 
 /// The cubic B-spline factors of the regular patch at rate `n`, recovered from the table:
@@ -176,10 +176,10 @@ enum FaceEval<'t> {
 
 /// A point evaluated on its own (the boundary curve): one row of each stencil.
 #[derive(Clone, Debug)]
-struct PointPlan<'t> {
-    stencils: Stencils<'t>,
-    control: Range<u32>,
-    source: VertexSource,
+pub(crate) struct PointPlan<'t> {
+    pub(crate) stencils: Stencils<'t>,
+    pub(crate) control: Range<u32>,
+    pub(crate) source: VertexSource,
 }
 
 /// A row of output vertices `start + t * step`, `t = 0..len`, at parameters
@@ -263,15 +263,12 @@ fn stencils<'t>(
     ]
     .map(|kind| table.weights(&section(patch, kind, points, n)));
     let (position, du, dv) = (position?, du?, dv?);
-    let side = match points {
-        PointSet::Dual => n as usize,
-        PointSet::Primal => n as usize + 1,
-    };
+    let count = points.count(n) as usize;
     let k = patch.points.len();
-    if position.len() != side * side * k || du.len() != position.len() || dv.len() != du.len() {
+    if position.len() != count * k || du.len() != position.len() || dv.len() != du.len() {
         return Err(RuntimeError::LayoutMismatch {
             key: section(patch, StencilKind::Position, points, n),
-            table: position.len() / (side * side),
+            table: position.len() / count.max(1),
             patch: k,
         });
     }
@@ -600,18 +597,13 @@ impl<'t> DualGrid<'t> {
             (face_positions, face_normals),
             |f, (p, q)| self.evaluate_face(f, control, p, q),
         );
-        curve_positions
-            .par_iter_mut()
-            .zip(curve_normals.par_iter_mut())
-            .zip(self.boundary_points.par_iter())
-            .for_each(|((p, q), plan)| {
-                let points = &self.control[plan.control.start as usize..plan.control.end as usize];
-                let mut local = [[0.0f32; 3]; MAX_PATCH];
-                for (l, &v) in local.iter_mut().zip(points) {
-                    *l = control[v as usize];
-                }
-                (*p, *q) = weighted_point(&plan.stencils, &local[..points.len()], 0);
-            });
+        evaluate_points(
+            &self.boundary_points,
+            &self.control,
+            control,
+            curve_positions,
+            curve_normals,
+        );
     }
 
     fn evaluate_face(
@@ -716,7 +708,7 @@ impl<'t> DualGrid<'t> {
 /// Run `work(item, slice)` for every item in parallel, where item `i` owns
 /// `out[ends[i-1]..ends[i]]` (`ends` are prefix sums). Items are grouped into contiguous chunks of
 /// about equal output so that the split costs little next to the work.
-fn for_each_range<T: SplitSlices + Send>(
+pub(crate) fn for_each_range<T: SplitSlices + Send>(
     ends: &[usize],
     out: T,
     work: impl Fn(usize, T) + Sync + Send,
@@ -754,7 +746,7 @@ fn for_each_range<T: SplitSlices + Send>(
 }
 
 /// Mutable slices (or tuples of them, split in step) that [`for_each_range`] hands out.
-trait SplitSlices: Sized {
+pub(crate) trait SplitSlices: Sized {
     fn split_at(self, mid: usize) -> (Self, Self);
 }
 
@@ -774,7 +766,7 @@ impl<A, B> SplitSlices for (&mut [A], &mut [B]) {
 
 /// Merge two rows running along an edge into triangles, in order of their parameters
 /// `param_a(i) / den_a` and `param_b(j) / den_b`; `b` lies to the right of the edge.
-fn merge_rows(
+pub(crate) fn merge_rows(
     a: impl Fn(u32) -> u32,
     na: u32,
     param_a: impl Fn(u32) -> u64,
@@ -837,7 +829,7 @@ fn connect_strip(strip: &Strip, out: &mut [[u32; 3]]) {
     }
 }
 
-fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+pub(crate) fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],
@@ -845,7 +837,7 @@ fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
     ]
 }
 
-fn unit(v: [f32; 3]) -> [f32; 3] {
+pub(crate) fn unit(v: [f32; 3]) -> [f32; 3] {
     let length = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
     if length > 0.0 {
         v.map(|x| x / length)
@@ -854,9 +846,36 @@ fn unit(v: [f32; 3]) -> [f32; 3] {
     }
 }
 
+/// Evaluate points planned one by one (`plans[i]` into `positions[i]`, `normals[i]`), in
+/// parallel: each plan's control points are `indices[plan.control]`, vertices of `control`.
+pub(crate) fn evaluate_points(
+    plans: &[PointPlan],
+    indices: &[u32],
+    control: &[[f32; 3]],
+    positions: &mut [[f32; 3]],
+    normals: &mut [[f32; 3]],
+) {
+    positions
+        .par_iter_mut()
+        .zip(normals.par_iter_mut())
+        .zip(plans.par_iter())
+        .for_each(|((p, q), plan)| {
+            let points = &indices[plan.control.start as usize..plan.control.end as usize];
+            let mut local = [[0.0f32; 3]; MAX_PATCH];
+            for (l, &v) in local.iter_mut().zip(points) {
+                *l = control[v as usize];
+            }
+            (*p, *q) = weighted_point(&plan.stencils, &local[..points.len()], 0);
+        });
+}
+
 /// Position and unit normal of table point `point` (row of the stencils) from the patch's
 /// control points.
-fn weighted_point(s: &Stencils, control: &[[f32; 3]], point: usize) -> ([f32; 3], [f32; 3]) {
+pub(crate) fn weighted_point(
+    s: &Stencils,
+    control: &[[f32; 3]],
+    point: usize,
+) -> ([f32; 3], [f32; 3]) {
     let k = control.len();
     let rows = point * k..(point + 1) * k;
     let (wp, wu, wv) = (&s.position[rows.clone()], &s.du[rows.clone()], &s.dv[rows]);

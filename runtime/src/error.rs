@@ -45,6 +45,14 @@ pub enum MeshError {
         /// Why.
         reason: String,
     },
+    /// A triangle scheme (Loop) was asked of a mesh with a face that is not a triangle.
+    #[error("face {face} has {vertices} vertices; the Loop scheme needs a mesh of triangles (triangulate it, or use --scheme catmull-clark)")]
+    NotTriangle {
+        /// 0-based face.
+        face: usize,
+        /// Its number of vertices.
+        vertices: usize,
+    },
     /// The faces around a vertex form more than one fan.
     #[error("vertex {vertex} (OBJ `v` number {}) is non-manifold: its {faces} faces form more than one fan", vertex + 1)]
     NonManifoldVertex {

@@ -13,6 +13,8 @@ pub mod exact_eval;
 pub mod geometry;
 pub mod isolate;
 pub mod lai_cheng;
+pub mod loop_isolate;
+pub mod loop_refine;
 pub mod mesh_output;
 pub mod obj;
 pub mod patch;
@@ -20,6 +22,9 @@ pub mod rates;
 pub mod refine;
 pub mod stencil_table;
 pub mod topology;
+pub mod triangle_dual_grid;
 pub mod triangle_mesh;
+pub mod triangle_patch;
+pub mod triangle_topology;
 
 pub use error::{MeshError, RuntimeError};

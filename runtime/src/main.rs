@@ -11,12 +11,15 @@ use runtime::dual_grid::{tessellate, DualGrid};
 use runtime::exact_eval::{evaluate_subface, parse_rational};
 use runtime::isolate::{isolate_with_origins, Isolation};
 use runtime::lai_cheng::{tessellate_adaptive, write_obj_polygons, AdaptiveOptions};
+use runtime::loop_isolate::isolate_loop;
+use runtime::loop_refine::loop_refine;
 use runtime::mesh_output::{write_mesh, MeshFormat};
 use runtime::obj::read_obj;
 use runtime::rates::{tolerance_rates, view_rates, ViewCamera};
 use runtime::refine::refine;
 use runtime::stencil_table::StencilTable;
 use runtime::topology::Mesh;
+use runtime::triangle_dual_grid::{tessellate_triangles, TriangleDualGrid};
 use runtime::RuntimeError;
 
 #[derive(Parser)]
@@ -59,6 +62,10 @@ enum Command {
         /// A stencil table file instead of the embedded default.
         #[arg(long)]
         table: Option<PathBuf>,
+        /// Subdivision scheme: catmull-clark or loop (a triangle mesh; --refine then takes
+        /// Loop steps).
+        #[arg(long, default_value = "catmull-clark")]
+        scheme: String,
     },
     /// Exact limit position and first derivatives of face F at rational (u, v), in the face's
     /// own parameters (rounded once to f64).
@@ -98,6 +105,10 @@ struct TessellateArgs {
     /// Output triangle mesh: .obj, .ply (with per-vertex face, u, v), .glb or .gltf.
     #[arg(short = 'o', long = "output")]
     output: PathBuf,
+    /// Subdivision scheme: catmull-clark (any polygons) or loop (triangles; the dual grid
+    /// with --rate or --rates).
+    #[arg(long, default_value = "catmull-clark")]
+    scheme: String,
     /// Dual points per face side, 1..=24, on every face.
     #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=24), conflicts_with_all = ["rates", "tolerance", "view"])]
     rate: u32,
@@ -155,6 +166,9 @@ enum TablesCommand {
     Info {
         /// A table file written by `stencilgen tables`.
         file: Option<PathBuf>,
+        /// Without a file: which embedded default (catmull-clark or loop).
+        #[arg(long, default_value = "catmull-clark", conflicts_with = "file")]
+        scheme: String,
     },
 }
 
@@ -256,6 +270,9 @@ fn tessellate_command(args: TessellateArgs) -> Result<(), RuntimeError> {
         }
     };
     let input = load_mesh(mesh)?;
+    if parse_scheme(&args.scheme)? == Scheme::Loop {
+        return loop_command(&args, &input);
+    }
     let table = load_table(&args.table, input.boundary)?;
     let iso = isolate_with_origins(&input)?;
     if args.method == "adaptive" {
@@ -309,6 +326,84 @@ fn tessellate_command(args: TessellateArgs) -> Result<(), RuntimeError> {
             "rate_max": rates.iter().max(),
             "tolerance": args.tolerance,
             "faces_over_tolerance": unmet,
+            "threads": rayon::current_num_threads(),
+        });
+        println!("{stats}");
+    }
+    Ok(())
+}
+
+/// The schemes the runtime has tables for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Scheme {
+    CatmullClark,
+    Loop,
+}
+
+/// `--scheme NAME`: a scheme with a table, or an error saying which schemes exist and which
+/// have no table yet.
+fn parse_scheme(name: &str) -> Result<Scheme, RuntimeError> {
+    match name {
+        "catmull-clark" => Ok(Scheme::CatmullClark),
+        "loop" => Ok(Scheme::Loop),
+        other
+            if schemes::triangle::TRIANGLE_SCHEME_NAMES.contains(&other)
+                || schemes::quad::QUAD_SCHEME_NAMES.contains(&other) =>
+        {
+            Err(RuntimeError::Unsupported(format!(
+                "scheme `{other}`: no table for this scheme yet (the runtime has tables for catmull-clark and loop)"
+            )))
+        }
+        other => Err(RuntimeError::InvalidParameter {
+            name: format!("--scheme `{other}`"),
+            reason: "not a scheme; catmull-clark or loop".to_owned(),
+        }),
+    }
+}
+
+/// The Loop table: a file (which must be a Loop table), or the embedded default.
+fn load_loop_table(table: &Option<PathBuf>) -> Result<StencilTable, RuntimeError> {
+    match table {
+        Some(path) => StencilTable::read(path),
+        None => StencilTable::default_loop(),
+    }
+}
+
+/// `subtess tessellate MESH --scheme loop`: the triangle dual grid at `--rate` or `--rates`.
+fn loop_command(args: &TessellateArgs, input: &Mesh) -> Result<(), RuntimeError> {
+    if args.method != "dual-grid" || args.tolerance.is_some() || args.view.is_some() {
+        return Err(RuntimeError::Unsupported(
+            "--scheme loop tessellates with the dual grid at --rate or --rates (no --tolerance, --view or --method adaptive yet)".to_owned(),
+        ));
+    }
+    let table = load_loop_table(&args.table)?;
+    let iso = isolate_loop(input)?;
+    let rates = match &args.rates {
+        Some(path) => read_rates(path, input.faces(), &iso.origin)?,
+        None => vec![args.rate; iso.patches.len()],
+    };
+    let (mut triangles, time) = tessellate_triangles(&table, &iso.mesh, &iso.patches, &rates)?;
+    for source in &mut triangles.sources {
+        *source = iso.input_source(*source);
+    }
+    write_mesh(&triangles, &args.output)?;
+    if args.stats {
+        let count = triangles.triangles.len();
+        let loops = input.boundary_loops();
+        let stats = serde_json::json!({
+            "scheme": "loop",
+            "triangles": count,
+            "vertices": triangles.positions.len(),
+            "seconds": time.seconds,
+            "plan_seconds": time.plan_seconds,
+            "triangles_per_second": count as f64 / time.seconds.max(1e-12),
+            "watertight": loops == 0 && triangles.is_watertight(),
+            "boundary_loops": loops,
+            "input_faces": input.faces(),
+            "faces": iso.mesh.faces(),
+            "isolation_steps": iso.steps,
+            "rate_min": rates.iter().min(),
+            "rate_max": rates.iter().max(),
             "threads": rayon::current_num_threads(),
         });
         println!("{stats}");
@@ -376,6 +471,37 @@ fn adaptive_command(
     Ok(())
 }
 
+/// The bench's rates: `rate` everywhere, or 3, 5, 8, 12, 7, 16 in turn.
+fn bench_rates(faces: usize, rate: u32, mixed: bool) -> Vec<u32> {
+    if mixed {
+        (0..faces).map(|f| [3, 5, 8, 12, 7, 16][f % 6]).collect()
+    } else {
+        vec![rate; faces]
+    }
+}
+
+/// A mesh's vertices as the evaluators' f32 control points.
+fn f32_positions(mesh: &Mesh) -> Vec<[f32; 3]> {
+    mesh.positions.iter().map(|p| p.map(|c| c as f32)).collect()
+}
+
+/// Run `frame` once untimed (it brings the buffers and the table into memory), then `frames`
+/// times timed, in `pool`; the seconds of each timed frame, sorted.
+fn time_frames(pool: &rayon::ThreadPool, frames: u32, mut frame: impl FnMut() + Send) -> Vec<f64> {
+    let mut seconds: Vec<f64> = pool.install(|| {
+        frame();
+        (0..frames)
+            .map(|_| {
+                let started = Instant::now();
+                frame();
+                started.elapsed().as_secs_f64()
+            })
+            .collect()
+    });
+    seconds.sort_by(f64::total_cmp);
+    seconds
+}
+
 fn run(cli: Cli) -> Result<(), RuntimeError> {
     match cli.command {
         Command::Tessellate(args) => tessellate_command(*args),
@@ -387,56 +513,79 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
             refine: steps,
             frames,
             table,
+            scheme,
         } => {
             let mut input = load_mesh(&mesh)?;
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads.unwrap_or(0))
+                .build()
+                .map_err(|e| RuntimeError::Unsupported(format!("a pool of threads: {e}")))?;
+            let rates_label = if mixed {
+                "mixed 3..16".to_owned()
+            } else {
+                rate.to_string()
+            };
+            if parse_scheme(&scheme)? == Scheme::Loop {
+                let table = load_loop_table(&table)?;
+                for _ in 0..steps {
+                    input = loop_refine(&input)?.mesh;
+                }
+                let iso = isolate_loop(&input)?;
+                let faces = iso.patches.len();
+                let rates = bench_rates(faces, rate, mixed);
+                let (grid, control) = pool.install(|| {
+                    let grid = TriangleDualGrid::new(&table, &iso.mesh, &iso.patches, &rates)?;
+                    Ok::<_, RuntimeError>((grid, f32_positions(&iso.mesh)))
+                })?;
+                let mut positions = vec![[0.0f32; 3]; grid.vertex_count()];
+                let mut normals = positions.clone();
+                let mut triangles = vec![[0u32; 3]; grid.triangle_count()];
+                let seconds = time_frames(&pool, frames, || {
+                    grid.evaluate(&control, &mut positions, &mut normals);
+                    grid.connect(&mut triangles);
+                });
+                let count = grid.triangle_count();
+                let report = serde_json::json!({
+                    "mesh": mesh.display().to_string(),
+                    "scheme": "loop",
+                    "faces": faces,
+                    "rates": rates_label,
+                    "threads": pool.current_num_threads(),
+                    "frames": frames,
+                    "triangles": count,
+                    "vertices": grid.vertex_count(),
+                    "median_seconds": seconds[seconds.len() / 2],
+                    "min_seconds": seconds[0],
+                    "max_seconds": seconds[seconds.len() - 1],
+                    "triangles_per_second": count as f64 / seconds[seconds.len() / 2].max(1e-12),
+                });
+                println!("{report}");
+                return Ok(());
+            }
             let table = load_table(&table, input.boundary)?;
             for _ in 0..steps {
                 input = refine(&input).mesh;
             }
             let iso = isolate_with_origins(&input)?;
             let faces = iso.patches.len();
-            let rates: Vec<u32> = if mixed {
-                (0..faces).map(|f| [3, 5, 8, 12, 7, 16][f % 6]).collect()
-            } else {
-                vec![rate; faces]
-            };
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads.unwrap_or(0))
-                .build()
-                .map_err(|e| RuntimeError::Unsupported(format!("a pool of threads: {e}")))?;
+            let rates = bench_rates(faces, rate, mixed);
             let (grid, control) = pool.install(|| {
                 let grid = DualGrid::new(&table, &iso.mesh, &iso.patches, &rates)?;
-                let control: Vec<[f32; 3]> = iso
-                    .mesh
-                    .positions
-                    .iter()
-                    .map(|p| p.map(|c| c as f32))
-                    .collect();
-                Ok::<_, RuntimeError>((grid, control))
+                Ok::<_, RuntimeError>((grid, f32_positions(&iso.mesh)))
             })?;
             let mut positions = vec![[0.0f32; 3]; grid.vertex_count()];
             let mut normals = positions.clone();
             let mut triangles = vec![[0u32; 3]; grid.triangle_count()];
-            let mut seconds: Vec<f64> = pool.install(|| {
-                // One untimed frame brings the buffers and the table into memory.
+            let seconds = time_frames(&pool, frames, || {
                 grid.evaluate(&control, &mut positions, &mut normals);
                 grid.connect(&mut triangles);
-                (0..frames)
-                    .map(|_| {
-                        let started = Instant::now();
-                        grid.evaluate(&control, &mut positions, &mut normals);
-                        grid.connect(&mut triangles);
-                        started.elapsed().as_secs_f64()
-                    })
-                    .collect()
             });
-            seconds.sort_by(f64::total_cmp);
             let median = seconds[seconds.len() / 2];
             let count = grid.triangle_count();
             let report = serde_json::json!({
                 "mesh": mesh.display().to_string(),
                 "faces": faces,
-                "rates": if mixed { "mixed 3..16".to_owned() } else { rate.to_string() },
+                "rates": rates_label,
                 "threads": pool.current_num_threads(),
                 "frames": frames,
                 "triangles": count,
@@ -487,13 +636,16 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
             Ok(())
         }
         Command::Tables {
-            command: TablesCommand::Info { file },
+            command: TablesCommand::Info { file, scheme },
         } => {
             let name = match &file {
                 Some(path) => path.display().to_string(),
-                None => "(embedded default)".to_owned(),
+                None => format!("(embedded default, {scheme})"),
             };
-            let table = load_table(&file, schemes::BoundaryMode::EdgeOnly)?;
+            let table = match parse_scheme(&scheme)? {
+                Scheme::Loop if file.is_none() => StencilTable::default_loop()?,
+                _ => load_table(&file, schemes::BoundaryMode::EdgeOnly)?,
+            };
             let index = table.index();
             let weights: u64 = index
                 .entries

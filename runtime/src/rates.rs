@@ -154,6 +154,11 @@ impl<'a> PatchPoints<'a> {
         let side = match points {
             PointSet::Primal => n as usize + 1,
             PointSet::Dual => n as usize,
+            PointSet::TrianglePrimal | PointSet::TriangleDual => {
+                return Err(RuntimeError::Unsupported(format!(
+                    "tolerance rates on triangle grids ({key})"
+                )))
+            }
         };
         let k = self.patch.points.len();
         if weights.len() != side * side * k {
@@ -234,12 +239,14 @@ impl Samples {
             let n = f64::from(grid);
             for j in 0..g.side {
                 for i in 0..g.side {
-                    let (u, v) = match set {
-                        PointSet::Primal => (i as f64 / n, j as f64 / n),
-                        PointSet::Dual => (
+                    // `grid` refused the triangle point sets; only the quad ones reach here.
+                    let (u, v) = if set == PointSet::Primal {
+                        (i as f64 / n, j as f64 / n)
+                    } else {
+                        (
                             (2 * i + 1) as f64 / (2.0 * n),
                             (2 * j + 1) as f64 / (2.0 * n),
-                        ),
+                        )
                     };
                     uv.push([u, v]);
                     positions.push(points.at(&g, i, j));

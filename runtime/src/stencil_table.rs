@@ -31,6 +31,11 @@ impl StencilTable {
         Self::embedded(tables::default_catmull_clark())
     }
 
+    /// The embedded default Loop table (Warren's weights; validated, checksum included).
+    pub fn default_loop() -> Result<Self, RuntimeError> {
+        Self::embedded(tables::default_loop())
+    }
+
     fn embedded(bytes: &'static [u8]) -> Result<Self, RuntimeError> {
         let index = TableIndex::parse(bytes)?;
         Ok(StencilTable {
@@ -102,5 +107,20 @@ impl StencilTable {
             return corners.weights(key);
         }
         Ok(self.index.weights_f32(self.bytes(), key)?)
+    }
+}
+
+impl crate::triangle_dual_grid::TriangleStencils for StencilTable {
+    /// Triangle sections of a triangle-scheme (Loop) table; a quad table is refused by name
+    /// rather than read at the wrong layout.
+    fn triangle_weights(&self, key: &SectionKey) -> Result<&[f32], RuntimeError> {
+        let scheme = self.index.meta.scheme;
+        if !scheme.is_triangle() {
+            return Err(RuntimeError::Unsupported(format!(
+                "the stencil table is for {}, a quad scheme; triangle meshes need a Loop table",
+                scheme.name()
+            )));
+        }
+        self.weights(key)
     }
 }

@@ -8,7 +8,10 @@ use std::collections::HashSet;
 /// `2n`, points on the boundary curve `n`. As the tessellator makes them, `face` is a face of the
 /// mesh it was given (the isolated mesh); [`crate::isolate::Isolation::input_source`] turns them
 /// into the input mesh's faces, where a non-quad face is parameterized by its sub-faces (the
-/// quads of its first Catmull–Clark step, `subface` = the corner they hold).
+/// quads of its first Catmull–Clark step, `subface` = the corner they hold). On Loop meshes
+/// (`crate::triangle_dual_grid`) `(u, v)` are the triangle's barycentric parameters: centroids
+/// of the small triangles at rate `n` have denominator `3n`, primal points `n`, and
+/// [`crate::loop_isolate::LoopIsolation::input_source`] maps them to the input triangle.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct VertexSource {
     /// The face (of the mesh that was tessellated).

@@ -360,3 +360,96 @@ fn adaptive_method_from_the_command_line() {
     }
     let _ = std::fs::remove_file(obj);
 }
+
+/// A regular octahedron (every vertex valence 4: one Loop step isolates it).
+const OCTAHEDRON: &str = "v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\n\
+f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n";
+
+#[test]
+fn loop_scheme_tessellates_triangles() {
+    let mesh = temp("octahedron.obj");
+    std::fs::write(&mesh, OCTAHEDRON).expect("written");
+    let out_path = temp("octahedron-loop.ply");
+    let out = subtess(&format!(
+        "tessellate {} -o {} --scheme loop --rate 3 --stats",
+        mesh.display(),
+        out_path.display()
+    ));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stats = json(&out);
+    assert_eq!(stats["scheme"], "loop");
+    assert_eq!(stats["watertight"], true);
+    assert_eq!(stats["isolation_steps"], 1);
+    assert_eq!(stats["faces"], 32);
+    // Per triangle at rate n: 3n^2 - 3n + 3 triangles (21 at n = 3); a closed surface of genus 0
+    // has V = T/2 + 2.
+    assert_eq!(stats["triangles"], 32 * 21);
+    assert_eq!(stats["vertices"], 32 * 21 / 2 + 2);
+    // Per-input-face rates, inherited by the four children of each triangle.
+    let rates = temp("octahedron-rates.txt");
+    std::fs::write(&rates, "1 2 3 4 5 6 7 8").expect("written");
+    let out = subtess(&format!(
+        "tessellate {} -o {} --scheme loop --rates {} --stats",
+        mesh.display(),
+        out_path.display(),
+        rates.display()
+    ));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stats = json(&out);
+    assert_eq!(stats["watertight"], true);
+    assert_eq!(
+        (stats["rate_min"].clone(), stats["rate_max"].clone()),
+        (1.into(), 8.into())
+    );
+    let bench = subtess(&format!(
+        "bench {} --scheme loop --rate 4 --frames 2",
+        mesh.display()
+    ));
+    assert!(
+        bench.status.success(),
+        "{}",
+        String::from_utf8_lossy(&bench.stderr)
+    );
+    let report = json(&bench);
+    assert_eq!(report["triangles"], 32 * (3 * 16 - 3 * 4 + 3));
+    for path in [mesh, out_path, rates] {
+        let _ = std::fs::remove_file(path);
+    }
+}
+
+#[test]
+fn loop_scheme_errors_name_the_problem() {
+    let obj = temp("never.obj");
+    // The cube's first face is a quad.
+    let out = subtess(&format!(
+        "tessellate data/cube.obj -o {} --scheme loop",
+        obj.display()
+    ));
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("face 0 has 4 vertices"), "{err}");
+    for scheme in ["butterfly", "sqrt3"] {
+        let out = subtess(&format!(
+            "tessellate data/cube.obj -o {} --scheme {scheme}",
+            obj.display()
+        ));
+        assert!(!out.status.success());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("no table for this scheme yet"), "{err}");
+        assert!(err.contains(scheme), "{err}");
+    }
+    let out = subtess(&format!(
+        "tessellate data/cube.obj -o {} --scheme nonsense",
+        obj.display()
+    ));
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("nonsense"));
+}
