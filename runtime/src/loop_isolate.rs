@@ -7,20 +7,19 @@
 //! triangles), and no two input vertices share a refined triangle. The refined mesh is checked
 //! anyway; a triangle that still has no patch is an error naming it.
 //!
-//! A boundary corner with one triangle (an "ear") is refused up front: the triangle across
-//! from it has two boundary corners joined by an interior edge, a neighbourhood none of the
-//! table's layouts (a half-plane around a boundary vertex) describes, and every Loop step makes
-//! a smaller ear with the same neighbour, so no number of steps would isolate it.
+//! Next to a boundary corner with one triangle (an "ear") every Loop step leaves a triangle with
+//! two boundary corners joined by an interior edge, which no boundary layout (a half-plane
+//! around one boundary vertex) describes; its corners are regular, so it is the regular patch
+//! with phantom points ([`crate::triangle_patch::Phantoms`]).
 
 use crate::loop_refine::{child_to_parent, loop_refine};
 use crate::topology::Mesh;
 use crate::triangle_mesh::VertexSource;
-use crate::triangle_patch::{gather_triangle_patches, TrianglePatch};
+use crate::triangle_patch::{gather_triangle_patches, Phantoms, TrianglePatch};
 use crate::triangle_topology::{isolation_defect, require_triangles};
 use crate::{MeshError, RuntimeError};
 
-/// At most this many Loop steps are taken: one separates the irregular vertices, and after it
-/// only an ear's neighbour could lack a patch, which further steps do not change (module docs).
+/// At most this many Loop steps are taken: one separates the irregular vertices.
 pub const MAX_LOOP_STEPS: usize = 1;
 
 /// An isolated triangle mesh and where its triangles come from.
@@ -30,6 +29,9 @@ pub struct LoopIsolation {
     pub mesh: Mesh,
     /// The patch of every triangle.
     pub patches: Vec<TrianglePatch>,
+    /// The phantom points some patches read (control points numbered after the mesh's
+    /// vertices).
+    pub phantoms: Phantoms,
     /// Loop steps taken.
     pub steps: usize,
     /// The input triangle every triangle of `mesh` lies in.
@@ -60,31 +62,25 @@ impl LoopIsolation {
     }
 }
 
-/// Check that `mesh` is a Loop mesh the tables can evaluate (triangles only, no one-triangle
-/// boundary corner), refine it if some triangle needs it, and gather every triangle's patch.
+/// Check that `mesh` is a Loop mesh the tables can evaluate (triangles only), refine it if some
+/// triangle needs it, and gather every triangle's patch.
 pub fn isolate_loop(mesh: &Mesh) -> Result<LoopIsolation, RuntimeError> {
     require_triangles(mesh)?;
-    if let Some(v) =
-        (0..mesh.positions.len()).find(|&v| mesh.is_boundary_vertex(v) && mesh.fan(v).len() == 1)
-    {
-        return Err(RuntimeError::Unsupported(format!(
-            "Loop meshes with a boundary corner of one triangle: vertex {v} (OBJ `v` number {}) is one; the triangle across from it has two boundary corners joined by an interior edge, which no Loop table layout covers (split its triangle, or give the corner a second one)",
-            v + 1
-        )));
-    }
     let mut current = mesh.clone();
     let mut origin: Vec<u32> = (0..mesh.faces() as u32).collect();
     let mut child = vec![[0u8; MAX_LOOP_STEPS]; mesh.faces()];
     for steps in 0..=MAX_LOOP_STEPS {
+        let phantoms = Phantoms::new(&current);
         let attempt = match isolation_defect(&current) {
             Some((face, reason)) => Err(MeshError::NotIsolated { face, reason }),
-            None => gather_triangle_patches(&current),
+            None => gather_triangle_patches(&current, &phantoms),
         };
         match attempt {
             Ok(patches) => {
                 return Ok(LoopIsolation {
                     mesh: current,
                     patches,
+                    phantoms,
                     steps,
                     origin,
                     child,

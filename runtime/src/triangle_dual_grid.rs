@@ -45,7 +45,7 @@ use crate::dual_grid::{
 use crate::topology::{Mesh, NONE};
 use crate::triangle_mesh::{TriangleMesh, VertexSource};
 use crate::triangle_patch::{
-    dual_in_patch, dual_index, primal_in_patch, primal_index, TrianglePatch,
+    dual_in_patch, dual_index, primal_in_patch, primal_index, Phantoms, TrianglePatch,
 };
 use crate::RuntimeError;
 
@@ -217,6 +217,8 @@ pub struct TriangleDualGrid<'t> {
     polygon_triangles: Vec<usize>,
     vertex_count: usize,
     boundary: bool,
+    /// The mesh's phantom points, appended to the control points when a patch reads one.
+    phantoms: Option<Phantoms>,
 }
 
 fn section(patch: &TrianglePatch, kind: StencilKind, points: PointSet, n: u32) -> SectionKey {
@@ -322,7 +324,15 @@ impl<'t> TriangleDualGrid<'t> {
             polygon_triangles: Vec::new(),
             vertex_count: 0,
             boundary: false,
+            phantoms: None,
         };
+        let vertices = mesh.positions.len() as u32;
+        if patches
+            .iter()
+            .any(|p| p.points.iter().any(|&c| c >= vertices))
+        {
+            grid.phantoms = Some(Phantoms::new(mesh));
+        }
         for (patch, &n) in patches.iter().zip(rates) {
             if patch.points.len() > MAX_TRIANGLE_PATCH {
                 return Err(RuntimeError::Unsupported(format!(
@@ -573,6 +583,14 @@ impl<'t> TriangleDualGrid<'t> {
         positions: &mut [[f32; 3]],
         normals: &mut [[f32; 3]],
     ) {
+        let extended;
+        let control = match &self.phantoms {
+            Some(phantoms) => {
+                extended = phantoms.extend(control);
+                extended.as_slice()
+            }
+            None => control,
+        };
         let owned = self.first[self.rates.len()] as usize;
         let (face_positions, point_positions) = positions.split_at_mut(owned);
         let (face_normals, point_normals) = normals.split_at_mut(owned);

@@ -3,7 +3,14 @@
 //!
 //! A triangle of an isolated mesh ([`crate::triangle_topology::isolation_defect`] finds none)
 //! is one patch: at a boundary corner if it has one (the irregular one if there is one), else at
-//! an interior irregular corner, else the regular patch (valence 6) at corner 0. The patch corner
+//! an interior irregular corner, else the regular patch (valence 6) at corner 0. A triangle
+//! whose corners are all regular but whose boundary patch lacks a point — two boundary corners
+//! joined by an interior edge, as next to a one-triangle corner — is the regular patch with
+//! *phantom* points ([`Phantoms`]): with the phantom `a + b - c` across every boundary edge
+//! `(a, b)` of triangle `(a, b, c)`, Loop's regular rules on the extended net reproduce its
+//! boundary rules, so a triangle with regular corners is the box spline of its phantom-extended
+//! twelve points (the argument is in docs/algorithms/triangle-schemes.md; the boundary tables'
+//! `k = 3` sections equal it exactly). The patch corner
 //! `V` is at patch `(0,0)`, the next face corner counter-clockwise at `(1,0)`, the one after at
 //! `(0,1)`; a patch at face corner `r` sees the face rotated: with the face's barycentric weights
 //! `(w_0, w_1, w_2) = (1 - u - v, u, v)` the patch parameters are `(w_{r+1}, w_{r+2})`.
@@ -45,6 +52,64 @@ pub struct TrianglePatch {
     pub corner: usize,
 }
 
+/// The phantom points of a triangle mesh: one across every boundary edge, numbered after the
+/// mesh's vertices (phantom `i` is control point `vertices + i`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Phantoms {
+    /// The mesh's vertex count: the index of the first phantom.
+    pub vertices: u32,
+    /// The phantom of every boundary half-edge (its index among the phantoms), `NONE` elsewhere.
+    of_halfedge: Vec<u32>,
+    /// Phantom `i` is `a + b - c` for `definitions[i] = [a, b, c]`.
+    pub definitions: Vec<[u32; 3]>,
+}
+
+impl Phantoms {
+    /// One phantom per boundary half-edge `a -> b` of triangle `(a, b, c)`: `a + b - c`.
+    pub fn new(mesh: &Mesh) -> Self {
+        let mut of_halfedge = vec![NONE; mesh.twin.len()];
+        let mut definitions = Vec::new();
+        for (h, &twin) in mesh.twin.iter().enumerate() {
+            if twin == NONE {
+                of_halfedge[h] = definitions.len() as u32;
+                let (a, b) = (mesh.face_vertices[h], mesh.head(h));
+                definitions.push([a, b, mesh.head(mesh.next(h))]);
+            }
+        }
+        Phantoms {
+            vertices: mesh.positions.len() as u32,
+            of_halfedge,
+            definitions,
+        }
+    }
+
+    /// The control point of the phantom across boundary half-edge `h`.
+    fn across(&self, h: usize) -> Option<u32> {
+        match self.of_halfedge.get(h) {
+            Some(&p) if p != NONE => Some(self.vertices + p),
+            _ => None,
+        }
+    }
+
+    /// `control` followed by every phantom's position.
+    pub fn extend<T>(&self, control: &[[T; 3]]) -> Vec<[T; 3]>
+    where
+        T: Copy + std::ops::Add<Output = T> + std::ops::Sub<Output = T>,
+    {
+        let mut out = Vec::with_capacity(control.len() + self.definitions.len());
+        out.extend_from_slice(control);
+        for &[a, b, c] in &self.definitions {
+            let (a, b, c) = (
+                control[a as usize],
+                control[b as usize],
+                control[c as usize],
+            );
+            out.push(std::array::from_fn(|i| a[i] + b[i] - c[i]));
+        }
+        out
+    }
+}
+
 /// Index of primal point `(i, j)`, `i + j <= n`, in the triangle primal grid of rate `n`.
 pub fn primal_index(n: u32, i: u32, j: u32) -> usize {
     // Rows 0..j hold n + 1, n, .., n + 2 - j points.
@@ -77,8 +142,13 @@ pub fn dual_in_patch(corner: usize, n: u32, i: u32, j: u32, down: bool) -> (u32,
     ((p - shift) / 3, (q - shift) / 3)
 }
 
-/// The patch of triangle `face` of an isolated triangle mesh.
-pub fn triangle_patch(mesh: &Mesh, face: usize) -> Result<TrianglePatch, MeshError> {
+/// The patch of triangle `face` of an isolated triangle mesh (`phantoms`: the mesh's,
+/// [`Phantoms::new`]).
+pub fn triangle_patch(
+    mesh: &Mesh,
+    phantoms: &Phantoms,
+    face: usize,
+) -> Result<TrianglePatch, MeshError> {
     let not_isolated = |reason: String| MeshError::NotIsolated { face, reason };
     let corners = mesh.face(face);
     if corners.len() != 3 {
@@ -108,7 +178,15 @@ pub fn triangle_patch(mesh: &Mesh, face: usize) -> Result<TrianglePatch, MeshErr
     let h0 = mesh.face_halfedges(face).start + corner;
     let centre = corners[corner];
     if boundary(corner) {
-        boundary_patch(mesh, h0, centre).map_err(not_isolated)
+        boundary_patch(mesh, h0, centre)
+            .or_else(|reason| {
+                if irregular == 0 {
+                    phantom_patch(mesh, phantoms, face, corner)
+                } else {
+                    Err(reason)
+                }
+            })
+            .map_err(not_isolated)
     } else {
         interior_patch(mesh, face, centre, corners[(corner + 1) % 3], corner).map_err(not_isolated)
     }
@@ -120,8 +198,13 @@ pub fn triangle_patch(mesh: &Mesh, face: usize) -> Result<TrianglePatch, MeshErr
 }
 
 /// The patches of every triangle; the first triangle that is not one is an error.
-pub fn gather_triangle_patches(mesh: &Mesh) -> Result<Vec<TrianglePatch>, MeshError> {
-    (0..mesh.faces()).map(|f| triangle_patch(mesh, f)).collect()
+pub fn gather_triangle_patches(
+    mesh: &Mesh,
+    phantoms: &Phantoms,
+) -> Result<Vec<TrianglePatch>, MeshError> {
+    (0..mesh.faces())
+        .map(|f| triangle_patch(mesh, phantoms, f))
+        .collect()
 }
 
 /// The one-ring of interior vertex `e` of valence 6, from `from` counter-clockwise.
@@ -169,6 +252,62 @@ fn interior_patch(
         PatchKind {
             boundary: false,
             faces: valence as u32,
+            sector: 0,
+        },
+        points,
+    ))
+}
+
+/// The six neighbours of regular vertex `e`, counter-clockwise from `from`, a boundary vertex
+/// (three triangles, neighbours `E_0..E_3`) completed by the phantoms across its boundary edges:
+/// `E_0, E_1, E_2, E_3, E_3 + e - E_2, e + E_0 - E_1`.
+fn extended_ring(mesh: &Mesh, phantoms: &Phantoms, e: u32, from: u32) -> Result<Vec<u32>, String> {
+    if !mesh.is_boundary_vertex(e as usize) {
+        return regular_ring(mesh, e, from);
+    }
+    let fan = mesh.fan(e as usize);
+    let mut ring = neighbours(mesh, e as usize);
+    if fan.len() != 3 {
+        return Err(format!(
+            "boundary vertex {e} of a regular patch has {} triangles, not 3",
+            fan.len()
+        ));
+    }
+    let entering = mesh.prev(fan[2]);
+    for h in [entering, fan[0]] {
+        ring.push(phantoms.across(h).ok_or_else(|| {
+            format!("half-edge {h} at boundary vertex {e} is not on the boundary")
+        })?);
+    }
+    rotate_to(&ring, from).ok_or_else(|| format!("vertex {from} is not a neighbour of {e}"))
+}
+
+/// The regular patch (valence 6) at face corner `corner`, every corner regular, the one-rings
+/// of boundary corners completed by phantoms.
+fn phantom_patch(
+    mesh: &Mesh,
+    phantoms: &Phantoms,
+    face: usize,
+    corner: usize,
+) -> Result<(PatchKind, Vec<u32>), String> {
+    let corners = mesh.face(face);
+    let centre = corners[corner];
+    let ring = extended_ring(mesh, phantoms, centre, corners[(corner + 1) % 3])?;
+    let ring0 = extended_ring(mesh, phantoms, ring[0], centre)?;
+    let ring1 = extended_ring(mesh, phantoms, ring[1], centre)?;
+    // ring0 = V, E_5, O_0, O_1, O_2, E_1; ring1 = V, E_0, O_2, O_3, O_4, E_2.
+    if ring0[1] != ring[5] || ring0[5] != ring[1] || ring1[2] != ring0[4] {
+        return Err(format!(
+            "the phantom-extended one-rings around face {face}'s corner {corner} do not close"
+        ));
+    }
+    let mut points = vec![centre];
+    points.extend_from_slice(&ring);
+    points.extend_from_slice(&[ring0[2], ring0[3], ring0[4], ring1[3], ring1[4]]);
+    Ok((
+        PatchKind {
+            boundary: false,
+            faces: 6,
             sector: 0,
         },
         points,
