@@ -980,7 +980,7 @@ fn tangent_masks(matrices: &LocalMatrices, level: usize) -> Option<(Vec<f64>, Ve
 /// `count` independent null vectors of the (numerically) singular square matrix `b`, whose
 /// null space has dimension `count`: Gaussian elimination with complete pivoting for
 /// `n - count` steps, then back substitution with each remaining column set to 1 in turn.
-fn null_vectors(mut b: Vec<Vec<f64>>, count: usize) -> Vec<Vec<f64>> {
+pub(crate) fn null_vectors(mut b: Vec<Vec<f64>>, count: usize) -> Vec<Vec<f64>> {
     let n = b.len();
     let rank = n.saturating_sub(count);
     let mut columns: Vec<usize> = (0..n).collect();

@@ -13,6 +13,7 @@ pub mod exact_eval;
 pub mod geometry;
 pub mod isolate;
 pub mod lai_cheng;
+pub mod loop_exact_eval;
 pub mod loop_isolate;
 pub mod loop_refine;
 pub mod mesh_output;

@@ -11,6 +11,7 @@ use runtime::dual_grid::{tessellate, DualGrid};
 use runtime::exact_eval::{evaluate_subface, parse_rational};
 use runtime::isolate::{isolate_with_origins, Isolation};
 use runtime::lai_cheng::{tessellate_adaptive, write_obj_polygons, AdaptiveOptions};
+use runtime::loop_exact_eval::LoopExactEvaluator;
 use runtime::loop_isolate::isolate_loop;
 use runtime::loop_refine::loop_refine;
 use runtime::mesh_output::{write_mesh, MeshFormat};
@@ -72,7 +73,8 @@ enum Command {
     Eval {
         /// Input mesh (OBJ).
         mesh: PathBuf,
-        /// Subdivision scheme (catmull-clark).
+        /// Subdivision scheme: catmull-clark, or loop (a mesh of triangles, barycentric U,V
+        /// with U + V <= 1).
         #[arg(long, default_value = "catmull-clark")]
         scheme: String,
         /// Face number, 0-based, in OBJ order.
@@ -607,11 +609,7 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
             corner,
             json,
         } => {
-            if scheme != "catmull-clark" {
-                return Err(RuntimeError::Unsupported(format!(
-                    "scheme `{scheme}` in the runtime (catmull-clark so far)"
-                )));
-            }
+            let scheme = parse_scheme(&scheme)?;
             let (u, v) = uv
                 .split_once(',')
                 .ok_or_else(|| RuntimeError::InvalidParameter {
@@ -620,7 +618,10 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
                 })?;
             let (u, v) = (parse_rational(u.trim())?, parse_rational(v.trim())?);
             let input = load_mesh(&mesh)?;
-            let point = evaluate_subface(&input, face, corner, &u, &v)?;
+            let point = match scheme {
+                Scheme::CatmullClark => evaluate_subface(&input, face, corner, &u, &v)?,
+                Scheme::Loop => LoopExactEvaluator::new(&input)?.evaluate(face, &u, &v)?,
+            };
             if json {
                 let report = serde_json::json!({
                     "position": point.position,

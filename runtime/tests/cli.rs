@@ -246,7 +246,14 @@ fn eval_prints_the_limit_point() {
         ("eval data/cube.obj --face 0 --uv 1/0,0", "1/0"),
         ("eval data/cube.obj --face 0 --uv 2,0", "outside"),
         ("eval data/cube.obj --face 0 --uv 0.5", "two rationals"),
-        ("eval data/cube.obj --scheme loop --face 0 --uv 0,0", "loop"),
+        (
+            "eval data/cube.obj --scheme loop --face 0 --uv 0,0",
+            "triangles",
+        ),
+        (
+            "eval data/cube.obj --scheme butterfly --face 0 --uv 0,0",
+            "no table",
+        ),
     ] {
         let out = subtess(args);
         let stderr = String::from_utf8_lossy(&out.stderr);
@@ -364,6 +371,45 @@ fn adaptive_method_from_the_command_line() {
 /// A regular octahedron (every vertex valence 4: one Loop step isolates it).
 const OCTAHEDRON: &str = "v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\n\
 f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n";
+
+#[test]
+fn eval_evaluates_loop_surfaces_exactly() {
+    let mesh = temp("octahedron-eval.obj");
+    std::fs::write(&mesh, OCTAHEDRON).expect("written");
+    let eval = |uv: &str| {
+        let out = subtess(&format!(
+            "eval {} --scheme loop --face 0 --uv {uv} --json",
+            mesh.display()
+        ));
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let point = json(&out);
+        let get = |key: &str| -> Vec<f64> {
+            point[key]
+                .as_array()
+                .map(|a| a.iter().filter_map(|x| x.as_f64()).collect())
+                .unwrap_or_default()
+        };
+        (get("position"), get("du"), get("dv"))
+    };
+    // Loop's limit rule at valence 4 (Warren: beta = 3/32, chi = 1/(3/(8 beta) + 4) = 1/8):
+    // V/2 + (sum of the four neighbours)/8; face 0 = (1,0,0), (0,1,0), (0,0,1), and the
+    // neighbours of (1,0,0) are (0,+-1,0), (0,0,+-1), summing to 0.
+    let (p, du, dv) = eval("0,0");
+    assert_eq!(p, vec![0.5, 0.0, 0.0]);
+    // The tangent plane there is x = const: both masks have no x component.
+    assert!(du[0].abs() < 1e-15 && dv[0].abs() < 1e-15, "{du:?} {dv:?}");
+    // The centre of the face lies on the symmetry axis x = y = z.
+    let (c, _, _) = eval("1/3,1/3");
+    assert!(
+        (c[0] - c[1]).abs() < 1e-15 && (c[1] - c[2]).abs() < 1e-15,
+        "{c:?}"
+    );
+    let _ = std::fs::remove_file(mesh);
+}
 
 #[test]
 fn loop_scheme_tessellates_triangles() {

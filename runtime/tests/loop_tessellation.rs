@@ -645,6 +645,18 @@ proptest! {
 // ---------------------------------------------------------------------------------------------
 // With the default Loop table: the surface itself.
 
+fn rational(p: i64, q: i64) -> num_rational::BigRational {
+    num_rational::BigRational::new(p.into(), q.into())
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
 mod with_the_table {
     use super::*;
     use num_bigint::BigInt;
@@ -655,10 +667,6 @@ mod with_the_table {
 
     fn table() -> StencilTable {
         StencilTable::default_loop().unwrap_or_else(|e| panic!("the embedded Loop table: {e}"))
-    }
-
-    fn rational(p: i64, q: i64) -> BigRational {
-        BigRational::new(BigInt::from(p), BigInt::from(q))
     }
 
     /// `M_{222}` with direction `drop` removed once (`None`: none), centred like Loop's basis
@@ -719,14 +727,6 @@ mod with_the_table {
             }
         }
         out
-    }
-
-    fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-        [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ]
     }
 
     /// On a torus whose every vertex has valence 6, every output vertex is the quartic box
@@ -1072,6 +1072,58 @@ mod boundary_with_the_table {
         check_edges_agree(&icosahedron(), "icosahedron");
         if let Some(dir) = models() {
             check_edges_agree(&load(&dir.join("odedstein/hand_lowres.obj")), "hand");
+        }
+    }
+
+    /// Every `stride`-th output vertex (mixed rates) against exact evaluation at its source on
+    /// the input triangle (`runtime::loop_exact_eval`: substitution with exact local matrices
+    /// and the regular patch from subdivision; no stencil system): positions to f32 rounding,
+    /// normals within 1e-4.
+    fn check_exact_evaluation(m: &Mesh, label: &str, stride: usize) {
+        let out = tessellate_with_boundary(m, label);
+        let eval = runtime::loop_exact_eval::LoopExactEvaluator::new(m)
+            .unwrap_or_else(|e| panic!("{label}: {e}"));
+        let scale = m
+            .positions
+            .iter()
+            .flat_map(|p| p.iter().map(|c| c.abs()))
+            .fold(1.0f64, f64::max);
+        let mut checked = 0;
+        for (i, s) in out.sources.iter().enumerate().step_by(stride) {
+            let d = i64::from(s.denominator);
+            let (u, v) = (rational(i64::from(s.u), d), rational(i64::from(s.v), d));
+            let exact = eval
+                .evaluate(s.face as usize, &u, &v)
+                .unwrap_or_else(|e| panic!("{label}: {s:?}: {e}"));
+            let got = out.positions[i];
+            for c in 0..3 {
+                assert!(
+                    (f64::from(got[c]) - exact.position[c]).abs() <= 2e-6 * scale,
+                    "{label}: vertex {i} at {s:?}: {got:?} vs {:?}",
+                    exact.position
+                );
+            }
+            let n = cross(exact.du, exact.dv);
+            let length = n.iter().map(|x| x * x).sum::<f64>().sqrt();
+            let table = out.normals[i];
+            let dot: f64 = (0..3).map(|c| n[c] / length * f64::from(table[c])).sum();
+            assert!(
+                dot > 1.0 - 1e-4,
+                "{label}: normal at vertex {i} ({s:?}): {table:?} vs {n:?} (dot {dot})"
+            );
+            checked += 1;
+        }
+        assert!(checked > 0);
+    }
+
+    #[test]
+    fn every_output_vertex_is_the_exact_limit_surface_at_its_source() {
+        check_exact_evaluation(&icosahedron(), "icosahedron", 7);
+        check_exact_evaluation(&disc(), "disc", 3);
+        check_exact_evaluation(&single_triangle(), "single triangle", 1);
+        check_exact_evaluation(&eared_disc(), "eared disc", 1);
+        if let Some(dir) = models() {
+            check_exact_evaluation(&load(&dir.join("odedstein/hand_lowres.obj")), "hand", 97);
         }
     }
 
