@@ -659,7 +659,6 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 
 mod with_the_table {
     use super::*;
-    use num_bigint::BigInt;
     use num_rational::BigRational;
     use num_traits::ToPrimitive;
     use runtime::stencil_table::StencilTable;
