@@ -294,6 +294,10 @@ fn continuous_with_the_neighbouring_sector() {
     }
 }
 
+/// A face of [`FanMesh`]: corner ids (counter-clockwise), its sector, the corners' chart
+/// coordinates in that sector (used only to name the new vertices).
+type Face = ([usize; 3], i64, [(i64, i64); 3]);
+
 /// An explicit triangle mesh: the K-valent fan of radius `R` around V, subdivided by the
 /// butterfly's rules applied topologically (edge -> its two faces -> opposite and wing
 /// vertices), with no lattice charts and no library code.
@@ -304,7 +308,7 @@ struct FanMesh {
     /// The vertex of each name.
     by_name: HashMap<(u32, i64, i64), usize>,
     /// Faces: corners (ids, counter-clockwise), the sector and the corners' chart coordinates.
-    faces: Vec<([usize; 3], i64, [(i64, i64); 3])>,
+    faces: Vec<Face>,
 }
 
 /// The modified butterfly's extraordinary weights (Zorin, Schröder, Sweldens 1996, written
