@@ -645,6 +645,21 @@ mod tests {
     }
 
     #[test]
+    fn ring_three_is_in_the_documented_order() {
+        let m = ButterflyLocalMatrices::new(&butterfly(), 5).expect("builds");
+        let names = m.names();
+        assert_eq!(&names[..4], ["V", "(1,0)_0", "(1,0)_1", "(1,0)_2"]);
+        assert_eq!(&names[6..10], ["(2,0)_0", "(1,1)_0", "(2,0)_1", "(1,1)_1"]);
+        assert_eq!(
+            &names[16..],
+            [
+                "(3,0)_0", "(2,1)_0", "(1,2)_0", "(3,0)_1", "(2,1)_1", "(1,2)_1", "(2,1)_4",
+                "(1,2)_4"
+            ]
+        );
+    }
+
+    #[test]
     fn radius_one_is_too_small() {
         for k in 3..=8u32 {
             assert!(ButterflyLocalMatrices::with_radius(&butterfly(), k, 1).is_err());

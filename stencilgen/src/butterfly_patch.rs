@@ -85,9 +85,9 @@ fn require_field<S: Scalar>(m: &ButterflyLocalMatrices) -> Result<(), StencilErr
     if S::EXACT && !m.is_rational() {
         return Err(StencilError::Irrational {
             what: format!(
-                "the modified butterfly's extraordinary edge rule at valence {k} (weights \
-                 s_j = (1/4 + cos(2 pi j/{k}) + cos(4 pi j/{k})/2)/{k}, which involve \
-                 cos(2 pi/{k})), so its stencils are not rational",
+                "the modified butterfly at valence {k} (its extraordinary edge weights \
+                 s_j = (1/4 + cos(2 pi j/{k}) + cos(4 pi j/{k})/2)/{k} involve cos(2 pi/{k}), \
+                 and so do A and the stencils)",
                 k = m.valence
             ),
         });
