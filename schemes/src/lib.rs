@@ -14,6 +14,7 @@
 //! ```
 
 pub mod bivariate;
+pub mod butterfly_local;
 pub mod curve;
 pub mod local_matrices;
 pub mod loop_regular;
