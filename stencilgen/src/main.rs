@@ -15,6 +15,7 @@ use schemes::quad::QUAD_SCHEME_NAMES;
 use schemes::triangle::TRIANGLE_SCHEME_NAMES;
 use schemes::{BoundaryMode, CurveScheme, QuadScheme, TriangleScheme};
 use serde_json::{json, Value};
+use stencilgen::butterfly_patch::ButterflySubstitution;
 use stencilgen::extraordinary_patch::{canonical, Neighbourhood, OUTER_POINTS};
 use stencilgen::patch_stencils::{curve_scheme, quad_scheme};
 use stencilgen::rational::parse_rational;
@@ -323,7 +324,22 @@ fn run(cli: Cli) -> Result<(), StencilError> {
                         })
                     }
                 };
-                let out = if float {
+                let out = if triangle.name == "butterfly" {
+                    let TrianglePatchChoice::Interior(valence) = patch else {
+                        return Err(StencilError::UnsupportedScheme {
+                            scheme,
+                            reason: "the butterfly has no boundary rules here; give --valence"
+                                .to_owned(),
+                        });
+                    };
+                    if float {
+                        butterfly_stencil_json::<f64>(&triangle, valence, &u, &v, |x| json!(x))?
+                    } else {
+                        butterfly_stencil_json::<BigRational>(&triangle, valence, &u, &v, |x| {
+                            json!(x.to_string())
+                        })?
+                    }
+                } else if float {
                     triangle_stencil_json::<f64>(&triangle, patch, &u, &v, |x| json!(x))?
                 } else {
                     triangle_stencil_json::<BigRational>(&triangle, patch, &u, &v, |x| {
@@ -496,6 +512,32 @@ fn write_bytes(
 /// substitution: `{"scheme","valence","u","v","exact","order","weights","du","dv"}`. At the
 /// vertex itself the tangent masks are irrational in general: `null` in exact mode, with the
 /// reason in `"note"`; `--f64` gives them (subdominant eigenvectors).
+/// The butterfly's patch next to an interior vertex: positions only (its derivative stencils
+/// and tangent masks are not built yet, so `du`/`dv` are `null` with a note).
+fn butterfly_stencil_json<S: Scalar>(
+    scheme: &TriangleScheme,
+    valence: u32,
+    u: &BigRational,
+    v: &BigRational,
+    value: impl Fn(&S) -> Value,
+) -> Result<Value, StencilError> {
+    let mut substitution = ButterflySubstitution::<S>::new(scheme, valence)?;
+    let weights = substitution.stencil(u, v)?;
+    Ok(json!({
+        "scheme": scheme.name,
+        "valence": valence,
+        "boundary": false,
+        "u": u.to_string(),
+        "v": v.to_string(),
+        "exact": S::EXACT,
+        "order": substitution.matrices.names(),
+        "weights": weights.iter().map(&value).collect::<Vec<_>>(),
+        "du": Value::Null,
+        "dv": Value::Null,
+        "note": "the butterfly's derivative stencils are not built yet",
+    }))
+}
+
 /// Which Loop patch `stencilgen stencil` prints.
 #[derive(Clone, Copy, Debug)]
 enum TrianglePatchChoice {

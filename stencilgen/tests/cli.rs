@@ -223,7 +223,7 @@ fn loop_stencil_at_an_extraordinary_vertex() {
     );
     fails_with(
         "stencil --scheme butterfly --valence 5 --u 1/3 --v 0",
-        "Loop only",
+        "irrational",
     );
     fails_with(
         "stencil --scheme loop --boundary 3 --valence 5 --u 1/3 --v 0",
@@ -233,6 +233,31 @@ fn loop_stencil_at_an_extraordinary_vertex() {
         "stencil --scheme loop --boundary 2 --sector 2 --u 1/3 --v 0",
         "sectors 0..2",
     );
+}
+
+#[test]
+fn butterfly_stencil_next_to_an_extraordinary_vertex() {
+    // The midpoint of the edge V E_0 is the extraordinary edge rule itself (Zorin, Schroeder,
+    // Sweldens 1996): 3/4 V + sum s_j E_j, s_j = (1/4 + cos(2 pi j/K) + cos(4 pi j/K)/2) / K.
+    let k = 5;
+    let out = json(&format!(
+        "stencil --scheme butterfly --valence {k} --u 1/2 --v 0 --f64 --json"
+    ));
+    let w: Vec<f64> = out["weights"]
+        .as_array()
+        .map(|a| a.iter().filter_map(serde_json::Value::as_f64).collect())
+        .unwrap_or_default();
+    assert!((w[0] - 0.75).abs() < 1e-12, "{w:?}");
+    for j in 0..k {
+        let t = 2.0 * std::f64::consts::PI * j as f64 / k as f64;
+        let s = (0.25 + t.cos() + 0.5 * (2.0 * t).cos()) / k as f64;
+        assert!((w[1 + j] - s).abs() < 1e-12, "s_{j}: {} vs {s}", w[1 + j]);
+    }
+    assert!(w[1 + k..].iter().all(|x| x.abs() < 1e-12));
+    // Rational at valence 4: exact, and interpolating at the vertex.
+    let exact = json("stencil --scheme butterfly --valence 4 --u 0 --v 0 --json");
+    assert_eq!(exact["weights"][0], "1");
+    assert!(exact["du"].is_null());
 }
 
 #[test]
