@@ -371,18 +371,20 @@ fn load_loop_table(table: &Option<PathBuf>) -> Result<StencilTable, RuntimeError
     }
 }
 
-/// `subtess tessellate MESH --scheme loop`: the triangle dual grid at `--rate` or `--rates`.
+/// `subtess tessellate MESH --scheme loop`: the triangle dual grid at `--rate`, `--rates` or
+/// `--view` (the projected-edge rule is the same for triangles).
 fn loop_command(args: &TessellateArgs, input: &Mesh) -> Result<(), RuntimeError> {
-    if args.method != "dual-grid" || args.tolerance.is_some() || args.view.is_some() {
+    if args.method != "dual-grid" || args.tolerance.is_some() {
         return Err(RuntimeError::Unsupported(
-            "--scheme loop tessellates with the dual grid at --rate or --rates (no --tolerance, --view or --method adaptive yet)".to_owned(),
+            "--scheme loop tessellates with the dual grid at --rate, --rates or --view (no --tolerance or --method adaptive yet)".to_owned(),
         ));
     }
     let table = load_loop_table(&args.table)?;
     let iso = isolate_loop(input)?;
-    let rates = match &args.rates {
-        Some(path) => read_rates(path, input.faces(), &iso.origin)?,
-        None => vec![args.rate; iso.patches.len()],
+    let rates = match (&args.rates, &args.view) {
+        (Some(path), _) => read_rates(path, input.faces(), &iso.origin)?,
+        (None, Some(camera)) => view_rates(&iso.mesh, camera)?,
+        (None, None) => vec![args.rate; iso.patches.len()],
     };
     let (mut triangles, time) = tessellate_triangles(&table, &iso.mesh, &iso.patches, &rates)?;
     for source in &mut triangles.sources {

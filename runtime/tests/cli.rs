@@ -412,6 +412,41 @@ fn eval_evaluates_loop_surfaces_exactly() {
 }
 
 #[test]
+fn loop_scheme_takes_view_dependent_rates() {
+    let mesh = temp("octahedron-view.obj");
+    std::fs::write(&mesh, OCTAHEDRON).expect("written");
+    let out_path = temp("octahedron-view.obj.out.obj");
+    let stats = |view: &str| {
+        let out = subtess(&format!(
+            "tessellate {} -o {} --scheme loop --view {view} --stats",
+            mesh.display(),
+            out_path.display()
+        ));
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        json(&out)
+    };
+    let far = stats("0,0,40,0,0,0,45,1080,8");
+    let near = stats("0,0,4,0,0,0,45,1080,8");
+    assert_eq!(
+        (far["watertight"].clone(), near["watertight"].clone()),
+        (true.into(), true.into())
+    );
+    let count = |s: &serde_json::Value| s["triangles"].as_u64().unwrap_or(0);
+    assert!(count(&far) < count(&near), "{far} vs {near}");
+    // The nearer camera sees longer edges: higher rates, up to the selection's 24.
+    assert!(
+        near["rate_max"].as_u64() > far["rate_max"].as_u64(),
+        "{far} vs {near}"
+    );
+    let _ = std::fs::remove_file(mesh);
+    let _ = std::fs::remove_file(out_path);
+}
+
+#[test]
 fn loop_scheme_tessellates_triangles() {
     let mesh = temp("octahedron.obj");
     std::fs::write(&mesh, OCTAHEDRON).expect("written");
