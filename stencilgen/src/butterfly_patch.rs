@@ -37,7 +37,7 @@ use num_traits::{One, Zero};
 use schemes::butterfly_local::ButterflyLocalMatrices;
 use schemes::TriangleScheme;
 
-use crate::exact_solve::solve_dense;
+use crate::exact_solve::limit_mask;
 use crate::regular_patch::StencilKind;
 use crate::scaling_system::{NormalizationRow, Relation, ScalingSystem, SparseRow};
 use crate::solve::{solve_system, Solution};
@@ -420,15 +420,7 @@ impl<S: Scalar> ButterflySubstitution<S> {
             detail: format!("limit mask at valence {}: {detail}", m.valence),
         };
         if let Some(a) = &m.a_exact {
-            let mut rows: Vec<(Vec<BigRational>, BigRational)> = (0..size)
-                .map(|j| {
-                    let mut row: Vec<BigRational> = (0..size).map(|i| a[i][j].clone()).collect();
-                    row[j] -= BigRational::one();
-                    (row, BigRational::zero())
-                })
-                .collect();
-            rows.push((vec![BigRational::one(); size], BigRational::one()));
-            let mask = solve_dense(rows, size).map_err(|e| failure(format!("{e:?}")))?;
+            let mask = limit_mask(a).map_err(|e| failure(format!("{e:?}")))?;
             return Ok(mask.iter().map(S::from_rational).collect());
         }
         // (A^T - I) w = 0 and 1^T w = 1, in the least-squares sense.

@@ -128,6 +128,21 @@ fn dot(a: &[BigRational], b: &[BigRational]) -> BigRational {
         .fold(BigRational::zero(), |acc, (x, y)| acc + x * y)
 }
 
+/// The limit-position mask of a local subdivision matrix `A` (`K x K`, rows the level-1
+/// points): the left fixed vector `l A = l` with `sum l = 1`, solved exactly.
+pub fn limit_mask(a: &[Vec<BigRational>]) -> Result<Vec<BigRational>, BlockFailure> {
+    let size = a.len();
+    let mut rows: Vec<(Vec<BigRational>, BigRational)> = (0..size)
+        .map(|j| {
+            let mut row: Vec<BigRational> = (0..size).map(|i| a[i][j].clone()).collect();
+            row[j] -= BigRational::one();
+            (row, BigRational::zero())
+        })
+        .collect();
+    rows.push((vec![BigRational::one(); size], BigRational::one()));
+    solve_dense(rows, size)
+}
+
 /// Gauss–Jordan elimination of an overdetermined system `rows = [(a_i, b_i)]` in `width`
 /// unknowns: the unique solution, or why there is none.
 pub fn solve_dense(

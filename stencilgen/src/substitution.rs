@@ -21,7 +21,7 @@ use num_traits::{One, Zero};
 use schemes::{CurveScheme, QuadScheme};
 
 use crate::ev_tangents::ev_tangents;
-use crate::exact_solve::solve_dense;
+use crate::exact_solve::limit_mask;
 use crate::extraordinary_patch::{LocalMatrices, Neighbourhood, SUB_PATCH_ORIGINS};
 use crate::patch_stencils::regular_curve;
 use crate::regular_patch::{RegularBasis, StencilKind};
@@ -128,19 +128,9 @@ impl<S: Scalar> Substitution<S> {
 
     /// The stencil at the EV: the limit mask (exact), or the eigenvector tangent masks (f64).
     fn at_vertex(&self, kind: StencilKind) -> Result<Vec<S>, StencilError> {
-        let size = self.matrices.size();
         if kind == StencilKind::Position {
             // phi(0) = phi(0) A, sum phi(0) = 1.
-            let mut rows: Vec<(Vec<BigRational>, BigRational)> = (0..size)
-                .map(|j| {
-                    let mut row: Vec<BigRational> =
-                        (0..size).map(|i| self.matrices.a[i][j].clone()).collect();
-                    row[j] -= BigRational::one();
-                    (row, BigRational::zero())
-                })
-                .collect();
-            rows.push((vec![BigRational::one(); size], BigRational::one()));
-            let mask = solve_dense(rows, size).map_err(|e| StencilError::Inconsistent {
+            let mask = limit_mask(&self.matrices.a).map_err(|e| StencilError::Inconsistent {
                 scheme: self.scheme.name.to_owned(),
                 n: 1,
                 detail: format!("limit mask at {}: {e:?}", self.matrices.describe()),

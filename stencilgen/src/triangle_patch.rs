@@ -30,7 +30,7 @@ use schemes::triangle_local::{TriangleLocalMatrices, TriangleNeighbourhood};
 use schemes::TriangleScheme;
 
 use crate::ev_tangents::{left_null_space, subdominant_eigenvalues};
-use crate::exact_solve::solve_dense;
+use crate::exact_solve::limit_mask;
 use crate::loop_basis::LoopRegularBasis;
 use crate::regular_patch::StencilKind;
 use crate::scalar::rational_to_f64;
@@ -423,17 +423,7 @@ impl<S: Scalar> TriangleSubstitution<S> {
     /// exactly (Loop: `(1 - v chi) V + chi sum E_i`, `chi = 1 / (3 / (8 beta) + v)`, in the
     /// interior; the boundary curve's `(E_0 + 4 V + E_k) / 6` at a boundary vertex).
     pub fn limit_mask(&self) -> Result<Vec<S>, StencilError> {
-        let size = self.matrices.size();
-        let mut rows: Vec<(Vec<BigRational>, BigRational)> = (0..size)
-            .map(|j| {
-                let mut row: Vec<BigRational> =
-                    (0..size).map(|i| self.matrices.a[i][j].clone()).collect();
-                row[j] -= BigRational::one();
-                (row, BigRational::zero())
-            })
-            .collect();
-        rows.push((vec![BigRational::one(); size], BigRational::one()));
-        let mask = solve_dense(rows, size).map_err(|e| StencilError::Inconsistent {
+        let mask = limit_mask(&self.matrices.a).map_err(|e| StencilError::Inconsistent {
             scheme: self.scheme.name.to_owned(),
             n: 1,
             detail: format!("limit mask, {:?}: {e:?}", self.matrices.neighbourhood),
