@@ -7,6 +7,7 @@
 //! ```
 
 pub mod bezier;
+pub mod butterfly_refine;
 pub mod dual_grid;
 pub mod error;
 pub mod exact_eval;
@@ -24,8 +25,10 @@ pub mod refine;
 pub mod stencil_table;
 pub mod topology;
 pub mod triangle_dual_grid;
+pub mod triangle_isolation;
 pub mod triangle_mesh;
 pub mod triangle_patch;
+pub mod triangle_split;
 pub mod triangle_topology;
 
 pub use error::{MeshError, RuntimeError};

@@ -9,7 +9,7 @@
 //! 1. **Isolation** as the tessellator does it ([`isolate_loop`]): at most one Loop step. The
 //!    refined control points are recomputed exactly (rationals) from the input's f64 positions,
 //!    which are exact binary rationals, with the same rules; `(u, v)` descends into the child
-//!    that holds it (the inverse of [`crate::loop_refine::child_to_parent`]).
+//!    that holds it (the inverse of [`crate::triangle_split::child_to_parent`]).
 //! 2. **Patch** of that triangle ([`crate::triangle_patch`]): control points in the table's
 //!    layout (phantoms `a + b - c` included, exactly), the patch parameters
 //!    `(u', v') = (w_{r+1}, w_{r+2})` of the child's barycentric weights for a patch at corner
@@ -41,9 +41,10 @@ use schemes::triangle_local::{TriangleLocalMatrices, SUB_TRIANGLES};
 use schemes::TriangleScheme;
 
 use crate::exact_eval::{null_vectors, LimitPoint};
-use crate::loop_isolate::{isolate_loop, LoopIsolation};
+use crate::loop_isolate::isolate_loop;
 use crate::patch::PatchKind;
 use crate::topology::{Mesh, NONE};
+use crate::triangle_isolation::TriangleIsolation;
 use crate::triangle_topology::neighbours;
 use crate::RuntimeError;
 
@@ -79,7 +80,7 @@ fn to_f64(p: &Point) -> [f64; 3] {
 #[derive(Debug)]
 pub struct LoopExactEvaluator {
     input_faces: usize,
-    iso: LoopIsolation,
+    iso: TriangleIsolation,
     /// Exact control points of the isolated mesh, then its phantoms.
     control: Vec<Point>,
     /// The local matrices of every patch kind the isolated mesh has.
@@ -304,7 +305,7 @@ fn mul(a: [[i64; 2]; 2], b: [[i64; 2]; 2]) -> [[i64; 2]; 2] {
 }
 
 /// The child of a Loop step holding parent point `(u, v)`, the child's own `(s, t)`, and
-/// `d(s, t)/d(u, v)` (the inverse of [`crate::loop_refine::child_to_parent`]).
+/// `d(s, t)/d(u, v)` (the inverse of [`crate::triangle_split::child_to_parent`]).
 fn child_of(u: &BigRational, v: &BigRational) -> (u8, BigRational, BigRational, [[i64; 2]; 2]) {
     let (one, two, half) = (BigRational::one(), ratio(2, 1), ratio(1, 2));
     let w0 = &one - u - v;

@@ -1,15 +1,8 @@
 //! One uniform Loop refinement step on a triangle mesh (Loop 1987, with Warren's weights: the
 //! rules of `schemes::TriangleScheme` "loop" that the Loop stencil tables were generated with).
 //!
-//! New vertices are numbered vertex points first (old vertex `i` stays vertex `i`), then one
-//! edge point per edge in order of first appearance ([`LoopRefinement::edges`]). Triangle `f`
-//! `(c_0, c_1, c_2)` with half-edges `h_i = c_i -> c_{i+1}` becomes four, numbered `4f + c`:
-//! the corner triangles `(c_i, e(h_i), e(h_{i-1}))` for `c = i = 0, 1, 2`, then the middle one
-//! `(e(h_0), e(h_1), e(h_2))`; all keep the parent's orientation. In the parent's barycentric
-//! `(u, v)` (DESIGN.md: `(0,0)` at `c_0`, `(1,0)` at `c_1`, `(0,1)` at `c_2`) a child's own
-//! `(s, t)` is, for `c = 0, 1, 2, 3`:
-//! `(s/2, t/2)`, `(1 - s/2 - t/2, s/2)`, `(t/2, 1 - s/2 - t/2)`, `(1/2 - t/2, s/2 + t/2)`
-//! ([`child_to_parent`]). Rules:
+//! The new vertices, the four children of every triangle and their parameters are numbered as
+//! [`crate::triangle_split`] says. Rules:
 //!
 //! * interior vertex of valence `v`: `(1 - v beta) V + beta sum E_i`, `beta = 3/(8v)` for
 //!   `v > 3` and `3/16` for `v = 3`;
@@ -20,6 +13,7 @@
 
 use crate::geometry::{add, scale};
 use crate::topology::{Mesh, NONE};
+use crate::triangle_split::TriangleSplit;
 use crate::triangle_topology::{neighbours, require_triangles};
 use crate::MeshError;
 
@@ -42,47 +36,25 @@ pub fn loop_beta(valence: usize) -> f64 {
     }
 }
 
-/// The parent's integer barycentric numerators `(u, v)` over `2d` of the point `(s, t) / d` of
-/// child `child` (module docs), exactly.
-pub fn child_to_parent(child: u8, s: u32, t: u32, d: u32) -> (u32, u32) {
-    match child {
-        0 => (s, t),
-        1 => (2 * d - s - t, s),
-        2 => (t, 2 * d - s - t),
-        _ => (d - t, s + t),
-    }
-}
-
 /// Refine the triangle mesh `mesh` once.
 pub fn loop_refine(mesh: &Mesh) -> Result<LoopRefinement, MeshError> {
     require_triangles(mesh)?;
     let p = &mesh.positions;
     let nv = p.len();
-    let halfedges = mesh.face_vertices.len();
-    let mut edge_of = vec![NONE; halfedges];
-    let mut edges = Vec::new();
-    let mut edge_points = Vec::new();
-    for h in 0..halfedges {
-        if edge_of[h] != NONE {
-            continue;
+    let split = TriangleSplit::new(mesh);
+    let edge_points = split.first_halfedge.iter().map(|&h| {
+        let h = h as usize;
+        let ends = add(p[mesh.face_vertices[h] as usize], p[mesh.head(h) as usize]);
+        match mesh.twin[h] {
+            NONE => scale(0.5, ends),
+            t => {
+                // The vertices opposite the edge in its two triangles.
+                let c = mesh.head(mesh.next(h)) as usize;
+                let d = mesh.head(mesh.next(t as usize)) as usize;
+                add(scale(3.0 / 8.0, ends), scale(1.0 / 8.0, add(p[c], p[d])))
+            }
         }
-        let id = edges.len() as u32;
-        edge_of[h] = id;
-        let (a, b) = (mesh.face_vertices[h], mesh.head(h));
-        edges.push([a, b]);
-        let ends = add(p[a as usize], p[b as usize]);
-        let t = mesh.twin[h];
-        let point = if t == NONE {
-            scale(0.5, ends)
-        } else {
-            edge_of[t as usize] = id;
-            // The vertices opposite the edge in its two triangles.
-            let c = mesh.head(mesh.next(h)) as usize;
-            let d = mesh.head(mesh.next(t as usize)) as usize;
-            add(scale(3.0 / 8.0, ends), scale(1.0 / 8.0, add(p[c], p[d])))
-        };
-        edge_points.push(point);
-    }
+    });
     let mut positions: Vec<[f64; 3]> = (0..nv)
         .map(|v| {
             let ring = neighbours(mesh, v);
@@ -104,18 +76,12 @@ pub fn loop_refine(mesh: &Mesh) -> Result<LoopRefinement, MeshError> {
         })
         .collect();
     positions.extend(edge_points);
-    let mut faces = Vec::with_capacity(4 * mesh.faces());
-    for f in 0..mesh.faces() {
-        let hs: Vec<usize> = mesh.face_halfedges(f).collect();
-        let e = |i: usize| (nv + edge_of[hs[i % 3]] as usize) as i64;
-        for (i, &h) in hs.iter().enumerate() {
-            let c = i64::from(mesh.face_vertices[h]);
-            faces.push(vec![c, e(i), e(i + 2)]);
-        }
-        faces.push(vec![e(0), e(1), e(2)]);
-    }
+    let faces = split.child_faces(mesh, nv);
     let mesh = Mesh::new(positions, &faces, &[], mesh.boundary)?;
-    Ok(LoopRefinement { mesh, edges })
+    Ok(LoopRefinement {
+        mesh,
+        edges: split.edges,
+    })
 }
 
 #[cfg(test)]
@@ -165,21 +131,5 @@ mod tests {
         // Child 3 (the middle) is (e01, e12, e20), child 1 is (c1, e12, e01).
         assert_eq!(r.mesh.face(3), &[3, 4, 5]);
         assert_eq!(r.mesh.face(1), &[1, 4, 3]);
-    }
-
-    #[test]
-    fn children_map_their_corners_onto_the_parents_points() {
-        // Child corners (0,0), (1,0), (0,1) over d = 1 land on the parent's corners and edge
-        // midpoints (over 2): the child triangles listed in the module docs.
-        let expect = [
-            [(0, 0), (1, 0), (0, 1)],
-            [(2, 0), (1, 1), (1, 0)],
-            [(0, 2), (0, 1), (1, 1)],
-            [(1, 0), (1, 1), (0, 1)],
-        ];
-        for (c, corners) in expect.iter().enumerate() {
-            let got = [(0, 0), (1, 0), (0, 1)].map(|(s, t)| child_to_parent(c as u8, s, t, 1));
-            assert_eq!(&got, corners, "child {c}");
-        }
     }
 }

@@ -11,7 +11,7 @@ use std::collections::HashSet;
 /// quads of its first Catmull–Clark step, `subface` = the corner they hold). On Loop meshes
 /// (`crate::triangle_dual_grid`) `(u, v)` are the triangle's barycentric parameters: centroids
 /// of the small triangles at rate `n` have denominator `3n`, primal points `n`, and
-/// [`crate::loop_isolate::LoopIsolation::input_source`] maps them to the input triangle.
+/// [`crate::triangle_isolation::TriangleIsolation::input_source`] maps them to the input triangle.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct VertexSource {
     /// The face (of the mesh that was tessellated).

@@ -19,11 +19,12 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use proptest::prelude::*;
-use runtime::loop_isolate::{isolate_loop, LoopIsolation};
+use runtime::loop_isolate::isolate_loop;
 use runtime::loop_refine::loop_refine;
 use runtime::obj::read_obj;
 use runtime::topology::Mesh;
 use runtime::triangle_dual_grid::{TriangleDualGrid, TriangleStencils};
+use runtime::triangle_isolation::TriangleIsolation;
 use runtime::triangle_mesh::TriangleMesh;
 use runtime::{MeshError, RuntimeError};
 use schemes::BoundaryMode;
@@ -303,7 +304,7 @@ fn load(path: &Path) -> Mesh {
 /// Tessellate with flat stencils at per-input-face rates; sources in the input's triangles.
 fn tessellate_flat(
     stencils: &FlatStencils,
-    iso: &LoopIsolation,
+    iso: &TriangleIsolation,
     positions: &[[f64; 3]],
     input_rates: &[u32],
 ) -> TriangleMesh {
@@ -360,7 +361,7 @@ fn check_topology(input: &Mesh, out: &TriangleMesh, label: &str) {
 
 /// The isolated mesh's vertices placed linearly on the input: input vertices where they are,
 /// edge points at their edge's midpoint, step by step (from the refinement's own edge lists).
-fn linear_positions(input: &Mesh, iso: &LoopIsolation) -> Vec<[f64; 3]> {
+fn linear_positions(input: &Mesh, iso: &TriangleIsolation) -> Vec<[f64; 3]> {
     let mut current = input.clone();
     let mut linear = input.positions.clone();
     for _ in 0..iso.steps {
