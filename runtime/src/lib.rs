@@ -8,6 +8,7 @@
 
 pub mod bezier;
 pub mod butterfly_refine;
+pub mod cone_chart;
 pub mod dual_grid;
 pub mod error;
 pub mod exact_eval;

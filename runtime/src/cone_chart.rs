@@ -1,0 +1,261 @@
+//! Names the vertices of a triangle mesh around a vertex `V` of valence `K` by their cone
+//! coordinates, the names the triangle stencil tables' layouts use
+//! (`schemes::triangle_local::TrianglePoint`): `V` is the centre, its neighbours
+//! counter-clockwise from a chosen first one are `(1, 0)` of sectors `0..K`, and every other
+//! point is `(a, b)`, `a >= 1`, `b >= 0`, of the sector whose skew chart holds it (`a + b` is its
+//! graph distance from `V`).
+//!
+//! The chart grows face by face from `V`'s fan: a triangle `(p, q, r)`, counter-clockwise, with
+//! `p` and `q` named, has `r = p + R (q - p)` in `p`'s sector chart, `R (a, b) = (-b, a + b)` the
+//! lattice's 60-degree turn (neighbours lie in the same or an adjacent sector, so one turn of
+//! the chart relates their coordinates). Where the mesh around `V` is not the regular
+//! `K`-valent cone — another irregular vertex, or a boundary, within the radius — some point
+//! gets two names or none, and the chart says so instead of guessing.
+
+use std::collections::HashMap;
+
+use schemes::triangle_local::{canonical_triangle_point, TrianglePoint};
+
+use crate::topology::{Mesh, NONE};
+use crate::triangle_topology::{neighbours, rotate_to};
+
+/// The cone coordinates of the vertices within graph distance `radius` of a vertex.
+#[derive(Clone, Debug)]
+pub struct ConeChart {
+    /// The valence `K` of the centre.
+    pub valence: u32,
+    vertex_of: HashMap<TrianglePoint, u32>,
+    point_of: HashMap<u32, TrianglePoint>,
+}
+
+/// `(a, b)` turned by `turns` sixths of a full turn counter-clockwise, in skew coordinates.
+fn turn(a: i64, b: i64, turns: i64) -> (i64, i64) {
+    let (mut a, mut b) = (a, b);
+    for _ in 0..turns.rem_euclid(6) {
+        (a, b) = (-b, a + b);
+    }
+    (a, b)
+}
+
+/// Graph distance from the centre.
+fn ring(p: TrianglePoint) -> i64 {
+    match p {
+        TrianglePoint::Centre => 0,
+        TrianglePoint::Sector { a, b, .. } => a + b,
+    }
+}
+
+impl ConeChart {
+    /// Name the vertices within `radius` of `centre`, with `first` (a neighbour of `centre`) as
+    /// `E_0`; `Err` says where the mesh is not a regular cone around `centre`.
+    pub fn new(mesh: &Mesh, centre: u32, first: u32, radius: i64) -> Result<Self, String> {
+        let ring0 = rotate_to(&neighbours(mesh, centre as usize), first)
+            .ok_or_else(|| format!("vertex {first} is not a neighbour of {centre}"))?;
+        if mesh.is_boundary_vertex(centre as usize) {
+            return Err(format!("vertex {centre} is on the boundary"));
+        }
+        let valence = ring0.len() as u32;
+        let mut chart = ConeChart {
+            valence,
+            vertex_of: HashMap::new(),
+            point_of: HashMap::new(),
+        };
+        chart.name(centre, TrianglePoint::Centre)?;
+        for (s, &e) in ring0.iter().enumerate() {
+            chart.name(
+                e,
+                TrianglePoint::Sector {
+                    s: s as u32,
+                    a: 1,
+                    b: 0,
+                },
+            )?;
+        }
+        let mut visited = vec![false; mesh.faces()];
+        let mut queue: Vec<usize> = mesh.fan(centre as usize);
+        while let Some(h) = queue.pop() {
+            let f = mesh.face_of[h] as usize;
+            if visited[f] {
+                continue;
+            }
+            visited[f] = true;
+            let (p, q) = (mesh.face_vertices[h], mesh.head(h));
+            let r = mesh.head(mesh.next(h));
+            let point = chart.third(p, q)?;
+            if ring(point) > radius {
+                continue;
+            }
+            chart.name(r, point)?;
+            for g in [mesh.next(h), mesh.prev(h)] {
+                match mesh.twin[g] {
+                    NONE => {
+                        return Err(format!(
+                            "edge ({}, {}) within {radius} of vertex {centre} is on the boundary",
+                            mesh.face_vertices[g],
+                            mesh.head(g)
+                        ))
+                    }
+                    t if !visited[mesh.face_of[t as usize] as usize] => queue.push(t as usize),
+                    _ => {}
+                }
+            }
+        }
+        Ok(chart)
+    }
+
+    /// Give `vertex` the name `point`, or fail if either already has another.
+    fn name(&mut self, vertex: u32, point: TrianglePoint) -> Result<(), String> {
+        match (self.point_of.get(&vertex), self.vertex_of.get(&point)) {
+            (None, None) => {
+                self.point_of.insert(vertex, point);
+                self.vertex_of.insert(point, vertex);
+                Ok(())
+            }
+            (Some(&p), Some(&v)) if p == point && v == vertex => Ok(()),
+            _ => Err(format!(
+                "vertex {vertex} is reached as two different points around the centre: the \
+                 mesh there is not a regular cone"
+            )),
+        }
+    }
+
+    /// The name of the third corner of the counter-clockwise triangle `(p, q, r)`.
+    fn third(&self, p: u32, q: u32) -> Result<TrianglePoint, String> {
+        let named = |v: u32| {
+            self.point_of
+                .get(&v)
+                .copied()
+                .ok_or_else(|| format!("vertex {v} has no name yet"))
+        };
+        let (p, q) = (named(p)?, named(q)?);
+        let k = i64::from(self.valence);
+        // The chart: p's sector (q's when p is the centre).
+        let sector = match (p, q) {
+            (TrianglePoint::Sector { s, .. }, _)
+            | (TrianglePoint::Centre, TrianglePoint::Sector { s, .. }) => i64::from(s),
+            _ => return Err("an edge from the centre to itself".to_owned()),
+        };
+        let in_chart = |x: TrianglePoint| match x {
+            TrianglePoint::Centre => (0, 0),
+            TrianglePoint::Sector { s, a, b } => {
+                // Adjacent sectors differ by -1, 0 or 1 (mod K).
+                let mut d = (i64::from(s) - sector).rem_euclid(k);
+                if d > k / 2 {
+                    d -= k;
+                }
+                turn(a, b, d)
+            }
+        };
+        let (pa, pb) = in_chart(p);
+        let (qa, qb) = in_chart(q);
+        let (da, db) = turn(qa - pa, qb - pb, 1);
+        Ok(canonical_triangle_point(
+            self.valence,
+            sector,
+            pa + da,
+            pb + db,
+        ))
+    }
+
+    /// The vertex named `point` in sector-`rotation` terms: `(a, b)_s` is looked up as
+    /// `(a, b)_{s + rotation}` (the layouts are written for sector 0).
+    pub fn vertex(&self, point: TrianglePoint, rotation: u32) -> Option<u32> {
+        let point = match point {
+            TrianglePoint::Centre => TrianglePoint::Centre,
+            TrianglePoint::Sector { s, a, b } => TrianglePoint::Sector {
+                s: (s + rotation) % self.valence,
+                a,
+                b,
+            },
+        };
+        self.vertex_of.get(&point).copied()
+    }
+
+    /// The name of `vertex`, if it is within the chart.
+    pub fn point(&self, vertex: u32) -> Option<TrianglePoint> {
+        self.point_of.get(&vertex).copied()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use schemes::BoundaryMode;
+
+    /// A regular torus `m x m` with vertex `(a, b)` at index `a + m b` (mod m).
+    fn torus(m: i64) -> Mesh {
+        let index = |a: i64, b: i64| a.rem_euclid(m) + m * b.rem_euclid(m);
+        let positions = (0..m * m)
+            .map(|k| [(k % m) as f64, (k / m) as f64, 0.0])
+            .collect();
+        let mut faces = Vec::new();
+        for b in 0..m {
+            for a in 0..m {
+                faces.push(vec![index(a, b), index(a + 1, b), index(a, b + 1)]);
+                faces.push(vec![index(a + 1, b), index(a + 1, b + 1), index(a, b + 1)]);
+            }
+        }
+        Mesh::new(positions, &faces, &[], BoundaryMode::EdgeOnly).expect("torus")
+    }
+
+    /// On the plane the cone coordinates are the lattice's, sector by sector: `(a, b)_s` is the
+    /// lattice point `R^s (a, b)`.
+    #[test]
+    fn on_a_regular_torus_the_chart_is_the_lattice() {
+        let m = 16;
+        let mesh = torus(m);
+        let index = |a: i64, b: i64| (a.rem_euclid(m) + m * b.rem_euclid(m)) as u32;
+        let (ca, cb) = (5, 7);
+        let chart = ConeChart::new(&mesh, index(ca, cb), index(ca + 1, cb), 4).expect("regular");
+        assert_eq!(chart.valence, 6);
+        for s in 0..6u32 {
+            for a in 1..=4i64 {
+                for b in 0..=4 - a {
+                    let (x, y) = turn(a, b, i64::from(s));
+                    let p = TrianglePoint::Sector { s, a, b };
+                    assert_eq!(chart.vertex(p, 0), Some(index(ca + x, cb + y)), "{p:?}");
+                }
+            }
+        }
+        // Rotating the lookup by one sector turns the lattice by 60 degrees.
+        let p = TrianglePoint::Sector { s: 0, a: 2, b: 1 };
+        let (x, y) = turn(2, 1, 1);
+        assert_eq!(chart.vertex(p, 1), Some(index(ca + x, cb + y)));
+        // Nothing beyond the radius is named.
+        assert_eq!(
+            chart.vertex(TrianglePoint::Sector { s: 0, a: 5, b: 0 }, 0),
+            None
+        );
+    }
+
+    #[test]
+    fn an_octahedron_is_a_four_valent_cone_until_it_closes() {
+        let p = vec![
+            [1.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+        ];
+        let f = vec![
+            vec![0, 2, 4],
+            vec![2, 1, 4],
+            vec![1, 3, 4],
+            vec![3, 0, 4],
+            vec![2, 0, 5],
+            vec![1, 2, 5],
+            vec![3, 1, 5],
+            vec![0, 3, 5],
+        ];
+        let mesh = Mesh::new(p, &f, &[], BoundaryMode::EdgeOnly).expect("octahedron");
+        let chart = ConeChart::new(&mesh, 4, 0, 1).expect("the one-ring is a cone");
+        assert_eq!(chart.valence, 4);
+        assert_eq!(
+            chart.point(2),
+            Some(TrianglePoint::Sector { s: 1, a: 1, b: 0 })
+        );
+        // At radius 2 the opposite pole is reached as (1,1) of every sector: not a cone.
+        assert!(ConeChart::new(&mesh, 4, 0, 2).is_err());
+    }
+}
