@@ -54,7 +54,7 @@
 //! **Numbers.** Every matrix is kept in f64 (the weights' f64 values) and, when all weights are
 //! rational (`K = 3, 4, 6`), also exactly as [`BigRational`].
 
-use std::collections::{BTreeMap, HashMap, VecDeque};
+use std::collections::{BTreeMap, BTreeSet, HashMap, VecDeque};
 use std::ops::{Add, Mul};
 
 use num_bigint::BigInt;
@@ -131,7 +131,7 @@ pub fn butterfly_layout(valence: u32) -> Vec<TrianglePoint> {
 
 /// The graph-distance ball of radius `radius` around `{V, E_0, E_1}` on the cone, ordered by
 /// ring (distance from `V`), then sector, then `b`.
-fn layout_ball(valence: u32, radius: u32) -> Vec<TrianglePoint> {
+pub(crate) fn layout_ball(valence: u32, radius: u32) -> Vec<TrianglePoint> {
     let neighbours = |p: TrianglePoint| -> Vec<TrianglePoint> {
         match p {
             TrianglePoint::Centre => (0..valence)
@@ -170,11 +170,17 @@ fn layout_ball(valence: u32, radius: u32) -> Vec<TrianglePoint> {
         }
     }
     let mut points: Vec<TrianglePoint> = distance.into_keys().collect();
-    points.sort_by_key(|p| match *p {
+    points.sort_by_key(|&p| layout_key(p));
+    points
+}
+
+/// The order of every butterfly layout (the EV patch's and each region's,
+/// [`crate::butterfly_regions`]): `V` first, then by ring `a + b`, then sector, then `b`.
+pub fn layout_key(p: TrianglePoint) -> (i64, i64, i64) {
+    match p {
         TrianglePoint::Centre => (0, 0, 0),
         TrianglePoint::Sector { s, a, b } => (a + b, i64::from(s), b),
-    });
-    points
+    }
 }
 
 /// Names of layout points: `V`, or `(a,b)_s`.
@@ -186,7 +192,7 @@ pub fn point_name(p: TrianglePoint) -> String {
 }
 
 /// The number fields the matrices are built in: f64 and exact rationals.
-trait Weight: Clone + Zero + Add<Output = Self> + Mul<Output = Self> {
+pub(crate) trait Weight: Clone + Zero + Add<Output = Self> + Mul<Output = Self> {
     /// The weight in this field, `None` if it is irrational and the field exact.
     fn from_weight(w: TriangleWeight) -> Option<Self>;
     /// `1`.
@@ -220,7 +226,7 @@ type Combination<T> = Vec<(TrianglePoint, T)>;
 
 /// The modified butterfly's rules at one valence, in one number field.
 #[derive(Clone, Debug)]
-struct ButterflyRules<T> {
+pub(crate) struct ButterflyRules<T> {
     valence: u32,
     /// `(3/4, [s_0, .., s_{K-1}])` at an edge of `V`; `None` at `K = 6` (regular rule).
     extraordinary: Option<(T, Vec<T>)>,
@@ -230,7 +236,7 @@ struct ButterflyRules<T> {
 
 impl<T: Weight> ButterflyRules<T> {
     /// `None` when a weight is irrational in an exact field.
-    fn new(scheme: &TriangleScheme, valence: u32) -> Option<Self> {
+    pub(crate) fn new(scheme: &TriangleScheme, valence: u32) -> Option<Self> {
         let TriangleRefinement::Dyadic {
             edge,
             edge_denominator,
@@ -263,7 +269,7 @@ impl<T: Weight> ButterflyRules<T> {
 
     /// The level-`(k-1)` combination of the level-`k` point `point`, or the reason the chart
     /// cannot name the stencil.
-    fn refine(&self, point: TrianglePoint) -> Result<Combination<T>, String> {
+    pub(crate) fn refine(&self, point: TrianglePoint) -> Result<Combination<T>, String> {
         let TrianglePoint::Sector { s, a, b } = point else {
             return Ok(vec![(TrianglePoint::Centre, T::one_weight())]);
         };
@@ -365,7 +371,7 @@ pub struct ButterflyLocalMatrices {
 
 /// The interiors of two convex polygons (counter-clockwise, skew coordinates) meet: no edge of
 /// either separates them (the separating-axis test; affine coordinates keep separation).
-fn interiors_meet(p: &[(i64, i64)], q: &[(i64, i64)]) -> bool {
+pub(crate) fn interiors_meet(p: &[(i64, i64)], q: &[(i64, i64)]) -> bool {
     let separated_by = |poly: &[(i64, i64)]| {
         (0..poly.len()).any(|e| {
             let (a, b) = (poly[e], poly[(e + 1) % poly.len()]);
@@ -408,41 +414,57 @@ struct Built<T> {
     tiles: Vec<ButterflyTile>,
 }
 
-/// Build `A` and the tile rows over `layout` in the field `T`; `Err` names the first point
-/// whose rule reads a point outside the layout (or past the chart's cut).
-fn build<T: Weight>(
-    rules: &ButterflyRules<T>,
-    layout: &[TrianglePoint],
-    hull: &[(i64, i64)],
-    level: u32,
-) -> Result<Built<T>, String> {
-    let index: HashMap<TrianglePoint, usize> =
-        layout.iter().enumerate().map(|(i, &p)| (p, i)).collect();
-    let size = layout.len();
-    // rows[k][p]: the level-k point p in level-0 layout weights.
-    let mut memo: Vec<HashMap<TrianglePoint, Vec<T>>> = vec![HashMap::new(); level as usize + 1];
-    fn row_of<T: Weight>(
-        rules: &ButterflyRules<T>,
-        index: &HashMap<TrianglePoint, usize>,
-        size: usize,
-        memo: &mut Vec<HashMap<TrianglePoint, Vec<T>>>,
-        k: usize,
-        p: TrianglePoint,
-    ) -> Result<Vec<T>, String> {
-        if let Some(r) = memo[k].get(&p) {
+/// Rows of level-`k` points in level-0 layout weights, memoized per level: the one
+/// implementation of "apply the true rules `k` times" that the EV patch and every region
+/// ([`crate::butterfly_regions`]) use. Reading a level-0 point outside the layout is an error,
+/// which is how every layout is checked; rule weights that are exactly zero (`s_1`, `s_3` at
+/// `K = 4`) read nothing.
+pub(crate) struct RowMemo<'a, T> {
+    rules: &'a ButterflyRules<T>,
+    index: HashMap<TrianglePoint, usize>,
+    size: usize,
+    /// `memo[k][p]`: the level-`k` point `p` in level-0 layout weights.
+    memo: Vec<HashMap<TrianglePoint, Vec<T>>>,
+}
+
+impl<'a, T: Weight> RowMemo<'a, T> {
+    /// Rows over `layout`, for points of levels `0..=max_level`.
+    pub(crate) fn new(
+        rules: &'a ButterflyRules<T>,
+        layout: &[TrianglePoint],
+        max_level: u32,
+    ) -> Self {
+        RowMemo {
+            rules,
+            index: layout.iter().enumerate().map(|(i, &p)| (p, i)).collect(),
+            size: layout.len(),
+            memo: vec![HashMap::new(); max_level as usize + 1],
+        }
+    }
+
+    /// The level-`k` point `p` in level-0 layout weights.
+    pub(crate) fn row(&mut self, k: usize, p: TrianglePoint) -> Result<Vec<T>, String> {
+        if let Some(r) = self.memo.get(k).and_then(|m| m.get(&p)) {
             return Ok(r.clone());
         }
+        if k >= self.memo.len() {
+            return Err(format!("level {k} is past the memo's deepest level"));
+        }
         let row = if k == 0 {
-            let i = *index
+            let i = *self
+                .index
                 .get(&p)
                 .ok_or_else(|| format!("level-0 point {} is not in the layout", point_name(p)))?;
-            let mut r = vec![T::zero(); size];
+            let mut r = vec![T::zero(); self.size];
             r[i] = T::one_weight();
             r
         } else {
-            let mut r = vec![T::zero(); size];
-            for (parent, w) in rules.refine(p)? {
-                let pr = row_of(rules, index, size, memo, k - 1, parent)?;
+            let mut r = vec![T::zero(); self.size];
+            for (parent, w) in self.rules.refine(p)? {
+                if w.is_zero() {
+                    continue;
+                }
+                let pr = self.row(k - 1, parent)?;
                 for (x, y) in r.iter_mut().zip(pr) {
                     if !y.is_zero() {
                         *x = x.clone() + w.clone() * y;
@@ -451,13 +473,63 @@ fn build<T: Weight>(
             }
             r
         };
-        memo[k].insert(p, row.clone());
+        self.memo[k].insert(p, row.clone());
         Ok(row)
     }
-    let a = layout
+
+    /// The rows of the level-`k` points `points`, unfolded in sector 0's chart.
+    pub(crate) fn chart_rows(
+        &mut self,
+        k: u32,
+        points: &[(i64, i64)],
+    ) -> Result<Vec<Vec<T>>, String> {
+        points
+            .iter()
+            .map(|&(j1, j2)| {
+                let p = canonical_triangle_point(self.rules.valence, 0, j1, j2);
+                self.row(k as usize, p)
+            })
+            .collect()
+    }
+}
+
+/// Every level-0 point that the level-`level` points `points` (sector-0 chart) read through
+/// the rules, counting only nonzero rule weights: the closure a layout must hold.
+pub(crate) fn level0_reads<T: Weight>(
+    rules: &ButterflyRules<T>,
+    level: u32,
+    points: &[(i64, i64)],
+) -> Result<BTreeSet<TrianglePoint>, String> {
+    let mut current: BTreeSet<TrianglePoint> = points
         .iter()
-        .map(|&p| row_of(rules, &index, size, &mut memo, 1, p))
-        .collect::<Result<Vec<_>, _>>()?;
+        .map(|&(j1, j2)| canonical_triangle_point(rules.valence, 0, j1, j2))
+        .collect();
+    for _ in 0..level {
+        let mut parents = BTreeSet::new();
+        for &p in &current {
+            for (parent, w) in rules.refine(p)? {
+                if !w.is_zero() {
+                    parents.insert(parent);
+                }
+            }
+        }
+        current = parents;
+    }
+    Ok(current)
+}
+
+/// Regular tiles and the level-`L` lattice points they need.
+pub(crate) struct TileSet {
+    /// Every control point of some tile, sector-0 chart, in first-use order.
+    pub(crate) regular_points: Vec<(i64, i64)>,
+    /// The tiles, control points as indices into `regular_points`.
+    pub(crate) tiles: Vec<ButterflyTile>,
+}
+
+/// The tiles with corners `tile_corners` (level-`L` chart coordinates) and, for each, the
+/// level-`L` lattice points `j` with `T ∩ (j + int H)` nonempty: the only ones whose `psi`
+/// does not vanish on `T`.
+pub(crate) fn tile_set(hull: &[(i64, i64)], tile_corners: Vec<[(i64, i64); 3]>) -> TileSet {
     let mut regular_points: Vec<(i64, i64)> = Vec::new();
     let mut point_index: BTreeMap<(i64, i64), usize> = BTreeMap::new();
     let mut tiles = Vec::new();
@@ -466,7 +538,7 @@ fn build<T: Weight>(
         .map(|&(a, b)| a.abs().max(b.abs()).max((a + b).abs()))
         .max()
         .unwrap_or(0);
-    for corners in outer_half_tiles(level) {
+    for corners in tile_corners {
         let mut points = Vec::new();
         let (lo1, hi1) = (
             corners.iter().map(|c| c.0).min().unwrap_or(0) - radius,
@@ -493,13 +565,30 @@ fn build<T: Weight>(
         }
         tiles.push(ButterflyTile { corners, points });
     }
-    let rows = regular_points
+    TileSet {
+        regular_points,
+        tiles,
+    }
+}
+
+/// Build `A` and the tile rows over `layout` in the field `T`; `Err` names the first point
+/// whose rule reads a point outside the layout (or past the chart's cut).
+fn build<T: Weight>(
+    rules: &ButterflyRules<T>,
+    layout: &[TrianglePoint],
+    hull: &[(i64, i64)],
+    level: u32,
+) -> Result<Built<T>, String> {
+    let mut memo = RowMemo::new(rules, layout, level.max(1));
+    let a = layout
         .iter()
-        .map(|&(j1, j2)| {
-            let p = canonical_triangle_point(rules.valence, 0, j1, j2);
-            row_of(rules, &index, size, &mut memo, level as usize, p)
-        })
+        .map(|&p| memo.row(1, p))
         .collect::<Result<Vec<_>, _>>()?;
+    let TileSet {
+        regular_points,
+        tiles,
+    } = tile_set(hull, outer_half_tiles(level));
+    let rows = memo.chart_rows(level, &regular_points)?;
     Ok(Built {
         a,
         regular_points,
