@@ -7,6 +7,8 @@
 //! ```
 
 pub mod bezier;
+pub mod butterfly_isolate;
+pub mod butterfly_patch;
 pub mod butterfly_refine;
 pub mod cone_chart;
 pub mod dual_grid;
