@@ -24,7 +24,7 @@ use schemes::butterfly_regions::ButterflyRegions;
 use schemes::triangle_local::{canonical_triangle_point, TrianglePoint};
 use schemes::TriangleScheme;
 
-use crate::cone_chart::ConeChart;
+use crate::cone_chart::{ConeChart, ConeCharts};
 use crate::patch::PatchKind;
 use crate::topology::Mesh;
 use crate::triangle_patch::TrianglePatch;
@@ -130,6 +130,7 @@ pub fn gather_butterfly_patches(
         .map(|v| mesh.fan(v).len())
         .collect();
     let mut patches: Vec<Option<TrianglePatch>> = vec![None; mesh.faces()];
+    let mut charts = ConeCharts::new(mesh);
     let not_isolated = |face: usize, reason: String| MeshError::NotIsolated { face, reason };
     for v in 0..mesh.positions.len() {
         if valence[v] == 6 || valence[v] == 0 {
@@ -145,7 +146,8 @@ pub fn gather_butterfly_patches(
         })?;
         let radius = regions.iter().map(|r| reach(&r.layout)).max().unwrap_or(1);
         let first = neighbours(mesh, v)[0];
-        let chart = ConeChart::new(mesh, v as u32, first, radius)
+        let chart = charts
+            .chart(mesh, v as u32, first, radius)
             .map_err(|e| not_isolated(first_face, format!("around vertex {v}: {e}")))?;
         for s in 0..k {
             for (r, region) in regions.iter().enumerate() {
@@ -201,7 +203,8 @@ pub fn gather_butterfly_patches(
             Some(p) => Ok(p),
             None => {
                 let corners = mesh.face(f);
-                let chart = ConeChart::new(mesh, corners[0], corners[1], radius)
+                let chart = charts
+                    .chart(mesh, corners[0], corners[1], radius)
                     .map_err(|e| not_isolated(f, e))?;
                 if chart.valence != 6 {
                     return Err(not_isolated(

@@ -12,8 +12,6 @@
 //! `K`-valent cone — another irregular vertex, or a boundary, within the radius — some point
 //! gets two names or none, and the chart says so instead of guessing.
 
-use std::collections::HashMap;
-
 use schemes::triangle_local::{canonical_triangle_point, TrianglePoint};
 
 use crate::topology::{Mesh, NONE};
@@ -24,8 +22,19 @@ use crate::triangle_topology::{neighbours, rotate_to};
 pub struct ConeChart {
     /// The valence `K` of the centre.
     pub valence: u32,
-    vertex_of: HashMap<TrianglePoint, u32>,
-    point_of: HashMap<u32, TrianglePoint>,
+    radius: i64,
+    /// The vertex of every point ([`NONE`] if none), by [`ConeChart::slot`].
+    vertex_of: Vec<u32>,
+}
+
+/// Scratch space for charts of one mesh: which faces and vertices the current chart has seen
+/// and what it named them, stamped so that nothing is cleared between charts.
+#[derive(Clone, Debug)]
+pub struct ConeCharts {
+    stamp: u32,
+    face_seen: Vec<u32>,
+    vertex_seen: Vec<u32>,
+    vertex_point: Vec<TrianglePoint>,
 }
 
 /// `(a, b)` turned by `turns` sixths of a full turn counter-clockwise, in skew coordinates.
@@ -45,47 +54,68 @@ fn ring(p: TrianglePoint) -> i64 {
     }
 }
 
-impl ConeChart {
+impl ConeCharts {
+    /// Scratch space for charts of `mesh`.
+    pub fn new(mesh: &Mesh) -> Self {
+        ConeCharts {
+            stamp: 0,
+            face_seen: vec![0; mesh.faces()],
+            vertex_seen: vec![0; mesh.positions.len()],
+            vertex_point: vec![TrianglePoint::Centre; mesh.positions.len()],
+        }
+    }
+
     /// Name the vertices within `radius` of `centre`, with `first` (a neighbour of `centre`) as
     /// `E_0`; `Err` says where the mesh is not a regular cone around `centre`.
-    pub fn new(mesh: &Mesh, centre: u32, first: u32, radius: i64) -> Result<Self, String> {
-        let ring0 = rotate_to(&neighbours(mesh, centre as usize), first)
-            .ok_or_else(|| format!("vertex {first} is not a neighbour of {centre}"))?;
+    pub fn chart(
+        &mut self,
+        mesh: &Mesh,
+        centre: u32,
+        first: u32,
+        radius: i64,
+    ) -> Result<ConeChart, String> {
         if mesh.is_boundary_vertex(centre as usize) {
             return Err(format!("vertex {centre} is on the boundary"));
         }
+        let ring0 = rotate_to(&neighbours(mesh, centre as usize), first)
+            .ok_or_else(|| format!("vertex {first} is not a neighbour of {centre}"))?;
         let valence = ring0.len() as u32;
+        self.stamp = self.stamp.wrapping_add(1);
+        if self.stamp == 0 {
+            self.face_seen.fill(0);
+            self.vertex_seen.fill(0);
+            self.stamp = 1;
+        }
+        let radius = radius.max(1);
+        let slots = 1 + valence as usize * (radius * (radius + 1) / 2) as usize;
         let mut chart = ConeChart {
             valence,
-            vertex_of: HashMap::new(),
-            point_of: HashMap::new(),
+            radius,
+            vertex_of: vec![NONE; slots],
         };
-        chart.name(centre, TrianglePoint::Centre)?;
+        self.name(&mut chart, centre, TrianglePoint::Centre)?;
         for (s, &e) in ring0.iter().enumerate() {
-            chart.name(
-                e,
-                TrianglePoint::Sector {
-                    s: s as u32,
-                    a: 1,
-                    b: 0,
-                },
-            )?;
+            let point = TrianglePoint::Sector {
+                s: s as u32,
+                a: 1,
+                b: 0,
+            };
+            self.name(&mut chart, e, point)?;
         }
-        let mut visited = vec![false; mesh.faces()];
-        let mut queue: Vec<usize> = mesh.fan(centre as usize);
-        while let Some(h) = queue.pop() {
+        let mut stack: Vec<usize> = mesh.fan(centre as usize);
+        while let Some(h) = stack.pop() {
             let f = mesh.face_of[h] as usize;
-            if visited[f] {
+            if self.face_seen[f] == self.stamp {
                 continue;
             }
-            visited[f] = true;
+            self.face_seen[f] = self.stamp;
             let (p, q) = (mesh.face_vertices[h], mesh.head(h));
             let r = mesh.head(mesh.next(h));
-            let point = chart.third(p, q)?;
+            let point = self.third(valence, p, q)?;
             if ring(point) > radius {
                 continue;
             }
-            chart.name(r, point)?;
+            self.name(&mut chart, r, point)?;
             for g in [mesh.next(h), mesh.prev(h)] {
                 match mesh.twin[g] {
                     NONE => {
@@ -95,7 +125,9 @@ impl ConeChart {
                             mesh.head(g)
                         ))
                     }
-                    t if !visited[mesh.face_of[t as usize] as usize] => queue.push(t as usize),
+                    t if self.face_seen[mesh.face_of[t as usize] as usize] != self.stamp => {
+                        stack.push(t as usize)
+                    }
                     _ => {}
                 }
             }
@@ -104,14 +136,23 @@ impl ConeChart {
     }
 
     /// Give `vertex` the name `point`, or fail if either already has another.
-    fn name(&mut self, vertex: u32, point: TrianglePoint) -> Result<(), String> {
-        match (self.point_of.get(&vertex), self.vertex_of.get(&point)) {
-            (None, None) => {
-                self.point_of.insert(vertex, point);
-                self.vertex_of.insert(point, vertex);
+    fn name(
+        &mut self,
+        chart: &mut ConeChart,
+        vertex: u32,
+        point: TrianglePoint,
+    ) -> Result<(), String> {
+        let slot = chart.slot(point, 0).ok_or("a point beyond the radius")?;
+        let seen = self.vertex_seen[vertex as usize] == self.stamp;
+        let taken = chart.vertex_of[slot];
+        match (seen, taken) {
+            (false, NONE) => {
+                self.vertex_seen[vertex as usize] = self.stamp;
+                self.vertex_point[vertex as usize] = point;
+                chart.vertex_of[slot] = vertex;
                 Ok(())
             }
-            (Some(&p), Some(&v)) if p == point && v == vertex => Ok(()),
+            (true, v) if v == vertex && self.vertex_point[vertex as usize] == point => Ok(()),
             _ => Err(format!(
                 "vertex {vertex} is reached as two different points around the centre: the \
                  mesh there is not a regular cone"
@@ -120,15 +161,16 @@ impl ConeChart {
     }
 
     /// The name of the third corner of the counter-clockwise triangle `(p, q, r)`.
-    fn third(&self, p: u32, q: u32) -> Result<TrianglePoint, String> {
+    fn third(&self, valence: u32, p: u32, q: u32) -> Result<TrianglePoint, String> {
         let named = |v: u32| {
-            self.point_of
-                .get(&v)
-                .copied()
-                .ok_or_else(|| format!("vertex {v} has no name yet"))
+            if self.vertex_seen[v as usize] == self.stamp {
+                Ok(self.vertex_point[v as usize])
+            } else {
+                Err(format!("vertex {v} has no name yet"))
+            }
         };
         let (p, q) = (named(p)?, named(q)?);
-        let k = i64::from(self.valence);
+        let k = i64::from(valence);
         // The chart: p's sector (q's when p is the centre).
         let sector = match (p, q) {
             (TrianglePoint::Sector { s, .. }, _)
@@ -149,31 +191,58 @@ impl ConeChart {
         let (pa, pb) = in_chart(p);
         let (qa, qb) = in_chart(q);
         let (da, db) = turn(qa - pa, qb - pb, 1);
-        Ok(canonical_triangle_point(
-            self.valence,
-            sector,
-            pa + da,
-            pb + db,
-        ))
+        Ok(canonical_triangle_point(valence, sector, pa + da, pb + db))
+    }
+}
+
+impl ConeChart {
+    /// Name the vertices within `radius` of `centre` (one chart; [`ConeCharts`] reuses its
+    /// scratch space over many).
+    pub fn new(mesh: &Mesh, centre: u32, first: u32, radius: i64) -> Result<Self, String> {
+        ConeCharts::new(mesh).chart(mesh, centre, first, radius)
+    }
+
+    /// Where `point`, read `rotation` sectors on, is stored (`None` beyond the radius).
+    fn slot(&self, point: TrianglePoint, rotation: u32) -> Option<usize> {
+        match point {
+            TrianglePoint::Centre => Some(0),
+            TrianglePoint::Sector { s, a, b } => {
+                let m = a + b;
+                if a < 1 || b < 0 || m > self.radius {
+                    return None;
+                }
+                let per_sector = (self.radius * (self.radius + 1) / 2) as usize;
+                let s = ((s + rotation) % self.valence) as usize;
+                Some(1 + s * per_sector + ((m - 1) * m / 2 + b) as usize)
+            }
+        }
     }
 
     /// The vertex named `point` in sector-`rotation` terms: `(a, b)_s` is looked up as
     /// `(a, b)_{s + rotation}` (the layouts are written for sector 0).
     pub fn vertex(&self, point: TrianglePoint, rotation: u32) -> Option<u32> {
-        let point = match point {
-            TrianglePoint::Centre => TrianglePoint::Centre,
-            TrianglePoint::Sector { s, a, b } => TrianglePoint::Sector {
-                s: (s + rotation) % self.valence,
-                a,
-                b,
-            },
-        };
-        self.vertex_of.get(&point).copied()
+        let v = self.vertex_of[self.slot(point, rotation)?];
+        (v != NONE).then_some(v)
     }
 
     /// The name of `vertex`, if it is within the chart.
     pub fn point(&self, vertex: u32) -> Option<TrianglePoint> {
-        self.point_of.get(&vertex).copied()
+        let slot = self.vertex_of.iter().position(|&v| v == vertex)?;
+        if slot == 0 {
+            return Some(TrianglePoint::Centre);
+        }
+        let per_sector = (self.radius * (self.radius + 1) / 2) as usize;
+        let (s, mut rest) = ((slot - 1) / per_sector, ((slot - 1) % per_sector) as i64);
+        let mut m = 1;
+        while rest >= m {
+            rest -= m;
+            m += 1;
+        }
+        Some(TrianglePoint::Sector {
+            s: s as u32,
+            a: m - rest,
+            b: rest,
+        })
     }
 }
 

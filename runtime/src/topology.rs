@@ -8,7 +8,6 @@
 //! edge has one or two faces traversing it in opposite directions, and the faces around every
 //! vertex form a single fan (a disc, or a half-disc at the boundary).
 
-use std::collections::HashMap;
 
 use schemes::BoundaryMode;
 
@@ -199,23 +198,42 @@ impl Mesh {
     }
 
     fn link_twins(&mut self) -> Result<(), MeshError> {
-        let mut directed: HashMap<(u32, u32), usize> =
-            HashMap::with_capacity(self.face_vertices.len());
-        for h in 0..self.face_vertices.len() {
+        // Half-edges grouped by tail (counting sort): a twin is found among its head's few
+        // outgoing half-edges, without hashing every directed edge.
+        let halfedges = self.face_vertices.len();
+        let mut start = vec![0u32; self.positions.len() + 1];
+        for &v in &self.face_vertices {
+            start[v as usize + 1] += 1;
+        }
+        for v in 0..self.positions.len() {
+            start[v + 1] += start[v];
+        }
+        let mut fill = start.clone();
+        let mut outgoing = vec![0u32; halfedges];
+        for (h, &v) in self.face_vertices.iter().enumerate() {
+            outgoing[fill[v as usize] as usize] = h as u32;
+            fill[v as usize] += 1;
+        }
+        let leaving =
+            |v: u32| &outgoing[start[v as usize] as usize..start[v as usize + 1] as usize];
+        for h in 0..halfedges {
             let (a, b) = (self.face_vertices[h], self.head(h));
-            if let Some(&other) = directed.get(&(a, b)) {
+            // The same directed edge twice: the first earlier copy, as a scan in order finds it.
+            if let Some(&other) = leaving(a)
+                .iter()
+                .find(|&&g| (g as usize) < h && self.head(g as usize) == b)
+            {
                 return Err(MeshError::NonManifoldEdge {
                     a: a as usize,
                     b: b as usize,
-                    faces: vec![self.face_of[other] as usize, self.face_of[h] as usize],
+                    faces: vec![
+                        self.face_of[other as usize] as usize,
+                        self.face_of[h] as usize,
+                    ],
                 });
             }
-            directed.insert((a, b), h);
-        }
-        for h in 0..self.face_vertices.len() {
-            let (a, b) = (self.face_vertices[h], self.head(h));
-            if let Some(&t) = directed.get(&(b, a)) {
-                self.twin[h] = t as u32;
+            if let Some(&t) = leaving(b).iter().find(|&&g| self.head(g as usize) == a) {
+                self.twin[h] = t;
             }
         }
         Ok(())

@@ -164,3 +164,16 @@ fn gathered_layouts_match_whole_mesh_refinement() {
         check_layouts_against_refinement(name, &iso);
     }
 }
+
+#[test]
+#[ignore]
+fn time_spot_isolation() {
+    let Some(dir) = models() else { return };
+    let m = load(&dir.join("crane/spot_triangulated.obj"));
+    let t = std::time::Instant::now();
+    let iso = isolate_butterfly(&m).unwrap_or_else(|e| panic!("spot: {e}"));
+    println!("isolate {:?}", t.elapsed());
+    let t = std::time::Instant::now();
+    let _ = butterfly_refine(&iso.mesh).expect("refines");
+    println!("one refinement of the isolated mesh {:?}", t.elapsed());
+}
