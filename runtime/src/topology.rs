@@ -8,7 +8,6 @@
 //! edge has one or two faces traversing it in opposite directions, and the faces around every
 //! vertex form a single fan (a disc, or a half-disc at the boundary).
 
-
 use schemes::BoundaryMode;
 
 use crate::obj::ObjMesh;

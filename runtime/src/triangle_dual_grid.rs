@@ -50,8 +50,9 @@ use crate::triangle_patch::{
 use crate::RuntimeError;
 
 /// The largest patch (control points) the evaluator takes: an interior vertex of valence `v`
-/// has `v + 6`, a boundary vertex with `k` triangles at most `k + 7`.
-const MAX_TRIANGLE_PATCH: usize = 32;
+/// has `v + 6`, a boundary vertex with `k` triangles at most `k + 7`; a butterfly region at
+/// most 33 (`3K + 9` at valence 8).
+const MAX_TRIANGLE_PATCH: usize = 40;
 
 /// The largest rate the evaluator takes.
 pub const MAX_TRIANGLE_RATE: u32 = 64;
@@ -630,20 +631,19 @@ impl<'t> TriangleDualGrid<'t> {
             *l = control[v as usize];
         }
         let local = &local[..points.len()];
-        if points.len() == REGULAR_POINTS {
-            // The regular patch, most of any isolated mesh: fixed-length dot products over
-            // coordinate columns, which the compiler unrolls and vectorizes.
-            let mut columns = [[0.0f32; REGULAR_POINTS]; 3];
-            for (l, p) in local.iter().enumerate() {
-                for c in 0..3 {
-                    columns[c][l] = p[c];
-                }
+        // The regular patches, most of any isolated mesh (Loop's 12 points, the butterfly's 27):
+        // fixed-length dot products over coordinate columns, which the compiler unrolls and
+        // vectorizes.
+        match points.len() {
+            LOOP_REGULAR_POINTS => {
+                return fixed_points::<LOOP_REGULAR_POINTS>(plan, map, n, local, positions, normals)
             }
-            for (at, &row) in map.iter().enumerate() {
-                let stencils = if at < n * n { &plan.dual } else { &plan.primal };
-                (positions[at], normals[at]) = regular_point(stencils, &columns, row as usize);
+            BUTTERFLY_REGULAR_POINTS => {
+                return fixed_points::<BUTTERFLY_REGULAR_POINTS>(
+                    plan, map, n, local, positions, normals,
+                )
             }
-            return;
+            _ => {}
         }
         for (at, &row) in map.iter().enumerate() {
             let stencils = if at < n * n { &plan.dual } else { &plan.primal };
@@ -727,18 +727,43 @@ impl<'t> TriangleDualGrid<'t> {
     }
 }
 
-/// Control points of the regular patch (valence 6): `V`, six neighbours, five outer points.
-const REGULAR_POINTS: usize = 12;
+/// Control points of Loop's regular patch (valence 6): `V`, six neighbours, five outer points.
+const LOOP_REGULAR_POINTS: usize = 12;
 
-/// [`weighted_point`] for the regular patch, from the control points' coordinate columns.
-fn regular_point(
+/// Control points of the butterfly's regular patch: the radius-2 ball around the triangle.
+const BUTTERFLY_REGULAR_POINTS: usize = 27;
+
+/// Every point of a face whose patch has `N` control points: [`weighted_point`] from the
+/// control points' coordinate columns.
+fn fixed_points<const N: usize>(
+    plan: &FacePlan,
+    map: &[u32],
+    n: usize,
+    local: &[[f32; 3]],
+    positions: &mut [[f32; 3]],
+    normals: &mut [[f32; 3]],
+) {
+    let mut columns = [[0.0f32; N]; 3];
+    for (l, p) in local.iter().enumerate() {
+        for c in 0..3 {
+            columns[c][l] = p[c];
+        }
+    }
+    for (at, &row) in map.iter().enumerate() {
+        let stencils = if at < n * n { &plan.dual } else { &plan.primal };
+        (positions[at], normals[at]) = fixed_point::<N>(stencils, &columns, row as usize);
+    }
+}
+
+/// [`weighted_point`] for a patch of `N` control points, from their coordinate columns.
+fn fixed_point<const N: usize>(
     s: &Stencils,
-    columns: &[[f32; REGULAR_POINTS]; 3],
+    columns: &[[f32; N]; 3],
     point: usize,
 ) -> ([f32; 3], [f32; 3]) {
-    let rows = point * REGULAR_POINTS..(point + 1) * REGULAR_POINTS;
-    let weights = |w: &[f32]| -> [f32; REGULAR_POINTS] {
-        let mut out = [0.0; REGULAR_POINTS];
+    let rows = point * N..(point + 1) * N;
+    let weights = |w: &[f32]| -> [f32; N] {
+        let mut out = [0.0; N];
         out.copy_from_slice(w);
         out
     };
@@ -747,9 +772,7 @@ fn regular_point(
         weights(&s.du[rows.clone()]),
         weights(&s.dv[rows]),
     );
-    let dot = |w: &[f32; REGULAR_POINTS], x: &[f32; REGULAR_POINTS]| -> f32 {
-        w.iter().zip(x).map(|(a, b)| a * b).sum()
-    };
+    let dot = |w: &[f32; N], x: &[f32; N]| -> f32 { w.iter().zip(x).map(|(a, b)| a * b).sum() };
     let p = columns.map(|x| dot(&wp, &x));
     let du = columns.map(|x| dot(&wu, &x));
     let dv = columns.map(|x| dot(&wv, &x));
