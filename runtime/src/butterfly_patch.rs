@@ -20,6 +20,7 @@
 
 use std::collections::BTreeMap;
 
+use rayon::prelude::*;
 use schemes::butterfly_regions::ButterflyRegions;
 use schemes::triangle_local::{canonical_triangle_point, TrianglePoint};
 use schemes::TriangleScheme;
@@ -196,39 +197,55 @@ pub fn gather_butterfly_patches(
         .and_then(|r| r.first())
         .ok_or_else(|| RuntimeError::Unsupported("no regular butterfly region".into()))?;
     let radius = reach(&regular.layout);
-    patches
-        .into_iter()
-        .enumerate()
-        .map(|(f, patch)| match patch {
-            Some(p) => Ok(p),
-            None => {
-                let corners = mesh.face(f);
-                let chart = charts
-                    .chart(mesh, corners[0], corners[1], radius)
-                    .map_err(|e| not_isolated(f, e))?;
-                if chart.valence != 6 {
-                    return Err(not_isolated(
-                        f,
-                        format!(
-                            "its corner {} has valence {} but the triangle is in none of its \
-                             regions",
-                            corners[0], chart.valence
-                        ),
-                    )
-                    .into());
-                }
-                let points =
-                    gather(&chart, &regular.layout, 0, &valence).map_err(|e| not_isolated(f, e))?;
-                Ok(TrianglePatch {
-                    kind: PatchKind {
-                        boundary: false,
-                        faces: 6,
-                        sector: 0,
-                    },
-                    points,
-                    corner: 0,
-                })
+    // The regular triangles, most of the mesh, in one chunk per thread, each with its own
+    // chart scratch space.
+    let regular_patch =
+        |charts: &mut ConeCharts, f: usize| -> Result<TrianglePatch, RuntimeError> {
+            let corners = mesh.face(f);
+            let chart = charts
+                .chart(mesh, corners[0], corners[1], radius)
+                .map_err(|e| not_isolated(f, e))?;
+            if chart.valence != 6 {
+                return Err(not_isolated(
+                    f,
+                    format!(
+                        "its corner {} has valence {} but the triangle is in none of its regions",
+                        corners[0], chart.valence
+                    ),
+                )
+                .into());
             }
+            let points =
+                gather(&chart, &regular.layout, 0, &valence).map_err(|e| not_isolated(f, e))?;
+            Ok(TrianglePatch {
+                kind: PatchKind {
+                    boundary: false,
+                    faces: 6,
+                    sector: 0,
+                },
+                points,
+                corner: 0,
+            })
+        };
+    let chunk = mesh.faces().div_ceil(rayon::current_num_threads()).max(1);
+    let mut out: Vec<TrianglePatch> = Vec::with_capacity(mesh.faces());
+    let chunks: Vec<Result<Vec<TrianglePatch>, RuntimeError>> = patches
+        .par_chunks_mut(chunk)
+        .enumerate()
+        .map(|(c, slice)| {
+            let mut charts = ConeCharts::new(mesh);
+            slice
+                .iter_mut()
+                .enumerate()
+                .map(|(i, patch)| match patch.take() {
+                    Some(p) => Ok(p),
+                    None => regular_patch(&mut charts, c * chunk + i),
+                })
+                .collect()
         })
-        .collect()
+        .collect();
+    for c in chunks {
+        out.extend(c?);
+    }
+    Ok(out)
 }
