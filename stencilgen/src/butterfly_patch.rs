@@ -42,7 +42,9 @@ use crate::regular_patch::StencilKind;
 use crate::scaling_system::{NormalizationRow, Relation, ScalingSystem, SparseRow};
 use crate::solve::{solve_system, Solution};
 use crate::triangle_patch::triangle_grid_points;
-use crate::triangle_system::{triangle_stencils, TriangleStencils, MAX_TRIANGLE_RATE};
+use crate::triangle_system::{
+    triangle_stencils_up_to, TriangleStencils, MAX_BASIS_RATE, MAX_TRIANGLE_RATE,
+};
 use crate::{Scalar, StencilError};
 
 /// Position stencils at the grid points of the butterfly EV patch.
@@ -175,7 +177,20 @@ pub fn regular_basis<S: Scalar>(
     scheme: &TriangleScheme,
     d: u32,
 ) -> Result<TriangleStencils<S>, StencilError> {
-    let exact = triangle_stencils::<BigRational>(&scheme.regular_mask(), d, StencilKind::Position)?;
+    regular_basis_kind(scheme, d, StencilKind::Position)
+}
+
+/// [`regular_basis`] or one of its derivatives along the skew axes (`DerivativeU` is
+/// `d psi / d y_1` at fixed `y_2`, normalized by Schaefer–Warren section 4's
+/// `sum_j (j_1 - y_1) psi_u(y - j) = 1`, `sum_j (j_2 - y_2) psi_u(y - j) = 0`), on the rate-`d`
+/// grid, `d <= `[`MAX_BASIS_RATE`] (the exact path reaches the dual grid's `3n`).
+pub fn regular_basis_kind<S: Scalar>(
+    scheme: &TriangleScheme,
+    d: u32,
+    kind: StencilKind,
+) -> Result<TriangleStencils<S>, StencilError> {
+    let exact =
+        triangle_stencils_up_to::<BigRational>(&scheme.regular_mask(), d, kind, MAX_BASIS_RATE)?;
     Ok(TriangleStencils {
         scheme: exact.scheme,
         n: exact.n,

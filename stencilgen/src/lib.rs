@@ -25,6 +25,7 @@
 
 pub mod bivariate_system;
 pub mod butterfly_patch;
+pub mod butterfly_regions;
 pub mod curve_stencils;
 pub mod curve_system;
 pub mod error;

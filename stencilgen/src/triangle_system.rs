@@ -103,17 +103,31 @@ fn in_support(hull: &[(i64, i64)], d: u32, n: u32, k: (i64, i64), strict: bool) 
     })
 }
 
-/// Solve the triangular-lattice system of `mask` at rate `n`.
+/// Largest rate [`triangle_stencils_up_to`] is used at: the centroids of the rate-24 grid
+/// live on `1/72`, where the butterfly table needs its regular basis (exact path only; the f64
+/// path's dense orbit factorizations are out of reach there, docs/algorithms/butterfly.md).
+pub const MAX_BASIS_RATE: u32 = 3 * MAX_TRIANGLE_RATE;
+
+/// Solve the triangular-lattice system of `mask` at rate `n` (`1..=`[`MAX_TRIANGLE_RATE`]).
 pub fn triangle_stencils<S: Scalar>(
     mask: &LatticeMask,
     n: u32,
     kind: StencilKind,
 ) -> Result<TriangleStencils<S>, StencilError> {
-    if n == 0 || n > MAX_TRIANGLE_RATE {
-        return Err(StencilError::RateOutOfRange {
-            n,
-            max: MAX_TRIANGLE_RATE,
-        });
+    triangle_stencils_up_to(mask, n, kind, MAX_TRIANGLE_RATE)
+}
+
+/// [`triangle_stencils`] with the rate bounded by `max_rate` instead (at most
+/// [`MAX_BASIS_RATE`]): for the exact path at the dual grid's rates.
+pub fn triangle_stencils_up_to<S: Scalar>(
+    mask: &LatticeMask,
+    n: u32,
+    kind: StencilKind,
+    max_rate: u32,
+) -> Result<TriangleStencils<S>, StencilError> {
+    let max = max_rate.min(MAX_BASIS_RATE);
+    if n == 0 || n > max {
+        return Err(StencilError::RateOutOfRange { n, max });
     }
     let hull = mask.hull();
     if hull.len() < 3 || mask.dilation < 2 {

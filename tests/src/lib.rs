@@ -6,3 +6,4 @@
 
 pub mod box_spline;
 pub mod bspline;
+pub mod butterfly_fan;
