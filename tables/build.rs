@@ -10,7 +10,7 @@ fn main() {
         eprintln!("OUT_DIR is not set");
         std::process::exit(1);
     };
-    let tables: [(&str, Generator); 3] = [
+    let tables: [(&str, Generator); 4] = [
         ("catmull-clark.subtess", stencilgen::table::default_table),
         (
             "catmull-clark-corners.subtess",
@@ -19,6 +19,10 @@ fn main() {
         (
             "loop.subtess",
             stencilgen::triangle_table::default_loop_table,
+        ),
+        (
+            "butterfly.subtess",
+            stencilgen::butterfly_table::default_butterfly_table,
         ),
     ];
     for (name, generate) in tables {

@@ -7,6 +7,8 @@ use std::time::Instant;
 
 use clap::{Parser, Subcommand};
 use runtime::bezier::{tessellate_bezier, BezierOptions, BezierPatches};
+use runtime::butterfly_isolate::isolate_butterfly;
+use runtime::butterfly_refine::butterfly_refine;
 use runtime::dual_grid::{tessellate, DualGrid};
 use runtime::exact_eval::{evaluate_subface, parse_rational};
 use runtime::isolate::{isolate_with_origins, Isolation};
@@ -21,6 +23,7 @@ use runtime::refine::refine;
 use runtime::stencil_table::StencilTable;
 use runtime::topology::Mesh;
 use runtime::triangle_dual_grid::{tessellate_triangles, TriangleDualGrid};
+use runtime::triangle_isolation::TriangleIsolation;
 use runtime::RuntimeError;
 
 #[derive(Parser)]
@@ -63,8 +66,8 @@ enum Command {
         /// A stencil table file instead of the embedded default.
         #[arg(long)]
         table: Option<PathBuf>,
-        /// Subdivision scheme: catmull-clark or loop (a triangle mesh; --refine then takes
-        /// Loop steps).
+        /// Subdivision scheme: catmull-clark, or loop or butterfly (a triangle mesh; --refine
+        /// then takes steps of that scheme).
         #[arg(long, default_value = "catmull-clark")]
         scheme: String,
     },
@@ -107,8 +110,8 @@ struct TessellateArgs {
     /// Output triangle mesh: .obj, .ply (with per-vertex face, u, v), .glb or .gltf.
     #[arg(short = 'o', long = "output")]
     output: PathBuf,
-    /// Subdivision scheme: catmull-clark (any polygons) or loop (triangles; the dual grid
-    /// with --rate or --rates).
+    /// Subdivision scheme: catmull-clark (any polygons), loop (triangles) or butterfly (closed
+    /// triangle meshes); the triangle schemes take --rate, --rates or --view.
     #[arg(long, default_value = "catmull-clark")]
     scheme: String,
     /// Dual points per face side, 1..=24, on every face.
@@ -168,7 +171,7 @@ enum TablesCommand {
     Info {
         /// A table file written by `stencilgen tables`.
         file: Option<PathBuf>,
-        /// Without a file: which embedded default (catmull-clark or loop).
+        /// Without a file: which embedded default (catmull-clark, loop or butterfly).
         #[arg(long, default_value = "catmull-clark", conflicts_with = "file")]
         scheme: String,
     },
@@ -272,8 +275,9 @@ fn tessellate_command(args: TessellateArgs) -> Result<(), RuntimeError> {
         }
     };
     let input = load_mesh(mesh)?;
-    if parse_scheme(&args.scheme)? == Scheme::Loop {
-        return loop_command(&args, &input);
+    let scheme = parse_scheme(&args.scheme)?;
+    if scheme.is_triangle() {
+        return triangle_command(&args, &input, scheme);
     }
     let table = load_table(&args.table, input.boundary)?;
     let iso = isolate_with_origins(&input)?;
@@ -340,6 +344,48 @@ fn tessellate_command(args: TessellateArgs) -> Result<(), RuntimeError> {
 enum Scheme {
     CatmullClark,
     Loop,
+    Butterfly,
+}
+
+impl Scheme {
+    fn name(self) -> &'static str {
+        match self {
+            Scheme::CatmullClark => "catmull-clark",
+            Scheme::Loop => "loop",
+            Scheme::Butterfly => "butterfly",
+        }
+    }
+
+    /// Whether the scheme subdivides triangles (the triangle dual grid tessellates it).
+    fn is_triangle(self) -> bool {
+        self != Scheme::CatmullClark
+    }
+
+    /// The triangle scheme's table: a file (which must be this scheme's), or the embedded
+    /// default.
+    fn triangle_table(self, table: &Option<PathBuf>) -> Result<StencilTable, RuntimeError> {
+        match (table, self) {
+            (Some(path), _) => StencilTable::read(path),
+            (None, Scheme::Butterfly) => StencilTable::default_butterfly(),
+            (None, _) => StencilTable::default_loop(),
+        }
+    }
+
+    /// Isolate a triangle mesh for this scheme's table.
+    fn isolate_triangles(self, mesh: &Mesh) -> Result<TriangleIsolation, RuntimeError> {
+        match self {
+            Scheme::Butterfly => isolate_butterfly(mesh),
+            _ => isolate_loop(mesh),
+        }
+    }
+
+    /// One subdivision step of a triangle mesh by this scheme's rules.
+    fn refine_triangles(self, mesh: &Mesh) -> Result<Mesh, RuntimeError> {
+        Ok(match self {
+            Scheme::Butterfly => butterfly_refine(mesh)?.mesh,
+            _ => loop_refine(mesh)?.mesh,
+        })
+    }
 }
 
 /// `--scheme NAME`: a scheme with a table, or an error saying which schemes exist and which
@@ -348,39 +394,37 @@ fn parse_scheme(name: &str) -> Result<Scheme, RuntimeError> {
     match name {
         "catmull-clark" => Ok(Scheme::CatmullClark),
         "loop" => Ok(Scheme::Loop),
+        "butterfly" => Ok(Scheme::Butterfly),
         other
             if schemes::triangle::TRIANGLE_SCHEME_NAMES.contains(&other)
                 || schemes::quad::QUAD_SCHEME_NAMES.contains(&other) =>
         {
             Err(RuntimeError::Unsupported(format!(
-                "scheme `{other}`: no table for this scheme yet (the runtime has tables for catmull-clark and loop)"
+                "scheme `{other}`: no table for this scheme yet (the runtime has tables for catmull-clark, loop and butterfly)"
             )))
         }
         other => Err(RuntimeError::InvalidParameter {
             name: format!("--scheme `{other}`"),
-            reason: "not a scheme; catmull-clark or loop".to_owned(),
+            reason: "not a scheme; catmull-clark, loop or butterfly".to_owned(),
         }),
     }
 }
 
-/// The Loop table: a file (which must be a Loop table), or the embedded default.
-fn load_loop_table(table: &Option<PathBuf>) -> Result<StencilTable, RuntimeError> {
-    match table {
-        Some(path) => StencilTable::read(path),
-        None => StencilTable::default_loop(),
-    }
-}
-
-/// `subtess tessellate MESH --scheme loop`: the triangle dual grid at `--rate`, `--rates` or
-/// `--view` (the projected-edge rule is the same for triangles).
-fn loop_command(args: &TessellateArgs, input: &Mesh) -> Result<(), RuntimeError> {
+/// `subtess tessellate MESH --scheme loop|butterfly`: the triangle dual grid at `--rate`,
+/// `--rates` or `--view` (the projected-edge rule is the same for triangles).
+fn triangle_command(
+    args: &TessellateArgs,
+    input: &Mesh,
+    scheme: Scheme,
+) -> Result<(), RuntimeError> {
     if args.method != "dual-grid" || args.tolerance.is_some() {
-        return Err(RuntimeError::Unsupported(
-            "--scheme loop tessellates with the dual grid at --rate, --rates or --view (no --tolerance or --method adaptive yet)".to_owned(),
-        ));
+        return Err(RuntimeError::Unsupported(format!(
+            "--scheme {} tessellates with the dual grid at --rate, --rates or --view (no --tolerance or --method adaptive yet)",
+            scheme.name()
+        )));
     }
-    let table = load_loop_table(&args.table)?;
-    let iso = isolate_loop(input)?;
+    let table = scheme.triangle_table(&args.table)?;
+    let iso = scheme.isolate_triangles(input)?;
     let rates = match (&args.rates, &args.view) {
         (Some(path), _) => read_rates(path, input.faces(), &iso.origin)?,
         (None, Some(camera)) => view_rates(&iso.mesh, camera)?,
@@ -395,7 +439,7 @@ fn loop_command(args: &TessellateArgs, input: &Mesh) -> Result<(), RuntimeError>
         let count = triangles.triangles.len();
         let loops = input.boundary_loops();
         let stats = serde_json::json!({
-            "scheme": "loop",
+            "scheme": scheme.name(),
             "triangles": count,
             "vertices": triangles.positions.len(),
             "seconds": time.seconds,
@@ -529,12 +573,13 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
             } else {
                 rate.to_string()
             };
-            if parse_scheme(&scheme)? == Scheme::Loop {
-                let table = load_loop_table(&table)?;
+            let scheme = parse_scheme(&scheme)?;
+            if scheme.is_triangle() {
+                let table = scheme.triangle_table(&table)?;
                 for _ in 0..steps {
-                    input = loop_refine(&input)?.mesh;
+                    input = scheme.refine_triangles(&input)?;
                 }
-                let iso = isolate_loop(&input)?;
+                let iso = scheme.isolate_triangles(&input)?;
                 let faces = iso.patches.len();
                 let rates = bench_rates(faces, rate, mixed);
                 let (grid, control) = pool.install(|| {
@@ -551,7 +596,7 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
                 let count = grid.triangle_count();
                 let report = serde_json::json!({
                     "mesh": mesh.display().to_string(),
-                    "scheme": "loop",
+                    "scheme": scheme.name(),
                     "faces": faces,
                     "rates": rates_label,
                     "threads": pool.current_num_threads(),
@@ -623,6 +668,11 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
             let point = match scheme {
                 Scheme::CatmullClark => evaluate_subface(&input, face, corner, &u, &v)?,
                 Scheme::Loop => LoopExactEvaluator::new(&input)?.evaluate(face, &u, &v)?,
+                Scheme::Butterfly => {
+                    return Err(RuntimeError::Unsupported(
+                        "exact evaluation of the butterfly is not implemented yet (`subtess tessellate --scheme butterfly` evaluates it from the table)".to_owned(),
+                    ))
+                }
             };
             if json {
                 let report = serde_json::json!({
@@ -647,6 +697,7 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
             };
             let table = match parse_scheme(&scheme)? {
                 Scheme::Loop if file.is_none() => StencilTable::default_loop()?,
+                Scheme::Butterfly if file.is_none() => StencilTable::default_butterfly()?,
                 _ => load_table(&file, schemes::BoundaryMode::EdgeOnly)?,
             };
             let index = table.index();

@@ -36,6 +36,12 @@ impl StencilTable {
         Self::embedded(tables::default_loop())
     }
 
+    /// The embedded default butterfly table (the modified butterfly's regions around interior
+    /// vertices of valence 3..=8; validated, checksum included).
+    pub fn default_butterfly() -> Result<Self, RuntimeError> {
+        Self::embedded(tables::default_butterfly())
+    }
+
     fn embedded(bytes: &'static [u8]) -> Result<Self, RuntimeError> {
         let index = TableIndex::parse(bytes)?;
         Ok(StencilTable {

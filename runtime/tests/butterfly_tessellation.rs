@@ -1,5 +1,11 @@
-//! Butterfly meshes end to end: isolation, the region patches and their layouts, and (with the
-//! butterfly table) the tessellation.
+//! Butterfly meshes end to end: isolation, the region patches and their layouts, and the
+//! tessellation from the default butterfly table.
+//!
+//! The butterfly interpolates, so its limit surface passes through every vertex of every
+//! refinement level: at a dyadic parameter `(i/2^m, j/2^m)` of a triangle the surface is the
+//! vertex that `m` whole-mesh butterfly steps (`runtime::butterfly_refine`, the rules written
+//! out) put there. That checks the table's stencils, the region layouts and their rotations,
+//! and the triangle dual grid's point maps together, without the solver that made the table.
 
 mod common;
 
@@ -8,13 +14,16 @@ use std::collections::HashMap;
 use runtime::butterfly_isolate::isolate_butterfly;
 use runtime::butterfly_refine::butterfly_refine;
 use runtime::cone_chart::ConeChart;
+use runtime::stencil_table::StencilTable;
 use runtime::topology::Mesh;
+use runtime::triangle_dual_grid::TriangleDualGrid;
 use runtime::triangle_isolation::TriangleIsolation;
+use runtime::triangle_split::child_to_parent;
 use schemes::butterfly_regions::ButterflyRegions;
 use schemes::triangle_local::{canonical_triangle_point, TrianglePoint};
 use schemes::TriangleScheme;
 
-use common::{icosahedron, load, models, octahedron, tetrahedron, torus};
+use common::{check_topology, icosahedron, load, models, octahedron, tetrahedron, torus};
 
 fn regions_of(iso: &TriangleIsolation) -> Vec<(u32, u32)> {
     let mut kinds: Vec<(u32, u32)> = iso
@@ -176,4 +185,95 @@ fn time_spot_isolation() {
     let t = std::time::Instant::now();
     let _ = butterfly_refine(&iso.mesh).expect("refines");
     println!("one refinement of the isolated mesh {:?}", t.elapsed());
+}
+
+/// The child of a triangle holding the point `(u, v) / 2d` of the parent, and the point in the
+/// child's own parameters over `d` (the inverse of `child_to_parent`).
+fn child_holding(u: u32, v: u32, d: u32) -> (u8, u32, u32) {
+    let (u, v, d) = (i64::from(u), i64::from(v), i64::from(d));
+    let candidates = [
+        (0u8, u, v),
+        (1, v, 2 * d - u - v),
+        (2, 2 * d - u - v, u),
+        (3, v - d + u, d - u),
+    ];
+    for (c, s, t) in candidates {
+        if s >= 0 && t >= 0 && s + t <= d {
+            let (s, t) = (s as u32, t as u32);
+            assert_eq!(child_to_parent(c, s, t, d as u32), (u as u32, v as u32));
+            return (c, s, t);
+        }
+    }
+    panic!("({u}, {v}) / {} is outside the triangle", 2 * d)
+}
+
+/// The vertex of the `m`-times refined mesh at the dyadic point `(u, v) / 2^m` of triangle `f`.
+fn refined_vertex(levels: &[Mesh], f: usize, u: u32, v: u32, m: usize) -> u32 {
+    let (mut f, mut u, mut v, mut d) = (f, u, v, 1u32 << m);
+    for _ in 0..m {
+        let (c, s, t) = child_holding(u, v, d / 2);
+        (f, u, v, d) = (4 * f + c as usize, s, t, d / 2);
+    }
+    let corner = match (u, v) {
+        (0, 0) => 0,
+        (1, 0) => 1,
+        _ => 2,
+    };
+    levels[m].face(f)[corner]
+}
+
+/// Every output vertex at a dyadic source equals the refined mesh's vertex there; `rate` is a
+/// power of two.
+fn check_against_refinement(name: &str, table: &StencilTable, iso: &TriangleIsolation, rate: u32) {
+    let m = rate.trailing_zeros() as usize;
+    let mut levels = vec![iso.mesh.clone()];
+    for _ in 0..m {
+        let next = butterfly_refine(&levels[levels.len() - 1])
+            .expect("refines")
+            .mesh;
+        levels.push(next);
+    }
+    let rates = vec![rate; iso.mesh.faces()];
+    let grid = TriangleDualGrid::new(table, &iso.mesh, &iso.patches, &rates)
+        .unwrap_or_else(|e| panic!("{name}: plan: {e}"));
+    let out = grid.tessellate(&iso.mesh);
+    let scale = iso
+        .mesh
+        .positions
+        .iter()
+        .flatten()
+        .fold(0.0f64, |a, c| a.max(c.abs()));
+    let mut checked = 0;
+    let mut worst = 0.0f64;
+    for (p, s) in out.positions.iter().zip(&out.sources) {
+        if s.denominator != rate {
+            continue;
+        }
+        let w = refined_vertex(&levels, s.face as usize, s.u, s.v, m);
+        let q = levels[m].positions[w as usize];
+        for c in 0..3 {
+            worst = worst.max((f64::from(p[c]) - q[c]).abs() / scale);
+        }
+        checked += 1;
+    }
+    println!("{name}: {checked} dyadic vertices, worst relative error {worst:.2e}");
+    assert!(checked > 0, "{name}: nothing checked");
+    assert!(worst < 2e-6, "{name}: {worst:.2e}");
+    check_topology(&iso.mesh, &out, name);
+}
+
+#[test]
+fn the_surface_passes_through_every_refined_vertex() {
+    let table = StencilTable::default_butterfly().expect("embedded butterfly table");
+    for (name, m) in [
+        ("tetrahedron", tetrahedron()),
+        ("octahedron", octahedron()),
+        ("icosahedron", icosahedron()),
+        ("torus", torus(12, 12)),
+    ] {
+        let iso = isolate_butterfly(&m).unwrap_or_else(|e| panic!("{name}: {e}"));
+        for rate in [1, 2, 4, 8] {
+            check_against_refinement(&format!("{name} at rate {rate}"), &table, &iso, rate);
+        }
+    }
 }

@@ -168,11 +168,13 @@ fn tile_weights<S: Scalar>(
 
 /// The butterfly's regular basis function on the rate-`d` grid, in the field `S`.
 ///
-/// The regular mask is rational at every valence, so `psi` is always solved exactly and then
-/// rounded: the exact path solves each residue cycle on one support width and substitutes
-/// along the trees, while the f64 path factors whole orbits densely, which for the butterfly's
-/// radius-3 support is far slower (rate 8: 17 s in f64 against 0.04 s exact; rate 24: 1.1 s
-/// exact, see docs/algorithms/butterfly.md) and no more accurate.
+/// The regular mask is rational at every valence, so `psi` is solved exactly and then rounded,
+/// except at odd rates in an inexact field: the exact path solves each residue cycle on one
+/// support width and substitutes along the trees, while the f64 path factors whole orbits
+/// densely. With trees (even rates) that makes f64 far slower (rate 8: 17 s in f64 against
+/// 0.04 s exact; rate 24: 1.1 s exact, see docs/algorithms/butterfly.md); at an odd rate every
+/// class lies on a cycle, the orbits are the cycles, and the exact arithmetic is what costs
+/// (rate 21: 12 s exact against 0.5 s in f64, which agrees within 1e-12).
 pub fn regular_basis<S: Scalar>(
     scheme: &TriangleScheme,
     d: u32,
@@ -189,8 +191,11 @@ pub fn regular_basis_kind<S: Scalar>(
     d: u32,
     kind: StencilKind,
 ) -> Result<TriangleStencils<S>, StencilError> {
-    let exact =
-        triangle_stencils_up_to::<BigRational>(&scheme.regular_mask(), d, kind, MAX_BASIS_RATE)?;
+    let mask = scheme.regular_mask();
+    if !S::EXACT && d % 2 == 1 {
+        return triangle_stencils_up_to::<S>(&mask, d, kind, MAX_BASIS_RATE);
+    }
+    let exact = triangle_stencils_up_to::<BigRational>(&mask, d, kind, MAX_BASIS_RATE)?;
     Ok(TriangleStencils {
         scheme: exact.scheme,
         n: exact.n,
@@ -479,6 +484,24 @@ mod tests {
             assert!(ButterflySubstitution::<BigRational>::new(&butterfly(), k).is_err());
         }
         assert!(butterfly_patch_stencils::<f64>(&butterfly(), 5, 2).is_ok());
+    }
+
+    /// At odd rates the f64 field solves in f64 directly: the same values as the exact solve,
+    /// rounded, within 1e-12.
+    #[test]
+    fn odd_rates_in_f64_agree_with_the_exact_basis() {
+        for kind in [
+            StencilKind::Position,
+            StencilKind::DerivativeU,
+            StencilKind::DerivativeV,
+        ] {
+            let float = regular_basis_kind::<f64>(&butterfly(), 9, kind).expect("f64");
+            let exact = regular_basis_kind::<BigRational>(&butterfly(), 9, kind).expect("exact");
+            assert_eq!(float.values.len(), exact.values.len());
+            for (a, b) in float.values.iter().zip(&exact.values) {
+                assert!((a - b.to_f64()).abs() < 1e-12, "{kind:?}: {a} vs {b}");
+            }
+        }
     }
 
     #[test]

@@ -26,6 +26,7 @@
 pub mod bivariate_system;
 pub mod butterfly_patch;
 pub mod butterfly_regions;
+pub mod butterfly_table;
 pub mod curve_stencils;
 pub mod curve_system;
 pub mod error;

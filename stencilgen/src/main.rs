@@ -16,6 +16,7 @@ use schemes::triangle::TRIANGLE_SCHEME_NAMES;
 use schemes::{BoundaryMode, CurveScheme, QuadScheme, TriangleScheme};
 use serde_json::{json, Value};
 use stencilgen::butterfly_patch::ButterflySubstitution;
+use stencilgen::butterfly_table::{build_butterfly_table, ButterflyTableSpec};
 use stencilgen::extraordinary_patch::{canonical, Neighbourhood, OUTER_POINTS};
 use stencilgen::patch_stencils::{curve_scheme, quad_scheme};
 use stencilgen::rational::parse_rational;
@@ -93,8 +94,8 @@ enum Command {
     },
     /// Write a versioned binary stencil table (docs/table-format.md).
     Tables {
-        /// Schemes, comma separated: quad schemes, or `loop` (one file each; with several, the
-        /// scheme name is appended to the file stem).
+        /// Schemes, comma separated: quad schemes, `loop` or `butterfly` (one file each; with
+        /// several, the scheme name is appended to the file stem).
         #[arg(long, default_value = "catmull-clark", value_delimiter = ',')]
         schemes: Vec<String>,
         /// Interior valences: a range `3..8` (inclusive) or a list `3,5,6`.
@@ -269,6 +270,23 @@ fn run(cli: Cli) -> Result<(), StencilError> {
                             reason: "triangle tables are generated from the f64 path (the tests check it against exact substitution within 1e-12)".to_owned(),
                         });
                     }
+                    let started = std::time::Instant::now();
+                    if triangle.name == "butterfly" {
+                        if boundary {
+                            return Err(StencilError::UnsupportedScheme {
+                                scheme: name.clone(),
+                                reason: "the butterfly's boundary rules are not implemented"
+                                    .to_owned(),
+                            });
+                        }
+                        let spec = ButterflyTableSpec {
+                            valences: set.valences.clone(),
+                            rates: set.rates.clone(),
+                            precision,
+                        };
+                        write_bytes(&path, &build_butterfly_table(&spec)?, started)?;
+                        continue;
+                    }
                     let spec = TriangleTableSpec {
                         scheme: triangle,
                         valences: set.valences.clone(),
@@ -276,7 +294,6 @@ fn run(cli: Cli) -> Result<(), StencilError> {
                         rates: set.rates.clone(),
                         precision,
                     };
-                    let started = std::time::Instant::now();
                     let bytes = build_triangle_table(&spec)?;
                     write_bytes(&path, &bytes, started)?;
                     continue;

@@ -178,6 +178,8 @@ pub enum SchemeId {
     SwNonpolyQuad = 2,
     /// Loop with Warren's rational weights (a triangle scheme: triangle point sets).
     Loop = 3,
+    /// The modified butterfly (a triangle scheme; `sector` numbers a vertex's regions).
+    Butterfly = 4,
 }
 
 impl SchemeId {
@@ -187,12 +189,13 @@ impl SchemeId {
             SchemeId::CatmullClark => "catmull-clark",
             SchemeId::SwNonpolyQuad => "sw-nonpoly-quad",
             SchemeId::Loop => "loop",
+            SchemeId::Butterfly => "butterfly",
         }
     }
 
     /// Whether the scheme subdivides triangles (its sections use the triangle point sets).
     pub fn is_triangle(self) -> bool {
-        matches!(self, SchemeId::Loop)
+        matches!(self, SchemeId::Loop | SchemeId::Butterfly)
     }
 
     /// From the catalogue name.
@@ -201,6 +204,7 @@ impl SchemeId {
             SchemeId::CatmullClark,
             SchemeId::SwNonpolyQuad,
             SchemeId::Loop,
+            SchemeId::Butterfly,
         ]
         .into_iter()
         .find(|s| s.name() == name)
@@ -211,6 +215,7 @@ impl SchemeId {
             1 => Some(SchemeId::CatmullClark),
             2 => Some(SchemeId::SwNonpolyQuad),
             3 => Some(SchemeId::Loop),
+            4 => Some(SchemeId::Butterfly),
             _ => None,
         }
     }
@@ -292,7 +297,8 @@ pub struct SectionKey {
     pub boundary: bool,
     /// The vertex's valence (interior) or number of faces (boundary).
     pub faces: u32,
-    /// Which of a boundary vertex's patches (0 for interior vertices).
+    /// Which of a boundary vertex's patches (0 for interior vertices); for the butterfly, which
+    /// of an interior vertex's regions (`schemes::butterfly_regions`).
     pub sector: u32,
     /// Grid rate.
     pub n: u32,
@@ -315,6 +321,12 @@ impl fmt::Display for SectionKey {
             write!(
                 f,
                 "{kind} on the {grid} grid, n = {}, boundary vertex with {} faces, sector {}",
+                self.n, self.faces, self.sector
+            )
+        } else if self.sector != 0 {
+            write!(
+                f,
+                "{kind} on the {grid} grid, n = {}, valence {}, region {}",
                 self.n, self.faces, self.sector
             )
         } else {

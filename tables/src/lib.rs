@@ -1,5 +1,5 @@
 //! The default stencil tables, embedded: the Catmull–Clark table, its small pinned-corner
-//! companion, and the Loop table.
+//! companion, the Loop table and the butterfly table.
 //!
 //! The default Catmull–Clark table (interior valences 3..=8, boundary vertices with 1..=6 faces
 //! "edge only", n = 1..=24, primal and dual grids, positions and both derivatives, f32) is about
@@ -26,6 +26,11 @@ static CATMULL_CLARK_CORNERS: &Aligned<[u8]> = &Aligned(*include_bytes!(concat!(
 
 static LOOP: &Aligned<[u8]> = &Aligned(*include_bytes!(concat!(env!("OUT_DIR"), "/loop.subtess")));
 
+static BUTTERFLY: &Aligned<[u8]> = &Aligned(*include_bytes!(concat!(
+    env!("OUT_DIR"),
+    "/butterfly.subtess"
+)));
+
 /// The default Catmull–Clark table's bytes (64-byte aligned).
 pub fn default_catmull_clark() -> &'static [u8] {
     &CATMULL_CLARK.0
@@ -46,6 +51,15 @@ pub fn default_loop() -> &'static [u8] {
     &LOOP.0
 }
 
+/// The default butterfly table's bytes (64-byte aligned): the nine regions of interior vertices
+/// of valence 3..=8 (region 0 only at valence 6, the regular patch), n = 1..=8, triangle primal
+/// and dual grids, positions and both derivatives, f32
+/// (`stencilgen::butterfly_table::ButterflyTableSpec::default_butterfly`; 5.3 MiB). Rates up
+/// to 24 need a table written by `stencilgen tables --schemes butterfly`.
+pub fn default_butterfly() -> &'static [u8] {
+    &BUTTERFLY.0
+}
+
 #[cfg(test)]
 mod tests {
     #[test]
@@ -54,6 +68,7 @@ mod tests {
             super::default_catmull_clark(),
             super::default_catmull_clark_corners(),
             super::default_loop(),
+            super::default_butterfly(),
         ] {
             assert_eq!(bytes.as_ptr() as usize % 64, 0);
             assert_eq!(&bytes[..8], b"SUBTESS\0");

@@ -53,3 +53,22 @@ fn regenerated_loop_table_is_byte_identical() {
         table.coverage()
     );
 }
+
+#[test]
+fn regenerated_butterfly_table_is_byte_identical() {
+    let fresh = stencilgen::butterfly_table::default_butterfly_table()
+        .expect("the butterfly table generates");
+    let embedded = tables::default_butterfly();
+    assert!(
+        fresh == embedded,
+        "the embedded butterfly table differs from a fresh generation"
+    );
+    let table = table_format::Table::parse(embedded).expect("the embedded table is valid");
+    assert_eq!(table.meta.scheme, table_format::SchemeId::Butterfly);
+    println!(
+        "butterfly table: {} bytes, {} sections; {}",
+        table.size(),
+        table.entries.len(),
+        table.coverage()
+    );
+}
