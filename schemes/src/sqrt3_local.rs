@@ -16,16 +16,17 @@
 //! level-`(k+1)` points are all integer points:
 //!
 //! ```text
-//!   level-1 coordinates around V (sector 0; o level 0, x half level, . level 1)
+//!   level-1 coordinates of sector 0 (o level 0, x half level, . level 1 only)
 //!
-//!     o . . o . . o
-//!      . x . . x .
-//!       . . x . .        the half-level point (1,1) is the centroid of V, E_0, E_1,
-//!        o . . o         (2,2) that of E_0, E_1, (3,3)_0 = (1,1) of level 0
-//!         . x .
-//!          . .           the level-1 point (1,0) is the centroid of V, (1,1)_0, (1,1)_{K-1}
-//!           V . . E_0
+//!           E1  .   .   o          (0,3)  (1,3)  (2,3)  (3,3)
+//!         .   .   x   .          (0,2)  (1,2)  (2,2)  (3,2)
+//!       .   x   .   .          (0,1)  (1,1)  (2,1)  (3,1)
+//!     V   .   .   E0         (0,0)  (1,0)  (2,0)  (3,0)
 //! ```
+//!
+//! The half-level point `(1,1)` is the centroid of `V, E_0, E_1`, `(2,2)` that of
+//! `E_0, E_1, (3,3)`; the level-1 point `(1,0)` is the centroid of the half-level triangle
+//! `V, (1,1)_0, (1,1)_{K-1}`.
 //!
 //! **Rules** (Kobbelt 2000). One √3 step: every triangle gets its centroid, and every old
 //! vertex of valence `v` moves to `(1 - alpha_v) p + (alpha_v / v) sum` of its `v` neighbours,
@@ -49,9 +50,9 @@
 //! each ring counter-clockwise from `E_0`'s direction (sector, then `b`); `3K + 9` points, the
 //! butterfly's layout shape. Why radius 2: the regular basis `psi` of the two-step mask is
 //! supported on `S = H / 2`, `H` the hull of the mask's 73 indices (a 12-gon with corners
-//! `(5,-1)`, `(4,1)` and their turns; `S` reaches `2.25` along the lattice directions), so the
-//! level-0 points at graph distance 2 from the patch influence it and those at distance 3
-//! (at least `3√3/2 > 2.3` away) do not. Both closures are checked when the matrices are built
+//! `(5,-1)`, `(4,1)` and their turns; `S` reaches `2.25` along the lattice directions and
+//! `√21/2 < 2.3` at its corners), so level-0 points at graph distance 2 from the patch influence
+//! it and those at distance 3 (at least `3√3/2 > 2.5` away) do not. Both closures are checked when the matrices are built
 //! (a rule reading an unlisted point is an error), and radius 1 fails.
 //!
 //! **A** (`N x N`): row `i` is the level-1 layout point `i` in level-0 layout weights, so
