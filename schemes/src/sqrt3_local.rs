@@ -165,17 +165,25 @@ pub fn point_name(p: TrianglePoint) -> String {
 trait Weight: Clone + Zero + Add<Output = Self> + Mul<Output = Self> {
     /// The weight in this field, `None` if it is irrational and the field exact.
     fn from_weight(w: TriangleWeight) -> Option<Self>;
+    /// `1`.
+    fn one_weight() -> Self;
 }
 
 impl Weight for f64 {
     fn from_weight(w: TriangleWeight) -> Option<Self> {
         Some(w.value)
     }
+    fn one_weight() -> Self {
+        1.0
+    }
 }
 
 impl Weight for BigRational {
     fn from_weight(w: TriangleWeight) -> Option<Self> {
         w.exact.map(big)
+    }
+    fn one_weight() -> Self {
+        BigRational::from_integer(BigInt::from(1))
     }
 }
 
@@ -417,8 +425,7 @@ impl<T: Weight> Rows<'_, T> {
                 .index
                 .get(&p)
                 .ok_or_else(|| format!("level-0 point {} is not in the layout", point_name(p)))?;
-            r[i] = T::from_weight(TriangleWeight::ratio(1, 1))
-                .ok_or_else(|| "1 is rational".to_owned())?;
+            r[i] = T::one_weight();
         } else {
             for (parent, w) in self.rules.refine(p)? {
                 let pr = self.row(k - 1, parent)?;

@@ -336,6 +336,22 @@ impl<S: Scalar> Sqrt3Substitution<S> {
         })
     }
 
+    /// Hand over the regular basis at one rate (it does not depend on the valence), so that
+    /// substitutions at several valences, or a grid system and a substitution, solve it once.
+    /// `psi` must be √3's ternary basis ([`sqrt3_regular_basis`]); an error otherwise.
+    pub fn share_basis(&mut self, psi: TriangleStencils<S>) -> Result<(), StencilError> {
+        if psi.dilation != 3 || psi.kind != StencilKind::Position || psi.scheme != self.scheme.name
+        {
+            return Err(StencilError::UnsupportedScheme {
+                scheme: psi.scheme,
+                reason: "the basis handed to a sqrt3 substitution must be sqrt3's position basis"
+                    .to_owned(),
+            });
+        }
+        self.bases.insert(psi.n, psi);
+        Ok(())
+    }
+
     /// The `N` position weights at `(u, v)`, `u, v >= 0`, `u + v <= 1`: triple `x` `k` times
     /// until `u + v > 1/3`, take the regular tile's weights at `9x`, apply `A` `k` times
     /// (`phi(x) = phi(3x) A`). At `(0, 0)`: [`Self::limit_mask`].
@@ -481,6 +497,10 @@ mod tests {
         assert!(sqrt3_patch_stencils::<f64>(&sqrt3(), 5, 0).is_err());
         assert!(sqrt3_patch_stencils::<f64>(&sqrt3(), 5, 25).is_err());
         let loop_ = TriangleScheme::by_name("loop").expect("catalogued");
+        let loop_basis =
+            triangle_stencils::<BigRational>(&loop_.regular_mask(), 2, StencilKind::Position)
+                .expect("solvable");
+        assert!(s.share_basis(loop_basis).is_err());
         assert!(matches!(
             sqrt3_patch_stencils::<f64>(&loop_, 5, 2),
             Err(StencilError::UnsupportedScheme { .. })

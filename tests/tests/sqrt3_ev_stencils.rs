@@ -52,9 +52,10 @@ fn exact(k: u32, n: u32) -> Sqrt3PatchStencils<BigRational> {
     sqrt3_patch_stencils_at(&matrices(k), &basis(n), &triangle_grid_points(n), n).expect("solvable")
 }
 
-fn float(k: u32, n: u32) -> Sqrt3PatchStencils<f64> {
+/// [`basis`] rounded to f64.
+fn float_basis(n: u32) -> TriangleStencils<f64> {
     let psi = basis(n);
-    let psi = TriangleStencils {
+    TriangleStencils {
         values: psi.values.iter().map(rational_to_f64).collect(),
         scheme: psi.scheme,
         n: psi.n,
@@ -63,8 +64,12 @@ fn float(k: u32, n: u32) -> Sqrt3PatchStencils<f64> {
         hull: psi.hull,
         bbox: psi.bbox,
         residual: psi.residual,
-    };
-    sqrt3_patch_stencils_at(&matrices(k), &psi, &triangle_grid_points(n), n).expect("solvable")
+    }
+}
+
+fn float(k: u32, n: u32) -> Sqrt3PatchStencils<f64> {
+    sqrt3_patch_stencils_at(&matrices(k), &float_basis(n), &triangle_grid_points(n), n)
+        .expect("solvable")
 }
 
 fn layout(k: u32) -> Vec<TrianglePoint> {
@@ -81,6 +86,7 @@ fn grid_system_equals_substitution_exactly_for_rational_valences() {
     for k in [3, 4, 6] {
         let mut sub = Sqrt3Substitution::<BigRational>::new(&sqrt3(), k).expect("valid");
         for n in 1..=6 {
+            sub.share_basis(basis(n)).expect("sqrt3's basis");
             let grid = exact(k, n);
             assert_eq!(grid.residual, 0.0);
             for (&(i, j), stencil) in grid.points.iter().zip(&grid.stencils) {
@@ -98,6 +104,7 @@ fn grid_system_equals_substitution_in_f64_for_every_valence() {
     for k in 3..=8 {
         let mut sub = Sqrt3Substitution::<f64>::new(&sqrt3(), k).expect("valid");
         for n in [1, 2, 3, 4, 6, 9] {
+            sub.share_basis(float_basis(n)).expect("sqrt3's basis");
             let grid = float(k, n);
             assert!(grid.residual < 1e-12, "K = {k} n = {n}: {}", grid.residual);
             for (&(i, j), stencil) in grid.points.iter().zip(&grid.stencils) {
@@ -593,6 +600,7 @@ fn grid_system_equals_substitution_at_every_rate_up_to_24() {
         let psi = sqrt3_regular_basis::<f64>(&scheme, n).expect("solvable");
         let points = triangle_grid_points(n);
         for (m, sub) in matrices.iter().zip(subs.iter_mut()) {
+            sub.share_basis(psi.clone()).expect("sqrt3's basis");
             let grid = sqrt3_patch_stencils_at(m, &psi, &points, n).expect("solvable");
             for (&(i, j), stencil) in grid.points.iter().zip(&grid.stencils) {
                 let by_substitution = sub
