@@ -20,6 +20,7 @@ pub mod curve;
 pub mod local_matrices;
 pub mod loop_regular;
 pub mod quad;
+pub mod sqrt3_local;
 pub mod triangle;
 pub mod triangle_local;
 

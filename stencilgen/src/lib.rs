@@ -43,6 +43,7 @@ pub mod regular_patch;
 pub mod scalar;
 pub mod scaling_system;
 pub mod solve;
+pub mod sqrt3_patch;
 pub mod stencil_set;
 pub mod substitution;
 pub mod table;

@@ -3,7 +3,7 @@
 //! `stencilgen curve --scheme NAME --n N [--derivative] [--f64] [--json]` prints the values of
 //! a curve scheme's basis function(s) (or their derivatives) on the grid `(1/n) Z`;
 //! `stencilgen stencil --scheme S --valence V --u p/q --v p/q [--f64] [--json]` the stencil of
-//! the patch next to an extraordinary vertex (quad schemes, and Loop); `stencilgen triangle --scheme S --n N` the regular
+//! the patch next to an extraordinary vertex (quad schemes, Loop, the butterfly and √3); `stencilgen triangle --scheme S --n N` the regular
 //! basis function of a triangle scheme on `(1/n) Z^2`. See `docs/cli.md` for the JSON layouts.
 
 use std::process::ExitCode;
@@ -21,6 +21,7 @@ use stencilgen::extraordinary_patch::{canonical, Neighbourhood, OUTER_POINTS};
 use stencilgen::patch_stencils::{curve_scheme, quad_scheme};
 use stencilgen::rational::parse_rational;
 use stencilgen::regular_patch::StencilKind;
+use stencilgen::sqrt3_patch::Sqrt3Substitution;
 use stencilgen::stencil_set::StencilSetSpec;
 use stencilgen::substitution::Substitution;
 use stencilgen::table::{build_table, TableSpec};
@@ -63,8 +64,9 @@ enum Command {
     },
     /// Stencil of the patch next to an extraordinary vertex at a rational (u, v).
     Stencil {
-        /// Quad scheme name (catmull-clark, sw-nonpoly-quad), or `loop` (interior vertices;
-        /// (u, v) barycentric on the triangle V, E0, E1).
+        /// Quad scheme name (catmull-clark, sw-nonpoly-quad), or a triangle scheme: `loop`
+        /// (interior and boundary vertices), `butterfly` or `sqrt3` (interior vertices); (u, v)
+        /// barycentric on the triangle V, E0, E1.
         #[arg(long)]
         scheme: String,
         /// Valence of the (interior) extraordinary vertex at (0, 0).
@@ -356,6 +358,20 @@ fn run(cli: Cli) -> Result<(), StencilError> {
                             json!(x.to_string())
                         })?
                     }
+                } else if triangle.name == "sqrt3" {
+                    let TrianglePatchChoice::Interior(valence) = patch else {
+                        return Err(StencilError::UnsupportedScheme {
+                            scheme,
+                            reason: "sqrt3 has no boundary rules here; give --valence".to_owned(),
+                        });
+                    };
+                    if float {
+                        sqrt3_stencil_json::<f64>(&triangle, valence, &u, &v, |x| json!(x))?
+                    } else {
+                        sqrt3_stencil_json::<BigRational>(&triangle, valence, &u, &v, |x| {
+                            json!(x.to_string())
+                        })?
+                    }
                 } else if float {
                     triangle_stencil_json::<f64>(&triangle, patch, &u, &v, |x| json!(x))?
                 } else {
@@ -552,6 +568,33 @@ fn butterfly_stencil_json<S: Scalar>(
         "du": Value::Null,
         "dv": Value::Null,
         "note": "the butterfly's derivative stencils are not built yet",
+    }))
+}
+
+/// √3's patch next to an interior vertex (two √3 steps as one ternary step): positions only
+/// (its derivative stencils and tangent masks are not built yet, so `du`/`dv` are `null` with
+/// a note).
+fn sqrt3_stencil_json<S: Scalar>(
+    scheme: &TriangleScheme,
+    valence: u32,
+    u: &BigRational,
+    v: &BigRational,
+    value: impl Fn(&S) -> Value,
+) -> Result<Value, StencilError> {
+    let mut substitution = Sqrt3Substitution::<S>::new(scheme, valence)?;
+    let weights = substitution.stencil(u, v)?;
+    Ok(json!({
+        "scheme": scheme.name,
+        "valence": valence,
+        "boundary": false,
+        "u": u.to_string(),
+        "v": v.to_string(),
+        "exact": S::EXACT,
+        "order": substitution.matrices.names(),
+        "weights": weights.iter().map(&value).collect::<Vec<_>>(),
+        "du": Value::Null,
+        "dv": Value::Null,
+        "note": "the sqrt3 derivative stencils are not built yet",
     }))
 }
 

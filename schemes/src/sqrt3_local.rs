@@ -1,0 +1,766 @@
+//! √3 subdivision (Kobbelt 2000) around an interior extraordinary vertex of valence `K`: the
+//! patch layout, the local subdivision matrix `A` of two √3 steps and the regular tiles of the
+//! patch's outer part with their control points as rows of level-0 weights
+//! (Schaefer–Warren sections 5.1–5.3: two √3 steps are one ternary step aligned with the
+//! original lattice). Data only: `stencilgen::sqrt3_patch` solves with them.
+//!
+//! **Sectors and the patch** are those of [`crate::triangle_local`]: sector `s` holds the points
+//! `(a, b)`, `a >= 1`, `b >= 0`, of its own skew chart, named by [`canonical_triangle_point`];
+//! the patch is the triangle `V, E_0, E_1` of sector 0, `(u, v)` barycentric, `V` at `(0, 0)`.
+//!
+//! **Levels.** "Level `k`" is the ternary level: `2k` √3 steps. In level-`(k+1)` integer skew
+//! coordinates (level-`k` coordinates times 3) of a sector's chart, the level-`k` points are
+//! the multiples of 3, the points after one more √3 step (the half level) are those with
+//! `a = b (mod 3)` (the old vertices and the centroids of the old triangles, the classes
+//! `(0,0)`, `(1,1)`, `(2,2)` mod 3: a lattice turned by 30 degrees with spacing `1/√3`), and the
+//! level-`(k+1)` points are all integer points:
+//!
+//! ```text
+//!   level-1 coordinates of sector 0 (o level 0, x half level, . level 1 only)
+//!
+//!           E1  .   .   o          (0,3)  (1,3)  (2,3)  (3,3)
+//!         .   .   x   .          (0,2)  (1,2)  (2,2)  (3,2)
+//!       .   x   .   .          (0,1)  (1,1)  (2,1)  (3,1)
+//!     V   .   .   E0         (0,0)  (1,0)  (2,0)  (3,0)
+//! ```
+//!
+//! The half-level point `(1,1)` is the centroid of `V, E_0, E_1`, `(2,2)` that of
+//! `E_0, E_1, (3,3)`; the level-1 point `(1,0)` is the centroid of the half-level triangle
+//! `V, (1,1)_0, (1,1)_{K-1}`.
+//!
+//! **Rules** (Kobbelt 2000). One √3 step: every triangle gets its centroid, and every old
+//! vertex of valence `v` moves to `(1 - alpha_v) p + (alpha_v / v) sum` of its `v` neighbours,
+//! `alpha_v = (4 - 2 cos(2π/v))/9` ([`TriangleVertexRule::Sqrt3`]); the old edges are flipped.
+//! Old vertices keep their valence, centroids have valence 6, so only `V` is extraordinary. At
+//! the half level `V`'s neighbours are the `K` centroids `(1,1)_s` (level-`(k+1)` coordinates),
+//! at level `k + 1` the `K` centroids `(1,0)_s` on the original edges' directions. Every rule
+//! reads a one-ring, which develops into the point's sector chart turned at most one sector
+//! either way, so [`canonical_triangle_point`] names the true vertices at every `K >= 3`.
+//!
+//! **The layout** is the graph-distance ball of radius [`LAYOUT_RADIUS`] around `{V, E_0, E_1}`
+//! on the `K`-valent cone, in this order ([`sqrt3_layout`]):
+//!
+//! ```text
+//!   V                                       the vertex
+//!   ring 1: E_0 ..= E_{K-1}                 (1, 0) of sectors 0..K
+//!   ring 2: (2,0)_0 (1,1)_0 (2,0)_1 ...     every (a, b), a + b = 2, of every sector
+//!   ring 3: (3,0)_0 (2,1)_0 (1,2)_0 (3,0)_1 (2,1)_1 (1,2)_1 (2,1)_{K-1} (1,2)_{K-1}
+//! ```
+//!
+//! each ring counter-clockwise from `E_0`'s direction (sector, then `b`); `3K + 9` points, the
+//! butterfly's layout shape. Why radius 2: the regular basis `psi` of the two-step mask is
+//! supported on `S = H / 2`, `H` the hull of the mask's 73 indices (a 12-gon with corners
+//! `(5,-1)`, `(4,1)` and their turns; `S` reaches `2.25` along the lattice directions and
+//! `√21/2 < 2.3` at its corners), so level-0 points at graph distance 2 from the patch influence
+//! it and those at distance 3 (at least `3√3/2 > 2.5` away) do not. Both closures are checked when the matrices are built
+//! (a rule reading an unlisted point is an error), and radius 1 fails.
+//!
+//! **A** (`N x N`): row `i` is the level-1 layout point `i` in level-0 layout weights, so
+//! `phi(x) = phi(3x) A` for `u + v <= 1/3`.
+//!
+//! **Regular tiles.** A level-`L` triangle `T` (level-`L` coordinates) is regular — the surface
+//! on it is `sum_j psi(y - j) p^L_j` over the unfolded lattice — when `V` is outside
+//! `T + int S`: the level-`(L+m)` points influencing `T` lie in `T + int S / 3^m`, their parents
+//! in `T + int S / 3^(m-1)` (`S/3 + H/3 = S`), so none of them, and none of the half-level
+//! points between (the mask is positive), is `V`, the only point with an irregular rule; and a
+//! convex region without `V` spans less than 180 degrees, so it develops into sector 0's chart
+//! without overlapping itself (the cone has at least 180 degrees). In integers: `2T` does not
+//! meet `int H`. [`Sqrt3LocalMatrices::tile_level`] is the smallest `L` for which every level-`L`
+//! triangle of `1/3 <= u + v <= 1` passes: `L = 2` (four √3 steps; the level-1 triangle
+//! `(1,0), (1,1), (0,1)` doubled meets `int H`), 72 tiles. Each tile's control points, the
+//! level-`L` lattice points `j` with `T ∩ (j + int S)` nonempty, are rows of level-0 layout
+//! weights after `L` ternary steps of the true rules.
+//!
+//! **Numbers.** Every matrix is kept in f64 (the weights' f64 values) and, when `alpha_K` is
+//! rational (`K = 3, 4, 6`), also exactly as [`BigRational`].
+//!
+//! The cone ball and the separating-axis test duplicate private helpers of
+//! [`crate::butterfly_local`] (to be shared later).
+
+use std::collections::{BTreeMap, HashMap, VecDeque};
+use std::ops::{Add, Mul};
+
+use num_bigint::BigInt;
+use num_rational::{BigRational, Rational64};
+use num_traits::Zero;
+
+use crate::local_matrices::UnsupportedNeighbourhood;
+use crate::triangle::{TriangleRefinement, NEIGHBOURS};
+use crate::triangle_local::{canonical_triangle_point, TrianglePoint};
+use crate::{TriangleScheme, TriangleVertexRule, TriangleWeight};
+
+/// The graph distance from `{V, E_0, E_1}` that the layout reaches (the smallest that works,
+/// see the module docs).
+pub const LAYOUT_RADIUS: u32 = 2;
+
+/// The six neighbours of a half-level point among the half-level points (level-`(k+1)`
+/// coordinates), counter-clockwise: the steps of the lattice `a = b (mod 3)` turned by 30
+/// degrees.
+pub const HALF_LEVEL_STEPS: [(i64, i64); 6] =
+    [(1, 1), (-1, 2), (-2, 1), (-1, -1), (1, -2), (2, -1)];
+
+/// The layout of valence `valence` in table order (see the module docs): the ball of graph
+/// radius [`LAYOUT_RADIUS`] around the patch.
+pub fn sqrt3_layout(valence: u32) -> Vec<TrianglePoint> {
+    layout_ball(valence, LAYOUT_RADIUS)
+}
+
+/// The graph-distance ball of radius `radius` around `{V, E_0, E_1}` on the cone, ordered by
+/// ring (distance from `V`), then sector, then `b`.
+fn layout_ball(valence: u32, radius: u32) -> Vec<TrianglePoint> {
+    let neighbours = |p: TrianglePoint| -> Vec<TrianglePoint> {
+        match p {
+            TrianglePoint::Centre => (0..valence)
+                .map(|s| TrianglePoint::Sector { s, a: 1, b: 0 })
+                .collect(),
+            TrianglePoint::Sector { s, a, b } => NEIGHBOURS
+                .iter()
+                .map(|&(da, db)| canonical_triangle_point(valence, i64::from(s), a + da, b + db))
+                .collect(),
+        }
+    };
+    let mut distance: HashMap<TrianglePoint, u32> = HashMap::new();
+    let mut queue = VecDeque::new();
+    for p in [
+        TrianglePoint::Centre,
+        TrianglePoint::Sector { s: 0, a: 1, b: 0 },
+        TrianglePoint::Sector {
+            s: 1 % valence,
+            a: 1,
+            b: 0,
+        },
+    ] {
+        distance.insert(p, 0);
+        queue.push_back(p);
+    }
+    while let Some(p) = queue.pop_front() {
+        let d = distance[&p];
+        if d == radius {
+            continue;
+        }
+        for q in neighbours(p) {
+            if let std::collections::hash_map::Entry::Vacant(e) = distance.entry(q) {
+                e.insert(d + 1);
+                queue.push_back(q);
+            }
+        }
+    }
+    let mut points: Vec<TrianglePoint> = distance.into_keys().collect();
+    points.sort_by_key(|p| match *p {
+        TrianglePoint::Centre => (0, 0, 0),
+        TrianglePoint::Sector { s, a, b } => (a + b, i64::from(s), b),
+    });
+    points
+}
+
+/// Names of layout points: `V`, or `(a,b)_s`.
+pub fn point_name(p: TrianglePoint) -> String {
+    match p {
+        TrianglePoint::Centre => "V".to_owned(),
+        TrianglePoint::Sector { s, a, b } => format!("({a},{b})_{s}"),
+    }
+}
+
+/// The number fields the matrices are built in: f64 and exact rationals.
+trait Weight: Clone + Zero + Add<Output = Self> + Mul<Output = Self> {
+    /// The weight in this field, `None` if it is irrational and the field exact.
+    fn from_weight(w: TriangleWeight) -> Option<Self>;
+    /// `1`.
+    fn one_weight() -> Self;
+}
+
+impl Weight for f64 {
+    fn from_weight(w: TriangleWeight) -> Option<Self> {
+        Some(w.value)
+    }
+    fn one_weight() -> Self {
+        1.0
+    }
+}
+
+impl Weight for BigRational {
+    fn from_weight(w: TriangleWeight) -> Option<Self> {
+        w.exact.map(big)
+    }
+    fn one_weight() -> Self {
+        BigRational::from_integer(BigInt::from(1))
+    }
+}
+
+fn big(r: Rational64) -> BigRational {
+    BigRational::new(BigInt::from(*r.numer()), BigInt::from(*r.denom()))
+}
+
+/// A linear combination of coarser points making a finer point.
+type Combination<T> = Vec<(TrianglePoint, T)>;
+
+/// √3's rules at one valence, in one number field.
+#[derive(Clone, Debug)]
+struct Sqrt3Rules<T> {
+    valence: u32,
+    /// `(1 - alpha_K, alpha_K / K)` at `V`.
+    extraordinary: (T, T),
+    /// `(1 - alpha_6, alpha_6 / 6) = (2/3, 1/18)` at every other vertex.
+    regular: (T, T),
+    /// `1/3`, a centroid's weight per corner.
+    third: T,
+}
+
+impl<T: Weight> Sqrt3Rules<T> {
+    /// `None` when `alpha_K` is irrational in an exact field.
+    fn new(valence: u32) -> Option<Self> {
+        let pair = |v: u32| {
+            let (c, b) = TriangleVertexRule::Sqrt3.weights(v);
+            Some((T::from_weight(c)?, T::from_weight(b)?))
+        };
+        Some(Sqrt3Rules {
+            valence,
+            extraordinary: pair(valence)?,
+            regular: pair(6)?,
+            third: T::from_weight(TriangleWeight::ratio(1, 3))?,
+        })
+    }
+
+    /// A vertex rule: `centre` on `p`, `beta` on each of `ring`.
+    fn vertex(
+        p: TrianglePoint,
+        (centre, beta): &(T, T),
+        ring: Vec<TrianglePoint>,
+    ) -> Combination<T> {
+        let mut out = vec![(p, centre.clone())];
+        out.extend(ring.into_iter().map(|q| (q, beta.clone())));
+        out
+    }
+
+    /// The first √3 step: the half-level point `point` (level-`(k+1)` coordinates,
+    /// `a = b (mod 3)`) in level-`k` points (level-`k` coordinates).
+    fn first(&self, point: TrianglePoint) -> Result<Combination<T>, String> {
+        let TrianglePoint::Sector { s, a, b } = point else {
+            let ring = (0..self.valence)
+                .map(|s| TrianglePoint::Sector { s, a: 1, b: 0 })
+                .collect();
+            return Ok(Self::vertex(point, &self.extraordinary, ring));
+        };
+        let s = i64::from(s);
+        let at = |x: i64, y: i64| canonical_triangle_point(self.valence, s, x, y);
+        if a % 3 == 0 && b % 3 == 0 {
+            let (x, y) = (a / 3, b / 3);
+            let ring = NEIGHBOURS
+                .iter()
+                .map(|&(dx, dy)| at(x + dx, y + dy))
+                .collect();
+            return Ok(Self::vertex(at(x, y), &self.regular, ring));
+        }
+        if (a - b).rem_euclid(3) != 0 {
+            return Err(format!("{} is not a half-level point", point_name(point)));
+        }
+        // A centroid: the three of its half-level neighbours that are old vertices.
+        Ok(HALF_LEVEL_STEPS
+            .iter()
+            .map(|&(da, db)| (a + da, b + db))
+            .filter(|&(x, y)| x.rem_euclid(3) == 0 && y.rem_euclid(3) == 0)
+            .map(|(x, y)| (at(x / 3, y / 3), self.third.clone()))
+            .collect())
+    }
+
+    /// The second √3 step: the level-`(k+1)` point `point` in half-level points (both in
+    /// level-`(k+1)` coordinates).
+    fn second(&self, point: TrianglePoint) -> Combination<T> {
+        let TrianglePoint::Sector { s, a, b } = point else {
+            let ring = (0..self.valence)
+                .map(|s| TrianglePoint::Sector { s, a: 1, b: 1 })
+                .collect();
+            return Self::vertex(point, &self.extraordinary, ring);
+        };
+        let s = i64::from(s);
+        let at = |x: i64, y: i64| canonical_triangle_point(self.valence, s, x, y);
+        if (a - b).rem_euclid(3) == 0 {
+            let ring = HALF_LEVEL_STEPS
+                .iter()
+                .map(|&(da, db)| at(a + da, b + db))
+                .collect();
+            return Self::vertex(point, &self.regular, ring);
+        }
+        // A centroid of a half-level triangle: its three neighbours on the half level.
+        NEIGHBOURS
+            .iter()
+            .map(|&(da, db)| (a + da, b + db))
+            .filter(|&(x, y)| (x - y).rem_euclid(3) == 0)
+            .map(|(x, y)| (at(x, y), self.third.clone()))
+            .collect()
+    }
+
+    /// One ternary step (two √3 steps): the level-`(k+1)` point `point` in level-`k` points.
+    fn refine(&self, point: TrianglePoint) -> Result<Combination<T>, String> {
+        let mut out: BTreeMap<TrianglePoint, T> = BTreeMap::new();
+        for (h, w) in self.second(point) {
+            for (p, x) in self.first(h)? {
+                let e = out.entry(p).or_insert_with(T::zero);
+                *e = e.clone() + w.clone() * x;
+            }
+        }
+        Ok(out.into_iter().collect())
+    }
+}
+
+/// One regular tile of the patch's outer part at level [`Sqrt3LocalMatrices::tile_level`].
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Sqrt3Tile {
+    /// Its corners, level-`L` sector-0 skew coordinates, counter-clockwise.
+    pub corners: [(i64, i64); 3],
+    /// Its control points: indices into [`Sqrt3LocalMatrices::regular_points`], every
+    /// level-`L` lattice point `j` with `T ∩ (j + int S)` nonempty.
+    pub points: Vec<usize>,
+}
+
+impl Sqrt3Tile {
+    /// Whether `(y_1/d, y_2/d)` (level-`L` coordinates) lies in the closed tile.
+    pub fn contains(&self, y: (i64, i64), d: i64) -> bool {
+        (0..3).all(|e| {
+            let (p, q) = (self.corners[e], self.corners[(e + 1) % 3]);
+            let cross = (q.0 - p.0) * (y.1 - d * p.1) - (q.1 - p.1) * (y.0 - d * p.0);
+            cross >= 0
+        })
+    }
+}
+
+/// The local subdivision matrices of √3 around an interior vertex of valence `K`, two √3
+/// steps at a time (see the module docs).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sqrt3LocalMatrices {
+    /// The scheme's name.
+    pub scheme: String,
+    /// The valence `K`.
+    pub valence: u32,
+    /// The control points, in table order ([`sqrt3_layout`]).
+    pub layout: Vec<TrianglePoint>,
+    /// `A` (`N x N`, `N` = layout size), f64: row `i` is the level-1 (two √3 steps) layout
+    /// point `i` in level-0 layout weights, so `P_1 = A P_0` and `phi(x) = phi(3x) A`.
+    pub a: Vec<Vec<f64>>,
+    /// `A` exactly, when `alpha_K` is rational (`K = 3, 4, 6`).
+    pub a_exact: Option<Vec<Vec<BigRational>>>,
+    /// The hull `H` of the regular two-step mask's indices, counter-clockwise; the support
+    /// of the regular basis function `psi` is `S = H / 2`.
+    pub hull: Vec<(i64, i64)>,
+    /// The ternary level `L` of the regular tiles (2, i.e. four √3 steps).
+    pub tile_level: u32,
+    /// Every level-`L` lattice point some tile needs, unfolded in sector 0's chart.
+    pub regular_points: Vec<(i64, i64)>,
+    /// For each of `regular_points`, its level-0 weights over the layout (`L` steps), f64.
+    pub regular_rows: Vec<Vec<f64>>,
+    /// The same rows exactly, when every weight is rational.
+    pub regular_rows_exact: Option<Vec<Vec<BigRational>>>,
+    /// The regular tiles covering `1/3 <= u + v <= 1`: up triangles `(a,b),(a+1,b),(a,b+1)`
+    /// then down triangles `(a+1,b),(a+1,b+1),(a,b+1)`, each by `b`, then `a`.
+    pub tiles: Vec<Sqrt3Tile>,
+}
+
+/// The interiors of two convex polygons (counter-clockwise, skew coordinates) meet: no edge of
+/// either separates them (the separating-axis test; affine coordinates keep separation).
+fn interiors_meet(p: &[(i64, i64)], q: &[(i64, i64)]) -> bool {
+    let separated_by = |poly: &[(i64, i64)]| {
+        (0..poly.len()).any(|e| {
+            let (a, b) = (poly[e], poly[(e + 1) % poly.len()]);
+            let f = |x: &(i64, i64)| (b.0 - a.0) * (x.1 - a.1) - (b.1 - a.1) * (x.0 - a.0);
+            let lo_p = p.iter().map(f).min().unwrap_or(0);
+            let hi_p = p.iter().map(f).max().unwrap_or(0);
+            let lo_q = q.iter().map(f).min().unwrap_or(0);
+            let hi_q = q.iter().map(f).max().unwrap_or(0);
+            hi_p <= lo_q || hi_q <= lo_p
+        })
+    };
+    !separated_by(p) && !separated_by(q)
+}
+
+/// The level-`level` triangles of `1/3 <= u + v <= 1` (`level >= 1`), in
+/// [`Sqrt3LocalMatrices::tiles`] order, by corners.
+fn outer_tiles(level: u32) -> Vec<[(i64, i64); 3]> {
+    let m = 3i64.pow(level);
+    let mut up = Vec::new();
+    let mut down = Vec::new();
+    for b in 0..m {
+        for a in 0..m - b {
+            if 3 * (a + b) >= m {
+                up.push([(a, b), (a + 1, b), (a, b + 1)]);
+            }
+            if 3 * (a + b + 1) >= m && a + b + 2 <= m {
+                down.push([(a + 1, b), (a + 1, b + 1), (a, b + 1)]);
+            }
+        }
+    }
+    up.extend(down);
+    up
+}
+
+/// `T` scaled by 2: the test `T ∩ (j + int H/2) != ∅` is `2T ∩ (2j + int H) != ∅`.
+fn doubled(t: &[(i64, i64); 3]) -> [(i64, i64); 3] {
+    t.map(|(a, b)| (2 * a, 2 * b))
+}
+
+/// What one build of the matrices needs: the rows of `A`, the tiles and their rows.
+struct Built<T> {
+    a: Vec<Vec<T>>,
+    regular_points: Vec<(i64, i64)>,
+    rows: Vec<Vec<T>>,
+    tiles: Vec<Sqrt3Tile>,
+}
+
+/// The rows of level-`k` points in level-0 layout weights, memoized per level.
+struct Rows<'a, T> {
+    rules: &'a Sqrt3Rules<T>,
+    index: HashMap<TrianglePoint, usize>,
+    memo: Vec<HashMap<TrianglePoint, Vec<T>>>,
+}
+
+impl<T: Weight> Rows<'_, T> {
+    /// The level-`k` point `p` in level-0 layout weights, or the first unlisted point read.
+    fn row(&mut self, k: usize, p: TrianglePoint) -> Result<Vec<T>, String> {
+        if let Some(r) = self.memo[k].get(&p) {
+            return Ok(r.clone());
+        }
+        let size = self.index.len();
+        let mut r = vec![T::zero(); size];
+        if k == 0 {
+            let i = *self
+                .index
+                .get(&p)
+                .ok_or_else(|| format!("level-0 point {} is not in the layout", point_name(p)))?;
+            r[i] = T::one_weight();
+        } else {
+            for (parent, w) in self.rules.refine(p)? {
+                let pr = self.row(k - 1, parent)?;
+                for (x, y) in r.iter_mut().zip(pr) {
+                    if !y.is_zero() {
+                        *x = x.clone() + w.clone() * y;
+                    }
+                }
+            }
+        }
+        self.memo[k].insert(p, r.clone());
+        Ok(r)
+    }
+}
+
+/// Build `A` and the tile rows over `layout` in the field `T`; `Err` names the first point
+/// whose rule reads a point outside the layout.
+fn build<T: Weight>(
+    rules: &Sqrt3Rules<T>,
+    layout: &[TrianglePoint],
+    hull: &[(i64, i64)],
+    level: u32,
+) -> Result<Built<T>, String> {
+    let mut rows = Rows {
+        rules,
+        index: layout.iter().enumerate().map(|(i, &p)| (p, i)).collect(),
+        memo: vec![HashMap::new(); level as usize + 1],
+    };
+    let a = layout
+        .iter()
+        .map(|&p| rows.row(1, p))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut regular_points: Vec<(i64, i64)> = Vec::new();
+    let mut point_index: BTreeMap<(i64, i64), usize> = BTreeMap::new();
+    let mut tiles = Vec::new();
+    // Lattice points j with T ∩ (j + int H/2) nonempty are within hex radius / 2 of T.
+    let radius = hull
+        .iter()
+        .map(|&(a, b)| a.abs().max(b.abs()).max((a + b).abs()))
+        .max()
+        .unwrap_or(0)
+        / 2
+        + 1;
+    for corners in outer_tiles(level) {
+        let twice = doubled(&corners);
+        let mut points = Vec::new();
+        let range = |c: fn(&(i64, i64)) -> i64| {
+            let lo = corners.iter().map(c).min().unwrap_or(0) - radius;
+            let hi = corners.iter().map(c).max().unwrap_or(0) + radius;
+            lo..=hi
+        };
+        for j2 in range(|c| c.1) {
+            for j1 in range(|c| c.0) {
+                let shifted: Vec<(i64, i64)> = hull
+                    .iter()
+                    .map(|&(a, b)| (a + 2 * j1, b + 2 * j2))
+                    .collect();
+                if !interiors_meet(&twice, &shifted) {
+                    continue;
+                }
+                let next = regular_points.len();
+                let u = *point_index.entry((j1, j2)).or_insert(next);
+                if u == next {
+                    regular_points.push((j1, j2));
+                }
+                points.push(u);
+            }
+        }
+        tiles.push(Sqrt3Tile { corners, points });
+    }
+    let valence = rules.valence;
+    let tile_rows = regular_points
+        .iter()
+        .map(|&(j1, j2)| rows.row(level as usize, canonical_triangle_point(valence, 0, j1, j2)))
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(Built {
+        a,
+        regular_points,
+        rows: tile_rows,
+        tiles,
+    })
+}
+
+/// The smallest ternary level `L >= 1` at which every triangle `T` of `1/3 <= u + v <= 1`
+/// keeps `V` outside `T + int S`, `S = H/2` (module docs): `2T ∩ int H` is empty.
+pub fn regular_tile_level(hull: &[(i64, i64)]) -> u32 {
+    (1..)
+        .find(|&level| {
+            outer_tiles(level)
+                .iter()
+                .all(|t| !interiors_meet(&doubled(t), hull))
+        })
+        .unwrap_or(1)
+}
+
+impl Sqrt3LocalMatrices {
+    /// Build the layout, `A` and the regular tiles of √3 (`sqrt3`) around an interior vertex
+    /// of valence `valence >= 3`.
+    pub fn new(scheme: &TriangleScheme, valence: u32) -> Result<Self, UnsupportedNeighbourhood> {
+        Self::with_radius(scheme, valence, LAYOUT_RADIUS)
+    }
+
+    /// [`Self::new`] over the ball of graph radius `radius` (for checking that
+    /// [`LAYOUT_RADIUS`] is the smallest that works: smaller balls are errors).
+    pub fn with_radius(
+        scheme: &TriangleScheme,
+        valence: u32,
+        radius: u32,
+    ) -> Result<Self, UnsupportedNeighbourhood> {
+        let unsupported = |reason: String| UnsupportedNeighbourhood {
+            scheme: scheme.name.to_owned(),
+            reason,
+        };
+        if scheme.vertex != TriangleVertexRule::Sqrt3
+            || scheme.refinement != TriangleRefinement::Sqrt3
+        {
+            return Err(unsupported(
+                "these local matrices are √3's (Kobbelt 2000: centroids, edge flips)".to_owned(),
+            ));
+        }
+        if valence < 3 {
+            return Err(unsupported(format!(
+                "an interior vertex needs valence >= 3, not {valence}"
+            )));
+        }
+        let layout = layout_ball(valence, radius);
+        let hull = scheme.regular_mask().hull();
+        let level = regular_tile_level(&hull);
+        let fail = |e: String| unsupported(format!("valence {valence}, radius {radius}: {e}"));
+        let rules = Sqrt3Rules::<f64>::new(valence)
+            .ok_or_else(|| unsupported("f64 weights always exist".to_owned()))?;
+        let built = build(&rules, &layout, &hull, level).map_err(fail)?;
+        let exact = match Sqrt3Rules::<BigRational>::new(valence) {
+            Some(rules) => Some(build(&rules, &layout, &hull, level).map_err(fail)?),
+            None => None,
+        };
+        let (a_exact, regular_rows_exact) = match exact {
+            Some(e) => (Some(e.a), Some(e.rows)),
+            None => (None, None),
+        };
+        Ok(Sqrt3LocalMatrices {
+            scheme: scheme.name.to_owned(),
+            valence,
+            layout,
+            a: built.a,
+            a_exact,
+            hull,
+            tile_level: level,
+            regular_points: built.regular_points,
+            regular_rows: built.rows,
+            regular_rows_exact,
+            tiles: built.tiles,
+        })
+    }
+
+    /// The number of control points `N = 3K + 9`.
+    pub fn size(&self) -> usize {
+        self.layout.len()
+    }
+
+    /// Whether every weight is rational (`a_exact` and `regular_rows_exact` are present).
+    pub fn is_rational(&self) -> bool {
+        self.a_exact.is_some()
+    }
+
+    /// Names of the layout's points ([`point_name`]).
+    pub fn names(&self) -> Vec<String> {
+        self.layout.iter().map(|&p| point_name(p)).collect()
+    }
+
+    /// The tile holding `(y_1/d, y_2/d)` in level-`L` coordinates (`1/3 <= u + v <= 1`), the
+    /// first in [`Self::tiles`] order.
+    pub fn tile_containing(&self, y: (i64, i64), d: i64) -> Option<usize> {
+        self.tiles.iter().position(|t| t.contains(y, d))
+    }
+
+    /// The layout index of the reflection `(a, b) -> (b, a)` of sector 0 (the patch's
+    /// `u <-> v` mirror) applied to layout point `i`: `(a, b)_s -> (b, a)_{-s}`.
+    pub fn mirror(&self, i: usize) -> Option<usize> {
+        let k = i64::from(self.valence);
+        let image = match self.layout.get(i)? {
+            TrianglePoint::Centre => TrianglePoint::Centre,
+            &TrianglePoint::Sector { s, a, b } => {
+                canonical_triangle_point(self.valence, (-i64::from(s)).rem_euclid(k), b, a)
+            }
+        };
+        self.layout.iter().position(|&p| p == image)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use num_traits::One;
+
+    fn sqrt3() -> TriangleScheme {
+        TriangleScheme::by_name("sqrt3").expect("catalogued")
+    }
+
+    #[test]
+    fn layout_is_the_radius_two_ball_with_3k_plus_9_points() {
+        for k in 3..=8u32 {
+            let m = Sqrt3LocalMatrices::new(&sqrt3(), k).expect("builds");
+            assert_eq!(m.size(), 3 * k as usize + 9, "K = {k}");
+            assert_eq!(m.layout[0], TrianglePoint::Centre);
+            for s in 0..k {
+                assert_eq!(
+                    m.layout[1 + s as usize],
+                    TrianglePoint::Sector { s, a: 1, b: 0 }
+                );
+            }
+            let mut sorted = m.layout.clone();
+            sorted.sort();
+            sorted.dedup();
+            assert_eq!(sorted.len(), m.size());
+            assert_eq!(m.is_rational(), matches!(k, 3 | 4 | 6));
+        }
+        let names = Sqrt3LocalMatrices::new(&sqrt3(), 5)
+            .expect("builds")
+            .names();
+        assert_eq!(&names[..4], ["V", "(1,0)_0", "(1,0)_1", "(1,0)_2"]);
+        assert_eq!(&names[6..10], ["(2,0)_0", "(1,1)_0", "(2,0)_1", "(1,1)_1"]);
+        assert_eq!(
+            &names[16..],
+            [
+                "(3,0)_0", "(2,1)_0", "(1,2)_0", "(3,0)_1", "(2,1)_1", "(1,2)_1", "(2,1)_4",
+                "(1,2)_4"
+            ]
+        );
+    }
+
+    #[test]
+    fn radius_one_is_too_small() {
+        for k in 3..=8u32 {
+            let e = Sqrt3LocalMatrices::with_radius(&sqrt3(), k, 1).expect_err("too small");
+            assert!(e.reason.contains("not in the layout"), "{}", e.reason);
+        }
+    }
+
+    #[test]
+    fn hull_is_the_twelve_gon_and_tiles_are_level_two() {
+        let m = Sqrt3LocalMatrices::new(&sqrt3(), 5).expect("builds");
+        // Two √3 steps of delta_0 reach (5,-1) (a vertex step (3,0) then a half-level step
+        // (2,-1)) and (4,1): twelve corners, the turns of these two.
+        let mut hull = m.hull.clone();
+        hull.sort_unstable();
+        let mut expected = vec![
+            (5, -1),
+            (4, 1),
+            (1, 4),
+            (-1, 5),
+            (-4, 5),
+            (-5, 4),
+            (-5, 1),
+            (-4, -1),
+            (-1, -4),
+            (1, -5),
+            (4, -5),
+            (5, -4),
+        ];
+        expected.sort_unstable();
+        assert_eq!(hull, expected);
+        assert_eq!(m.tile_level, 2);
+        assert_eq!(m.tiles.len(), 72);
+        // The level-1 triangle (1,0), (1,1), (0,1) has V in T + int S: level 1 is not regular.
+        assert!(interiors_meet(&doubled(&[(1, 0), (1, 1), (0, 1)]), &m.hull));
+        // Every point of the outer part, on the rate-27 grid, is in a tile.
+        for j in 0..=27i64 {
+            for i in 0..=27 - j {
+                if 3 * (i + j) >= 27 {
+                    assert!(m.tile_containing((i, j), 3).is_some(), "({i}, {j})/27");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn rows_are_affine() {
+        for k in 3..=8u32 {
+            let m = Sqrt3LocalMatrices::new(&sqrt3(), k).expect("builds");
+            for r in m.a.iter().chain(&m.regular_rows) {
+                assert!((r.iter().sum::<f64>() - 1.0).abs() < 1e-13, "K = {k}");
+            }
+            if let (Some(a), Some(rows)) = (&m.a_exact, &m.regular_rows_exact) {
+                for r in a.iter().chain(rows) {
+                    assert!(r.iter().sum::<BigRational>().is_one(), "K = {k}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_vertex_row_is_two_vertex_rules() {
+        // Written from Kobbelt's rules: V' = (1 - a) V + (a/K) sum E_s, the centroids
+        // c_s = (V + E_s + E_{s+1})/3 with sum c_s = (K V + 2 sum E)/3, and
+        // V'' = (1 - a) V' + (a/K) sum c_s, so V weighs (1 - a)^2 + a/3 and each E_s
+        // (1 - a) a / K + 2 a / (3 K); a = (4 - 2 cos(2 pi / K))/9 = 5/9, 4/9, 1/3.
+        for k in [3u32, 4, 6] {
+            let m = Sqrt3LocalMatrices::new(&sqrt3(), k).expect("builds");
+            let a = m.a_exact.as_ref().expect("rational");
+            let alpha = match k {
+                3 => Rational64::new(5, 9),
+                4 => Rational64::new(4, 9),
+                _ => Rational64::new(1, 3),
+            };
+            let one = Rational64::one();
+            let kk = Rational64::from_integer(i64::from(k));
+            assert_eq!(
+                a[0][0],
+                big((one - alpha) * (one - alpha) + alpha / 3),
+                "K = {k}"
+            );
+            let e = big((one - alpha) * alpha / kk + alpha * 2 / (kk * 3));
+            assert!(a[0][1..=k as usize].iter().all(|w| *w == e), "K = {k}");
+            assert!(a[0][k as usize + 1..].iter().all(Zero::is_zero));
+        }
+    }
+
+    #[test]
+    fn mirror_is_an_involution_fixing_v() {
+        for k in 3..=8u32 {
+            let m = Sqrt3LocalMatrices::new(&sqrt3(), k).expect("builds");
+            assert_eq!(m.mirror(0), Some(0));
+            assert_eq!(m.mirror(1), Some(2));
+            for i in 0..m.size() {
+                let j = m.mirror(i).expect("the layout is symmetric");
+                assert_eq!(m.mirror(j), Some(i));
+            }
+        }
+    }
+
+    #[test]
+    fn other_schemes_are_errors() {
+        let loop_ = TriangleScheme::by_name("loop").expect("catalogued");
+        assert!(Sqrt3LocalMatrices::new(&loop_, 5).is_err());
+        assert!(Sqrt3LocalMatrices::new(&sqrt3(), 2).is_err());
+    }
+}

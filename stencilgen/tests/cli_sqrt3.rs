@@ -1,0 +1,106 @@
+//! `stencilgen stencil --scheme sqrt3`: √3's patch next to an interior extraordinary vertex,
+//! on the command line (docs/cli.md).
+
+use std::process::{Command, Output};
+
+use num_bigint::BigInt;
+use num_integer::Integer;
+use num_rational::BigRational;
+use num_traits::One;
+
+fn stencilgen(args: &str) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_stencilgen"))
+        .args(args.split_whitespace())
+        .output()
+        .expect("stencilgen runs")
+}
+
+fn json(args: &str) -> serde_json::Value {
+    let out = stencilgen(args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("valid JSON")
+}
+
+fn fails_with(args: &str, message: &str) {
+    let out = stencilgen(args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{args:?} succeeded");
+    assert!(out.status.code().is_some(), "{args:?} was killed");
+    assert!(stderr.contains(message), "{args:?}: {stderr}");
+    assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+}
+
+fn numbers(v: &serde_json::Value) -> Vec<f64> {
+    v.as_array()
+        .map(|a| a.iter().filter_map(serde_json::Value::as_f64).collect())
+        .unwrap_or_default()
+}
+
+fn rationals(v: &serde_json::Value) -> Vec<BigRational> {
+    v.as_array()
+        .map(|a| {
+            a.iter()
+                .filter_map(serde_json::Value::as_str)
+                .map(|s| s.parse::<BigRational>().expect("p/q"))
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+#[test]
+fn sqrt3_limit_position_is_kobbelts_rule() {
+    // Kobbelt (2000): V_inf = (1 - b) V + (b/K) sum E_s with b = 3 a / (1 + 3 a),
+    // a = (4 - 2 cos(2 pi/K))/9.
+    let k = 5;
+    let out = json(&format!(
+        "stencil --scheme sqrt3 --valence {k} --u 0 --v 0 --f64 --json"
+    ));
+    assert_eq!(out["order"].as_array().map(Vec::len), Some(3 * k + 9));
+    assert_eq!(out["order"][0], "V");
+    assert_eq!(out["order"][1], "(1,0)_0");
+    let w = numbers(&out["weights"]);
+    let a = (4.0 - 2.0 * (2.0 * std::f64::consts::PI / k as f64).cos()) / 9.0;
+    let b = 3.0 * a / (1.0 + 3.0 * a);
+    assert!((w[0] - (1.0 - b)).abs() < 1e-12, "{w:?}");
+    for x in &w[1..=k] {
+        assert!((x - b / k as f64).abs() < 1e-12, "{w:?}");
+    }
+    assert!(w[k + 1..].iter().all(|x| x.abs() < 1e-12));
+    assert!(out["du"].is_null() && out["note"].is_string());
+    // Valence 4: a = 4/9, b = 4/7.
+    let exact = json("stencil --scheme sqrt3 --valence 4 --u 0 --v 0 --json");
+    assert_eq!(exact["weights"][0], "3/7");
+    assert_eq!(exact["weights"][1], "1/7");
+    assert_eq!(exact["weights"][5], "0");
+}
+
+#[test]
+fn sqrt3_edge_midpoint_at_valence_six_has_the_papers_normalization_2256() {
+    // Schaefer–Warren Fig. 4: the stencil at the midpoint of an edge of the regular mesh has
+    // the implicit normalization 2256. At valence 6 the EV patch is a regular face.
+    let out = json("stencil --scheme sqrt3 --valence 6 --u 1/2 --v 0 --json");
+    let w = rationals(&out["weights"]);
+    let lcm = w.iter().fold(BigInt::one(), |acc, x| acc.lcm(x.denom()));
+    assert_eq!(lcm, BigInt::from(2256));
+    assert_eq!(w.iter().sum::<BigRational>(), BigRational::one());
+}
+
+#[test]
+fn sqrt3_errors() {
+    fails_with(
+        "stencil --scheme sqrt3 --valence 5 --u 1/3 --v 0",
+        "irrational",
+    );
+    fails_with(
+        "stencil --scheme sqrt3 --boundary 3 --u 1/3 --v 0",
+        "no boundary rules",
+    );
+    fails_with(
+        "stencil --scheme sqrt3 --valence 4 --u 2/3 --v 2/3",
+        "outside the patch",
+    );
+}

@@ -1,0 +1,619 @@
+//! √3's patch next to an interior extraordinary vertex of valence 3..=8, two √3 steps as one
+//! ternary step (Schaefer–Warren sections 5.1–5.3): the grid system against substitution
+//! (exactly for K = 3, 4, 6; within 1e-12 in f64 for the irrational K = 5, 7, 8), valence 6
+//! against the regular basis function of the uniform system, the limit mask at V against
+//! Kobbelt's limit rule, partition of unity, the mirror u <-> v, continuity with the
+//! neighbouring sector's patch, f64 against exact, and an independent brute-force check: a
+//! random net on an explicit K-valent fan mesh refined by plain √3 mesh operations written out
+//! here (face centroids, Kobbelt's vertex rule, edge flips), whose vertices' limit positions
+//! (Kobbelt's limit rule applied on the refined mesh) must equal the stencils at those
+//! vertices' ternary parameters (i/3^m, j/3^m).
+
+use std::collections::{BTreeMap, BTreeSet, HashMap};
+use std::sync::{Mutex, OnceLock, PoisonError};
+
+use num_rational::BigRational;
+use num_traits::{One, Zero};
+use schemes::sqrt3_local::Sqrt3LocalMatrices;
+use schemes::triangle::{apply_map, lattice_symmetries};
+use schemes::triangle_local::TrianglePoint;
+use schemes::TriangleScheme;
+use stencilgen::regular_patch::StencilKind;
+use stencilgen::scalar::rational_to_f64;
+use stencilgen::sqrt3_patch::{
+    sqrt3_patch_stencils, sqrt3_patch_stencils_at, sqrt3_regular_basis, Sqrt3PatchStencils,
+    Sqrt3Substitution,
+};
+use stencilgen::triangle_patch::triangle_grid_points;
+use stencilgen::triangle_system::{triangle_stencils, TriangleStencils};
+use subtess_tests::bspline::q;
+
+fn sqrt3() -> TriangleScheme {
+    TriangleScheme::by_name("sqrt3").expect("catalogued")
+}
+
+/// √3's regular basis `psi` at rate `n`, solved exactly once per rate for the whole binary
+/// (it does not depend on the valence, and the odd rates cost about a second each).
+fn basis(n: u32) -> TriangleStencils<BigRational> {
+    static CACHE: OnceLock<Mutex<HashMap<u32, TriangleStencils<BigRational>>>> = OnceLock::new();
+    let cache = CACHE.get_or_init(|| Mutex::new(HashMap::new()));
+    let mut cache = cache.lock().unwrap_or_else(PoisonError::into_inner);
+    cache
+        .entry(n)
+        .or_insert_with(|| sqrt3_regular_basis::<BigRational>(&sqrt3(), n).expect("solvable"))
+        .clone()
+}
+
+fn matrices(k: u32) -> Sqrt3LocalMatrices {
+    Sqrt3LocalMatrices::new(&sqrt3(), k).expect("valid")
+}
+
+fn exact(k: u32, n: u32) -> Sqrt3PatchStencils<BigRational> {
+    sqrt3_patch_stencils_at(&matrices(k), &basis(n), &triangle_grid_points(n), n).expect("solvable")
+}
+
+/// [`basis`] rounded to f64.
+fn float_basis(n: u32) -> TriangleStencils<f64> {
+    let psi = basis(n);
+    TriangleStencils {
+        values: psi.values.iter().map(rational_to_f64).collect(),
+        scheme: psi.scheme,
+        n: psi.n,
+        kind: psi.kind,
+        dilation: psi.dilation,
+        hull: psi.hull,
+        bbox: psi.bbox,
+        residual: psi.residual,
+    }
+}
+
+fn float(k: u32, n: u32) -> Sqrt3PatchStencils<f64> {
+    sqrt3_patch_stencils_at(&matrices(k), &float_basis(n), &triangle_grid_points(n), n)
+        .expect("solvable")
+}
+
+fn layout(k: u32) -> Vec<TrianglePoint> {
+    Sqrt3LocalMatrices::new(&sqrt3(), k).expect("valid").layout
+}
+
+/// Kobbelt's (2000) `alpha_v = (4 - 2 cos(2π/v)) / 9`, written from the paper.
+fn alpha(v: usize) -> f64 {
+    (4.0 - 2.0 * (2.0 * std::f64::consts::PI / v as f64).cos()) / 9.0
+}
+
+#[test]
+fn grid_system_equals_substitution_exactly_for_rational_valences() {
+    for k in [3, 4, 6] {
+        let mut sub = Sqrt3Substitution::<BigRational>::new(&sqrt3(), k).expect("valid");
+        for n in 1..=6 {
+            sub.share_basis(basis(n)).expect("sqrt3's basis");
+            let grid = exact(k, n);
+            assert_eq!(grid.residual, 0.0);
+            for (&(i, j), stencil) in grid.points.iter().zip(&grid.stencils) {
+                let by_substitution = sub
+                    .stencil(&q(i, i64::from(n)), &q(j, i64::from(n)))
+                    .expect("in the patch");
+                assert_eq!(stencil, &by_substitution, "K = {k}, ({i}/{n}, {j}/{n})");
+            }
+        }
+    }
+}
+
+#[test]
+fn grid_system_equals_substitution_in_f64_for_every_valence() {
+    for k in 3..=8 {
+        let mut sub = Sqrt3Substitution::<f64>::new(&sqrt3(), k).expect("valid");
+        for n in [1, 2, 3, 4, 6, 9] {
+            sub.share_basis(float_basis(n)).expect("sqrt3's basis");
+            let grid = float(k, n);
+            assert!(grid.residual < 1e-12, "K = {k} n = {n}: {}", grid.residual);
+            for (&(i, j), stencil) in grid.points.iter().zip(&grid.stencils) {
+                let by_substitution = sub
+                    .stencil(&q(i, i64::from(n)), &q(j, i64::from(n)))
+                    .expect("in the patch");
+                for (a, b) in stencil.iter().zip(&by_substitution) {
+                    assert!(
+                        (a - b).abs() < 1e-12,
+                        "K = {k}, ({i}/{n}, {j}/{n}): {a} vs {b}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn f64_matches_exact_where_exact_exists() {
+    // Through the public entry point (which solves psi itself, exactly, and rounds it).
+    for k in [3, 4, 6] {
+        for n in [4, 6] {
+            let e = sqrt3_patch_stencils::<BigRational>(&sqrt3(), k, n).expect("solvable");
+            let f = sqrt3_patch_stencils::<f64>(&sqrt3(), k, n).expect("solvable");
+            assert_eq!(e.points, f.points);
+            for (a, b) in e.stencils.iter().flatten().zip(f.stencils.iter().flatten()) {
+                assert!((rational_to_f64(a) - b).abs() < 1e-12, "K = {k}, n = {n}");
+            }
+        }
+    }
+}
+
+/// The point of the plane where layout point `p` sits at valence 6: `(a, b)` of sector `s` is
+/// `R^s (a, b)`, `R` the rotation by 60 degrees.
+fn plane_position(p: TrianglePoint) -> (i64, i64) {
+    match p {
+        TrianglePoint::Centre => (0, 0),
+        TrianglePoint::Sector { s, a, b } => apply_map(lattice_symmetries()[s as usize], (a, b)),
+    }
+}
+
+#[test]
+fn valence_six_is_the_regular_basis_function() {
+    // At valence 6 the patch is a face of the regular lattice: the weight of the control point
+    // at p is psi(x - p), psi from the uniform two-step system (triangle_system), which knows
+    // nothing of layouts, tiles or A.
+    let positions: Vec<(i64, i64)> = layout(6).into_iter().map(plane_position).collect();
+    let mask = sqrt3().regular_mask();
+    for n in 1..=6u32 {
+        let psi =
+            triangle_stencils::<BigRational>(&mask, n, StencilKind::Position).expect("solvable");
+        let s = sqrt3_patch_stencils::<BigRational>(&sqrt3(), 6, n).expect("solvable");
+        let ni = i64::from(n);
+        for (&(i, j), stencil) in s.points.iter().zip(&s.stencils) {
+            let expected: Vec<BigRational> = positions
+                .iter()
+                .map(|&(a, b)| psi.at(i - ni * a, j - ni * b))
+                .collect();
+            assert_eq!(stencil, &expected, "({i}/{n}, {j}/{n})");
+            // Every lattice point with a nonzero weight there is in the layout.
+            for (p, w) in psi.stencil_at((i, j)) {
+                assert!(positions.contains(&p), "({i}/{n}, {j}/{n}): {p:?} has {w}");
+            }
+        }
+    }
+}
+
+#[test]
+fn limit_mask_at_v_is_kobbelts_limit_rule() {
+    // Kobbelt (2000): one step maps V and the average R of its ring to
+    // ((1 - a) V + a R, (V + 2 R)/3) (the new ring is the K centroids), whose left fixed vector
+    // gives V_inf = (1 - b) V + b R, b = 3a / (1 + 3a): 1 - b at V, b/K at each E_s, 0 beyond.
+    for k in 3..=8u32 {
+        let kk = k as usize;
+        let a = alpha(kk);
+        let b = 3.0 * a / (1.0 + 3.0 * a);
+        let s = float(k, 3);
+        let w = s.at(0, 0).expect("grid");
+        assert!((w[0] - (1.0 - b)).abs() < 1e-12, "K = {k}: {}", w[0]);
+        for (c, x) in w.iter().enumerate().skip(1) {
+            let e = if c <= kk { b / f64::from(k) } else { 0.0 };
+            assert!((x - e).abs() < 1e-12, "K = {k}, point {c}: {x} vs {e}");
+        }
+    }
+    // Exactly where alpha is rational: 5/9, 4/9, 1/3 (cos(2 pi/K) = -1/2, 0, 1/2).
+    for (k, a) in [(3u32, q(5, 9)), (4, q(4, 9)), (6, q(1, 3))] {
+        let b = &a * q(3, 1) / (q(1, 1) + &a * q(3, 1));
+        let w = exact(k, 2);
+        let w = w.at(0, 0).expect("grid");
+        assert_eq!(w[0], q(1, 1) - &b, "K = {k}");
+        for (c, x) in w.iter().enumerate().skip(1) {
+            let e = if c <= k as usize {
+                &b / q(i64::from(k), 1)
+            } else {
+                BigRational::zero()
+            };
+            assert_eq!(x, &e, "K = {k}, point {c}");
+        }
+    }
+}
+
+#[test]
+fn partition_of_unity() {
+    for k in [3, 4, 6] {
+        for n in [2, 5] {
+            for w in &exact(k, n).stencils {
+                assert!(w.iter().sum::<BigRational>().is_one(), "K = {k}");
+            }
+        }
+    }
+    for k in 3..=8 {
+        for w in &float(k, 5).stencils {
+            assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-12, "K = {k}");
+        }
+    }
+}
+
+/// The test's own naming of cone points: `(s, a, b)` given in sector `s`'s chart (any `a, b`),
+/// turned sector by sector until `a >= 1, b >= 0` (`(a, b)` of sector `s` is `(a + b, -a)` of
+/// sector `s + 1`), `V` as `(0, 0, 0)`. The convention of `TrianglePoint`, written out here.
+fn name(k: u32, s: i64, a: i64, b: i64) -> (u32, i64, i64) {
+    let (mut s, mut a, mut b) = (s, a, b);
+    loop {
+        if a == 0 && b == 0 {
+            return (0, 0, 0);
+        }
+        if a >= 1 && b >= 0 {
+            return (s.rem_euclid(i64::from(k)) as u32, a, b);
+        }
+        if b < 0 {
+            (s, a, b) = (s - 1, -b, a + b);
+        } else {
+            (s, a, b) = (s + 1, a + b, -a);
+        }
+    }
+}
+
+fn name_of(p: TrianglePoint) -> (u32, i64, i64) {
+    match p {
+        TrianglePoint::Centre => (0, 0, 0),
+        TrianglePoint::Sector { s, a, b } => (s, a, b),
+    }
+}
+
+#[test]
+fn mirror_symmetry_u_v() {
+    // Reflecting sector 0 across its bisector, (a, b) -> (b, a), maps sector s to sector -s
+    // with its axes swapped; the rules are symmetric, so stencil(i, j) = stencil(j, i) with the
+    // layout reflected.
+    for k in 3..=8u32 {
+        let lay = layout(k);
+        let index: HashMap<_, _> = lay
+            .iter()
+            .enumerate()
+            .map(|(i, &p)| (name_of(p), i))
+            .collect();
+        let mirror: Vec<usize> = lay
+            .iter()
+            .map(|&p| {
+                let (s, a, b) = name_of(p);
+                index[&name(k, -i64::from(s), b, a)]
+            })
+            .collect();
+        let s = float(k, 5);
+        for &(i, j) in &s.points {
+            let (a, b) = (s.at(i, j).expect("grid"), s.at(j, i).expect("grid"));
+            for p in 0..a.len() {
+                assert!(
+                    (a[p] - b[mirror[p]]).abs() < 1e-12,
+                    "K = {k} ({i}, {j}) point {p}"
+                );
+            }
+        }
+        if matches!(k, 3 | 4) {
+            let e = exact(k, 5);
+            for &(i, j) in &e.points {
+                let (a, b) = (e.at(i, j).expect("grid"), e.at(j, i).expect("grid"));
+                for p in 0..a.len() {
+                    assert_eq!(a[p], b[mirror[p]], "K = {k} ({i}, {j}) point {p}");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn continuous_with_the_neighbouring_sector() {
+    // The edge u = 0 (V to E_1) is the edge v = 0 of sector 1's patch, which is this patch
+    // turned by one sector: stencil(0, t) over the mesh = stencil(t, 0) turned.
+    for k in 3..=8u32 {
+        let lay = layout(k);
+        let as_map = |w: &[f64], turn: u32| {
+            let mut m: BTreeMap<(u32, i64, i64), f64> = BTreeMap::new();
+            for (p, x) in lay.iter().zip(w) {
+                let (s, a, b) = name_of(*p);
+                let key = if (a, b) == (0, 0) {
+                    (0, 0, 0)
+                } else {
+                    ((s + turn) % k, a, b)
+                };
+                *m.entry(key).or_insert(0.0) += x;
+            }
+            m
+        };
+        for n in [3, 5, 6] {
+            let s = float(k, n);
+            for t in 0..=i64::from(n) {
+                let here = as_map(s.at(0, t).expect("grid"), 0);
+                let there = as_map(s.at(t, 0).expect("grid"), 1);
+                for key in here.keys().chain(there.keys()) {
+                    let (a, b) = (
+                        here.get(key).copied().unwrap_or(0.0),
+                        there.get(key).copied().unwrap_or(0.0),
+                    );
+                    assert!(
+                        (a - b).abs() < 1e-12,
+                        "K = {k}, t = {t}/{n}, {key:?}: {a} vs {b}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// An explicit triangle mesh on the K-valent cone: faces are corner ids (counter-clockwise);
+/// every vertex has a value (`None` where a rule ran off the finite mesh) and a name (its
+/// position in units of `1/unit` of the level-0 spacing, [`name`]), used only to build the
+/// first mesh and to find vertices by parameter at the end.
+struct FanMesh {
+    valence: u32,
+    unit: i64,
+    values: Vec<Option<f64>>,
+    names: Vec<(u32, i64, i64)>,
+    faces: Vec<[usize; 3]>,
+}
+
+impl FanMesh {
+    /// The fan of `radius` rings around V, random values everywhere.
+    fn new(k: u32, radius: i64, unit: i64, value: &mut dyn FnMut() -> f64) -> Self {
+        let mut mesh = FanMesh {
+            valence: k,
+            unit,
+            values: Vec::new(),
+            names: Vec::new(),
+            faces: Vec::new(),
+        };
+        let mut ids: HashMap<(u32, i64, i64), usize> = HashMap::new();
+        for s in 0..i64::from(k) {
+            for b in 0..radius {
+                for a in 0..radius - b {
+                    let mut tris = vec![[(a, b), (a + 1, b), (a, b + 1)]];
+                    if a + b + 2 <= radius {
+                        tris.push([(a + 1, b), (a + 1, b + 1), (a, b + 1)]);
+                    }
+                    for tri in tris {
+                        let face = tri.map(|(x, y)| {
+                            let key = name(k, s, unit * x, unit * y);
+                            *ids.entry(key).or_insert_with(|| {
+                                mesh.values.push(Some(value()));
+                                mesh.names.push(key);
+                                mesh.names.len() - 1
+                            })
+                        });
+                        mesh.faces.push(face);
+                    }
+                }
+            }
+        }
+        mesh
+    }
+
+    /// The name's coordinates in sector `s`'s chart, `s` at most one sector away.
+    fn in_chart(&self, (t, a, b): (u32, i64, i64), s: u32) -> (i64, i64) {
+        if (a, b) == (0, 0) {
+            return (0, 0);
+        }
+        let k = self.valence;
+        match (t + k - s) % k {
+            0 => (a, b),
+            1 => (-b, a + b),
+            d if d == k - 1 => (a + b, -a),
+            d => panic!("a face spans {d} sectors"),
+        }
+    }
+
+    /// The name of the centroid of `face`, from its corners' names.
+    fn centroid_name(&self, face: [usize; 3]) -> (u32, i64, i64) {
+        let names = face.map(|v| self.names[v]);
+        let s = names
+            .iter()
+            .find(|n| (n.1, n.2) != (0, 0))
+            .expect("a face has a corner other than V")
+            .0;
+        let (mut a, mut b) = (0, 0);
+        for n in names {
+            let (x, y) = self.in_chart(n, s);
+            a += x;
+            b += y;
+        }
+        assert!(
+            a % 3 == 0 && b % 3 == 0,
+            "centroid off the unit grid: raise `unit`"
+        );
+        name(self.valence, i64::from(s), a / 3, b / 3)
+    }
+
+    /// The ring of every vertex (distinct neighbours), and whether it is on the boundary (an
+    /// edge with one face).
+    fn rings(&self) -> (Vec<BTreeSet<usize>>, Vec<bool>) {
+        let mut edges: HashMap<(usize, usize), usize> = HashMap::new();
+        let mut ring = vec![BTreeSet::new(); self.values.len()];
+        for f in &self.faces {
+            for e in 0..3 {
+                let (p, r) = (f[e], f[(e + 1) % 3]);
+                *edges.entry((p.min(r), p.max(r))).or_default() += 1;
+                ring[p].insert(r);
+                ring[r].insert(p);
+            }
+        }
+        let mut boundary = vec![false; self.values.len()];
+        for (&(p, r), &count) in &edges {
+            if count == 1 {
+                boundary[p] = true;
+                boundary[r] = true;
+            }
+        }
+        (ring, boundary)
+    }
+
+    /// Kobbelt's vertex rule with weight `a(valence)` at interior vertex `v`.
+    fn smoothed(
+        &self,
+        v: usize,
+        ring: &[BTreeSet<usize>],
+        boundary: &[bool],
+        a: &dyn Fn(usize) -> f64,
+    ) -> Option<f64> {
+        if boundary[v] {
+            return None;
+        }
+        let n = ring[v].len();
+        let mut sum = 0.0;
+        for &w in &ring[v] {
+            sum += self.values[w]?;
+        }
+        Some((1.0 - a(n)) * self.values[v]? + a(n) / n as f64 * sum)
+    }
+
+    /// One √3 step (Kobbelt 2000): a centroid in every face, every old vertex by the vertex
+    /// rule, every interior edge flipped (the edge p q between faces f1 = (p, q, ..) and
+    /// f2 = (q, p, ..) becomes the triangles (p, m2, m1) and (q, m1, m2)); boundary edges are
+    /// dropped, so the mesh shrinks by a strip per step.
+    fn subdivide(&self) -> FanMesh {
+        let (ring, boundary) = self.rings();
+        let old = self.values.len();
+        let mut values: Vec<Option<f64>> = (0..old)
+            .map(|v| self.smoothed(v, &ring, &boundary, &alpha))
+            .collect();
+        let mut names = self.names.clone();
+        for f in &self.faces {
+            let sum: Option<f64> = f.iter().map(|&v| self.values[v]).sum();
+            values.push(sum.map(|s| s / 3.0));
+            names.push(self.centroid_name(*f));
+        }
+        let mut directed: HashMap<(usize, usize), usize> = HashMap::new();
+        for (i, f) in self.faces.iter().enumerate() {
+            for e in 0..3 {
+                directed.insert((f[e], f[(e + 1) % 3]), i);
+            }
+        }
+        let mut faces = Vec::new();
+        for (&(p, r), &f1) in &directed {
+            if p > r {
+                continue;
+            }
+            let Some(&f2) = directed.get(&(r, p)) else {
+                continue;
+            };
+            let (m1, m2) = (old + f1, old + f2);
+            faces.push([p, m2, m1]);
+            faces.push([r, m1, m2]);
+        }
+        FanMesh {
+            valence: self.valence,
+            unit: self.unit,
+            values,
+            names,
+            faces,
+        }
+    }
+
+    /// The limit position of vertex `v`: Kobbelt's rule `V_inf = (1 - b) V + b R`,
+    /// `b = 3 a_v / (1 + 3 a_v)`, `R` the average of the ring (the pair recursion of
+    /// `limit_mask_at_v_is_kobbelts_limit_rule`).
+    fn limit(&self, v: usize, ring: &[BTreeSet<usize>], boundary: &[bool]) -> Option<f64> {
+        let b = |n: usize| 3.0 * alpha(n) / (1.0 + 3.0 * alpha(n));
+        self.smoothed(v, ring, boundary, &b)
+    }
+
+    fn by_name(&self) -> HashMap<(u32, i64, i64), usize> {
+        self.names
+            .iter()
+            .enumerate()
+            .map(|(i, &n)| (n, i))
+            .collect()
+    }
+}
+
+fn random_source() -> impl FnMut() -> f64 {
+    let mut seed = 0x2545_f491_4f6c_dd1du64;
+    move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    }
+}
+
+/// Refine a random fan `2 m` times and compare the limit positions of the vertices at the
+/// patch's ternary points `(i/3^m, j/3^m)` with `stencil(i, j)` applied to the layout's values;
+/// the largest difference.
+fn brute_force(k: u32, m: u32, stencil: &mut dyn FnMut(i64, i64) -> Vec<f64>) -> f64 {
+    let unit = 3i64.pow(m);
+    let mut random = random_source();
+    let mut mesh = FanMesh::new(k, 6, unit, &mut random);
+    let level0 = mesh.by_name();
+    let net: Vec<f64> = layout(k)
+        .iter()
+        .map(|&p| {
+            let (s, a, b) = name_of(p);
+            let key = name(k, i64::from(s), unit * a, unit * b);
+            mesh.values[level0[&key]].expect("level 0 is complete")
+        })
+        .collect();
+    for _ in 0..2 * m {
+        mesh = mesh.subdivide();
+    }
+    let ids = mesh.by_name();
+    let (ring, boundary) = mesh.rings();
+    let mut worst = 0f64;
+    for (i, j) in triangle_grid_points(unit as u32) {
+        let id = ids[&name(k, 0, i, j)];
+        let limit = mesh
+            .limit(id, &ring, &boundary)
+            .expect("inside the valid region");
+        let predicted: f64 = stencil(i, j).iter().zip(&net).map(|(a, b)| a * b).sum();
+        worst = worst.max((predicted - limit).abs());
+    }
+    worst
+}
+
+#[test]
+fn brute_force_subdivision_at_ternary_points() {
+    // A random net on the fan of radius 6 (every vertex random, also those outside the layout:
+    // a layout too small would show), refined by two and four √3 steps; the limit position of
+    // the vertex at (i/3^m, j/3^m) must be the grid stencil at rate 3^m applied to the net.
+    for k in 3..=8u32 {
+        for m in [1, 2] {
+            let s = float(k, 3u32.pow(m));
+            let worst = brute_force(k, m, &mut |i, j| s.at(i, j).expect("grid").to_vec());
+            assert!(worst < 1e-12, "K = {k}, m = {m}: off by {worst:e}");
+        }
+    }
+}
+
+#[test]
+fn brute_force_six_steps_by_substitution() {
+    // Six √3 steps: the points (i/27, j/27), past the grid systems' rate 24, by substitution.
+    for k in [3, 5] {
+        let mut sub = Sqrt3Substitution::<f64>::new(&sqrt3(), k).expect("valid");
+        let worst = brute_force(k, 3, &mut |i, j| {
+            sub.stencil(&q(i, 27), &q(j, 27)).expect("in the patch")
+        });
+        assert!(worst < 1e-12, "K = {k}: off by {worst:e}");
+    }
+}
+
+#[test]
+#[ignore = "slow sweep: every rate 7..=24 for K = 3, 5, 8"]
+fn grid_system_equals_substitution_at_every_rate_up_to_24() {
+    let scheme = sqrt3();
+    let valences = [3, 5, 8];
+    let matrices: Vec<Sqrt3LocalMatrices> = valences
+        .iter()
+        .map(|&k| Sqrt3LocalMatrices::new(&scheme, k).expect("valid"))
+        .collect();
+    let mut subs: Vec<Sqrt3Substitution<f64>> = valences
+        .iter()
+        .map(|&k| Sqrt3Substitution::new(&scheme, k).expect("valid"))
+        .collect();
+    for n in 7..=24u32 {
+        // psi does not depend on the valence: one solve per rate for the three grids.
+        let psi = sqrt3_regular_basis::<f64>(&scheme, n).expect("solvable");
+        let points = triangle_grid_points(n);
+        for (m, sub) in matrices.iter().zip(subs.iter_mut()) {
+            sub.share_basis(psi.clone()).expect("sqrt3's basis");
+            let grid = sqrt3_patch_stencils_at(m, &psi, &points, n).expect("solvable");
+            for (&(i, j), stencil) in grid.points.iter().zip(&grid.stencils) {
+                let by_substitution = sub
+                    .stencil(&q(i, i64::from(n)), &q(j, i64::from(n)))
+                    .expect("in the patch");
+                for (a, c) in stencil.iter().zip(&by_substitution) {
+                    assert!(
+                        (a - c).abs() < 1e-12,
+                        "K = {}, ({i}/{n}, {j}/{n})",
+                        m.valence
+                    );
+                }
+            }
+        }
+    }
+}
