@@ -11,6 +11,7 @@ mod common;
 
 use std::collections::HashMap;
 
+use proptest::prelude::*;
 use runtime::butterfly_isolate::isolate_butterfly;
 use runtime::butterfly_refine::butterfly_refine;
 use runtime::cone_chart::ConeChart;
@@ -36,36 +37,28 @@ fn regions_of(iso: &TriangleIsolation) -> Vec<(u32, u32)> {
     kinds
 }
 
+/// Three steps separate neighbouring extraordinary vertices (six edges apart, module docs of
+/// `runtime::butterfly_isolate`); a regular torus needs none. Every region of the valence shows
+/// up, and nothing else.
 #[test]
 fn isolation_separates_the_extraordinary_vertices() {
-    let cases: Vec<(&str, Mesh)> = vec![
-        ("tetrahedron", tetrahedron()),
-        ("octahedron", octahedron()),
-        ("icosahedron", icosahedron()),
-        ("torus", torus(12, 12)),
+    let cases: Vec<(&str, Mesh, usize, u32)> = vec![
+        ("tetrahedron", tetrahedron(), 3, 3),
+        ("octahedron", octahedron(), 3, 4),
+        ("icosahedron", icosahedron(), 3, 5),
+        ("torus", torus(12, 12), 0, 6),
     ];
-    for (name, m) in cases {
+    for (name, m, steps, k) in cases {
         let iso = isolate_butterfly(&m).unwrap_or_else(|e| panic!("{name}: {e}"));
-        println!(
-            "{name}: {} steps, {} triangles, patches {:?}",
-            iso.steps,
-            iso.mesh.faces(),
-            regions_of(&iso)
-        );
+        assert_eq!(iso.steps, steps, "{name}");
+        assert_eq!(iso.mesh.faces(), m.faces() << (2 * steps), "{name}");
+        let mut expected: Vec<(u32, u32)> = vec![(6, 0)];
+        if k != 6 {
+            expected.extend((0..9).map(|r| (k, r)));
+        }
+        expected.sort_unstable();
+        assert_eq!(regions_of(&iso), expected, "{name}");
     }
-}
-
-#[test]
-fn spot_isolates() {
-    let Some(dir) = models() else { return };
-    let m = load(&dir.join("crane/spot_triangulated.obj"));
-    let iso = isolate_butterfly(&m).unwrap_or_else(|e| panic!("spot: {e}"));
-    println!(
-        "spot: {} steps, {} triangles, {} kinds",
-        iso.steps,
-        iso.mesh.faces(),
-        regions_of(&iso).len()
-    );
 }
 
 /// The gathered layouts are the right vertices, in the right order and rotation: the level-`L`
@@ -174,19 +167,6 @@ fn gathered_layouts_match_whole_mesh_refinement() {
     }
 }
 
-#[test]
-#[ignore]
-fn time_spot_isolation() {
-    let Some(dir) = models() else { return };
-    let m = load(&dir.join("crane/spot_triangulated.obj"));
-    let t = std::time::Instant::now();
-    let iso = isolate_butterfly(&m).unwrap_or_else(|e| panic!("spot: {e}"));
-    println!("isolate {:?}", t.elapsed());
-    let t = std::time::Instant::now();
-    let _ = butterfly_refine(&iso.mesh).expect("refines");
-    println!("one refinement of the isolated mesh {:?}", t.elapsed());
-}
-
 /// The child of a triangle holding the point `(u, v) / 2d` of the parent, and the point in the
 /// child's own parameters over `d` (the inverse of `child_to_parent`).
 fn child_holding(u: u32, v: u32, d: u32) -> (u8, u32, u32) {
@@ -276,4 +256,104 @@ fn the_surface_passes_through_every_refined_vertex() {
             check_against_refinement(&format!("{name} at rate {rate}"), &table, &iso, rate);
         }
     }
+}
+
+/// A vertex normal of a fine mesh: the area-weighted average of the normals of the triangles
+/// around it (their cross products summed).
+fn ring_normal(mesh: &Mesh, v: usize) -> [f64; 3] {
+    let p = &mesh.positions;
+    let mut sum = [0.0; 3];
+    for h in mesh.fan(v) {
+        let (a, b) = (mesh.head(h) as usize, mesh.head(mesh.next(h)) as usize);
+        let (e, f) = (
+            [0, 1, 2].map(|c| p[a][c] - p[v][c]),
+            [0, 1, 2].map(|c| p[b][c] - p[v][c]),
+        );
+        let n = [
+            e[1] * f[2] - e[2] * f[1],
+            e[2] * f[0] - e[0] * f[2],
+            e[0] * f[1] - e[1] * f[0],
+        ];
+        sum = [0, 1, 2].map(|c| sum[c] + n[c]);
+    }
+    let length = sum.iter().map(|c| c * c).sum::<f64>().sqrt();
+    sum.map(|c| c / length)
+}
+
+/// The table's normals (from the d/du, d/dv stencils, at the extraordinary vertices the
+/// spectral-projector tangents) against the ring normals of the mesh refined four more times
+/// at the same vertices: the surface is only C1, so the fine mesh's ring normal approaches the
+/// limit normal slowly, and the bound is loose; the normals of the convex shapes point out.
+#[test]
+fn normals_follow_the_refined_surface() {
+    let table = StencilTable::default_butterfly().expect("embedded butterfly table");
+    for (name, m) in [("octahedron", octahedron()), ("icosahedron", icosahedron())] {
+        let iso = isolate_butterfly(&m).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let (rate, extra) = (2u32, 4usize);
+        let mut levels = vec![iso.mesh.clone()];
+        for _ in 0..extra {
+            let next = butterfly_refine(&levels[levels.len() - 1])
+                .expect("refines")
+                .mesh;
+            levels.push(next);
+        }
+        let grid = TriangleDualGrid::new(
+            &table,
+            &iso.mesh,
+            &iso.patches,
+            &vec![rate; iso.mesh.faces()],
+        )
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let out = grid.tessellate(&iso.mesh);
+        let mut worst = 0.0f64;
+        for ((p, n), s) in out.positions.iter().zip(&out.normals).zip(&out.sources) {
+            let n = n.map(f64::from);
+            let outwards: f64 = (0..3).map(|c| n[c] * f64::from(p[c])).sum();
+            assert!(outwards > 0.0, "{name}: an inward normal at {p:?}");
+            if s.denominator != rate {
+                continue;
+            }
+            // The vertex at level 1 (rate 2) is the same vertex at every later level.
+            let w = refined_vertex(&levels, s.face as usize, s.u, s.v, 1);
+            let fine = ring_normal(&levels[extra], w as usize);
+            let cos: f64 = (0..3).map(|c| n[c] * fine[c]).sum();
+            worst = worst.max(cos.clamp(-1.0, 1.0).acos());
+        }
+        println!("{name}: worst normal angle {worst:.2e} rad");
+        assert!(worst < 5e-3, "{name}: {worst}");
+    }
+}
+
+/// Random per-face rates: the output is an oriented manifold with the input's Euler
+/// characteristic, whatever the neighbouring rates and patch kinds.
+fn check_random_rates(name: &str, iso: &TriangleIsolation, rates: &[u32]) {
+    let table = StencilTable::default_butterfly().expect("embedded butterfly table");
+    let grid = TriangleDualGrid::new(&table, &iso.mesh, &iso.patches, rates)
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+    let out = grid.tessellate(&iso.mesh);
+    check_topology(&iso.mesh, &out, name);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(6))]
+
+    #[test]
+    fn random_rates_give_manifolds(rates in proptest::collection::vec(1u32..=8, 1280)) {
+        let iso = isolate_butterfly(&icosahedron()).expect("isolates");
+        prop_assert_eq!(iso.mesh.faces(), rates.len());
+        check_random_rates("icosahedron", &iso, &rates);
+    }
+}
+
+#[test]
+fn spot_tessellates_to_a_closed_manifold_at_mixed_rates() {
+    let Some(dir) = models() else { return };
+    let m = load(&dir.join("crane/spot_triangulated.obj"));
+    let iso = isolate_butterfly(&m).unwrap_or_else(|e| panic!("spot: {e}"));
+    assert_eq!(iso.steps, 3);
+    // Rates 1 and 2, alternating in runs of odd lengths so neighbours differ.
+    let rates: Vec<u32> = (0..iso.mesh.faces())
+        .map(|f| 1 + ((f / 7) % 2) as u32)
+        .collect();
+    check_random_rates("spot", &iso, &rates);
 }
