@@ -10,6 +10,9 @@
 //! 5,120 triangles; the same threads and rates.
 #![allow(missing_docs)] // criterion_group! generates an undocumented function
 
+#[path = "../tests/common/mod.rs"]
+mod common;
+
 use std::path::Path;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
@@ -95,48 +98,7 @@ fn triangle_mesh() -> (String, Mesh) {
         let m = Mesh::from_obj(&obj).unwrap_or_else(|e| panic!("{e}")).0;
         return ("spot triangulated".to_owned(), m);
     }
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let p = vec![
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ];
-    let faces: Vec<Vec<i64>> = [
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ]
-    .iter()
-    .map(|f| f.to_vec())
-    .collect();
-    let mut m = Mesh::new(p, &faces, &[], schemes::BoundaryMode::EdgeOnly)
-        .unwrap_or_else(|e| panic!("{e}"));
+    let mut m = common::icosahedron();
     for _ in 0..4 {
         m = loop_refine(&m).unwrap_or_else(|e| panic!("{e}")).mesh;
     }

@@ -133,6 +133,7 @@ pub fn butterfly_refine(mesh: &Mesh) -> Result<LoopRefinement, RuntimeError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_meshes::{lattice_torus, octahedron};
     use schemes::triangle::TriangleRefinement;
     use schemes::BoundaryMode;
 
@@ -172,28 +173,6 @@ mod tests {
         assert_eq!(total, 1.0, "no other offsets carry weight");
     }
 
-    fn octahedron() -> Mesh {
-        let p = vec![
-            [1.0, 0.0, 0.0],
-            [-1.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [0.0, -1.0, 0.0],
-            [0.0, 0.0, 1.0],
-            [0.0, 0.0, -1.0],
-        ];
-        let f = vec![
-            vec![0, 2, 4],
-            vec![2, 1, 4],
-            vec![1, 3, 4],
-            vec![3, 0, 4],
-            vec![2, 0, 5],
-            vec![1, 2, 5],
-            vec![3, 1, 5],
-            vec![0, 3, 5],
-        ];
-        Mesh::new(p, &f, &[], BoundaryMode::EdgeOnly).expect("valid octahedron")
-    }
-
     /// Expected numbers by hand from the valence-4 rule: the edge (+x, +y) of the octahedron,
     /// both ends of valence 4: each end gives 3/4 a + 3/8 b - 1/8 (the vertex opposite b).
     #[test]
@@ -221,21 +200,10 @@ mod tests {
     fn the_regular_rule_reproduces_cubics() {
         let m = 12i64;
         let g = |a: f64, b: f64| a * a * a - 2.0 * a * a * b + 0.5 * b * b * b - a * b + 3.0;
-        let index = |a: i64, b: i64| a.rem_euclid(m) + m * b.rem_euclid(m);
-        let positions: Vec<[f64; 3]> = (0..m * m)
-            .map(|k| {
-                let (a, b) = ((k % m) as f64, (k / m) as f64);
-                [a, b, g(a, b)]
-            })
-            .collect();
-        let mut faces = Vec::new();
-        for b in 0..m {
-            for a in 0..m {
-                faces.push(vec![index(a, b), index(a + 1, b), index(a, b + 1)]);
-                faces.push(vec![index(a + 1, b), index(a + 1, b + 1), index(a, b + 1)]);
-            }
-        }
-        let torus = Mesh::new(positions, &faces, &[], BoundaryMode::EdgeOnly).expect("torus");
+        let torus = lattice_torus(m, |a, b| {
+            let (a, b) = (a as f64, b as f64);
+            [a, b, g(a, b)]
+        });
         let r = butterfly_refine(&torus).expect("refines");
         let mut checked = 0;
         for (e, &[x, y]) in r.edges.iter().enumerate() {

@@ -249,22 +249,10 @@ impl ConeChart {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use schemes::BoundaryMode;
+    use crate::test_meshes::{lattice_torus, octahedron};
 
-    /// A regular torus `m x m` with vertex `(a, b)` at index `a + m b` (mod m).
     fn torus(m: i64) -> Mesh {
-        let index = |a: i64, b: i64| a.rem_euclid(m) + m * b.rem_euclid(m);
-        let positions = (0..m * m)
-            .map(|k| [(k % m) as f64, (k / m) as f64, 0.0])
-            .collect();
-        let mut faces = Vec::new();
-        for b in 0..m {
-            for a in 0..m {
-                faces.push(vec![index(a, b), index(a + 1, b), index(a, b + 1)]);
-                faces.push(vec![index(a + 1, b), index(a + 1, b + 1), index(a, b + 1)]);
-            }
-        }
-        Mesh::new(positions, &faces, &[], BoundaryMode::EdgeOnly).expect("torus")
+        lattice_torus(m, |a, b| [a as f64, b as f64, 0.0])
     }
 
     /// On the plane the cone coordinates are the lattice's, sector by sector: `(a, b)_s` is the
@@ -299,25 +287,7 @@ mod tests {
 
     #[test]
     fn an_octahedron_is_a_four_valent_cone_until_it_closes() {
-        let p = vec![
-            [1.0, 0.0, 0.0],
-            [-1.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [0.0, -1.0, 0.0],
-            [0.0, 0.0, 1.0],
-            [0.0, 0.0, -1.0],
-        ];
-        let f = vec![
-            vec![0, 2, 4],
-            vec![2, 1, 4],
-            vec![1, 3, 4],
-            vec![3, 0, 4],
-            vec![2, 0, 5],
-            vec![1, 2, 5],
-            vec![3, 1, 5],
-            vec![0, 3, 5],
-        ];
-        let mesh = Mesh::new(p, &f, &[], BoundaryMode::EdgeOnly).expect("octahedron");
+        let mesh = octahedron();
         let chart = ConeChart::new(&mesh, 4, 0, 1).expect("the one-ring is a cone");
         assert_eq!(chart.valence, 4);
         assert_eq!(

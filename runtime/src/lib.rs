@@ -26,6 +26,8 @@ pub mod patch;
 pub mod rates;
 pub mod refine;
 pub mod stencil_table;
+#[cfg(test)]
+mod test_meshes;
 pub mod topology;
 pub mod triangle_dual_grid;
 pub mod triangle_isolation;
