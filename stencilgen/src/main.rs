@@ -15,7 +15,7 @@ use schemes::quad::QUAD_SCHEME_NAMES;
 use schemes::triangle::TRIANGLE_SCHEME_NAMES;
 use schemes::{BoundaryMode, CurveScheme, QuadScheme, TriangleScheme};
 use serde_json::{json, Value};
-use stencilgen::butterfly_patch::ButterflySubstitution;
+use stencilgen::butterfly_regions::ButterflyRegionSubstitution;
 use stencilgen::butterfly_table::{build_butterfly_table, ButterflyTableSpec};
 use stencilgen::extraordinary_patch::{canonical, Neighbourhood, OUTER_POINTS};
 use stencilgen::patch_stencils::{curve_scheme, quad_scheme};
@@ -545,8 +545,10 @@ fn write_bytes(
 /// substitution: `{"scheme","valence","u","v","exact","order","weights","du","dv"}`. At the
 /// vertex itself the tangent masks are irrational in general: `null` in exact mode, with the
 /// reason in `"note"`; `--f64` gives them (subdominant eigenvectors).
-/// The butterfly's patch next to an interior vertex: positions only (its derivative stencils
-/// and tangent masks are not built yet, so `du`/`dv` are `null` with a note).
+/// The butterfly's patch next to an interior vertex (region 0 of
+/// `stencilgen::butterfly_regions`), by substitution: positions and both derivatives; at the
+/// vertex itself the derivatives are the one-sided ones along the patch's edges,
+/// `(e_{E_0} - e_V) P` and `(e_{E_1} - e_V) P` (`P` the spectral projector of `A` for 1/2).
 fn butterfly_stencil_json<S: Scalar>(
     scheme: &TriangleScheme,
     valence: u32,
@@ -554,8 +556,19 @@ fn butterfly_stencil_json<S: Scalar>(
     v: &BigRational,
     value: impl Fn(&S) -> Value,
 ) -> Result<Value, StencilError> {
-    let mut substitution = ButterflySubstitution::<S>::new(scheme, valence)?;
-    let weights = substitution.stencil(u, v)?;
+    let mut substitution = ButterflyRegionSubstitution::<S>::new(scheme, valence)?;
+    let mut row = |kind| -> Result<Vec<Value>, StencilError> {
+        Ok(substitution
+            .stencil(0, u, v, kind)?
+            .iter()
+            .map(&value)
+            .collect())
+    };
+    let (weights, du, dv) = (
+        row(StencilKind::Position)?,
+        row(StencilKind::DerivativeU)?,
+        row(StencilKind::DerivativeV)?,
+    );
     Ok(json!({
         "scheme": scheme.name,
         "valence": valence,
@@ -563,11 +576,10 @@ fn butterfly_stencil_json<S: Scalar>(
         "u": u.to_string(),
         "v": v.to_string(),
         "exact": S::EXACT,
-        "order": substitution.matrices.names(),
-        "weights": weights.iter().map(&value).collect::<Vec<_>>(),
-        "du": Value::Null,
-        "dv": Value::Null,
-        "note": "the butterfly's derivative stencils are not built yet",
+        "order": substitution.stencils.regions.corner.names(),
+        "weights": weights,
+        "du": du,
+        "dv": dv,
     }))
 }
 

@@ -257,7 +257,36 @@ fn butterfly_stencil_next_to_an_extraordinary_vertex() {
     // Rational at valence 4: exact, and interpolating at the vertex.
     let exact = json("stencil --scheme butterfly --valence 4 --u 0 --v 0 --json");
     assert_eq!(exact["weights"][0], "1");
-    assert!(exact["du"].is_null());
+    // The tangents at the vertex, by hand: the one-ring block of A is closed (the edge points
+    // at V read only V and its ring), its Fourier mode 1 has eigenvalue 1/2 with left vectors
+    // cos, sin (2 pi j/K) on E_j and 0 at V, right vectors the same on the ring. Normalized
+    // (l.r = 1), D_u = (e_E0 - e_V) P puts (2/K) cos(2 pi j/K) on E_j and D_v = (e_E1 - e_V) P
+    // puts (2/K) cos(2 pi (j - 1)/K): at K = 4, (1/2, 0, -1/2, 0) and (0, 1/2, 0, -1/2).
+    let strings = |key: &str| -> Vec<String> {
+        exact[key]
+            .as_array()
+            .map(|a| a.iter().filter_map(|x| x.as_str().map(str::to_owned)).collect())
+            .unwrap_or_default()
+    };
+    let (du, dv) = (strings("du"), strings("dv"));
+    assert_eq!(&du[..5], ["0", "1/2", "0", "-1/2", "0"], "{du:?}");
+    assert_eq!(&dv[..5], ["0", "0", "1/2", "0", "-1/2"], "{dv:?}");
+    assert!(du[5..].iter().chain(&dv[5..]).all(|x| x == "0"));
+    let f = json("stencil --scheme butterfly --valence 7 --u 0 --v 0 --f64 --json");
+    let floats = |key: &str| -> Vec<f64> {
+        f[key]
+            .as_array()
+            .map(|a| a.iter().filter_map(serde_json::Value::as_f64).collect())
+            .unwrap_or_default()
+    };
+    for j in 0..7 {
+        let t = 2.0 * std::f64::consts::PI * j as f64 / 7.0;
+        let du = floats("du")[1 + j];
+        let dv = floats("dv")[1 + j];
+        assert!((du - 2.0 / 7.0 * t.cos()).abs() < 1e-9, "du E_{j}: {du}");
+        let t1 = 2.0 * std::f64::consts::PI * (j as f64 - 1.0) / 7.0;
+        assert!((dv - 2.0 / 7.0 * t1.cos()).abs() < 1e-9, "dv E_{j}: {dv}");
+    }
 }
 
 #[test]
