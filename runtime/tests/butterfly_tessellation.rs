@@ -357,3 +357,28 @@ fn spot_tessellates_to_a_closed_manifold_at_mixed_rates() {
         .collect();
     check_random_rates("spot", &iso, &rates);
 }
+
+/// A full table written by `stencilgen tables --schemes butterfly --n 1..24` (named by the
+/// environment variable `BUTTERFLY_TABLE`): the same check at rate 16, and the manifold and
+/// outward-normal checks at every rate from 9 to 24. `BUTTERFLY_TABLE=FILE cargo test --release -p subtess-runtime --test
+/// butterfly_tessellation -- --ignored`.
+#[test]
+#[ignore]
+fn a_full_table_passes_through_every_refined_vertex() {
+    let Some(path) = std::env::var_os("BUTTERFLY_TABLE") else {
+        println!("skipping: BUTTERFLY_TABLE is not set");
+        return;
+    };
+    let table = StencilTable::read(std::path::Path::new(&path)).expect("a butterfly table");
+    let iso = isolate_butterfly(&icosahedron()).expect("isolates");
+    check_against_refinement("icosahedron at rate 16", &table, &iso, 16);
+    for rate in 9..=24 {
+        let grid = TriangleDualGrid::new(&table, &iso.mesh, &iso.patches, &vec![rate; 1280])
+            .unwrap_or_else(|e| panic!("rate {rate}: {e}"));
+        check_topology(
+            &iso.mesh,
+            &grid.tessellate(&iso.mesh),
+            &format!("rate {rate}"),
+        );
+    }
+}

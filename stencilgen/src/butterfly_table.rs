@@ -38,8 +38,9 @@ pub struct ButterflyTableSpec {
 }
 
 impl ButterflyTableSpec {
-    /// The butterfly table `subtess` embeds: valences 3..=8, n = 1..=8, f32 (5.7 MiB; the
-    /// rates up to 24 make a table about 20 times larger, written by `stencilgen tables`).
+    /// The butterfly table `subtess` embeds: valences 3..=8, n = 1..=8, f32 (5.3 MiB; the
+    /// rates up to 24 make a 109.2 MiB table, written by `stencilgen tables` in about 14 CPU
+    /// minutes).
     pub fn default_butterfly() -> Self {
         ButterflyTableSpec {
             valences: (3..=8).collect(),

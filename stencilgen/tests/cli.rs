@@ -265,7 +265,11 @@ fn butterfly_stencil_next_to_an_extraordinary_vertex() {
     let strings = |key: &str| -> Vec<String> {
         exact[key]
             .as_array()
-            .map(|a| a.iter().filter_map(|x| x.as_str().map(str::to_owned)).collect())
+            .map(|a| {
+                a.iter()
+                    .filter_map(|x| x.as_str().map(str::to_owned))
+                    .collect()
+            })
             .unwrap_or_default()
     };
     let (du, dv) = (strings("du"), strings("dv"));
