@@ -16,6 +16,7 @@
 pub mod bivariate;
 pub mod butterfly_local;
 pub mod butterfly_regions;
+pub mod cone;
 pub mod curve;
 pub mod local_matrices;
 pub mod loop_regular;

@@ -74,16 +74,15 @@
 //! **Numbers.** Every matrix is kept in f64 (the weights' f64 values) and, when `alpha_K` is
 //! rational (`K = 3, 4, 6`), also exactly as [`BigRational`].
 //!
-//! The cone ball and the separating-axis test duplicate private helpers of
-//! [`crate::butterfly_local`] (to be shared later).
+//! The cone ball, its order, point names and the separating-axis test are
+//! [`crate::cone`]'s, shared with the butterfly.
 
-use std::collections::{BTreeMap, HashMap, VecDeque};
-use std::ops::{Add, Mul};
+use std::collections::{BTreeMap, HashMap};
 
-use num_bigint::BigInt;
-use num_rational::{BigRational, Rational64};
-use num_traits::Zero;
+use num_rational::BigRational;
 
+use crate::cone::{interiors_meet, layout_ball, Weight};
+pub use crate::cone::{layout_key, point_name};
 use crate::local_matrices::UnsupportedNeighbourhood;
 use crate::triangle::{TriangleRefinement, NEIGHBOURS};
 use crate::triangle_local::{canonical_triangle_point, TrianglePoint};
@@ -103,92 +102,6 @@ pub const HALF_LEVEL_STEPS: [(i64, i64); 6] =
 /// radius [`LAYOUT_RADIUS`] around the patch.
 pub fn sqrt3_layout(valence: u32) -> Vec<TrianglePoint> {
     layout_ball(valence, LAYOUT_RADIUS)
-}
-
-/// The graph-distance ball of radius `radius` around `{V, E_0, E_1}` on the cone, ordered by
-/// ring (distance from `V`), then sector, then `b`.
-fn layout_ball(valence: u32, radius: u32) -> Vec<TrianglePoint> {
-    let neighbours = |p: TrianglePoint| -> Vec<TrianglePoint> {
-        match p {
-            TrianglePoint::Centre => (0..valence)
-                .map(|s| TrianglePoint::Sector { s, a: 1, b: 0 })
-                .collect(),
-            TrianglePoint::Sector { s, a, b } => NEIGHBOURS
-                .iter()
-                .map(|&(da, db)| canonical_triangle_point(valence, i64::from(s), a + da, b + db))
-                .collect(),
-        }
-    };
-    let mut distance: HashMap<TrianglePoint, u32> = HashMap::new();
-    let mut queue = VecDeque::new();
-    for p in [
-        TrianglePoint::Centre,
-        TrianglePoint::Sector { s: 0, a: 1, b: 0 },
-        TrianglePoint::Sector {
-            s: 1 % valence,
-            a: 1,
-            b: 0,
-        },
-    ] {
-        distance.insert(p, 0);
-        queue.push_back(p);
-    }
-    while let Some(p) = queue.pop_front() {
-        let d = distance[&p];
-        if d == radius {
-            continue;
-        }
-        for q in neighbours(p) {
-            if let std::collections::hash_map::Entry::Vacant(e) = distance.entry(q) {
-                e.insert(d + 1);
-                queue.push_back(q);
-            }
-        }
-    }
-    let mut points: Vec<TrianglePoint> = distance.into_keys().collect();
-    points.sort_by_key(|p| match *p {
-        TrianglePoint::Centre => (0, 0, 0),
-        TrianglePoint::Sector { s, a, b } => (a + b, i64::from(s), b),
-    });
-    points
-}
-
-/// Names of layout points: `V`, or `(a,b)_s`.
-pub fn point_name(p: TrianglePoint) -> String {
-    match p {
-        TrianglePoint::Centre => "V".to_owned(),
-        TrianglePoint::Sector { s, a, b } => format!("({a},{b})_{s}"),
-    }
-}
-
-/// The number fields the matrices are built in: f64 and exact rationals.
-trait Weight: Clone + Zero + Add<Output = Self> + Mul<Output = Self> {
-    /// The weight in this field, `None` if it is irrational and the field exact.
-    fn from_weight(w: TriangleWeight) -> Option<Self>;
-    /// `1`.
-    fn one_weight() -> Self;
-}
-
-impl Weight for f64 {
-    fn from_weight(w: TriangleWeight) -> Option<Self> {
-        Some(w.value)
-    }
-    fn one_weight() -> Self {
-        1.0
-    }
-}
-
-impl Weight for BigRational {
-    fn from_weight(w: TriangleWeight) -> Option<Self> {
-        w.exact.map(big)
-    }
-    fn one_weight() -> Self {
-        BigRational::from_integer(BigInt::from(1))
-    }
-}
-
-fn big(r: Rational64) -> BigRational {
-    BigRational::new(BigInt::from(*r.numer()), BigInt::from(*r.denom()))
 }
 
 /// A linear combination of coarser points making a finer point.
@@ -353,23 +266,6 @@ pub struct Sqrt3LocalMatrices {
     /// The regular tiles covering `1/3 <= u + v <= 1`: up triangles `(a,b),(a+1,b),(a,b+1)`
     /// then down triangles `(a+1,b),(a+1,b+1),(a,b+1)`, each by `b`, then `a`.
     pub tiles: Vec<Sqrt3Tile>,
-}
-
-/// The interiors of two convex polygons (counter-clockwise, skew coordinates) meet: no edge of
-/// either separates them (the separating-axis test; affine coordinates keep separation).
-fn interiors_meet(p: &[(i64, i64)], q: &[(i64, i64)]) -> bool {
-    let separated_by = |poly: &[(i64, i64)]| {
-        (0..poly.len()).any(|e| {
-            let (a, b) = (poly[e], poly[(e + 1) % poly.len()]);
-            let f = |x: &(i64, i64)| (b.0 - a.0) * (x.1 - a.1) - (b.1 - a.1) * (x.0 - a.0);
-            let lo_p = p.iter().map(f).min().unwrap_or(0);
-            let hi_p = p.iter().map(f).max().unwrap_or(0);
-            let lo_q = q.iter().map(f).min().unwrap_or(0);
-            let hi_q = q.iter().map(f).max().unwrap_or(0);
-            hi_p <= lo_q || hi_q <= lo_p
-        })
-    };
-    !separated_by(p) && !separated_by(q)
 }
 
 /// The level-`level` triangles of `1/3 <= u + v <= 1` (`level >= 1`), in
@@ -619,7 +515,10 @@ impl Sqrt3LocalMatrices {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::cone::big;
+    use num_rational::Rational64;
     use num_traits::One;
+    use num_traits::Zero;
 
     fn sqrt3() -> TriangleScheme {
         TriangleScheme::by_name("sqrt3").expect("catalogued")
