@@ -22,6 +22,7 @@ pub mod local_matrices;
 pub mod loop_regular;
 pub mod quad;
 pub mod sqrt3_local;
+pub mod sqrt3_regions;
 pub mod triangle;
 pub mod triangle_local;
 
