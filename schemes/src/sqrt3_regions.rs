@@ -362,7 +362,11 @@ mod tests {
                 sorted.sort_by_key(|&p| layout_key(p));
                 sorted.dedup();
                 assert_eq!(sorted, region.layout, "K = {k} region {i}");
-                assert_eq!(region.layout[0], TrianglePoint::Centre, "K = {k} region {i}");
+                assert_eq!(
+                    region.layout[0],
+                    TrianglePoint::Centre,
+                    "K = {k} region {i}"
+                );
                 if i > 0 {
                     for c in 0..region.size() {
                         assert!(
