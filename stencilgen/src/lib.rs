@@ -44,6 +44,7 @@ pub mod scalar;
 pub mod scaling_system;
 pub mod solve;
 pub mod sqrt3_patch;
+pub mod sqrt3_regions;
 pub mod stencil_set;
 pub mod substitution;
 pub mod table;
