@@ -22,6 +22,7 @@ use stencilgen::patch_stencils::{curve_scheme, quad_scheme};
 use stencilgen::rational::parse_rational;
 use stencilgen::regular_patch::StencilKind;
 use stencilgen::sqrt3_patch::Sqrt3Substitution;
+use stencilgen::sqrt3_table::{build_sqrt3_table, Sqrt3TableSpec};
 use stencilgen::stencil_set::StencilSetSpec;
 use stencilgen::substitution::Substitution;
 use stencilgen::table::{build_table, TableSpec};
@@ -96,7 +97,7 @@ enum Command {
     },
     /// Write a versioned binary stencil table (docs/table-format.md).
     Tables {
-        /// Schemes, comma separated: quad schemes, `loop` or `butterfly` (one file each; with
+        /// Schemes, comma separated: quad schemes, `loop`, `butterfly` or `sqrt3` (one file each; with
         /// several, the scheme name is appended to the file stem).
         #[arg(long, default_value = "catmull-clark", value_delimiter = ',')]
         schemes: Vec<String>,
@@ -287,6 +288,21 @@ fn run(cli: Cli) -> Result<(), StencilError> {
                             precision,
                         };
                         write_bytes(&path, &build_butterfly_table(&spec)?, started)?;
+                        continue;
+                    }
+                    if triangle.name == "sqrt3" {
+                        if boundary {
+                            return Err(StencilError::UnsupportedScheme {
+                                scheme: name.clone(),
+                                reason: "sqrt3's boundary rules are not implemented".to_owned(),
+                            });
+                        }
+                        let spec = Sqrt3TableSpec {
+                            valences: set.valences.clone(),
+                            rates: set.rates.clone(),
+                            precision,
+                        };
+                        write_bytes(&path, &build_sqrt3_table(&spec)?, started)?;
                         continue;
                     }
                     let spec = TriangleTableSpec {
