@@ -147,7 +147,13 @@ impl RegionTriangle {
     /// The level-`level` triangles covering this one, corners in level-`level` chart
     /// coordinates: up triangles (by `b`, then `a`), then down triangles (same order).
     pub fn sub_triangles(&self, level: u32) -> Vec<[(i64, i64); 3]> {
-        let m = 1i64 << level;
+        self.sub_triangles_scaled(1i64 << level)
+    }
+
+    /// The triangles of the lattice scaled by `1/m` covering this one (`m = 2^L` for a dyadic
+    /// level `L`, `3^L` for a ternary one: [`crate::sqrt3_regions`]), corners in those units,
+    /// in [`Self::sub_triangles`] order.
+    pub fn sub_triangles_scaled(&self, m: i64) -> Vec<[(i64, i64); 3]> {
         let big = self.corners().map(|(x, y)| (m * x, m * y));
         let inside = |p: (i64, i64), three: i64| {
             // The centroid `p / 3` is inside `big` (strictly: tiles do not overlap).

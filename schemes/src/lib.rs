@@ -16,11 +16,13 @@
 pub mod bivariate;
 pub mod butterfly_local;
 pub mod butterfly_regions;
+pub mod cone;
 pub mod curve;
 pub mod local_matrices;
 pub mod loop_regular;
 pub mod quad;
 pub mod sqrt3_local;
+pub mod sqrt3_regions;
 pub mod triangle;
 pub mod triangle_local;
 

@@ -74,16 +74,15 @@
 //! **Numbers.** Every matrix is kept in f64 (the weights' f64 values) and, when `alpha_K` is
 //! rational (`K = 3, 4, 6`), also exactly as [`BigRational`].
 //!
-//! The cone ball and the separating-axis test duplicate private helpers of
-//! [`crate::butterfly_local`] (to be shared later).
+//! The cone ball, its order, point names and the separating-axis test are
+//! [`crate::cone`]'s, shared with the butterfly.
 
-use std::collections::{BTreeMap, HashMap, VecDeque};
-use std::ops::{Add, Mul};
+use std::collections::{BTreeMap, BTreeSet, HashMap};
 
-use num_bigint::BigInt;
-use num_rational::{BigRational, Rational64};
-use num_traits::Zero;
+use num_rational::BigRational;
 
+use crate::cone::{interiors_meet, layout_ball, Weight};
+pub use crate::cone::{layout_key, point_name};
 use crate::local_matrices::UnsupportedNeighbourhood;
 use crate::triangle::{TriangleRefinement, NEIGHBOURS};
 use crate::triangle_local::{canonical_triangle_point, TrianglePoint};
@@ -105,99 +104,13 @@ pub fn sqrt3_layout(valence: u32) -> Vec<TrianglePoint> {
     layout_ball(valence, LAYOUT_RADIUS)
 }
 
-/// The graph-distance ball of radius `radius` around `{V, E_0, E_1}` on the cone, ordered by
-/// ring (distance from `V`), then sector, then `b`.
-fn layout_ball(valence: u32, radius: u32) -> Vec<TrianglePoint> {
-    let neighbours = |p: TrianglePoint| -> Vec<TrianglePoint> {
-        match p {
-            TrianglePoint::Centre => (0..valence)
-                .map(|s| TrianglePoint::Sector { s, a: 1, b: 0 })
-                .collect(),
-            TrianglePoint::Sector { s, a, b } => NEIGHBOURS
-                .iter()
-                .map(|&(da, db)| canonical_triangle_point(valence, i64::from(s), a + da, b + db))
-                .collect(),
-        }
-    };
-    let mut distance: HashMap<TrianglePoint, u32> = HashMap::new();
-    let mut queue = VecDeque::new();
-    for p in [
-        TrianglePoint::Centre,
-        TrianglePoint::Sector { s: 0, a: 1, b: 0 },
-        TrianglePoint::Sector {
-            s: 1 % valence,
-            a: 1,
-            b: 0,
-        },
-    ] {
-        distance.insert(p, 0);
-        queue.push_back(p);
-    }
-    while let Some(p) = queue.pop_front() {
-        let d = distance[&p];
-        if d == radius {
-            continue;
-        }
-        for q in neighbours(p) {
-            if let std::collections::hash_map::Entry::Vacant(e) = distance.entry(q) {
-                e.insert(d + 1);
-                queue.push_back(q);
-            }
-        }
-    }
-    let mut points: Vec<TrianglePoint> = distance.into_keys().collect();
-    points.sort_by_key(|p| match *p {
-        TrianglePoint::Centre => (0, 0, 0),
-        TrianglePoint::Sector { s, a, b } => (a + b, i64::from(s), b),
-    });
-    points
-}
-
-/// Names of layout points: `V`, or `(a,b)_s`.
-pub fn point_name(p: TrianglePoint) -> String {
-    match p {
-        TrianglePoint::Centre => "V".to_owned(),
-        TrianglePoint::Sector { s, a, b } => format!("({a},{b})_{s}"),
-    }
-}
-
-/// The number fields the matrices are built in: f64 and exact rationals.
-trait Weight: Clone + Zero + Add<Output = Self> + Mul<Output = Self> {
-    /// The weight in this field, `None` if it is irrational and the field exact.
-    fn from_weight(w: TriangleWeight) -> Option<Self>;
-    /// `1`.
-    fn one_weight() -> Self;
-}
-
-impl Weight for f64 {
-    fn from_weight(w: TriangleWeight) -> Option<Self> {
-        Some(w.value)
-    }
-    fn one_weight() -> Self {
-        1.0
-    }
-}
-
-impl Weight for BigRational {
-    fn from_weight(w: TriangleWeight) -> Option<Self> {
-        w.exact.map(big)
-    }
-    fn one_weight() -> Self {
-        BigRational::from_integer(BigInt::from(1))
-    }
-}
-
-fn big(r: Rational64) -> BigRational {
-    BigRational::new(BigInt::from(*r.numer()), BigInt::from(*r.denom()))
-}
-
 /// A linear combination of coarser points making a finer point.
 type Combination<T> = Vec<(TrianglePoint, T)>;
 
 /// √3's rules at one valence, in one number field.
 #[derive(Clone, Debug)]
-struct Sqrt3Rules<T> {
-    valence: u32,
+pub(crate) struct Sqrt3Rules<T> {
+    pub(crate) valence: u32,
     /// `(1 - alpha_K, alpha_K / K)` at `V`.
     extraordinary: (T, T),
     /// `(1 - alpha_6, alpha_6 / 6) = (2/3, 1/18)` at every other vertex.
@@ -208,7 +121,7 @@ struct Sqrt3Rules<T> {
 
 impl<T: Weight> Sqrt3Rules<T> {
     /// `None` when `alpha_K` is irrational in an exact field.
-    fn new(valence: u32) -> Option<Self> {
+    pub(crate) fn new(valence: u32) -> Option<Self> {
         let pair = |v: u32| {
             let (c, b) = TriangleVertexRule::Sqrt3.weights(v);
             Some((T::from_weight(c)?, T::from_weight(b)?))
@@ -291,7 +204,7 @@ impl<T: Weight> Sqrt3Rules<T> {
     }
 
     /// One ternary step (two √3 steps): the level-`(k+1)` point `point` in level-`k` points.
-    fn refine(&self, point: TrianglePoint) -> Result<Combination<T>, String> {
+    pub(crate) fn refine(&self, point: TrianglePoint) -> Result<Combination<T>, String> {
         let mut out: BTreeMap<TrianglePoint, T> = BTreeMap::new();
         for (h, w) in self.second(point) {
             for (p, x) in self.first(h)? {
@@ -355,23 +268,6 @@ pub struct Sqrt3LocalMatrices {
     pub tiles: Vec<Sqrt3Tile>,
 }
 
-/// The interiors of two convex polygons (counter-clockwise, skew coordinates) meet: no edge of
-/// either separates them (the separating-axis test; affine coordinates keep separation).
-fn interiors_meet(p: &[(i64, i64)], q: &[(i64, i64)]) -> bool {
-    let separated_by = |poly: &[(i64, i64)]| {
-        (0..poly.len()).any(|e| {
-            let (a, b) = (poly[e], poly[(e + 1) % poly.len()]);
-            let f = |x: &(i64, i64)| (b.0 - a.0) * (x.1 - a.1) - (b.1 - a.1) * (x.0 - a.0);
-            let lo_p = p.iter().map(f).min().unwrap_or(0);
-            let hi_p = p.iter().map(f).max().unwrap_or(0);
-            let lo_q = q.iter().map(f).min().unwrap_or(0);
-            let hi_q = q.iter().map(f).max().unwrap_or(0);
-            hi_p <= lo_q || hi_q <= lo_p
-        })
-    };
-    !separated_by(p) && !separated_by(q)
-}
-
 /// The level-`level` triangles of `1/3 <= u + v <= 1` (`level >= 1`), in
 /// [`Sqrt3LocalMatrices::tiles`] order, by corners.
 fn outer_tiles(level: u32) -> Vec<[(i64, i64); 3]> {
@@ -393,7 +289,7 @@ fn outer_tiles(level: u32) -> Vec<[(i64, i64); 3]> {
 }
 
 /// `T` scaled by 2: the test `T ∩ (j + int H/2) != ∅` is `2T ∩ (2j + int H) != ∅`.
-fn doubled(t: &[(i64, i64); 3]) -> [(i64, i64); 3] {
+pub(crate) fn doubled(t: &[(i64, i64); 3]) -> [(i64, i64); 3] {
     t.map(|(a, b)| (2 * a, 2 * b))
 }
 
@@ -405,18 +301,33 @@ struct Built<T> {
     tiles: Vec<Sqrt3Tile>,
 }
 
-/// The rows of level-`k` points in level-0 layout weights, memoized per level.
-struct Rows<'a, T> {
+/// The rows of level-`k` points in level-0 layout weights, memoized per level: the one
+/// implementation of "apply the true rules `k` times" that the EV patch and every region
+/// ([`crate::sqrt3_regions`]) use. Reading a level-0 point outside the layout is an error,
+/// which is how every layout is checked.
+pub(crate) struct Rows<'a, T> {
     rules: &'a Sqrt3Rules<T>,
     index: HashMap<TrianglePoint, usize>,
     memo: Vec<HashMap<TrianglePoint, Vec<T>>>,
 }
 
-impl<T: Weight> Rows<'_, T> {
+impl<'a, T: Weight> Rows<'a, T> {
+    /// Rows over `layout`, for points of levels `0..=max_level`.
+    pub(crate) fn new(rules: &'a Sqrt3Rules<T>, layout: &[TrianglePoint], max_level: u32) -> Self {
+        Rows {
+            rules,
+            index: layout.iter().enumerate().map(|(i, &p)| (p, i)).collect(),
+            memo: vec![HashMap::new(); max_level as usize + 1],
+        }
+    }
+
     /// The level-`k` point `p` in level-0 layout weights, or the first unlisted point read.
-    fn row(&mut self, k: usize, p: TrianglePoint) -> Result<Vec<T>, String> {
-        if let Some(r) = self.memo[k].get(&p) {
+    pub(crate) fn row(&mut self, k: usize, p: TrianglePoint) -> Result<Vec<T>, String> {
+        if let Some(r) = self.memo.get(k).and_then(|m| m.get(&p)) {
             return Ok(r.clone());
+        }
+        if k >= self.memo.len() {
+            return Err(format!("level {k} is past the memo's deepest level"));
         }
         let size = self.index.len();
         let mut r = vec![T::zero(); size];
@@ -439,25 +350,54 @@ impl<T: Weight> Rows<'_, T> {
         self.memo[k].insert(p, r.clone());
         Ok(r)
     }
+
+    /// The rows of the level-`k` points `points`, unfolded in sector 0's chart.
+    pub(crate) fn chart_rows(
+        &mut self,
+        k: u32,
+        points: &[(i64, i64)],
+    ) -> Result<Vec<Vec<T>>, String> {
+        points
+            .iter()
+            .map(|&(j1, j2)| {
+                let p = canonical_triangle_point(self.rules.valence, 0, j1, j2);
+                self.row(k as usize, p)
+            })
+            .collect()
+    }
 }
 
-/// Build `A` and the tile rows over `layout` in the field `T`; `Err` names the first point
-/// whose rule reads a point outside the layout.
-fn build<T: Weight>(
+/// Every level-0 point that the level-`level` points `points` (sector-0 chart) read through
+/// √3's rules: the closure a layout must hold (every rule weight is positive).
+pub(crate) fn level0_reads<T: Weight>(
     rules: &Sqrt3Rules<T>,
-    layout: &[TrianglePoint],
-    hull: &[(i64, i64)],
     level: u32,
-) -> Result<Built<T>, String> {
-    let mut rows = Rows {
-        rules,
-        index: layout.iter().enumerate().map(|(i, &p)| (p, i)).collect(),
-        memo: vec![HashMap::new(); level as usize + 1],
-    };
-    let a = layout
+    points: &[(i64, i64)],
+) -> Result<BTreeSet<TrianglePoint>, String> {
+    let mut current: BTreeSet<TrianglePoint> = points
         .iter()
-        .map(|&p| rows.row(1, p))
-        .collect::<Result<Vec<_>, _>>()?;
+        .map(|&(j1, j2)| canonical_triangle_point(rules.valence, 0, j1, j2))
+        .collect();
+    for _ in 0..level {
+        let mut parents = BTreeSet::new();
+        for &p in &current {
+            for (parent, _) in rules.refine(p)? {
+                parents.insert(parent);
+            }
+        }
+        current = parents;
+    }
+    Ok(current)
+}
+
+/// The tiles with corners `tile_corners` (level-`L` chart coordinates) and the level-`L`
+/// lattice points they need, in first-use order: for each tile the `j` with
+/// `T ∩ (j + int S)` nonempty, `S = H/2` (tested as `2T ∩ (2j + int H)`), the only `j` whose
+/// `psi(. - j)` does not vanish on `T`.
+pub(crate) fn sqrt3_tile_set(
+    hull: &[(i64, i64)],
+    tile_corners: Vec<[(i64, i64); 3]>,
+) -> (Vec<(i64, i64)>, Vec<Sqrt3Tile>) {
     let mut regular_points: Vec<(i64, i64)> = Vec::new();
     let mut point_index: BTreeMap<(i64, i64), usize> = BTreeMap::new();
     let mut tiles = Vec::new();
@@ -469,7 +409,7 @@ fn build<T: Weight>(
         .unwrap_or(0)
         / 2
         + 1;
-    for corners in outer_tiles(level) {
+    for corners in tile_corners {
         let twice = doubled(&corners);
         let mut points = Vec::new();
         let range = |c: fn(&(i64, i64)) -> i64| {
@@ -496,11 +436,24 @@ fn build<T: Weight>(
         }
         tiles.push(Sqrt3Tile { corners, points });
     }
-    let valence = rules.valence;
-    let tile_rows = regular_points
+    (regular_points, tiles)
+}
+
+/// Build `A` and the tile rows over `layout` in the field `T`; `Err` names the first point
+/// whose rule reads a point outside the layout.
+fn build<T: Weight>(
+    rules: &Sqrt3Rules<T>,
+    layout: &[TrianglePoint],
+    hull: &[(i64, i64)],
+    level: u32,
+) -> Result<Built<T>, String> {
+    let mut rows = Rows::new(rules, layout, level.max(1));
+    let a = layout
         .iter()
-        .map(|&(j1, j2)| rows.row(level as usize, canonical_triangle_point(valence, 0, j1, j2)))
+        .map(|&p| rows.row(1, p))
         .collect::<Result<Vec<_>, _>>()?;
+    let (regular_points, tiles) = sqrt3_tile_set(hull, outer_tiles(level));
+    let tile_rows = rows.chart_rows(level, &regular_points)?;
     Ok(Built {
         a,
         regular_points,
@@ -619,7 +572,10 @@ impl Sqrt3LocalMatrices {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::cone::big;
+    use num_rational::Rational64;
     use num_traits::One;
+    use num_traits::Zero;
 
     fn sqrt3() -> TriangleScheme {
         TriangleScheme::by_name("sqrt3").expect("catalogued")

@@ -413,7 +413,7 @@ impl<S: Scalar> ButterflyRegionSubstitution<S> {
 }
 
 /// A basis of the right null space of the dense rational matrix `m` (`rows x width`).
-fn null_space(mut m: Vec<Vec<BigRational>>, width: usize) -> Vec<Vec<BigRational>> {
+pub(crate) fn null_space(mut m: Vec<Vec<BigRational>>, width: usize) -> Vec<Vec<BigRational>> {
     let mut pivots = Vec::new();
     let mut rank = 0;
     for col in 0..width {

@@ -44,6 +44,8 @@ pub mod scalar;
 pub mod scaling_system;
 pub mod solve;
 pub mod sqrt3_patch;
+pub mod sqrt3_regions;
+pub mod sqrt3_table;
 pub mod stencil_set;
 pub mod substitution;
 pub mod table;

@@ -10,6 +10,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use num_rational::BigRational;
+use num_traits::Zero;
 use schemes::curve::CURVE_SCHEME_NAMES;
 use schemes::quad::QUAD_SCHEME_NAMES;
 use schemes::triangle::TRIANGLE_SCHEME_NAMES;
@@ -22,6 +23,8 @@ use stencilgen::patch_stencils::{curve_scheme, quad_scheme};
 use stencilgen::rational::parse_rational;
 use stencilgen::regular_patch::StencilKind;
 use stencilgen::sqrt3_patch::Sqrt3Substitution;
+use stencilgen::sqrt3_regions::Sqrt3RegionSubstitution;
+use stencilgen::sqrt3_table::{build_sqrt3_table, Sqrt3TableSpec};
 use stencilgen::stencil_set::StencilSetSpec;
 use stencilgen::substitution::Substitution;
 use stencilgen::table::{build_table, TableSpec};
@@ -96,7 +99,7 @@ enum Command {
     },
     /// Write a versioned binary stencil table (docs/table-format.md).
     Tables {
-        /// Schemes, comma separated: quad schemes, `loop` or `butterfly` (one file each; with
+        /// Schemes, comma separated: quad schemes, `loop`, `butterfly` or `sqrt3` (one file each; with
         /// several, the scheme name is appended to the file stem).
         #[arg(long, default_value = "catmull-clark", value_delimiter = ',')]
         schemes: Vec<String>,
@@ -287,6 +290,21 @@ fn run(cli: Cli) -> Result<(), StencilError> {
                             precision,
                         };
                         write_bytes(&path, &build_butterfly_table(&spec)?, started)?;
+                        continue;
+                    }
+                    if triangle.name == "sqrt3" {
+                        if boundary {
+                            return Err(StencilError::UnsupportedScheme {
+                                scheme: name.clone(),
+                                reason: "sqrt3's boundary rules are not implemented".to_owned(),
+                            });
+                        }
+                        let spec = Sqrt3TableSpec {
+                            valences: set.valences.clone(),
+                            rates: set.rates.clone(),
+                            precision,
+                        };
+                        write_bytes(&path, &build_sqrt3_table(&spec)?, started)?;
                         continue;
                     }
                     let spec = TriangleTableSpec {
@@ -583,9 +601,10 @@ fn butterfly_stencil_json<S: Scalar>(
     }))
 }
 
-/// √3's patch next to an interior vertex (two √3 steps as one ternary step): positions only
-/// (its derivative stencils and tangent masks are not built yet, so `du`/`dv` are `null` with
-/// a note).
+/// √3's patch next to an interior vertex (two √3 steps as one ternary step): positions by
+/// [`Sqrt3Substitution`], d/du and d/dv by region 0 of [`Sqrt3RegionSubstitution`] (the same
+/// layout); at `V` itself the derivatives are the tangent masks of Loop's convention
+/// (docs/algorithms/sqrt3.md), said in a note.
 fn sqrt3_stencil_json<S: Scalar>(
     scheme: &TriangleScheme,
     valence: u32,
@@ -595,7 +614,10 @@ fn sqrt3_stencil_json<S: Scalar>(
 ) -> Result<Value, StencilError> {
     let mut substitution = Sqrt3Substitution::<S>::new(scheme, valence)?;
     let weights = substitution.stencil(u, v)?;
-    Ok(json!({
+    let mut regions = Sqrt3RegionSubstitution::<S>::new(scheme, valence)?;
+    let du = regions.stencil(0, u, v, StencilKind::DerivativeU)?;
+    let dv = regions.stencil(0, u, v, StencilKind::DerivativeV)?;
+    let mut out = json!({
         "scheme": scheme.name,
         "valence": valence,
         "boundary": false,
@@ -604,10 +626,16 @@ fn sqrt3_stencil_json<S: Scalar>(
         "exact": S::EXACT,
         "order": substitution.matrices.names(),
         "weights": weights.iter().map(&value).collect::<Vec<_>>(),
-        "du": Value::Null,
-        "dv": Value::Null,
-        "note": "the sqrt3 derivative stencils are not built yet",
-    }))
+        "du": du.iter().map(&value).collect::<Vec<_>>(),
+        "dv": dv.iter().map(&value).collect::<Vec<_>>(),
+    });
+    if u.is_zero() && v.is_zero() && valence != 6 {
+        out["note"] = json!(
+            "at the vertex du/dv are tangent masks (subdominant left eigenvectors normalized on \
+             the reference net), not derivatives: those exist there only at valence 6"
+        );
+    }
+    Ok(out)
 }
 
 /// Which Loop patch `stencilgen stencil` prints.

@@ -46,7 +46,9 @@ use crate::regular_patch::StencilKind;
 use crate::scaling_system::{NormalizationRow, Relation, ScalingSystem, SparseRow};
 use crate::solve::{solve_system, Solution};
 use crate::triangle_patch::triangle_grid_points;
-use crate::triangle_system::{triangle_stencils, TriangleStencils, MAX_TRIANGLE_RATE};
+use crate::triangle_system::{
+    triangle_stencils_up_to, TriangleStencils, MAX_BASIS_RATE, MAX_TRIANGLE_RATE,
+};
 use crate::{Scalar, StencilError};
 
 /// Position stencils at the grid points of the √3 EV patch.
@@ -176,7 +178,27 @@ pub fn sqrt3_regular_basis<S: Scalar>(
     scheme: &TriangleScheme,
     d: u32,
 ) -> Result<TriangleStencils<S>, StencilError> {
-    let exact = triangle_stencils::<BigRational>(&scheme.regular_mask(), d, StencilKind::Position)?;
+    sqrt3_regular_basis_kind(scheme, d, StencilKind::Position)
+}
+
+/// [`sqrt3_regular_basis`] or one of its derivatives along the skew axes (`DerivativeU` is
+/// `d psi / d y_1` at fixed `y_2`, Schaefer–Warren section 4's normalization
+/// `sum_j (j_1 - y_1) psi_u(y - j) = 1`, `sum_j (j_2 - y_2) psi_u(y - j) = 0`), on the rate-`d`
+/// grid, `d <= `[`MAX_BASIS_RATE`] (the tables' dual points need `3n`).
+///
+/// Always solved exactly and rounded: at the tables' rates `3n` (multiples of 3, so the
+/// classes form trees hanging off the cycles) the exact path is the fast one, unlike the
+/// butterfly's odd rates. Measured (ignored test
+/// `f64_and_exact_regular_bases_agree_at_the_table_rates`, which also checks agreement within
+/// 1e-12): rate 9, 0.07 s exact against 8 s in f64; rate 15, 1 s against 3.6 s; rate 18,
+/// 0.9 s against 66 s.
+pub fn sqrt3_regular_basis_kind<S: Scalar>(
+    scheme: &TriangleScheme,
+    d: u32,
+    kind: StencilKind,
+) -> Result<TriangleStencils<S>, StencilError> {
+    let mask = scheme.regular_mask();
+    let exact = triangle_stencils_up_to::<BigRational>(&mask, d, kind, MAX_BASIS_RATE)?;
     Ok(TriangleStencils {
         scheme: exact.scheme,
         n: exact.n,
@@ -467,6 +489,7 @@ impl<S: Scalar> Sqrt3Substitution<S> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::triangle_system::triangle_stencils;
 
     fn sqrt3() -> TriangleScheme {
         TriangleScheme::by_name("sqrt3").expect("catalogued")
@@ -505,5 +528,32 @@ mod tests {
             sqrt3_patch_stencils::<f64>(&loop_, 5, 2),
             Err(StencilError::UnsupportedScheme { .. })
         ));
+    }
+
+    #[test]
+    #[ignore = "timing sweep (a few minutes): exact against f64 solves of psi and its derivatives at rates 3..=15"]
+    fn f64_and_exact_regular_bases_agree_at_the_table_rates() {
+        let scheme = sqrt3();
+        let mask = scheme.regular_mask();
+        for d in (3..=15).step_by(3) {
+            for kind in StencilKind::ALL {
+                let t0 = std::time::Instant::now();
+                let e = triangle_stencils_up_to::<BigRational>(&mask, d, kind, MAX_BASIS_RATE)
+                    .expect("exact");
+                let te = t0.elapsed().as_secs_f64();
+                let t1 = std::time::Instant::now();
+                let f =
+                    triangle_stencils_up_to::<f64>(&mask, d, kind, MAX_BASIS_RATE).expect("f64");
+                let tf = t1.elapsed().as_secs_f64();
+                let worst = e
+                    .values
+                    .iter()
+                    .zip(&f.values)
+                    .map(|(a, b)| (crate::Scalar::to_f64(a) - b).abs())
+                    .fold(0.0, f64::max);
+                eprintln!("rate {d} {kind:?}: exact {te:.2} s, f64 {tf:.2} s, |diff| {worst:e}");
+                assert!(worst < 1e-12, "rate {d} {kind:?}: {worst}");
+            }
+        }
     }
 }

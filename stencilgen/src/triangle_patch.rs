@@ -460,21 +460,33 @@ pub fn loop_ev_tangents(matrices: &TriangleLocalMatrices) -> Result<LoopEvTangen
     let v = matrices.valence as usize;
     let ring = 1 + v;
     let a1 = DMatrix::from_fn(ring, ring, |i, j| rational_to_f64(&matrices.a[i][j]));
-    let failure = |what: &str| StencilError::Inconsistent {
-        scheme: "tangents at the extraordinary vertex".to_owned(),
-        n: 0,
-        detail: format!("{} valence {v}: {what}", matrices.scheme),
-    };
-    let (l1, l2) = subdominant_eigenvalues(&a1).map_err(|e| failure(&e))?;
-    let mut basis = left_null_space(&a1, l1);
+    let (lambda, [mut du, mut dv]) =
+        ring_tangents(&a1, v).map_err(|what| StencilError::Inconsistent {
+            scheme: "tangents at the extraordinary vertex".to_owned(),
+            n: 0,
+            detail: format!("{} valence {v}: {what}", matrices.scheme),
+        })?;
+    du.resize(matrices.size(), 0.0);
+    dv.resize(matrices.size(), 0.0);
+    Ok(LoopEvTangents { lambda, du, dv })
+}
+
+/// The tangent masks at an extraordinary vertex of valence `v` from the 1-ring block `a1`
+/// (`V, E_0..E_{v-1}`, `(1 + v) x (1 + v)`, invariant under subdivision) of a triangle
+/// scheme's local subdivision matrix: the subdominant eigenvalue and the masks (over the ring)
+/// spanned by its left eigenvectors, normalized on the reference net `V = 0`,
+/// `E_i = (cos 2 pi i/v, sin 2 pi i/v)` so that the `u` mask maps it to `E_0` and the `v` mask
+/// to `E_1`. Loop's convention ([`loop_ev_tangents`]), shared with √3's
+/// ([`crate::sqrt3_regions`]).
+pub(crate) fn ring_tangents(a1: &DMatrix<f64>, v: usize) -> Result<(f64, [Vec<f64>; 2]), String> {
+    let (l1, l2) = subdominant_eigenvalues(a1)?;
+    let mut basis = left_null_space(a1, l1);
     if (l1 - l2).abs() > 1e-9 {
         basis.truncate(1);
-        basis.extend(left_null_space(&a1, l2).into_iter().take(1));
+        basis.extend(left_null_space(a1, l2).into_iter().take(1));
     }
     if basis.len() != 2 {
-        return Err(failure(
-            "the tangent plane is not spanned by two eigenvectors",
-        ));
+        return Err("the tangent plane is not spanned by two eigenvectors".to_owned());
     }
     let edge = |i: usize| {
         let t = 2.0 * std::f64::consts::PI * (i % v) as f64 / v as f64;
@@ -489,26 +501,18 @@ pub fn loop_ev_tangents(matrices: &TriangleLocalMatrices) -> Result<LoopEvTangen
     let (g0, g1) = (image(&basis[0]), image(&basis[1]));
     let det = g0[0] * g1[1] - g0[1] * g1[0];
     if det.abs() < 1e-12 {
-        return Err(failure(
-            "the eigenvectors do not span the reference net's plane",
-        ));
+        return Err("the eigenvectors do not span the reference net's plane".to_owned());
     }
     let mask = |target: [f64; 2]| -> Vec<f64> {
         let c0 = (target[0] * g1[1] - target[1] * g1[0]) / det;
         let c1 = (g0[0] * target[1] - g0[1] * target[0]) / det;
-        let mut m: Vec<f64> = basis[0]
+        basis[0]
             .iter()
             .zip(&basis[1])
             .map(|(a, b)| c0 * a + c1 * b)
-            .collect();
-        m.resize(matrices.size(), 0.0);
-        m
+            .collect()
     };
-    Ok(LoopEvTangents {
-        lambda: l1,
-        du: mask(edge(0)),
-        dv: mask(edge(1)),
-    })
+    Ok((l1, [mask(edge(0)), mask(edge(1))]))
 }
 
 #[cfg(test)]

@@ -70,7 +70,9 @@ fn sqrt3_limit_position_is_kobbelts_rule() {
         assert!((x - b / k as f64).abs() < 1e-12, "{w:?}");
     }
     assert!(w[k + 1..].iter().all(|x| x.abs() < 1e-12));
-    assert!(out["du"].is_null() && out["note"].is_string());
+    // At V the derivative rows are tangent masks (a note says so): they sum to 0.
+    assert!(out["note"].is_string());
+    assert!(numbers(&out["du"]).iter().sum::<f64>().abs() < 1e-12);
     // Valence 4: a = 4/9, b = 4/7.
     let exact = json("stencil --scheme sqrt3 --valence 4 --u 0 --v 0 --json");
     assert_eq!(exact["weights"][0], "3/7");
@@ -103,4 +105,25 @@ fn sqrt3_errors() {
         "stencil --scheme sqrt3 --valence 4 --u 2/3 --v 2/3",
         "outside the patch",
     );
+}
+
+#[test]
+fn sqrt3_derivatives_are_central_differences_of_positions() {
+    // d/du at (1/2, 1/4), K = 5, against (p(u + h) - p(u - h)) / 2h of the CLI's own positions,
+    // h = 1/12 (psi is C^1 with a Hölder derivative: about 1e-2, a wrong factor is O(1)).
+    let at = |u: &str, v: &str| {
+        json(&format!(
+            "stencil --scheme sqrt3 --valence 5 --u {u} --v {v} --f64 --json"
+        ))
+    };
+    let mid = at("1/2", "1/4");
+    let du = numbers(&mid["du"]);
+    assert!(du.iter().sum::<f64>().abs() < 1e-10);
+    let (plus, minus) = (
+        numbers(&at("7/12", "1/4")["weights"]),
+        numbers(&at("5/12", "1/4")["weights"]),
+    );
+    for ((d, p), m) in du.iter().zip(&plus).zip(&minus) {
+        assert!((d - (p - m) * 6.0).abs() < 2e-2, "{d} vs {}", (p - m) * 6.0);
+    }
 }

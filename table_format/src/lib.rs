@@ -180,6 +180,9 @@ pub enum SchemeId {
     Loop = 3,
     /// The modified butterfly (a triangle scheme; `sector` numbers a vertex's regions).
     Butterfly = 4,
+    /// √3 subdivision (Kobbelt 2000) as two-step ternary stencils (a triangle scheme; `sector`
+    /// numbers a vertex's regions, as for the butterfly).
+    Sqrt3 = 5,
 }
 
 impl SchemeId {
@@ -190,12 +193,13 @@ impl SchemeId {
             SchemeId::SwNonpolyQuad => "sw-nonpoly-quad",
             SchemeId::Loop => "loop",
             SchemeId::Butterfly => "butterfly",
+            SchemeId::Sqrt3 => "sqrt3",
         }
     }
 
     /// Whether the scheme subdivides triangles (its sections use the triangle point sets).
     pub fn is_triangle(self) -> bool {
-        matches!(self, SchemeId::Loop | SchemeId::Butterfly)
+        matches!(self, SchemeId::Loop | SchemeId::Butterfly | SchemeId::Sqrt3)
     }
 
     /// From the catalogue name.
@@ -205,6 +209,7 @@ impl SchemeId {
             SchemeId::SwNonpolyQuad,
             SchemeId::Loop,
             SchemeId::Butterfly,
+            SchemeId::Sqrt3,
         ]
         .into_iter()
         .find(|s| s.name() == name)
@@ -216,6 +221,7 @@ impl SchemeId {
             2 => Some(SchemeId::SwNonpolyQuad),
             3 => Some(SchemeId::Loop),
             4 => Some(SchemeId::Butterfly),
+            5 => Some(SchemeId::Sqrt3),
             _ => None,
         }
     }

@@ -238,6 +238,26 @@ fn triangle_point_sets_count_and_belong_to_triangle_schemes() {
     assert!(matches!(parse(&b), Err(TableError::WrongPointSet { .. })));
 }
 
+#[test]
+fn sqrt3_is_scheme_five_and_a_triangle_scheme() {
+    // docs/table-format.md: scheme id 5 = sqrt3, triangle point sets only.
+    assert_eq!(SchemeId::Sqrt3 as u32, 5);
+    assert_eq!(SchemeId::from_name("sqrt3"), Some(SchemeId::Sqrt3));
+    assert!(SchemeId::Sqrt3.is_triangle());
+    let meta = TableMeta {
+        scheme: SchemeId::Sqrt3,
+        precision: Precision::F32,
+        corners: false,
+    };
+    let tri = key(StencilKind::Position, PointSet::TrianglePrimal, 5, 1);
+    let bytes = encode(meta, &[(tri, 24, vec![0.25; 72])]).expect("valid");
+    assert_eq!(&bytes[52..56], &5u32.to_le_bytes());
+    parse(&bytes).expect("a sqrt3 table with triangle sections");
+    let quad = key(StencilKind::Position, PointSet::Primal, 5, 1);
+    let e = encode(meta, &[(quad, 1, vec![1.0; 4])]).expect_err("quad grid in a sqrt3 table");
+    assert!(matches!(e, TableError::WrongPointSet { .. }));
+}
+
 proptest! {
     /// Mutating random bytes of a valid table (re-sealed or not) gives Ok or a clean Err.
     #[test]

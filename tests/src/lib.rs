@@ -7,3 +7,4 @@
 pub mod box_spline;
 pub mod bspline;
 pub mod butterfly_fan;
+pub mod sqrt3_fan;
