@@ -39,6 +39,7 @@ pub mod orbit_block;
 pub mod orbits;
 pub mod patch_stencils;
 pub mod rational;
+pub mod region_table;
 pub mod regular_patch;
 pub mod scalar;
 pub mod scaling_system;
