@@ -10,7 +10,7 @@ fn main() {
         eprintln!("OUT_DIR is not set");
         std::process::exit(1);
     };
-    let tables: [(&str, Generator); 4] = [
+    let tables: [(&str, Generator); 5] = [
         ("catmull-clark.subtess", stencilgen::table::default_table),
         (
             "catmull-clark-corners.subtess",
@@ -24,6 +24,11 @@ fn main() {
             "butterfly.subtess",
             stencilgen::butterfly_table::default_butterfly_table,
         ),
+        ("sqrt3.subtess", || {
+            stencilgen::sqrt3_table::build_sqrt3_table(
+                &stencilgen::region_table::RegionTableSpec::default_sqrt3(),
+            )
+        }),
     ];
     for (name, generate) in tables {
         match generate() {

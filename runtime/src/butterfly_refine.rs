@@ -20,10 +20,10 @@ use schemes::TriangleScheme;
 
 use crate::geometry::{add, scale};
 use crate::loop_refine::LoopRefinement;
-use crate::topology::{Mesh, NONE};
+use crate::topology::Mesh;
 use crate::triangle_split::TriangleSplit;
-use crate::triangle_topology::{neighbours, require_triangles, rotate_to};
-use crate::{MeshError, RuntimeError};
+use crate::triangle_topology::{require_closed_triangles, ring_from};
+use crate::RuntimeError;
 
 /// The butterfly's extraordinary edge weights `(3/4, s_0 .. s_{K-1})` of every valence, as f64.
 #[derive(Clone, Debug)]
@@ -52,20 +52,6 @@ impl ButterflyWeights {
     }
 }
 
-/// Refuse a mesh the butterfly cannot refine: not all triangles, or with a boundary.
-pub fn require_closed_triangles(mesh: &Mesh) -> Result<(), RuntimeError> {
-    require_triangles(mesh)?;
-    if let Some(h) = mesh.twin.iter().position(|&t| t == NONE) {
-        return Err(RuntimeError::Unsupported(format!(
-            "the butterfly's boundary rules are not implemented, and edge ({}, {}) is on the \
-             boundary: the butterfly tessellates closed triangle meshes",
-            mesh.face_vertices[h],
-            mesh.head(h)
-        )));
-    }
-    Ok(())
-}
-
 /// The far vertex of the triangle across the edge of half-edge `h` (a closed mesh).
 fn across(mesh: &Mesh, h: usize) -> usize {
     mesh.head(mesh.next(mesh.twin[h] as usize)) as usize
@@ -73,28 +59,28 @@ fn across(mesh: &Mesh, h: usize) -> usize {
 
 /// Refine the closed triangle mesh `mesh` once.
 pub fn butterfly_refine(mesh: &Mesh) -> Result<LoopRefinement, RuntimeError> {
-    require_closed_triangles(mesh)?;
+    require_closed_triangles(mesh, "butterfly")?;
     let p = &mesh.positions;
     let nv = p.len();
     let valence: Vec<usize> = (0..nv).map(|v| mesh.fan(v).len()).collect();
     let max_valence = valence.iter().copied().max().unwrap_or(0);
     let weights = ButterflyWeights::new(max_valence)?;
     let split = TriangleSplit::new(mesh);
-    // The extraordinary rule of end `a` of the edge to `b`.
-    let extraordinary = |a: usize, b: u32| -> Result<[f64; 3], RuntimeError> {
+    // The extraordinary rule of the tail `a` of half-edge `h`.
+    let extraordinary = |h: usize| -> Result<[f64; 3], RuntimeError> {
+        let a = mesh.face_vertices[h] as usize;
         let (q, s) = weights.of(valence[a]).ok_or_else(|| {
             RuntimeError::Unsupported(format!(
                 "vertex {a} has valence {}: the butterfly needs at least 3",
                 valence[a]
             ))
         })?;
-        let ring = rotate_to(&neighbours(mesh, a), b).ok_or(MeshError::NotIsolated {
-            face: 0,
-            reason: format!("vertex {b} is not a neighbour of {a}"),
-        })?;
-        Ok(ring.iter().zip(s).fold(scale(*q, p[a]), |acc, (&e, &w)| {
-            add(acc, scale(w, p[e as usize]))
-        }))
+        Ok(ring_from(mesh, h)
+            .iter()
+            .zip(s)
+            .fold(scale(*q, p[a]), |acc, (&e, &w)| {
+                add(acc, scale(w, p[e as usize]))
+            }))
     };
     let mut positions = p.clone();
     for &h in &split.first_halfedge {
@@ -113,12 +99,9 @@ pub fn butterfly_refine(mesh: &Mesh) -> Result<LoopRefinement, RuntimeError> {
                     scale(-1.0 / 16.0, wings),
                 )
             }
-            (false, true) => extraordinary(a, b as u32)?,
-            (true, false) => extraordinary(b, a as u32)?,
-            (false, false) => scale(
-                0.5,
-                add(extraordinary(a, b as u32)?, extraordinary(b, a as u32)?),
-            ),
+            (false, true) => extraordinary(h)?,
+            (true, false) => extraordinary(t)?,
+            (false, false) => scale(0.5, add(extraordinary(h)?, extraordinary(t)?)),
         };
         positions.push(point);
     }

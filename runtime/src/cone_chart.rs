@@ -74,6 +74,21 @@ impl ConeCharts {
         first: u32,
         radius: i64,
     ) -> Result<ConeChart, String> {
+        self.chart_within(mesh, centre, first, radius, |_| true)
+    }
+
+    /// [`Self::chart`], naming beyond the one-ring only the points `within` accepts (growing
+    /// through the triangles whose third corner it accepts): a layout needs no more, and a
+    /// regular patch's layout may lie beside an extraordinary vertex that a whole ball around
+    /// its corner would wrap around (a valence-3 cone has only 180 degrees).
+    pub fn chart_within(
+        &mut self,
+        mesh: &Mesh,
+        centre: u32,
+        first: u32,
+        radius: i64,
+        within: impl Fn(TrianglePoint) -> bool,
+    ) -> Result<ConeChart, String> {
         if mesh.is_boundary_vertex(centre as usize) {
             return Err(format!("vertex {centre} is on the boundary"));
         }
@@ -112,7 +127,7 @@ impl ConeCharts {
             let (p, q) = (mesh.face_vertices[h], mesh.head(h));
             let r = mesh.head(mesh.next(h));
             let point = self.third(valence, p, q)?;
-            if ring(point) > radius {
+            if ring(point) > radius || !within(point) {
                 continue;
             }
             self.name(&mut chart, r, point)?;

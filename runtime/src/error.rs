@@ -46,7 +46,7 @@ pub enum MeshError {
         reason: String,
     },
     /// A triangle scheme (Loop) was asked of a mesh with a face that is not a triangle.
-    #[error("face {face} has {vertices} vertices; the triangle schemes (loop, butterfly) need a mesh of triangles (triangulate it, or use --scheme catmull-clark)")]
+    #[error("face {face} has {vertices} vertices; the triangle schemes (loop, butterfly, sqrt3) need a mesh of triangles (triangulate it, or use --scheme catmull-clark)")]
     NotTriangle {
         /// 0-based face.
         face: usize,

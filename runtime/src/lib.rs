@@ -7,8 +7,6 @@
 //! ```
 
 pub mod bezier;
-pub mod butterfly_isolate;
-pub mod butterfly_patch;
 pub mod butterfly_refine;
 pub mod cone_chart;
 pub mod dual_grid;
@@ -25,6 +23,9 @@ pub mod obj;
 pub mod patch;
 pub mod rates;
 pub mod refine;
+pub mod region_isolate;
+pub mod region_patch;
+pub mod sqrt3_refine;
 pub mod stencil_table;
 #[cfg(test)]
 mod test_meshes;

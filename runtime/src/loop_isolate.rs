@@ -16,6 +16,7 @@ use crate::loop_refine::loop_refine;
 use crate::topology::Mesh;
 use crate::triangle_isolation::{isolate_by_refinement, TriangleIsolation};
 use crate::triangle_patch::{gather_triangle_patches, Phantoms};
+use crate::triangle_split::Split;
 use crate::triangle_topology::{isolation_defect, require_triangles};
 use crate::MeshError;
 use crate::RuntimeError;
@@ -29,6 +30,7 @@ pub fn isolate_loop(mesh: &Mesh) -> Result<TriangleIsolation, RuntimeError> {
     require_triangles(mesh)?;
     isolate_by_refinement(
         mesh,
+        Split::Dyadic,
         MAX_LOOP_STEPS,
         |m| Ok(loop_refine(m)?.mesh),
         |m| {

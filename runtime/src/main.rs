@@ -7,8 +7,6 @@ use std::time::Instant;
 
 use clap::{Parser, Subcommand};
 use runtime::bezier::{tessellate_bezier, BezierOptions, BezierPatches};
-use runtime::butterfly_isolate::isolate_butterfly;
-use runtime::butterfly_refine::butterfly_refine;
 use runtime::dual_grid::{tessellate, DualGrid};
 use runtime::exact_eval::{evaluate_subface, parse_rational};
 use runtime::isolate::{isolate_with_origins, Isolation};
@@ -20,6 +18,8 @@ use runtime::mesh_output::{write_mesh, MeshFormat};
 use runtime::obj::read_obj;
 use runtime::rates::{tolerance_rates, view_rates, ViewCamera};
 use runtime::refine::refine;
+use runtime::region_isolate::isolate_regions;
+use runtime::region_patch::RegionScheme;
 use runtime::stencil_table::StencilTable;
 use runtime::topology::Mesh;
 use runtime::triangle_dual_grid::{tessellate_triangles, TriangleDualGrid};
@@ -66,8 +66,8 @@ enum Command {
         /// A stencil table file instead of the embedded default.
         #[arg(long)]
         table: Option<PathBuf>,
-        /// Subdivision scheme: catmull-clark, or loop or butterfly (a triangle mesh; --refine
-        /// then takes steps of that scheme).
+        /// Subdivision scheme: catmull-clark, or loop, butterfly or sqrt3 (a triangle mesh;
+        /// --refine then takes steps of that scheme, two √3 steps each for sqrt3).
         #[arg(long, default_value = "catmull-clark")]
         scheme: String,
     },
@@ -110,8 +110,8 @@ struct TessellateArgs {
     /// Output triangle mesh: .obj, .ply (with per-vertex face, u, v), .glb or .gltf.
     #[arg(short = 'o', long = "output")]
     output: PathBuf,
-    /// Subdivision scheme: catmull-clark (any polygons), loop (triangles) or butterfly (closed
-    /// triangle meshes); the triangle schemes take --rate, --rates or --view.
+    /// Subdivision scheme: catmull-clark (any polygons), loop (triangles), butterfly or sqrt3
+    /// (closed triangle meshes); the triangle schemes take --rate, --rates or --view.
     #[arg(long, default_value = "catmull-clark")]
     scheme: String,
     /// Dual points per face side, 1..=24, on every face.
@@ -171,7 +171,7 @@ enum TablesCommand {
     Info {
         /// A table file written by `stencilgen tables`.
         file: Option<PathBuf>,
-        /// Without a file: which embedded default (catmull-clark, loop or butterfly).
+        /// Without a file: which embedded default (catmull-clark, loop, butterfly or sqrt3).
         #[arg(long, default_value = "catmull-clark", conflicts_with = "file")]
         scheme: String,
     },
@@ -345,6 +345,7 @@ enum Scheme {
     CatmullClark,
     Loop,
     Butterfly,
+    Sqrt3,
 }
 
 impl Scheme {
@@ -353,6 +354,7 @@ impl Scheme {
             Scheme::CatmullClark => "catmull-clark",
             Scheme::Loop => "loop",
             Scheme::Butterfly => "butterfly",
+            Scheme::Sqrt3 => "sqrt3",
         }
     }
 
@@ -367,6 +369,7 @@ impl Scheme {
         match (table, self) {
             (Some(path), _) => StencilTable::read(path),
             (None, Scheme::Butterfly) => StencilTable::default_butterfly(),
+            (None, Scheme::Sqrt3) => StencilTable::default_sqrt3(),
             (None, _) => StencilTable::default_loop(),
         }
     }
@@ -374,17 +377,19 @@ impl Scheme {
     /// Isolate a triangle mesh for this scheme's table.
     fn isolate_triangles(self, mesh: &Mesh) -> Result<TriangleIsolation, RuntimeError> {
         match self {
-            Scheme::Butterfly => isolate_butterfly(mesh),
+            Scheme::Butterfly => isolate_regions(mesh, RegionScheme::Butterfly),
+            Scheme::Sqrt3 => isolate_regions(mesh, RegionScheme::Sqrt3),
             _ => isolate_loop(mesh),
         }
     }
 
-    /// One subdivision step of a triangle mesh by this scheme's rules.
+    /// One subdivision step of a triangle mesh by this scheme's rules (two for √3).
     fn refine_triangles(self, mesh: &Mesh) -> Result<Mesh, RuntimeError> {
-        Ok(match self {
-            Scheme::Butterfly => butterfly_refine(mesh)?.mesh,
-            _ => loop_refine(mesh)?.mesh,
-        })
+        match self {
+            Scheme::Butterfly => RegionScheme::Butterfly.refine(mesh),
+            Scheme::Sqrt3 => RegionScheme::Sqrt3.refine(mesh),
+            _ => Ok(loop_refine(mesh)?.mesh),
+        }
     }
 }
 
@@ -395,22 +400,23 @@ fn parse_scheme(name: &str) -> Result<Scheme, RuntimeError> {
         "catmull-clark" => Ok(Scheme::CatmullClark),
         "loop" => Ok(Scheme::Loop),
         "butterfly" => Ok(Scheme::Butterfly),
+        "sqrt3" => Ok(Scheme::Sqrt3),
         other
             if schemes::triangle::TRIANGLE_SCHEME_NAMES.contains(&other)
                 || schemes::quad::QUAD_SCHEME_NAMES.contains(&other) =>
         {
             Err(RuntimeError::Unsupported(format!(
-                "scheme `{other}`: no table for this scheme yet (the runtime has tables for catmull-clark, loop and butterfly)"
+                "scheme `{other}`: no table for this scheme yet (the runtime has tables for catmull-clark, loop, butterfly and sqrt3)"
             )))
         }
         other => Err(RuntimeError::InvalidParameter {
             name: format!("--scheme `{other}`"),
-            reason: "not a scheme; catmull-clark, loop or butterfly".to_owned(),
+            reason: "not a scheme; catmull-clark, loop, butterfly or sqrt3".to_owned(),
         }),
     }
 }
 
-/// `subtess tessellate MESH --scheme loop|butterfly`: the triangle dual grid at `--rate`,
+/// `subtess tessellate MESH --scheme loop|butterfly|sqrt3`: the triangle dual grid at `--rate`,
 /// `--rates` or `--view` (the projected-edge rule is the same for triangles).
 fn triangle_command(
     args: &TessellateArgs,
@@ -668,10 +674,11 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
             let point = match scheme {
                 Scheme::CatmullClark => evaluate_subface(&input, face, corner, &u, &v)?,
                 Scheme::Loop => LoopExactEvaluator::new(&input)?.evaluate(face, &u, &v)?,
-                Scheme::Butterfly => {
-                    return Err(RuntimeError::Unsupported(
-                        "exact evaluation of the butterfly is not implemented yet (`subtess tessellate --scheme butterfly` evaluates it from the table)".to_owned(),
-                    ))
+                Scheme::Butterfly | Scheme::Sqrt3 => {
+                    return Err(RuntimeError::Unsupported(format!(
+                        "exact evaluation of {0} is not implemented yet (`subtess tessellate --scheme {0}` evaluates it from the table)",
+                        scheme.name()
+                    )))
                 }
             };
             if json {
@@ -697,7 +704,9 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
             };
             let table = match parse_scheme(&scheme)? {
                 Scheme::Loop if file.is_none() => StencilTable::default_loop()?,
-                Scheme::Butterfly if file.is_none() => StencilTable::default_butterfly()?,
+                scheme @ (Scheme::Butterfly | Scheme::Sqrt3) if file.is_none() => {
+                    scheme.triangle_table(&None)?
+                }
                 _ => load_table(&file, schemes::BoundaryMode::EdgeOnly)?,
             };
             let index = table.index();

@@ -42,6 +42,12 @@ impl StencilTable {
         Self::embedded(tables::default_butterfly())
     }
 
+    /// The embedded default √3 table (the regions of two √3 steps taken as one ternary step,
+    /// around interior vertices of valence 3..=8; validated, checksum included).
+    pub fn default_sqrt3() -> Result<Self, RuntimeError> {
+        Self::embedded(tables::default_sqrt3())
+    }
+
     fn embedded(bytes: &'static [u8]) -> Result<Self, RuntimeError> {
         let index = TableIndex::parse(bytes)?;
         Ok(StencilTable {

@@ -1,14 +1,15 @@
 //! Isolation for triangle schemes: whole-mesh refinement steps until every triangle is a table
 //! patch, with every refined triangle remembering where it lies in the input triangle.
 //!
-//! The schemes differ in how they refine ([`crate::loop_refine`], [`crate::butterfly_refine`])
-//! and in what makes a triangle a patch ([`crate::loop_isolate`], [`crate::butterfly_isolate`]);
-//! the bookkeeping of children and parameters ([`crate::triangle_split`]) is this module's.
+//! The schemes differ in how they refine ([`crate::loop_refine`], [`crate::butterfly_refine`],
+//! [`crate::sqrt3_refine`]), into four or nine ([`Split`]), and in what makes a triangle a patch
+//! ([`crate::loop_isolate`], [`crate::region_patch`]); the bookkeeping of children and
+//! parameters ([`crate::triangle_split`]) is this module's.
 
 use crate::topology::Mesh;
 use crate::triangle_mesh::VertexSource;
 use crate::triangle_patch::{Phantoms, TrianglePatch};
-use crate::triangle_split::child_to_parent;
+use crate::triangle_split::Split;
 use crate::RuntimeError;
 
 /// The most refinement steps any triangle scheme's isolation takes.
@@ -26,6 +27,8 @@ pub struct TriangleIsolation {
     pub phantoms: Phantoms,
     /// Refinement steps taken.
     pub steps: usize,
+    /// How every step split a triangle.
+    pub split: Split,
     /// The input triangle every triangle of `mesh` lies in.
     pub origin: Vec<u32>,
     /// For every triangle of `mesh`, which child of its parent it is ([`crate::triangle_split`]
@@ -36,13 +39,14 @@ pub struct TriangleIsolation {
 impl TriangleIsolation {
     /// The input triangle and its own barycentric parameters of a point given on triangle
     /// `source.face` of the isolated mesh, exactly: a child's domain is an affine image of its
-    /// parent's ([`child_to_parent`]), so the denominator doubles per step.
+    /// parent's ([`Split::child_to_parent`]), so the denominator grows by the split's factor
+    /// per step.
     pub fn input_source(&self, source: VertexSource) -> VertexSource {
         let f = source.face as usize;
         let (mut u, mut v, mut d) = (source.u, source.v, source.denominator);
         for level in (0..self.steps).rev() {
-            (u, v) = child_to_parent(self.child[f][level], u, v, d);
-            d *= 2;
+            (u, v) = self.split.child_to_parent(self.child[f][level], u, v, d);
+            d *= self.split.factor();
         }
         VertexSource {
             face: self.origin[f],
@@ -54,10 +58,12 @@ impl TriangleIsolation {
     }
 }
 
-/// Refine `mesh` with `refine` until `gather` finds every triangle's patch, at most `max_steps`
-/// times (`<=` [`MAX_ISOLATION_STEPS`]); the last attempt's error is returned if it never does.
+/// Refine `mesh` with `refine` (which splits as `split` says) until `gather` finds every
+/// triangle's patch, at most `max_steps` times (`<=` [`MAX_ISOLATION_STEPS`]); the last
+/// attempt's error is returned if it never does.
 pub fn isolate_by_refinement(
     mesh: &Mesh,
+    split: Split,
     max_steps: usize,
     refine: impl Fn(&Mesh) -> Result<Mesh, RuntimeError>,
     gather: impl Fn(&Mesh) -> Result<(Vec<TrianglePatch>, Phantoms), RuntimeError>,
@@ -75,19 +81,20 @@ pub fn isolate_by_refinement(
                     patches,
                     phantoms,
                     steps,
+                    split,
                     origin,
                     child,
                 })
             }
             Err(e) if steps == max_steps => return Err(e),
             Err(_) => {
-                // Triangle f's children are 4f .. 4f + 3.
-                let faces = current.faces();
-                origin = (0..4 * faces).map(|c| origin[c / 4]).collect();
-                child = (0..4 * faces)
+                // Triangle f's children are nf .. nf + n - 1.
+                let (faces, n) = (current.faces(), split.children());
+                origin = (0..n * faces).map(|c| origin[c / n]).collect();
+                child = (0..n * faces)
                     .map(|c| {
-                        let mut path = child[c / 4];
-                        path[steps] = (c % 4) as u8;
+                        let mut path = child[c / n];
+                        path[steps] = (c % n) as u8;
                         path
                     })
                     .collect();

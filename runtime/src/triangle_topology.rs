@@ -8,7 +8,7 @@
 //! half-edge `V -> E_i` lies in the triangle `(V, E_i, E_{i+1})`, sector `i`.
 
 use crate::topology::{Mesh, NONE};
-use crate::MeshError;
+use crate::{MeshError, RuntimeError};
 
 /// Refuse a mesh with a face that is not a triangle, naming the face and its vertex count.
 pub fn require_triangles(mesh: &Mesh) -> Result<(), MeshError> {
@@ -31,6 +31,34 @@ pub fn neighbours(mesh: &Mesh, v: usize) -> Vec<u32> {
         out.push(mesh.face_vertices[mesh.prev(last)]);
     }
     out
+}
+
+/// Refuse a mesh that `scheme` (named in the message) cannot refine because its boundary rules
+/// are not implemented: not all triangles, or with a boundary edge (named).
+pub fn require_closed_triangles(mesh: &Mesh, scheme: &str) -> Result<(), RuntimeError> {
+    require_triangles(mesh)?;
+    if let Some(h) = mesh.twin.iter().position(|&t| t == NONE) {
+        return Err(RuntimeError::Unsupported(format!(
+            "the {scheme} boundary rules are not implemented, and edge ({}, {}) is on the \
+             boundary: the {scheme} scheme tessellates closed triangle meshes",
+            mesh.face_vertices[h],
+            mesh.head(h)
+        )));
+    }
+    Ok(())
+}
+
+/// The neighbours of the tail of half-edge `h` counter-clockwise from `h`'s head, on a closed
+/// mesh (every half-edge has a twin): `E_0 = head(h)`, `E_{i+1}` the head of
+/// `twin(prev(.))` of the half-edge to `E_i`.
+pub fn ring_from(mesh: &Mesh, h: usize) -> Vec<u32> {
+    let mut ring = vec![mesh.head(h)];
+    let mut g = mesh.twin[mesh.prev(h)] as usize;
+    while g != h && ring.len() <= mesh.face_vertices.len() {
+        ring.push(mesh.head(g));
+        g = mesh.twin[mesh.prev(g)] as usize;
+    }
+    ring
 }
 
 /// Whether vertex `v` is regular for Loop: interior of valence 6, or on the boundary with three
@@ -109,6 +137,16 @@ mod tests {
         assert_eq!(neighbours(&m, 1), vec![2, 0, 6]);
         // Every triangle has two irregular rim corners.
         assert!(isolation_defect(&m).is_some());
+    }
+
+    #[test]
+    fn a_ring_from_a_halfedge_runs_counter_clockwise_from_its_head() {
+        let m = crate::test_meshes::octahedron();
+        for h in 0..m.face_vertices.len() {
+            let v = m.face_vertices[h];
+            let want = rotate_to(&neighbours(&m, v as usize), m.head(h)).expect("a neighbour");
+            assert_eq!(ring_from(&m, h), want, "half-edge {h}");
+        }
     }
 
     #[test]

@@ -12,9 +12,10 @@ mod common;
 use std::collections::HashMap;
 
 use proptest::prelude::*;
-use runtime::butterfly_isolate::isolate_butterfly;
 use runtime::butterfly_refine::butterfly_refine;
 use runtime::cone_chart::ConeChart;
+use runtime::region_isolate::isolate_regions;
+use runtime::region_patch::RegionScheme;
 use runtime::stencil_table::StencilTable;
 use runtime::topology::Mesh;
 use runtime::triangle_dual_grid::TriangleDualGrid;
@@ -38,7 +39,7 @@ fn regions_of(iso: &TriangleIsolation) -> Vec<(u32, u32)> {
 }
 
 /// Three steps separate neighbouring extraordinary vertices (six edges apart, module docs of
-/// `runtime::butterfly_isolate`); a regular torus needs none. Every region of the valence shows
+/// `runtime::region_isolate`); a regular torus needs none. Every region of the valence shows
 /// up, and nothing else.
 #[test]
 fn isolation_separates_the_extraordinary_vertices() {
@@ -49,7 +50,8 @@ fn isolation_separates_the_extraordinary_vertices() {
         ("torus", torus(12, 12), 0, 6),
     ];
     for (name, m, steps, k) in cases {
-        let iso = isolate_butterfly(&m).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let iso =
+            isolate_regions(&m, RegionScheme::Butterfly).unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_eq!(iso.steps, steps, "{name}");
         assert_eq!(iso.mesh.faces(), m.faces() << (2 * steps), "{name}");
         let mut expected: Vec<(u32, u32)> = vec![(6, 0)];
@@ -162,7 +164,8 @@ fn gathered_layouts_match_whole_mesh_refinement() {
         ("octahedron", octahedron()),
         ("icosahedron", icosahedron()),
     ] {
-        let iso = isolate_butterfly(&m).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let iso =
+            isolate_regions(&m, RegionScheme::Butterfly).unwrap_or_else(|e| panic!("{name}: {e}"));
         check_layouts_against_refinement(name, &iso);
     }
 }
@@ -251,7 +254,8 @@ fn the_surface_passes_through_every_refined_vertex() {
         ("icosahedron", icosahedron()),
         ("torus", torus(12, 12)),
     ] {
-        let iso = isolate_butterfly(&m).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let iso =
+            isolate_regions(&m, RegionScheme::Butterfly).unwrap_or_else(|e| panic!("{name}: {e}"));
         for rate in [1, 2, 4, 8] {
             check_against_refinement(&format!("{name} at rate {rate}"), &table, &iso, rate);
         }
@@ -288,7 +292,8 @@ fn ring_normal(mesh: &Mesh, v: usize) -> [f64; 3] {
 fn normals_follow_the_refined_surface() {
     let table = StencilTable::default_butterfly().expect("embedded butterfly table");
     for (name, m) in [("octahedron", octahedron()), ("icosahedron", icosahedron())] {
-        let iso = isolate_butterfly(&m).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let iso =
+            isolate_regions(&m, RegionScheme::Butterfly).unwrap_or_else(|e| panic!("{name}: {e}"));
         let (rate, extra) = (2u32, 4usize);
         let mut levels = vec![iso.mesh.clone()];
         for _ in 0..extra {
@@ -339,7 +344,7 @@ proptest! {
 
     #[test]
     fn random_rates_give_manifolds(rates in proptest::collection::vec(1u32..=8, 1280)) {
-        let iso = isolate_butterfly(&icosahedron()).expect("isolates");
+        let iso = isolate_regions(&icosahedron(), RegionScheme::Butterfly).expect("isolates");
         prop_assert_eq!(iso.mesh.faces(), rates.len());
         check_random_rates("icosahedron", &iso, &rates);
     }
@@ -349,7 +354,7 @@ proptest! {
 fn spot_tessellates_to_a_closed_manifold_at_mixed_rates() {
     let Some(dir) = models() else { return };
     let m = load(&dir.join("crane/spot_triangulated.obj"));
-    let iso = isolate_butterfly(&m).unwrap_or_else(|e| panic!("spot: {e}"));
+    let iso = isolate_regions(&m, RegionScheme::Butterfly).unwrap_or_else(|e| panic!("spot: {e}"));
     assert_eq!(iso.steps, 3);
     // Rates 1 and 2, alternating in runs of odd lengths so neighbours differ.
     let rates: Vec<u32> = (0..iso.mesh.faces())
@@ -370,7 +375,7 @@ fn a_full_table_passes_through_every_refined_vertex() {
         return;
     };
     let table = StencilTable::read(std::path::Path::new(&path)).expect("a butterfly table");
-    let iso = isolate_butterfly(&icosahedron()).expect("isolates");
+    let iso = isolate_regions(&icosahedron(), RegionScheme::Butterfly).expect("isolates");
     check_against_refinement("icosahedron at rate 16", &table, &iso, 16);
     for rate in 9..=24 {
         let grid = TriangleDualGrid::new(&table, &iso.mesh, &iso.patches, &vec![rate; 1280])

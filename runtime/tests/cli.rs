@@ -256,6 +256,10 @@ fn eval_prints_the_limit_point() {
         ),
         (
             "eval data/cube.obj --scheme sqrt3 --face 0 --uv 0,0",
+            "not implemented",
+        ),
+        (
+            "eval data/cube.obj --scheme sw-nonpoly-quad --face 0 --uv 0,0",
             "no table",
         ),
     ] {
@@ -570,6 +574,72 @@ fn butterfly_scheme_tessellates_closed_triangle_meshes() {
 }
 
 #[test]
+fn sqrt3_scheme_tessellates_closed_triangle_meshes() {
+    let mesh = temp("octahedron-s.obj");
+    std::fs::write(&mesh, OCTAHEDRON).expect("written");
+    let out_path = temp("octahedron-sqrt3.obj");
+    let out = subtess(&format!(
+        "tessellate {} -o {} --scheme sqrt3 --rate 3 --stats",
+        mesh.display(),
+        out_path.display()
+    ));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stats = json(&out);
+    assert_eq!(stats["scheme"], "sqrt3");
+    assert_eq!(stats["watertight"], true);
+    // Neighbouring valence-4 vertices are nine edges apart after two ternary steps.
+    assert_eq!(stats["isolation_steps"], 2);
+    assert_eq!(stats["faces"], 8 * 81);
+    // 3n^2 - 3n + 3 triangles per triangle at rate n (21 at n = 3); genus 0: V = T/2 + 2.
+    assert_eq!(stats["triangles"], 8 * 81 * 21);
+    assert_eq!(stats["vertices"], 8 * 81 * 21 / 2 + 2);
+    let bench = subtess(&format!(
+        "bench {} --scheme sqrt3 --rate 2 --frames 2",
+        mesh.display()
+    ));
+    assert!(
+        bench.status.success(),
+        "{}",
+        String::from_utf8_lossy(&bench.stderr)
+    );
+    assert_eq!(json(&bench)["triangles"], 8 * 81 * 9);
+    // The embedded table stops at n = 8; the error names the missing section.
+    let out = subtess(&format!(
+        "tessellate {} -o {} --scheme sqrt3 --rate 9",
+        mesh.display(),
+        out_path.display()
+    ));
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("n = 9"), "{err}");
+    // A mesh with a boundary: √3's boundary rules are not implemented.
+    let open = temp("open-triangle-s.obj");
+    std::fs::write(&open, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").expect("written");
+    let out = subtess(&format!(
+        "tessellate {} -o {} --scheme sqrt3",
+        open.display(),
+        out_path.display()
+    ));
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("boundary"), "{err}");
+    let info = subtess("tables info --scheme sqrt3");
+    assert!(
+        info.status.success(),
+        "{}",
+        String::from_utf8_lossy(&info.stderr)
+    );
+    assert!(String::from_utf8_lossy(&info.stdout).contains("sqrt3"));
+    for path in [mesh, out_path, open] {
+        let _ = std::fs::remove_file(path);
+    }
+}
+
+#[test]
 fn loop_scheme_errors_name_the_problem() {
     let obj = temp("never.obj");
     // The cube's first face is a quad.
@@ -586,8 +656,15 @@ fn loop_scheme_errors_name_the_problem() {
     ));
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("face 0 has 4 vertices"), "{err}");
+    let out = subtess(&format!(
+        "tessellate data/cube.obj -o {} --scheme sw-nonpoly-quad",
+        obj.display()
+    ));
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("no table for this scheme yet"), "{err}");
-    assert!(err.contains("sqrt3"), "{err}");
+    assert!(err.contains("sw-nonpoly-quad"), "{err}");
     let out = subtess(&format!(
         "tessellate data/cube.obj -o {} --scheme nonsense",
         obj.display()

@@ -1,5 +1,5 @@
 //! The default stencil tables, embedded: the Catmull–Clark table, its small pinned-corner
-//! companion, the Loop table and the butterfly table.
+//! companion, the Loop table, the butterfly table and the √3 table.
 //!
 //! The default Catmull–Clark table (interior valences 3..=8, boundary vertices with 1..=6 faces
 //! "edge only", n = 1..=24, primal and dual grids, positions and both derivatives, f32) is about
@@ -31,6 +31,9 @@ static BUTTERFLY: &Aligned<[u8]> = &Aligned(*include_bytes!(concat!(
     "/butterfly.subtess"
 )));
 
+static SQRT3: &Aligned<[u8]> =
+    &Aligned(*include_bytes!(concat!(env!("OUT_DIR"), "/sqrt3.subtess")));
+
 /// The default Catmull–Clark table's bytes (64-byte aligned).
 pub fn default_catmull_clark() -> &'static [u8] {
     &CATMULL_CLARK.0
@@ -60,6 +63,15 @@ pub fn default_butterfly() -> &'static [u8] {
     &BUTTERFLY.0
 }
 
+/// The default √3 table's bytes (64-byte aligned): the nine regions of interior vertices of
+/// valence 3..=8 (region 0 only at valence 6, the regular patch) of two √3 steps taken as one
+/// ternary step, n = 1..=8, triangle primal and dual grids, positions and both derivatives, f32
+/// (`stencilgen::region_table::RegionTableSpec::default_sqrt3`; 5.3 MiB). Rates up to 24 need a
+/// table written by `stencilgen tables --schemes sqrt3`.
+pub fn default_sqrt3() -> &'static [u8] {
+    &SQRT3.0
+}
+
 #[cfg(test)]
 mod tests {
     #[test]
@@ -69,6 +81,7 @@ mod tests {
             super::default_catmull_clark_corners(),
             super::default_loop(),
             super::default_butterfly(),
+            super::default_sqrt3(),
         ] {
             assert_eq!(bytes.as_ptr() as usize % 64, 0);
             assert_eq!(&bytes[..8], b"SUBTESS\0");

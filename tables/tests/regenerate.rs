@@ -72,3 +72,24 @@ fn regenerated_butterfly_table_is_byte_identical() {
         table.coverage()
     );
 }
+
+#[test]
+fn regenerated_sqrt3_table_is_byte_identical() {
+    let fresh = stencilgen::sqrt3_table::build_sqrt3_table(
+        &stencilgen::region_table::RegionTableSpec::default_sqrt3(),
+    )
+    .expect("the sqrt3 table generates");
+    let embedded = tables::default_sqrt3();
+    assert!(
+        fresh == embedded,
+        "the embedded sqrt3 table differs from a fresh generation"
+    );
+    let table = table_format::Table::parse(embedded).expect("the embedded table is valid");
+    assert_eq!(table.meta.scheme, table_format::SchemeId::Sqrt3);
+    println!(
+        "sqrt3 table: {} bytes, {} sections; {}",
+        table.size(),
+        table.entries.len(),
+        table.coverage()
+    );
+}

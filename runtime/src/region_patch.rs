@@ -1,27 +1,30 @@
-//! Which butterfly table patch evaluates a triangle, and its control points in the table's
-//! order.
+//! Which table patch of a region scheme (the butterfly, √3) evaluates a triangle, and its
+//! control points in the table's order.
 //!
-//! The butterfly's regular basis function has support of radius 3, so an extraordinary vertex
-//! `V` of valence `K` shapes not only its own `K` triangles but every triangle `T` with `V` in
-//! `T + int H` (`H` the support): the **regions** of `schemes::butterfly_regions`, nine per
-//! sector (the corner triangle, three in the next band, five in the one after), each a table
-//! patch of its own: section key `faces = K`, `sector = region`, layout
-//! `ButterflyRegion::layout` in `V`'s cone coordinates (`crate::cone_chart`). The same region
-//! in sector `s` around `V` reads every layout point `(a, b)_t` as `(a, b)_{t + s}`. A triangle
-//! in no region is the regular patch: region 0 at valence 6 around its corner 0.
+//! The regular basis functions of the butterfly and of √3 (two steps) have supports wider than
+//! a one-ring (radius 3 and 2.5 in lattice units), so an extraordinary vertex `V` of valence
+//! `K` shapes not only its own `K` triangles but every triangle `T` with `V` in `T + int H`
+//! (`H` the support): the **regions** of `schemes::butterfly_regions` and
+//! `schemes::sqrt3_regions`, for both schemes the same nine per sector (the corner triangle,
+//! three in the next band, five in the one after), each a table patch of its own: section key
+//! `faces = K`, `sector = region`, with the region's layout in `V`'s cone coordinates
+//! ([`crate::cone_chart`]). The same region in sector `s` around `V` reads every layout point
+//! `(a, b)_t` as `(a, b)_{t + s}`. A triangle in no region is the regular patch: region 0 at
+//! valence 6 around its corner 0.
 //!
 //! A triangle is a patch when
 //! * it lies in the regions of at most one extraordinary vertex, and
 //! * its layout holds no other extraordinary vertex (the rules the table was made with are the
 //!   regular ones everywhere but at `V`).
 //!
-//! [`crate::butterfly_isolate`] refines until that holds. A region's frame puts its first
-//! corner at patch `(0,0)`: the patch's `corner` is the face corner that is the region's first.
+//! [`crate::region_isolate`] refines until that holds. A region's frame puts its first corner
+//! at patch `(0,0)`: the patch's `corner` is the face corner that is the region's first.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 
 use rayon::prelude::*;
 use schemes::butterfly_regions::ButterflyRegions;
+use schemes::sqrt3_regions::Sqrt3Regions;
 use schemes::triangle_local::{canonical_triangle_point, TrianglePoint};
 use schemes::TriangleScheme;
 
@@ -31,6 +34,55 @@ use crate::topology::Mesh;
 use crate::triangle_patch::TrianglePatch;
 use crate::triangle_topology::neighbours;
 use crate::{MeshError, RuntimeError};
+
+/// A triangle scheme whose extraordinary vertices shape nine regions per sector.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RegionScheme {
+    /// The modified butterfly (Zorin, Schröder and Sweldens 1996), dyadic.
+    Butterfly,
+    /// √3 (Kobbelt 2000), two steps as one ternary step.
+    Sqrt3,
+}
+
+impl RegionScheme {
+    /// The scheme's name in `schemes::TriangleScheme` and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            RegionScheme::Butterfly => "butterfly",
+            RegionScheme::Sqrt3 => "sqrt3",
+        }
+    }
+
+    /// The regions of an interior vertex of valence `k`: every region's corners and layout.
+    fn shapes(self, k: u32) -> Result<Vec<RegionShape>, RuntimeError> {
+        let name = self.name();
+        let scheme = TriangleScheme::by_name(name)
+            .ok_or_else(|| RuntimeError::Unsupported(format!("{name} is not catalogued")))?;
+        let failed = |e: &dyn std::fmt::Display| {
+            RuntimeError::Unsupported(format!("{name} at valence {k}: {e}"))
+        };
+        Ok(match self {
+            RegionScheme::Butterfly => ButterflyRegions::new(&scheme, k)
+                .map_err(|e| failed(&e))?
+                .regions
+                .into_iter()
+                .map(|r| RegionShape {
+                    corners: r.triangle.corners(),
+                    layout: r.layout,
+                })
+                .collect(),
+            RegionScheme::Sqrt3 => Sqrt3Regions::new(&scheme, k)
+                .map_err(|e| failed(&e))?
+                .regions
+                .into_iter()
+                .map(|r| RegionShape {
+                    corners: r.triangle.corners(),
+                    layout: r.layout,
+                })
+                .collect(),
+        })
+    }
+}
 
 /// The regions of every valence a mesh has: corners in sector-0 chart coordinates and layouts.
 #[derive(Clone, Debug)]
@@ -58,27 +110,16 @@ fn reach(layout: &[TrianglePoint]) -> i64 {
 }
 
 impl RegionCatalogue {
-    /// The regions of the valences in `valences` (and 6, the regular patch's).
-    pub fn new(valences: impl IntoIterator<Item = u32>) -> Result<Self, RuntimeError> {
-        let scheme = TriangleScheme::by_name("butterfly")
-            .ok_or_else(|| RuntimeError::Unsupported("the butterfly is not catalogued".into()))?;
+    /// The regions of `scheme` at the valences in `valences` (and 6, the regular patch's).
+    pub fn new(
+        scheme: RegionScheme,
+        valences: impl IntoIterator<Item = u32>,
+    ) -> Result<Self, RuntimeError> {
         let mut by_valence = BTreeMap::new();
         for k in valences.into_iter().chain([6]) {
-            if by_valence.contains_key(&k) {
-                continue;
+            if let std::collections::btree_map::Entry::Vacant(slot) = by_valence.entry(k) {
+                slot.insert(scheme.shapes(k)?);
             }
-            let regions = ButterflyRegions::new(&scheme, k).map_err(|e| {
-                RuntimeError::Unsupported(format!("the butterfly at valence {k}: {e}"))
-            })?;
-            let shapes = regions
-                .regions
-                .iter()
-                .map(|r| RegionShape {
-                    corners: r.triangle.corners(),
-                    layout: r.layout.clone(),
-                })
-                .collect();
-            by_valence.insert(k, shapes);
         }
         Ok(RegionCatalogue { by_valence })
     }
@@ -123,7 +164,7 @@ fn gather(
 
 /// The patch of every triangle of a closed triangle mesh, or the first triangle that is not
 /// one yet (see the module docs).
-pub fn gather_butterfly_patches(
+pub fn gather_region_patches(
     mesh: &Mesh,
     catalogue: &RegionCatalogue,
 ) -> Result<Vec<TrianglePatch>, RuntimeError> {
@@ -195,15 +236,18 @@ pub fn gather_butterfly_patches(
     let regular = catalogue
         .regions(6)
         .and_then(|r| r.first())
-        .ok_or_else(|| RuntimeError::Unsupported("no regular butterfly region".into()))?;
+        .ok_or_else(|| RuntimeError::Unsupported("no regular region".into()))?;
     let radius = reach(&regular.layout);
+    let regular_layout: BTreeSet<TrianglePoint> = regular.layout.iter().copied().collect();
     // The regular triangles, most of the mesh, in one chunk per thread, each with its own
     // chart scratch space.
     let regular_patch =
         |charts: &mut ConeCharts, f: usize| -> Result<TrianglePatch, RuntimeError> {
             let corners = mesh.face(f);
             let chart = charts
-                .chart(mesh, corners[0], corners[1], radius)
+                .chart_within(mesh, corners[0], corners[1], radius, |p| {
+                    regular_layout.contains(&p)
+                })
                 .map_err(|e| not_isolated(f, e))?;
             if chart.valence != 6 {
                 return Err(not_isolated(

@@ -1,0 +1,65 @@
+//! Isolation for the region schemes (the butterfly, √3): whole-mesh steps until every triangle
+//! is a table patch ([`crate::region_patch`]), the children tracked by
+//! [`crate::triangle_isolation`].
+//!
+//! A step keeps every vertex's valence and makes every new vertex regular, so it doubles (the
+//! butterfly) or triples (√3's ternary step) the graph distance between extraordinary vertices.
+//! A region's layout reaches about five rings from its vertex (four for √3), so two
+//! extraordinary vertices need to be about six edges apart: three butterfly steps or two
+//! ternary √3 steps for neighbours, fewer for vertices already apart.
+
+use std::collections::BTreeSet;
+
+use crate::butterfly_refine::butterfly_refine;
+use crate::region_patch::{gather_region_patches, RegionCatalogue, RegionScheme};
+use crate::sqrt3_refine::sqrt3_refine;
+use crate::topology::Mesh;
+use crate::triangle_isolation::{isolate_by_refinement, TriangleIsolation, MAX_ISOLATION_STEPS};
+use crate::triangle_patch::Phantoms;
+use crate::triangle_split::Split;
+use crate::triangle_topology::require_closed_triangles;
+use crate::RuntimeError;
+
+/// At most this many steps are taken (three butterfly steps separate neighbouring
+/// extraordinary vertices; one more covers meshes whose small size makes a chart close on
+/// itself).
+pub const MAX_REGION_STEPS: usize = MAX_ISOLATION_STEPS;
+
+impl RegionScheme {
+    /// How one of the scheme's whole-mesh steps splits a triangle.
+    pub fn split(self) -> Split {
+        match self {
+            RegionScheme::Butterfly => Split::Dyadic,
+            RegionScheme::Sqrt3 => Split::Ternary,
+        }
+    }
+
+    /// One whole-mesh step: a butterfly step, or two √3 steps.
+    pub fn refine(self, mesh: &Mesh) -> Result<Mesh, RuntimeError> {
+        match self {
+            RegionScheme::Butterfly => Ok(butterfly_refine(mesh)?.mesh),
+            RegionScheme::Sqrt3 => sqrt3_refine(mesh),
+        }
+    }
+}
+
+/// Check that `mesh` is a closed triangle mesh, refine it by `scheme` until every triangle is a
+/// table patch, and gather every triangle's patch.
+pub fn isolate_regions(
+    mesh: &Mesh,
+    scheme: RegionScheme,
+) -> Result<TriangleIsolation, RuntimeError> {
+    require_closed_triangles(mesh, scheme.name())?;
+    let valences: BTreeSet<u32> = (0..mesh.positions.len())
+        .map(|v| mesh.fan(v).len() as u32)
+        .filter(|&k| k != 0)
+        .collect();
+    let catalogue = RegionCatalogue::new(scheme, valences)?;
+    isolate_by_refinement(
+        mesh,
+        scheme.split(),
+        MAX_REGION_STEPS,
+        |m| scheme.refine(m),
+        |m| Ok((gather_region_patches(m, &catalogue)?, Phantoms::new(m))),
+    )
+}

@@ -1,0 +1,391 @@
+//! √3 meshes end to end: isolation by ternary steps, the region patches and their layouts, and
+//! the tessellation from the default √3 table.
+//!
+//! √3 approximates, so the independent reference is Kobbelt's limit-position rule
+//! (`runtime::sqrt3_refine::sqrt3_limit_position`, a closed form checked there to be invariant
+//! under the step): at a ternary parameter `(i/3^m, j/3^m)` of a triangle the limit surface is
+//! the limit position of the vertex that `m` whole-mesh ternary steps (two √3 steps each, the
+//! rules written out in `runtime::sqrt3_refine`) put there. That checks the table's stencils,
+//! the region layouts and their rotations, and the triangle dual grid's point maps together,
+//! without the solver that made the table.
+
+mod common;
+
+use std::collections::HashMap;
+
+use proptest::prelude::*;
+use runtime::cone_chart::ConeChart;
+use runtime::region_isolate::isolate_regions;
+use runtime::region_patch::RegionScheme;
+use runtime::sqrt3_refine::{sqrt3_limit_position, sqrt3_refine};
+use runtime::stencil_table::StencilTable;
+use runtime::topology::Mesh;
+use runtime::triangle_dual_grid::TriangleDualGrid;
+use runtime::triangle_isolation::TriangleIsolation;
+use runtime::triangle_split::{ternary_child_to_parent, TriangleSplit};
+use runtime::triangle_topology::neighbours;
+use schemes::sqrt3_regions::Sqrt3Regions;
+use schemes::triangle_local::{canonical_triangle_point, TrianglePoint};
+use schemes::TriangleScheme;
+
+use common::{check_topology, icosahedron, load, models, octahedron, tetrahedron, torus};
+
+fn regions_of(iso: &TriangleIsolation) -> Vec<(u32, u32)> {
+    let mut kinds: Vec<(u32, u32)> = iso
+        .patches
+        .iter()
+        .map(|p| (p.kind.faces, p.kind.sector))
+        .collect();
+    kinds.sort_unstable();
+    kinds.dedup();
+    kinds
+}
+
+/// `m` ternary steps of `mesh`, every level kept.
+fn levels_of(mesh: &Mesh, m: usize) -> Vec<Mesh> {
+    let mut levels = vec![mesh.clone()];
+    for _ in 0..m {
+        let next = sqrt3_refine(&levels[levels.len() - 1]).expect("refines");
+        levels.push(next);
+    }
+    levels
+}
+
+/// Two ternary steps separate neighbouring extraordinary vertices (nine edges apart; one step
+/// leaves them three apart, inside each other's regions); a regular torus needs none. Every
+/// region of the valence shows up, and nothing else.
+#[test]
+fn isolation_separates_the_extraordinary_vertices() {
+    let cases: Vec<(&str, Mesh, usize, u32)> = vec![
+        ("tetrahedron", tetrahedron(), 2, 3),
+        ("octahedron", octahedron(), 2, 4),
+        ("icosahedron", icosahedron(), 2, 5),
+        ("torus", torus(12, 12), 0, 6),
+    ];
+    for (name, m, steps, k) in cases {
+        let iso =
+            isolate_regions(&m, RegionScheme::Sqrt3).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(iso.steps, steps, "{name}");
+        assert_eq!(
+            iso.mesh.faces(),
+            m.faces() * 9usize.pow(steps as u32),
+            "{name}"
+        );
+        let mut expected: Vec<(u32, u32)> = vec![(6, 0)];
+        if k != 6 {
+            expected.extend((0..9).map(|r| (k, r)));
+        }
+        expected.sort_unstable();
+        assert_eq!(regions_of(&iso), expected, "{name}");
+    }
+}
+
+/// The vertex one ternary step puts at the third of the edge `(v, e)` nearer `v`
+/// (`runtime::triangle_split`'s numbering).
+fn third_near(coarse: &Mesh, v: u32, e: u32) -> u32 {
+    let split = TriangleSplit::new(coarse);
+    let i = split
+        .edges
+        .iter()
+        .position(|&[a, b]| (a, b) == (v, e) || (a, b) == (e, v))
+        .expect("V's edge");
+    (coarse.positions.len() + 2 * i + usize::from(split.edges[i][0] != v)) as u32
+}
+
+/// The gathered layouts are the right vertices, in the right order and rotation: the level-`L`
+/// points a region's rows make from its layout (`schemes::sqrt3_regions`, built from the
+/// scheme's rules on the cone) equal the vertices that `L` more whole-mesh ternary steps of the
+/// runtime put there, named by a cone chart of the refined mesh. For the corner region the rows
+/// are `A`'s (level 1, the layout's own points); for the others their tiles' points.
+fn check_layouts_against_refinement(name: &str, iso: &TriangleIsolation) {
+    let scheme = TriangleScheme::by_name("sqrt3").expect("catalogued");
+    let levels = levels_of(&iso.mesh, 1);
+    let mut catalogue: HashMap<u32, Sqrt3Regions> = HashMap::new();
+    let mut checked = HashMap::new();
+    let scale = 1.0
+        + iso
+            .mesh
+            .positions
+            .iter()
+            .flatten()
+            .fold(0.0f64, |m, c| m.max(c.abs()));
+    for (f, patch) in iso.patches.iter().enumerate() {
+        let k = patch.kind.faces;
+        let r = patch.kind.sector as usize;
+        if *checked.entry((k, r)).or_insert(0) >= 3 {
+            continue;
+        }
+        let regions = catalogue
+            .entry(k)
+            .or_insert_with(|| Sqrt3Regions::new(&scheme, k).expect("regions"));
+        let region = &regions.regions[r];
+        let (level, points, rows): (usize, Vec<TrianglePoint>, &Vec<Vec<f64>>) = if r == 0 {
+            (1, region.layout.clone(), &regions.corner.a)
+        } else {
+            let points = region
+                .regular_points
+                .iter()
+                .map(|&(a, b)| canonical_triangle_point(k, 0, a, b))
+                .collect();
+            (region.tile_level as usize, points, &region.regular_rows)
+        };
+        assert_eq!(
+            level, 1,
+            "{name}: every √3 region but the corner's tiles is level 1"
+        );
+        let at = |q: TrianglePoint| {
+            let i = region.layout.iter().position(|&p| p == q);
+            i.map(|i| patch.points[i]).unwrap_or_else(|| {
+                panic!("{name}: region {r} at valence {k} lacks {q:?} in its layout")
+            })
+        };
+        let v = at(TrianglePoint::Centre);
+        let e = third_near(
+            &levels[0],
+            v,
+            at(TrianglePoint::Sector { s: 0, a: 1, b: 0 }),
+        );
+        let refined = &levels[1];
+        let radius = points
+            .iter()
+            .map(|p| match *p {
+                TrianglePoint::Centre => 0,
+                TrianglePoint::Sector { a, b, .. } => a + b,
+            })
+            .max()
+            .unwrap_or(1);
+        let chart = ConeChart::new(refined, v, e, radius).expect("a regular cone around V");
+        for (p, row) in points.iter().zip(rows) {
+            let w = chart.vertex(*p, 0).expect("within the chart");
+            let expect = refined.positions[w as usize];
+            let got = row
+                .iter()
+                .zip(&patch.points)
+                .fold([0.0; 3], |acc, (x, &c)| {
+                    let q = iso.mesh.positions[c as usize];
+                    [0, 1, 2].map(|i| acc[i] + x * q[i])
+                });
+            for i in 0..3 {
+                assert!(
+                    (got[i] - expect[i]).abs() < 1e-12 * scale,
+                    "{name}: triangle {f}, valence {k}, region {r}, point {p:?}: {got:?} != {expect:?}"
+                );
+            }
+        }
+        *checked.get_mut(&(k, r)).expect("counted") += 1;
+    }
+    for ((k, r), n) in &checked {
+        assert!(*n > 0, "{name}: valence {k} region {r} unchecked");
+    }
+}
+
+#[test]
+fn gathered_layouts_match_whole_mesh_refinement() {
+    for (name, m) in [
+        ("tetrahedron", tetrahedron()),
+        ("octahedron", octahedron()),
+        ("icosahedron", icosahedron()),
+    ] {
+        let iso =
+            isolate_regions(&m, RegionScheme::Sqrt3).unwrap_or_else(|e| panic!("{name}: {e}"));
+        check_layouts_against_refinement(name, &iso);
+    }
+}
+
+/// The vertex of the `m`-times refined mesh at the ternary point `(u, v) / 3^m` of triangle
+/// `f`, found by searching the children (the inverse of `ternary_child_to_parent`).
+fn refined_vertex(levels: &[Mesh], f: usize, u: u32, v: u32, m: usize) -> u32 {
+    let (mut f, mut u, mut v, mut d) = (f, u, v, 3u32.pow(m as u32));
+    while d > 1 {
+        let child = (0..9u8).find_map(|c| {
+            (0..=d / 3).find_map(|s| {
+                (0..=d / 3 - s)
+                    .find(|&t| ternary_child_to_parent(c, s, t, d / 3) == (u, v))
+                    .map(|t| (c, s, t))
+            })
+        });
+        let (c, s, t) = child.unwrap_or_else(|| panic!("({u}, {v}) / {d} is outside"));
+        (f, u, v, d) = (9 * f + c as usize, s, t, d / 3);
+    }
+    let corner = match (u, v) {
+        (0, 0) => 0,
+        (1, 0) => 1,
+        _ => 2,
+    };
+    levels[m].face(f)[corner]
+}
+
+/// Kobbelt's limit position of vertex `v` of `mesh`.
+fn limit_position(mesh: &Mesh, v: usize) -> [f64; 3] {
+    let ring = neighbours(mesh, v);
+    let sum = ring.iter().fold([0.0; 3], |acc, &e| {
+        [0, 1, 2].map(|c| acc[c] + mesh.positions[e as usize][c])
+    });
+    let k = ring.len();
+    sqrt3_limit_position(mesh.positions[v], sum.map(|c| c / k as f64), k)
+}
+
+/// The ternary level `m <= max` of `(u, v) / d` and its numerators over `3^m`, if it has one.
+fn ternary_point(u: u32, v: u32, d: u32, max: usize) -> Option<(usize, u32, u32)> {
+    (0..=max).find_map(|m| {
+        let p = 3u32.pow(m as u32);
+        (u * p % d == 0 && v * p % d == 0).then(|| (m, u * p / d, v * p / d))
+    })
+}
+
+/// Every output vertex at a ternary source (level 0..=2: primal points at rates divisible by
+/// 3, triangle centres of the dual grid) equals Kobbelt's limit position of the refined mesh's
+/// vertex there.
+fn check_against_limit_positions(
+    name: &str,
+    table: &StencilTable,
+    iso: &TriangleIsolation,
+    levels: &[Mesh],
+    rate: u32,
+) {
+    let rates = vec![rate; iso.mesh.faces()];
+    let grid = TriangleDualGrid::new(table, &iso.mesh, &iso.patches, &rates)
+        .unwrap_or_else(|e| panic!("{name}: plan: {e}"));
+    let out = grid.tessellate(&iso.mesh);
+    let scale = iso
+        .mesh
+        .positions
+        .iter()
+        .flatten()
+        .fold(0.0f64, |a, c| a.max(c.abs()));
+    let mut checked = [0usize; 3];
+    let mut worst = 0.0f64;
+    for (p, s) in out.positions.iter().zip(&out.sources) {
+        let Some((m, u, v)) = ternary_point(s.u, s.v, s.denominator, levels.len() - 1) else {
+            continue;
+        };
+        let w = refined_vertex(levels, s.face as usize, u, v, m);
+        let q = limit_position(&levels[m], w as usize);
+        for c in 0..3 {
+            worst = worst.max((f64::from(p[c]) - q[c]).abs() / scale);
+        }
+        checked[m] += 1;
+    }
+    println!("{name}: ternary vertices per level {checked:?}, worst relative error {worst:.2e}");
+    assert!(checked.iter().sum::<usize>() > 0, "{name}: nothing checked");
+    assert!(worst < 2e-6, "{name}: {worst:.2e}");
+    check_topology(&iso.mesh, &out, name);
+}
+
+#[test]
+fn the_surface_meets_the_limit_positions_of_refined_vertices() {
+    let table = StencilTable::default_sqrt3().expect("embedded sqrt3 table");
+    for (name, m) in [
+        ("tetrahedron", tetrahedron()),
+        ("octahedron", octahedron()),
+        ("icosahedron", icosahedron()),
+        ("torus", torus(12, 12)),
+    ] {
+        let iso =
+            isolate_regions(&m, RegionScheme::Sqrt3).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let levels = levels_of(&iso.mesh, 2);
+        for rate in [1, 3, 6] {
+            check_against_limit_positions(
+                &format!("{name} at rate {rate}"),
+                &table,
+                &iso,
+                &levels,
+                rate,
+            );
+        }
+    }
+}
+
+/// A vertex normal of a fine mesh: the area-weighted average of the normals of the triangles
+/// around it (their cross products summed).
+fn ring_normal(mesh: &Mesh, v: usize) -> [f64; 3] {
+    let p = &mesh.positions;
+    let mut sum = [0.0; 3];
+    for h in mesh.fan(v) {
+        let (a, b) = (mesh.head(h) as usize, mesh.head(mesh.next(h)) as usize);
+        let (e, f) = (
+            [0, 1, 2].map(|c| p[a][c] - p[v][c]),
+            [0, 1, 2].map(|c| p[b][c] - p[v][c]),
+        );
+        let n = [
+            e[1] * f[2] - e[2] * f[1],
+            e[2] * f[0] - e[0] * f[2],
+            e[0] * f[1] - e[1] * f[0],
+        ];
+        sum = [0, 1, 2].map(|c| sum[c] + n[c]);
+    }
+    let length = sum.iter().map(|c| c * c).sum::<f64>().sqrt();
+    sum.map(|c| c / length)
+}
+
+/// The table's normals (from the d/du, d/dv stencils; at the extraordinary vertices Loop's
+/// eigenvector convention) against the ring normals of the mesh refined three more ternary
+/// steps at the same level-1 vertices; the normals of the convex shapes point out.
+#[test]
+fn normals_follow_the_refined_surface() {
+    let table = StencilTable::default_sqrt3().expect("embedded sqrt3 table");
+    for (name, m) in [("octahedron", octahedron()), ("tetrahedron", tetrahedron())] {
+        let iso =
+            isolate_regions(&m, RegionScheme::Sqrt3).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let (rate, extra) = (3u32, 3usize);
+        let levels = levels_of(&iso.mesh, extra);
+        let grid = TriangleDualGrid::new(
+            &table,
+            &iso.mesh,
+            &iso.patches,
+            &vec![rate; iso.mesh.faces()],
+        )
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let out = grid.tessellate(&iso.mesh);
+        let mut worst = 0.0f64;
+        for ((p, n), s) in out.positions.iter().zip(&out.normals).zip(&out.sources) {
+            let n = n.map(f64::from);
+            let outwards: f64 = (0..3).map(|c| n[c] * f64::from(p[c])).sum();
+            assert!(outwards > 0.0, "{name}: an inward normal at {p:?}");
+            let Some((1, u, v)) = ternary_point(s.u, s.v, s.denominator, 1) else {
+                continue;
+            };
+            // The level-1 vertex keeps its number at every later level.
+            let w = refined_vertex(&levels, s.face as usize, u, v, 1);
+            let fine = ring_normal(&levels[extra], w as usize);
+            let cos: f64 = (0..3).map(|c| n[c] * fine[c]).sum();
+            worst = worst.max(cos.clamp(-1.0, 1.0).acos());
+        }
+        println!("{name}: worst normal angle {worst:.2e} rad");
+        assert!(worst < 5e-3, "{name}: {worst}");
+    }
+}
+
+/// Random per-face rates: the output is an oriented manifold with the input's Euler
+/// characteristic, whatever the neighbouring rates and patch kinds.
+fn check_random_rates(name: &str, iso: &TriangleIsolation, rates: &[u32]) {
+    let table = StencilTable::default_sqrt3().expect("embedded sqrt3 table");
+    let grid = TriangleDualGrid::new(&table, &iso.mesh, &iso.patches, rates)
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+    let out = grid.tessellate(&iso.mesh);
+    check_topology(&iso.mesh, &out, name);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(6))]
+
+    #[test]
+    fn random_rates_give_manifolds(rates in proptest::collection::vec(1u32..=8, 1620)) {
+        let iso = isolate_regions(&icosahedron(), RegionScheme::Sqrt3).expect("isolates");
+        prop_assert_eq!(iso.mesh.faces(), rates.len());
+        check_random_rates("icosahedron", &iso, &rates);
+    }
+}
+
+#[test]
+fn spot_tessellates_to_a_closed_manifold_at_mixed_rates() {
+    let Some(dir) = models() else { return };
+    let m = load(&dir.join("crane/spot_triangulated.obj"));
+    let iso = isolate_regions(&m, RegionScheme::Sqrt3).unwrap_or_else(|e| panic!("spot: {e}"));
+    assert_eq!(iso.steps, 2);
+    // Rates 1 and 2, alternating in runs of odd lengths so neighbours differ.
+    let rates: Vec<u32> = (0..iso.mesh.faces())
+        .map(|f| 1 + ((f / 7) % 2) as u32)
+        .collect();
+    check_random_rates("spot", &iso, &rates);
+}
