@@ -789,6 +789,39 @@ mod tests {
         check_closed_form(&table, &iso, c, &[1, 2, 4, 8]);
     }
 
+    /// With rates among the divisors of 24 every `e_f(n)` is the closed form, so `T` just above
+    /// `4c / 9m^2` selects exactly `m` (every smaller divisor exceeds it), except `m = 2`, where
+    /// rate 1 already meets it (`c / 9 < 1.01 c / 9`).
+    #[test]
+    fn tolerance_rates_are_minimal_on_the_closed_form() {
+        let c = 0.25;
+        let table = StencilTable::default_loop().expect("table");
+        let iso = isolate_loop(&quadratic_torus(c)).expect("isolates");
+        let divisors = [1, 2, 3, 4, 6, 8, 12, 24];
+        for m in [2u32, 3, 4, 6, 8, 12, 24] {
+            let t = 1.01 * 4.0 * c / (9.0 * f64::from(m * m));
+            let chosen = triangle_tolerance_rates_among(&table, &iso, t, &divisors).expect("rates");
+            let expected = if m == 2 { 1 } else { m };
+            for f in inner_faces() {
+                assert_eq!(chosen.rates[f], expected, "face {f} T = {t}");
+            }
+        }
+    }
+
+    /// A flat lattice: the limit surface is affine on the inner triangles, which rate 1 meets
+    /// for any tolerance.
+    #[test]
+    fn a_flat_region_gets_rate_one() {
+        let table = StencilTable::default_loop().expect("table");
+        let iso = isolate_loop(&quadratic_torus(0.0)).expect("isolates");
+        for t in [1e-2, 1e-4, 1e-6] {
+            let chosen = triangle_tolerance_rates(&table, &iso, t).expect("rates");
+            for f in inner_faces() {
+                assert_eq!(chosen.rates[f], 1, "face {f} T = {t}");
+            }
+        }
+    }
+
     #[test]
     fn tables_say_which_rates_they_have() {
         let loop_table = StencilTable::default_loop().expect("table");
