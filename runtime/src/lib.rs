@@ -34,6 +34,7 @@ pub mod triangle_dual_grid;
 pub mod triangle_isolation;
 pub mod triangle_mesh;
 pub mod triangle_patch;
+pub mod triangle_rates;
 pub mod triangle_split;
 pub mod triangle_topology;
 

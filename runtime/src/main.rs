@@ -24,6 +24,7 @@ use runtime::stencil_table::StencilTable;
 use runtime::topology::Mesh;
 use runtime::triangle_dual_grid::{tessellate_triangles, TriangleDualGrid};
 use runtime::triangle_isolation::TriangleIsolation;
+use runtime::triangle_rates::triangle_tolerance_rates;
 use runtime::RuntimeError;
 
 #[derive(Parser)]
@@ -111,7 +112,8 @@ struct TessellateArgs {
     #[arg(short = 'o', long = "output")]
     output: PathBuf,
     /// Subdivision scheme: catmull-clark (any polygons), loop (triangles), butterfly or sqrt3
-    /// (closed triangle meshes); the triangle schemes take --rate, --rates or --view.
+    /// (closed triangle meshes); the triangle schemes take --rate, --rates, --tolerance or
+    /// --view.
     #[arg(long, default_value = "catmull-clark")]
     scheme: String,
     /// Dual points per face side, 1..=24, on every face.
@@ -124,7 +126,9 @@ struct TessellateArgs {
     rates: Option<PathBuf>,
     /// A distance T in the mesh's units. Dual grid: per face the smallest rate whose
     /// tessellation deviates from the limit surface by at most T, measured on the table's
-    /// rate-24 grid (docs/results.md). Adaptive: the guaranteed bound every polygon meets.
+    /// rate-24 grid (docs/results.md); loop and butterfly: on the triangle grids of the table's
+    /// two largest rates, rates among the table's (docs/cli.md). Adaptive: the guaranteed
+    /// bound every polygon meets.
     #[arg(long, conflicts_with = "view")]
     tolerance: Option<f64>,
     /// View-dependent rates: `PX,PY,PZ,TX,TY,TZ,FOV,HEIGHT,EDGE` = camera position, target,
@@ -417,24 +421,37 @@ fn parse_scheme(name: &str) -> Result<Scheme, RuntimeError> {
 }
 
 /// `subtess tessellate MESH --scheme loop|butterfly|sqrt3`: the triangle dual grid at `--rate`,
-/// `--rates` or `--view` (the projected-edge rule is the same for triangles).
+/// `--rates`, `--tolerance` (per triangle, `runtime::triangle_rates`) or `--view` (the
+/// projected-edge rule is the same for triangles).
 fn triangle_command(
     args: &TessellateArgs,
     input: &Mesh,
     scheme: Scheme,
 ) -> Result<(), RuntimeError> {
-    if args.method != "dual-grid" || args.tolerance.is_some() {
+    if args.method != "dual-grid" {
         return Err(RuntimeError::Unsupported(format!(
-            "--scheme {} tessellates with the dual grid at --rate, --rates or --view (no --tolerance or --method adaptive yet)",
+            "--scheme {} tessellates with the dual grid at --rate, --rates, --tolerance or --view (no --method adaptive yet)",
             scheme.name()
         )));
     }
     let table = scheme.triangle_table(&args.table)?;
     let iso = scheme.isolate_triangles(input)?;
-    let rates = match (&args.rates, &args.view) {
-        (Some(path), _) => read_rates(path, input.faces(), &iso.origin)?,
-        (None, Some(camera)) => view_rates(&iso.mesh, camera)?,
-        (None, None) => vec![args.rate; iso.patches.len()],
+    let mut unmet = None;
+    let rates = match (&args.rates, &args.view, args.tolerance) {
+        (Some(path), _, _) => read_rates(path, input.faces(), &iso.origin)?,
+        (None, Some(camera), _) => view_rates(&iso.mesh, camera)?,
+        (None, None, Some(t)) => {
+            let chosen = triangle_tolerance_rates(&table, &iso, t)?;
+            if let (false, Some(largest)) = (chosen.unmet.is_empty(), chosen.rates.iter().max()) {
+                eprintln!(
+                    "warning: {} triangles do not meet the tolerance {t} at rate {largest}; they get {largest}",
+                    chosen.unmet.len()
+                );
+            }
+            unmet = Some(chosen.unmet.len());
+            chosen.rates
+        }
+        (None, None, None) => vec![args.rate; iso.patches.len()],
     };
     let (mut triangles, time) = tessellate_triangles(&table, &iso.mesh, &iso.patches, &rates)?;
     for source in &mut triangles.sources {
@@ -458,6 +475,8 @@ fn triangle_command(
             "isolation_steps": iso.steps,
             "rate_min": rates.iter().min(),
             "rate_max": rates.iter().max(),
+            "tolerance": args.tolerance,
+            "faces_over_tolerance": unmet,
             "threads": rayon::current_num_threads(),
         });
         println!("{stats}");

@@ -634,39 +634,82 @@ pub fn tolerance_rates_among(
     candidates: &[u32],
 ) -> Result<ToleranceRates, RuntimeError> {
     check_faces(mesh, patches)?;
-    if !(tolerance.is_finite() && tolerance > 0.0) {
-        return Err(RuntimeError::InvalidParameter {
-            name: "tolerance".to_owned(),
-            reason: format!("{tolerance} (it must be a positive distance)"),
-        });
-    }
-    let mut sorted = candidates.to_vec();
-    sorted.sort_unstable();
-    sorted.dedup();
-    let largest = match sorted.last() {
-        Some(&n) if sorted[0] >= 1 && n <= MAX_SELECTED_RATE => n,
-        _ => {
-            return Err(RuntimeError::InvalidParameter {
-                name: "candidate rates".to_owned(),
-                reason: format!(
-                    "{candidates:?} (they must be 1..={MAX_SELECTED_RATE}, at least one)"
-                ),
-            })
-        }
-    };
+    check_tolerance(tolerance)?;
+    let sorted = sorted_candidates(candidates, &RATIONAL_RATES)?;
     let ctx = Context {
         table,
         mesh,
         patches,
     };
-    let chosen = (0..patches.len())
+    select_rates(
+        patches.len(),
+        tolerance,
+        &sorted,
+        |f| Samples::new(&PatchPoints::new(table, mesh, &patches[f])?, SELECTION_GRID),
+        |f, samples, n| Ok(FaceLocal::new(&ctx, f, n)?.deviation(samples)),
+    )
+}
+
+/// A tolerance is a positive, finite distance.
+pub(crate) fn check_tolerance(tolerance: f64) -> Result<(), RuntimeError> {
+    if tolerance.is_finite() && tolerance > 0.0 {
+        Ok(())
+    } else {
+        Err(RuntimeError::InvalidParameter {
+            name: "tolerance".to_owned(),
+            reason: format!("{tolerance} (it must be a positive distance)"),
+        })
+    }
+}
+
+/// `candidates` sorted and deduplicated: at least one, each one of `allowed` (sorted).
+pub(crate) fn sorted_candidates(
+    candidates: &[u32],
+    allowed: &[u32],
+) -> Result<Vec<u32>, RuntimeError> {
+    let mut sorted = candidates.to_vec();
+    sorted.sort_unstable();
+    sorted.dedup();
+    if sorted.is_empty() || sorted.iter().any(|n| allowed.binary_search(n).is_err()) {
+        let (first, last) = (allowed.first(), allowed.last());
+        let contiguous =
+            matches!((first, last), (Some(&a), Some(&b)) if (b - a) as usize + 1 == allowed.len());
+        let range = match (first, last) {
+            (Some(a), Some(b)) if contiguous => format!("{a}..={b}"),
+            _ => format!("{allowed:?}"),
+        };
+        return Err(RuntimeError::InvalidParameter {
+            name: "candidate rates".to_owned(),
+            reason: format!("{candidates:?} (they must be {range}, at least one)"),
+        });
+    }
+    Ok(sorted)
+}
+
+/// The selection shared by the quad and triangle tolerance rates: per face `f` (in parallel)
+/// the smallest `n` of `sorted` (ascending, non-empty) with `deviation(f, &prepare(f), n) <=
+/// tolerance`, trying them in order, or the largest (and `f` listed as unmet). `prepare` is
+/// what every rate reuses (the face's samples).
+pub(crate) fn select_rates<S>(
+    faces: usize,
+    tolerance: f64,
+    sorted: &[u32],
+    prepare: impl Fn(usize) -> Result<S, RuntimeError> + Sync,
+    deviation: impl Fn(usize, &S, u32) -> Result<f64, RuntimeError> + Sync,
+) -> Result<ToleranceRates, RuntimeError> {
+    let largest = *sorted
+        .last()
+        .ok_or_else(|| RuntimeError::InvalidParameter {
+            name: "candidate rates".to_owned(),
+            reason: "none given".to_owned(),
+        })?;
+    let chosen = (0..faces)
         .into_par_iter()
         .map(|f| -> Result<(u32, f64, bool), RuntimeError> {
-            let samples =
-                Samples::new(&PatchPoints::new(table, mesh, &patches[f])?, SELECTION_GRID)?;
+            let prepared = prepare(f)?;
             let mut last = 0.0;
-            for &n in &sorted {
-                last = FaceLocal::new(&ctx, f, n)?.deviation(&samples);
+            for &n in sorted {
+                last = deviation(f, &prepared, n)?;
                 if last <= tolerance {
                     return Ok((n, last, true));
                 }
@@ -726,7 +769,7 @@ pub fn measure_deviation(
 }
 
 /// Triangles bucketed in a uniform grid of cubic cells (by bounding box).
-struct TriangleCells {
+pub(crate) struct TriangleCells {
     triangles: Vec<[[f64; 3]; 3]>,
     size: f64,
     cells: HashMap<[i64; 3], Vec<u32>>,
@@ -736,7 +779,8 @@ struct TriangleCells {
 }
 
 impl TriangleCells {
-    fn new(mesh: &TriangleMesh) -> Self {
+    /// Bucket the triangles of `mesh` (cells about twice the mean triangle size).
+    pub(crate) fn new(mesh: &TriangleMesh) -> Self {
         let position = |i: u32| mesh.positions[i as usize].map(f64::from);
         let triangles: Vec<[[f64; 3]; 3]> = mesh
             .triangles
@@ -783,7 +827,7 @@ impl TriangleCells {
     /// The distance from `p` to the nearest triangle: cells in shells of growing Chebyshev
     /// radius `r` around `p`'s cell, until the best distance found is at most the distance from
     /// `p` to the searched block's surface (nothing outside the block can be nearer).
-    fn distance(&self, p: [f64; 3]) -> f64 {
+    pub(crate) fn distance(&self, p: [f64; 3]) -> f64 {
         let home = p.map(|x| (x / self.size).floor() as i64);
         let reach = (0..3)
             .map(|c| {

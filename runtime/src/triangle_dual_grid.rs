@@ -100,7 +100,7 @@ impl Zigzag {
 
 /// The small triangle `(i, j, down)` of point `t` of the zigzag along side `side` at rate `n`:
 /// ups touch the side, downs touch it at a point.
-fn zigzag_cell(n: u32, side: u8, t: u32) -> (u32, u32, bool) {
+pub(crate) fn zigzag_cell(n: u32, side: u8, t: u32) -> (u32, u32, bool) {
     let (half, down) = (t / 2, t % 2 == 1);
     match (side, down) {
         (0, _) => (half, 0, down),

@@ -672,3 +672,58 @@ fn loop_scheme_errors_name_the_problem() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("nonsense"));
 }
+
+/// `--tolerance` with the triangle schemes: a tighter tolerance never needs fewer triangles,
+/// the stats report the tolerance and the triangles that cannot meet it (with a warning), and
+/// `--method adaptive` is still refused.
+#[test]
+fn triangle_schemes_take_a_tolerance() {
+    let mesh = temp("octahedron-tolerance.obj");
+    std::fs::write(&mesh, OCTAHEDRON).expect("written");
+    let out_path = temp("octahedron-tolerance.out.obj");
+    let run = |args: &str| {
+        subtess(&format!(
+            "tessellate {} -o {} --stats {args}",
+            mesh.display(),
+            out_path.display()
+        ))
+    };
+    let stats = |args: &str| {
+        let out = run(args);
+        assert!(
+            out.status.success(),
+            "{args}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        json(&out)
+    };
+    let mut previous = 0;
+    for t in ["0.05", "0.01", "0.002"] {
+        let s = stats(&format!("--scheme loop --tolerance {t}"));
+        assert_eq!(s["watertight"], true, "{s}");
+        assert_eq!(s["tolerance"].as_f64(), t.parse().ok(), "{s}");
+        assert_eq!(s["faces_over_tolerance"], 0, "{s}");
+        let count = s["triangles"].as_u64().unwrap_or(0);
+        assert!(count >= previous, "T = {t}: {count} < {previous}");
+        previous = count;
+    }
+    // 0.002 of a unit octahedron needs more than rate 1 somewhere: 3n^2 - 3n + 3 per triangle.
+    assert!(previous > 32 * 3, "{previous}");
+    let s = stats("--scheme butterfly --tolerance 0.01");
+    assert_eq!(
+        (s["scheme"].clone(), s["watertight"].clone()),
+        ("butterfly".into(), true.into())
+    );
+    assert!(s["rate_max"].as_u64().is_some_and(|n| n <= 8), "{s}");
+    // Far below what the table's largest rate reaches: every triangle is reported.
+    let out = run("--scheme loop --tolerance 1e-9");
+    assert!(out.status.success());
+    assert_eq!(json(&out)["faces_over_tolerance"], 32);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("do not meet the tolerance"));
+    let out = run("--scheme loop --method adaptive --tolerance 0.01");
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--method adaptive"));
+    for path in [mesh, out_path] {
+        let _ = std::fs::remove_file(path);
+    }
+}
