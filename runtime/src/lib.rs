@@ -15,6 +15,7 @@ pub mod exact_eval;
 pub mod geometry;
 pub mod isolate;
 pub mod lai_cheng;
+pub mod lattice_walk;
 pub mod loop_exact_eval;
 pub mod loop_isolate;
 pub mod loop_refine;

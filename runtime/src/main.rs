@@ -284,9 +284,11 @@ fn tessellate_command(args: TessellateArgs) -> Result<(), RuntimeError> {
         return triangle_command(&args, &input, scheme);
     }
     let table = load_table(&args.table, input.boundary)?;
+    let started = Instant::now();
     let iso = isolate_with_origins(&input)?;
+    let isolation_seconds = started.elapsed().as_secs_f64();
     if args.method == "adaptive" {
-        return adaptive_command(&args, &input, &table, &iso);
+        return adaptive_command(&args, &input, &table, &iso, isolation_seconds);
     }
     if args.relative || args.triangulate {
         return Err(RuntimeError::InvalidParameter {
@@ -332,6 +334,7 @@ fn tessellate_command(args: TessellateArgs) -> Result<(), RuntimeError> {
             "input_faces": input.faces(),
             "faces": iso.mesh.faces(),
             "isolation_steps": iso.steps,
+            "isolation_seconds": isolation_seconds,
             "rate_min": rates.iter().min(),
             "rate_max": rates.iter().max(),
             "tolerance": args.tolerance,
@@ -435,7 +438,9 @@ fn triangle_command(
         )));
     }
     let table = scheme.triangle_table(&args.table)?;
+    let started = Instant::now();
     let iso = scheme.isolate_triangles(input)?;
+    let isolation_seconds = started.elapsed().as_secs_f64();
     let mut unmet = None;
     let rates = match (&args.rates, &args.view, args.tolerance) {
         (Some(path), _, _) => read_rates(path, input.faces(), &iso.origin)?,
@@ -473,6 +478,7 @@ fn triangle_command(
             "input_faces": input.faces(),
             "faces": iso.mesh.faces(),
             "isolation_steps": iso.steps,
+            "isolation_seconds": isolation_seconds,
             "rate_min": rates.iter().min(),
             "rate_max": rates.iter().max(),
             "tolerance": args.tolerance,
@@ -513,6 +519,7 @@ fn adaptive_command(
     input: &Mesh,
     table: &StencilTable,
     iso: &Isolation,
+    isolation_seconds: f64,
 ) -> Result<(), RuntimeError> {
     let tolerance = args
         .tolerance
@@ -539,6 +546,7 @@ fn adaptive_command(
         let mut report = stats.to_json();
         report["watertight"] =
             serde_json::json!(input.boundary_loops() == 0 && adaptive.is_watertight());
+        report["isolation_seconds"] = serde_json::json!(isolation_seconds);
         println!("{report}");
     }
     Ok(())
@@ -604,7 +612,9 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
                 for _ in 0..steps {
                     input = scheme.refine_triangles(&input)?;
                 }
+                let started = Instant::now();
                 let iso = scheme.isolate_triangles(&input)?;
+                let isolation_seconds = started.elapsed().as_secs_f64();
                 let faces = iso.patches.len();
                 let rates = bench_rates(faces, rate, mixed);
                 let (grid, control) = pool.install(|| {
@@ -632,6 +642,7 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
                     "min_seconds": seconds[0],
                     "max_seconds": seconds[seconds.len() - 1],
                     "triangles_per_second": count as f64 / seconds[seconds.len() / 2].max(1e-12),
+                    "isolation_seconds": isolation_seconds,
                 });
                 println!("{report}");
                 return Ok(());
@@ -640,7 +651,9 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
             for _ in 0..steps {
                 input = refine(&input).mesh;
             }
+            let started = Instant::now();
             let iso = isolate_with_origins(&input)?;
+            let isolation_seconds = started.elapsed().as_secs_f64();
             let faces = iso.patches.len();
             let rates = bench_rates(faces, rate, mixed);
             let (grid, control) = pool.install(|| {
@@ -669,6 +682,7 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
                 "min_seconds": seconds[0],
                 "max_seconds": seconds[seconds.len() - 1],
                 "triangles_per_second": count as f64 / median.max(1e-12),
+                "isolation_seconds": isolation_seconds,
             });
             println!("{report}");
             Ok(())

@@ -50,9 +50,11 @@ pub fn isolate_regions(
     scheme: RegionScheme,
 ) -> Result<TriangleIsolation, RuntimeError> {
     require_closed_triangles(mesh, scheme.name())?;
-    let valences: BTreeSet<u32> = (0..mesh.positions.len())
-        .map(|v| mesh.fan(v).len() as u32)
+    let valences: BTreeSet<u32> = mesh
+        .valences()
+        .into_iter()
         .filter(|&k| k != 0)
+        .map(|k| k as u32)
         .collect();
     let catalogue = RegionCatalogue::new(scheme, valences)?;
     isolate_by_refinement(

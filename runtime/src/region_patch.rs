@@ -29,8 +29,9 @@ use schemes::triangle_local::{canonical_triangle_point, TrianglePoint};
 use schemes::TriangleScheme;
 
 use crate::cone_chart::{ConeChart, ConeCharts};
+use crate::lattice_walk::LatticeWalk;
 use crate::patch::PatchKind;
-use crate::topology::Mesh;
+use crate::topology::{Mesh, NONE};
 use crate::triangle_patch::TrianglePatch;
 use crate::triangle_topology::neighbours;
 use crate::{MeshError, RuntimeError};
@@ -168,9 +169,7 @@ pub fn gather_region_patches(
     mesh: &Mesh,
     catalogue: &RegionCatalogue,
 ) -> Result<Vec<TrianglePatch>, RuntimeError> {
-    let valence: Vec<usize> = (0..mesh.positions.len())
-        .map(|v| mesh.fan(v).len())
-        .collect();
+    let valence = mesh.valences();
     let mut patches: Vec<Option<TrianglePatch>> = vec![None; mesh.faces()];
     let mut charts = ConeCharts::new(mesh);
     let not_isolated = |face: usize, reason: String| MeshError::NotIsolated { face, reason };
@@ -237,30 +236,17 @@ pub fn gather_region_patches(
         .regions(6)
         .and_then(|r| r.first())
         .ok_or_else(|| RuntimeError::Unsupported("no regular region".into()))?;
-    let radius = reach(&regular.layout);
-    let regular_layout: BTreeSet<TrianglePoint> = regular.layout.iter().copied().collect();
-    // The regular triangles, most of the mesh, in one chunk per thread, each with its own
-    // chart scratch space.
+    let regular = RegularLayout::new(&regular.layout);
+    let interior_regular = interior_regular(mesh, &valence);
     let regular_patch =
-        |charts: &mut ConeCharts, f: usize| -> Result<TrianglePatch, RuntimeError> {
-            let corners = mesh.face(f);
-            let chart = charts
-                .chart_within(mesh, corners[0], corners[1], radius, |p| {
-                    regular_layout.contains(&p)
-                })
-                .map_err(|e| not_isolated(f, e))?;
-            if chart.valence != 6 {
-                return Err(not_isolated(
-                    f,
-                    format!(
-                        "its corner {} has valence {} but the triangle is in none of its regions",
-                        corners[0], chart.valence
-                    ),
-                )
-                .into());
-            }
-            let points =
-                gather(&chart, &regular.layout, 0, &valence).map_err(|e| not_isolated(f, e))?;
+        |scratch: &mut RegularScratch, f: usize| -> Result<TrianglePatch, RuntimeError> {
+            let points = match regular.by_walk(mesh, &interior_regular, &mut scratch.halfedges, f) {
+                Some(points) => points,
+                None => {
+                    let charts = scratch.charts.get_or_insert_with(|| ConeCharts::new(mesh));
+                    regular.by_chart(mesh, &valence, charts, f)?
+                }
+            };
             Ok(TrianglePatch {
                 kind: PatchKind {
                     boundary: false,
@@ -271,25 +257,186 @@ pub fn gather_region_patches(
                 corner: 0,
             })
         };
+    // The regular triangles, most of the mesh, filled in place in one chunk per thread, each
+    // with its own scratch space; the first failing chunk's first error, as a sequential pass
+    // would report.
     let chunk = mesh.faces().div_ceil(rayon::current_num_threads()).max(1);
-    let mut out: Vec<TrianglePatch> = Vec::with_capacity(mesh.faces());
-    let chunks: Vec<Result<Vec<TrianglePatch>, RuntimeError>> = patches
+    let chunks: Vec<Result<(), RuntimeError>> = patches
         .par_chunks_mut(chunk)
         .enumerate()
         .map(|(c, slice)| {
-            let mut charts = ConeCharts::new(mesh);
-            slice
-                .iter_mut()
-                .enumerate()
-                .map(|(i, patch)| match patch.take() {
-                    Some(p) => Ok(p),
-                    None => regular_patch(&mut charts, c * chunk + i),
-                })
-                .collect()
+            let mut scratch = RegularScratch::default();
+            slice.iter_mut().enumerate().try_for_each(|(i, patch)| {
+                if patch.is_none() {
+                    *patch = Some(regular_patch(&mut scratch, c * chunk + i)?);
+                }
+                Ok(())
+            })
         })
         .collect();
     for c in chunks {
-        out.extend(c?);
+        c?;
     }
-    Ok(out)
+    // Every triangle has its patch now.
+    Ok(patches.into_iter().flatten().collect())
+}
+
+/// Whether every vertex is interior of valence 6 (a vertex is on the boundary where an edge
+/// leaving it is).
+fn interior_regular(mesh: &Mesh, valence: &[usize]) -> Vec<bool> {
+    let mut regular: Vec<bool> = valence.iter().map(|&k| k == 6).collect();
+    for (h, &t) in mesh.twin.iter().enumerate() {
+        if t == NONE {
+            regular[mesh.face_vertices[h] as usize] = false;
+        }
+    }
+    regular
+}
+
+/// The regular patch's layout and the two ways to find its vertices around a triangle.
+struct RegularLayout<'a> {
+    layout: &'a [TrianglePoint],
+    within: BTreeSet<TrianglePoint>,
+    radius: i64,
+    walk: Option<LatticeWalk>,
+}
+
+impl<'a> RegularLayout<'a> {
+    fn new(layout: &'a [TrianglePoint]) -> Self {
+        RegularLayout {
+            layout,
+            within: layout.iter().copied().collect(),
+            radius: reach(layout),
+            walk: LatticeWalk::new(layout),
+        }
+    }
+
+    /// The layout's vertices by the chart of corner 0 grown only through the layout: the
+    /// reference, and the reason where triangle `f` is not a regular patch.
+    fn by_chart(
+        &self,
+        mesh: &Mesh,
+        valence: &[usize],
+        charts: &mut ConeCharts,
+        f: usize,
+    ) -> Result<Vec<u32>, MeshError> {
+        let not_isolated = |reason: String| MeshError::NotIsolated { face: f, reason };
+        let corners = mesh.face(f);
+        let chart = charts
+            .chart_within(mesh, corners[0], corners[1], self.radius, |p| {
+                self.within.contains(&p)
+            })
+            .map_err(not_isolated)?;
+        if chart.valence != 6 {
+            return Err(not_isolated(format!(
+                "its corner {} has valence {} but the triangle is in none of its regions",
+                corners[0], chart.valence
+            )));
+        }
+        gather(&chart, self.layout, 0, valence).map_err(not_isolated)
+    }
+
+    /// The layout's vertices by a walk ([`LatticeWalk`]), where it vouches for the chart's
+    /// answer (`None` elsewhere).
+    fn by_walk(
+        &self,
+        mesh: &Mesh,
+        interior_regular: &[bool],
+        halfedges: &mut Vec<usize>,
+        f: usize,
+    ) -> Option<Vec<u32>> {
+        let walk = self.walk.as_ref()?;
+        let mut points = Vec::with_capacity(self.layout.len());
+        let start = mesh.face_halfedges(f).start;
+        walk.walk(mesh, start, interior_regular, halfedges, &mut points)
+            .then_some(points)
+    }
+}
+
+/// What the regular patches of one thread reuse: the walk's half-edges, and chart scratch
+/// space, made only when a walk cannot answer.
+#[derive(Default)]
+struct RegularScratch {
+    halfedges: Vec<usize>,
+    charts: Option<ConeCharts>,
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use super::*;
+    use crate::obj::read_obj;
+    use crate::test_meshes::{lattice_torus, octahedron, tetrahedron};
+
+    /// On every triangle of `mesh` the walk answers exactly where the chart finds a regular
+    /// patch, with the same vertices in the same order; the number of triangles it answers.
+    fn walk_agrees_with_chart(name: &str, mesh: &Mesh, scheme: RegionScheme) -> usize {
+        let catalogue = RegionCatalogue::new(scheme, [6]).expect("the regular region");
+        let regions = catalogue.regions(6).expect("valence 6");
+        let regular = RegularLayout::new(&regions[0].layout);
+        assert!(regular.walk.is_some(), "the layout is a disc of triangles");
+        let valence = mesh.valences();
+        let interior_regular = interior_regular(mesh, &valence);
+        let mut charts = ConeCharts::new(mesh);
+        let mut halfedges = Vec::new();
+        let mut walked = 0;
+        for f in 0..mesh.faces() {
+            let chart = regular.by_chart(mesh, &valence, &mut charts, f).ok();
+            let walk = regular.by_walk(mesh, &interior_regular, &mut halfedges, f);
+            assert_eq!(walk, chart, "{name} ({}), face {f}", scheme.name());
+            walked += usize::from(walk.is_some());
+        }
+        walked
+    }
+
+    /// Every mesh of `steps + 1` levels of `scheme`'s refinement of `mesh`: failed isolation
+    /// attempts (charts that leave the mesh or wrap around an extraordinary vertex) and
+    /// successful ones. The number of triangles the walk answers on the finest.
+    fn levels_agree(name: &str, mesh: &Mesh, scheme: RegionScheme, steps: usize) -> usize {
+        let mut mesh = mesh.clone();
+        for _ in 0..steps {
+            walk_agrees_with_chart(name, &mesh, scheme);
+            mesh = scheme
+                .refine(&mesh)
+                .expect("a closed triangle mesh refines");
+        }
+        walk_agrees_with_chart(name, &mesh, scheme)
+    }
+
+    #[test]
+    fn the_walk_finds_what_the_chart_finds() {
+        let torus = lattice_torus(8, |a, b| [a as f64, b as f64, 0.0]);
+        for scheme in [RegionScheme::Butterfly, RegionScheme::Sqrt3] {
+            assert_eq!(
+                walk_agrees_with_chart("torus", &torus, scheme),
+                torus.faces()
+            );
+            // Valence 3 (a chart wraps around it within its layout until it is far enough)
+            // and 4.
+            let steps = match scheme {
+                RegionScheme::Butterfly => 4,
+                RegionScheme::Sqrt3 => 2,
+            };
+            assert!(levels_agree("tetrahedron", &tetrahedron(), scheme, steps) > 0);
+            assert!(levels_agree("octahedron", &octahedron(), scheme, steps) > 0);
+        }
+    }
+
+    /// Spot (valences 4, 5, 7 and 8) through its isolation: three butterfly steps, two ternary
+    /// √3 steps.
+    #[test]
+    fn on_spot_the_walk_finds_what_the_chart_finds() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../shared/models/crane/spot_triangulated.obj");
+        if !path.is_file() {
+            println!("skipping: {} is absent", path.display());
+            return;
+        }
+        let obj = read_obj(&path).expect("Spot reads");
+        let (spot, _) = Mesh::from_obj(&obj).expect("Spot is a valid mesh");
+        for (scheme, steps) in [(RegionScheme::Butterfly, 3), (RegionScheme::Sqrt3, 2)] {
+            assert!(levels_agree("Spot", &spot, scheme, steps) > 0);
+        }
+    }
 }

@@ -27,6 +27,18 @@ pub fn octahedron() -> Mesh {
     Mesh::new(p, &f, &[], BoundaryMode::EdgeOnly).expect("a valid octahedron")
 }
 
+/// The regular tetrahedron, every vertex of valence 3.
+pub fn tetrahedron() -> Mesh {
+    let p = vec![
+        [1.0, 1.0, 1.0],
+        [1.0, -1.0, -1.0],
+        [-1.0, 1.0, -1.0],
+        [-1.0, -1.0, 1.0],
+    ];
+    let f = vec![vec![0, 1, 2], vec![0, 2, 3], vec![0, 3, 1], vec![1, 3, 2]];
+    Mesh::new(p, &f, &[], BoundaryMode::EdgeOnly).expect("a valid tetrahedron")
+}
+
 /// The skew lattice `Z^2` wrapped into an `m x m` torus: vertex `(a, b)` (mod `m`) is number
 /// `a + m b`, placed at `position(a, b)`; triangles `(a,b),(a+1,b),(a,b+1)` and
 /// `(a+1,b),(a+1,b+1),(a,b+1)`, every vertex of valence 6.

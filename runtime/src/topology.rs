@@ -190,6 +190,17 @@ impl Mesh {
         }
     }
 
+    /// The number of faces around every vertex (`fan(v).len()`, 0 for unused vertices), in
+    /// one pass over the faces: validation made the faces around a vertex one fan, so they are
+    /// the faces it appears in.
+    pub fn valences(&self) -> Vec<usize> {
+        let mut valence = vec![0; self.positions.len()];
+        for &v in &self.face_vertices {
+            valence[v as usize] += 1;
+        }
+        valence
+    }
+
     /// Whether vertex `v` is on the boundary.
     pub fn is_boundary_vertex(&self, v: usize) -> bool {
         let h = self.vertex_halfedge[v];

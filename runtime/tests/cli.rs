@@ -40,6 +40,7 @@ fn tessellate_prints_the_stats_contract() {
         "seconds",
         "triangles_per_second",
         "watertight",
+        "isolation_seconds",
     ] {
         assert!(stats.get(key).is_some(), "{key} missing: {stats}");
     }
@@ -144,6 +145,9 @@ fn bench_reports_throughput() {
     assert!(report["triangles_per_second"]
         .as_f64()
         .is_some_and(|t| t > 0.0));
+    assert!(report["isolation_seconds"]
+        .as_f64()
+        .is_some_and(|t| t >= 0.0));
 }
 
 #[test]
@@ -471,6 +475,7 @@ fn loop_scheme_tessellates_triangles() {
     );
     let stats = json(&out);
     assert_eq!(stats["scheme"], "loop");
+    assert!(stats["isolation_seconds"].as_f64().is_some());
     assert_eq!(stats["watertight"], true);
     assert_eq!(stats["isolation_steps"], 1);
     assert_eq!(stats["faces"], 32);
@@ -532,6 +537,9 @@ fn butterfly_scheme_tessellates_closed_triangle_meshes() {
     let stats = json(&out);
     assert_eq!(stats["scheme"], "butterfly");
     assert_eq!(stats["watertight"], true);
+    assert!(stats["isolation_seconds"]
+        .as_f64()
+        .is_some_and(|t| t >= 0.0));
     // Neighbouring valence-4 vertices are six edges apart after three steps.
     assert_eq!(stats["isolation_steps"], 3);
     assert_eq!(stats["faces"], 8 * 64);
@@ -548,6 +556,7 @@ fn butterfly_scheme_tessellates_closed_triangle_meshes() {
         String::from_utf8_lossy(&bench.stderr)
     );
     assert_eq!(json(&bench)["triangles"], 8 * 64 * 21);
+    assert!(json(&bench)["isolation_seconds"].as_f64().is_some());
     // The embedded table stops at n = 8; the error names the missing section.
     let out = subtess(&format!(
         "tessellate {} -o {} --scheme butterfly --rate 9",
@@ -590,6 +599,7 @@ fn sqrt3_scheme_tessellates_closed_triangle_meshes() {
     );
     let stats = json(&out);
     assert_eq!(stats["scheme"], "sqrt3");
+    assert!(stats["isolation_seconds"].as_f64().is_some());
     assert_eq!(stats["watertight"], true);
     // Neighbouring valence-4 vertices are nine edges apart after two ternary steps.
     assert_eq!(stats["isolation_steps"], 2);
