@@ -45,7 +45,7 @@
 //! surface on it is `sum_j psi(y - j) p^L_j` over the unfolded lattice, `y` its level-`L`
 //! coordinates — when `V` is outside `T + int H`: every point that influences `T` at any deeper
 //! level then lies in `T + int H` (parents of `c` are in `c + H/2`, halving per level), so no
-//! rule there reads `V`. [`ButterflyLocalMatrices::tile_level`] is the smallest `L` for which
+//! rule there reads `V`. [`ConeLocalMatrices::tile_level`] is the smallest `L` for which
 //! every level-`L` triangle of the outer half passes (`L = 3`: 48 tiles, since `H` reaches
 //! `(2, 0)` in its interior but no point of hex norm 4). Each tile's control points, the
 //! level-`L` lattice points `j` with `T ∩ (j + int H)` nonempty, are rows of level-0 layout
@@ -54,40 +54,14 @@
 //! **Numbers.** Every matrix is kept in f64 (the weights' f64 values) and, when all weights are
 //! rational (`K = 3, 4, 6`), also exactly as [`BigRational`].
 
-use std::collections::{BTreeMap, BTreeSet, HashMap};
+pub use crate::cone::{chart_sector, layout_key, point_name, LAYOUT_RADIUS};
+use crate::cone::{layout_ball, Weight};
+pub use crate::cone_local::{ConeLocalMatrices, RegularTile};
 
-use num_rational::BigRational;
-
-pub(crate) use crate::cone::{interiors_meet, layout_ball, Weight};
-pub use crate::cone::{layout_key, point_name};
-
-use crate::local_matrices::UnsupportedNeighbourhood;
+use crate::cone_local::Combination;
 use crate::triangle::{apply_map, lattice_symmetries, TriangleRefinement};
 use crate::triangle_local::{canonical_triangle_point, TrianglePoint};
-use crate::{TriangleScheme, TriangleVertexRule, TriangleWeight};
-
-/// The graph distance from `{V, E_0, E_1}` that the layout reaches (the smallest that works,
-/// see the module docs).
-pub const LAYOUT_RADIUS: u32 = 2;
-
-/// The number of 60-degree chart sectors, counter-clockwise from `(1, 0)`, between the chart's
-/// first sector and the lattice point `(a, b) != (0, 0)`: `0` for `a >= 1, b >= 0`, `1` for the
-/// next wedge, `-1` for the one clockwise, ... in `-2..=3` (the chart's cut is the ray at 180
-/// degrees, sector 3). The rotation is the one [`canonical_triangle_point`] applies.
-pub fn chart_sector(a: i64, b: i64) -> i64 {
-    let (mut a, mut b, mut s) = (a, b, 0);
-    while !(a >= 1 && b >= 0) {
-        if a == 0 && b == 0 {
-            return 0;
-        }
-        if b < 0 {
-            (s, a, b) = (s - 1, -b, a + b);
-        } else {
-            (s, a, b) = (s + 1, a + b, -a);
-        }
-    }
-    s
-}
+use crate::{TriangleScheme, TriangleWeight};
 
 /// The chart sectors (smallest, largest) that the regular edge stencil of the level-1 point
 /// `(a, b)` (`a >= 1, b >= 0`, not both even, not `(1, 0)`) reaches in its own sector's chart,
@@ -129,13 +103,10 @@ pub fn butterfly_layout(valence: u32) -> Vec<TrianglePoint> {
     layout_ball(valence, LAYOUT_RADIUS)
 }
 
-/// A linear combination of level-`(k-1)` points making a level-`k` point.
-type Combination<T> = Vec<(TrianglePoint, T)>;
-
 /// The modified butterfly's rules at one valence, in one number field.
 #[derive(Clone, Debug)]
 pub(crate) struct ButterflyRules<T> {
-    valence: u32,
+    pub(crate) valence: u32,
     /// `(3/4, [s_0, .., s_{K-1}])` at an edge of `V`; `None` at `K = 6` (regular rule).
     extraordinary: Option<(T, Vec<T>)>,
     /// The regular edge rule of the edge `(0,0)-(1,0)`.
@@ -225,379 +196,20 @@ impl<T: Weight> ButterflyRules<T> {
     }
 }
 
-/// One regular tile of the patch's outer half at level [`ButterflyLocalMatrices::tile_level`].
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct ButterflyTile {
-    /// Its corners, level-`L` sector-0 skew coordinates, counter-clockwise.
-    pub corners: [(i64, i64); 3],
-    /// Its control points: indices into [`ButterflyLocalMatrices::regular_points`], every
-    /// level-`L` lattice point `j` with `T ∩ (j + int H)` nonempty.
-    pub points: Vec<usize>,
-}
-
-impl ButterflyTile {
-    /// Whether `(y_1/d, y_2/d)` (level-`L` coordinates) lies in the closed tile.
-    pub fn contains(&self, y: (i64, i64), d: i64) -> bool {
-        (0..3).all(|e| {
-            let (p, q) = (self.corners[e], self.corners[(e + 1) % 3]);
-            let cross = (q.0 - p.0) * (y.1 - d * p.1) - (q.1 - p.1) * (y.0 - d * p.0);
-            cross >= 0
-        })
-    }
-}
+/// One regular tile of the patch's outer half at level [`ConeLocalMatrices::tile_level`]
+/// (the shared type, [`RegularTile`]).
+pub type ButterflyTile = RegularTile;
 
 /// The local subdivision matrices of the modified butterfly around an interior vertex of
-/// valence `K` (see the module docs).
-#[derive(Clone, Debug, PartialEq)]
-pub struct ButterflyLocalMatrices {
-    /// The scheme's name.
-    pub scheme: String,
-    /// The valence `K`.
-    pub valence: u32,
-    /// The control points, in table order ([`butterfly_layout`]).
-    pub layout: Vec<TrianglePoint>,
-    /// `A` (`N x N`, `N` = layout size), f64: row `i` is the level-1 layout point `i` in
-    /// level-0 layout weights, so `P_1 = A P_0`.
-    pub a: Vec<Vec<f64>>,
-    /// `A` exactly, when every weight is rational (`K = 3, 4, 6`).
-    pub a_exact: Option<Vec<Vec<BigRational>>>,
-    /// The hull `H` of the regular mask's indices, counter-clockwise: the support of the
-    /// regular basis function `psi`.
-    pub hull: Vec<(i64, i64)>,
-    /// The level `L` of the regular tiles (3).
-    pub tile_level: u32,
-    /// Every level-`L` lattice point some tile needs, unfolded in sector 0's chart.
-    pub regular_points: Vec<(i64, i64)>,
-    /// For each of `regular_points`, its level-0 weights over the layout (`L` steps), f64.
-    pub regular_rows: Vec<Vec<f64>>,
-    /// The same rows exactly, when every weight is rational.
-    pub regular_rows_exact: Option<Vec<Vec<BigRational>>>,
-    /// The regular tiles covering `1/2 <= u + v <= 1`: up triangles `(a,b),(a+1,b),(a,b+1)`
-    /// then down triangles `(a+1,b),(a+1,b+1),(a,b+1)`, each by `b`, then `a`.
-    pub tiles: Vec<ButterflyTile>,
-}
-
-/// The level-`level` triangles of `1/2 <= u + v <= 1`, in [`ButterflyLocalMatrices::tiles`]
-/// order, by corners.
-fn outer_half_tiles(level: u32) -> Vec<[(i64, i64); 3]> {
-    let m = 1i64 << level;
-    let mut up = Vec::new();
-    let mut down = Vec::new();
-    for b in 0..m {
-        for a in 0..m - b {
-            if a + b >= m / 2 {
-                up.push([(a, b), (a + 1, b), (a, b + 1)]);
-            }
-            if a + b + 1 >= m / 2 && a + b + 2 <= m {
-                down.push([(a + 1, b), (a + 1, b + 1), (a, b + 1)]);
-            }
-        }
-    }
-    up.extend(down);
-    up
-}
-
-/// What one build of the matrices needs: the rows of `A`, the tiles and their rows.
-struct Built<T> {
-    a: Vec<Vec<T>>,
-    regular_points: Vec<(i64, i64)>,
-    rows: Vec<Vec<T>>,
-    tiles: Vec<ButterflyTile>,
-}
-
-/// Rows of level-`k` points in level-0 layout weights, memoized per level: the one
-/// implementation of "apply the true rules `k` times" that the EV patch and every region
-/// ([`crate::butterfly_regions`]) use. Reading a level-0 point outside the layout is an error,
-/// which is how every layout is checked; rule weights that are exactly zero (`s_1`, `s_3` at
-/// `K = 4`) read nothing.
-pub(crate) struct RowMemo<'a, T> {
-    rules: &'a ButterflyRules<T>,
-    index: HashMap<TrianglePoint, usize>,
-    size: usize,
-    /// `memo[k][p]`: the level-`k` point `p` in level-0 layout weights.
-    memo: Vec<HashMap<TrianglePoint, Vec<T>>>,
-}
-
-impl<'a, T: Weight> RowMemo<'a, T> {
-    /// Rows over `layout`, for points of levels `0..=max_level`.
-    pub(crate) fn new(
-        rules: &'a ButterflyRules<T>,
-        layout: &[TrianglePoint],
-        max_level: u32,
-    ) -> Self {
-        RowMemo {
-            rules,
-            index: layout.iter().enumerate().map(|(i, &p)| (p, i)).collect(),
-            size: layout.len(),
-            memo: vec![HashMap::new(); max_level as usize + 1],
-        }
-    }
-
-    /// The level-`k` point `p` in level-0 layout weights.
-    pub(crate) fn row(&mut self, k: usize, p: TrianglePoint) -> Result<Vec<T>, String> {
-        if let Some(r) = self.memo.get(k).and_then(|m| m.get(&p)) {
-            return Ok(r.clone());
-        }
-        if k >= self.memo.len() {
-            return Err(format!("level {k} is past the memo's deepest level"));
-        }
-        let row = if k == 0 {
-            let i = *self
-                .index
-                .get(&p)
-                .ok_or_else(|| format!("level-0 point {} is not in the layout", point_name(p)))?;
-            let mut r = vec![T::zero(); self.size];
-            r[i] = T::one_weight();
-            r
-        } else {
-            let mut r = vec![T::zero(); self.size];
-            for (parent, w) in self.rules.refine(p)? {
-                if w.is_zero() {
-                    continue;
-                }
-                let pr = self.row(k - 1, parent)?;
-                for (x, y) in r.iter_mut().zip(pr) {
-                    if !y.is_zero() {
-                        *x = x.clone() + w.clone() * y;
-                    }
-                }
-            }
-            r
-        };
-        self.memo[k].insert(p, row.clone());
-        Ok(row)
-    }
-
-    /// The rows of the level-`k` points `points`, unfolded in sector 0's chart.
-    pub(crate) fn chart_rows(
-        &mut self,
-        k: u32,
-        points: &[(i64, i64)],
-    ) -> Result<Vec<Vec<T>>, String> {
-        points
-            .iter()
-            .map(|&(j1, j2)| {
-                let p = canonical_triangle_point(self.rules.valence, 0, j1, j2);
-                self.row(k as usize, p)
-            })
-            .collect()
-    }
-}
-
-/// Every level-0 point that the level-`level` points `points` (sector-0 chart) read through
-/// the rules, counting only nonzero rule weights: the closure a layout must hold.
-pub(crate) fn level0_reads<T: Weight>(
-    rules: &ButterflyRules<T>,
-    level: u32,
-    points: &[(i64, i64)],
-) -> Result<BTreeSet<TrianglePoint>, String> {
-    let mut current: BTreeSet<TrianglePoint> = points
-        .iter()
-        .map(|&(j1, j2)| canonical_triangle_point(rules.valence, 0, j1, j2))
-        .collect();
-    for _ in 0..level {
-        let mut parents = BTreeSet::new();
-        for &p in &current {
-            for (parent, w) in rules.refine(p)? {
-                if !w.is_zero() {
-                    parents.insert(parent);
-                }
-            }
-        }
-        current = parents;
-    }
-    Ok(current)
-}
-
-/// Regular tiles and the level-`L` lattice points they need.
-pub(crate) struct TileSet {
-    /// Every control point of some tile, sector-0 chart, in first-use order.
-    pub(crate) regular_points: Vec<(i64, i64)>,
-    /// The tiles, control points as indices into `regular_points`.
-    pub(crate) tiles: Vec<ButterflyTile>,
-}
-
-/// The tiles with corners `tile_corners` (level-`L` chart coordinates) and, for each, the
-/// level-`L` lattice points `j` with `T ∩ (j + int H)` nonempty: the only ones whose `psi`
-/// does not vanish on `T`.
-pub(crate) fn tile_set(hull: &[(i64, i64)], tile_corners: Vec<[(i64, i64); 3]>) -> TileSet {
-    let mut regular_points: Vec<(i64, i64)> = Vec::new();
-    let mut point_index: BTreeMap<(i64, i64), usize> = BTreeMap::new();
-    let mut tiles = Vec::new();
-    let radius = hull
-        .iter()
-        .map(|&(a, b)| a.abs().max(b.abs()).max((a + b).abs()))
-        .max()
-        .unwrap_or(0);
-    for corners in tile_corners {
-        let mut points = Vec::new();
-        let (lo1, hi1) = (
-            corners.iter().map(|c| c.0).min().unwrap_or(0) - radius,
-            corners.iter().map(|c| c.0).max().unwrap_or(0) + radius,
-        );
-        let (lo2, hi2) = (
-            corners.iter().map(|c| c.1).min().unwrap_or(0) - radius,
-            corners.iter().map(|c| c.1).max().unwrap_or(0) + radius,
-        );
-        for j2 in lo2..=hi2 {
-            for j1 in lo1..=hi1 {
-                let shifted: Vec<(i64, i64)> =
-                    hull.iter().map(|&(a, b)| (a + j1, b + j2)).collect();
-                if !interiors_meet(&corners, &shifted) {
-                    continue;
-                }
-                let next = regular_points.len();
-                let u = *point_index.entry((j1, j2)).or_insert(next);
-                if u == next {
-                    regular_points.push((j1, j2));
-                }
-                points.push(u);
-            }
-        }
-        tiles.push(ButterflyTile { corners, points });
-    }
-    TileSet {
-        regular_points,
-        tiles,
-    }
-}
-
-/// Build `A` and the tile rows over `layout` in the field `T`; `Err` names the first point
-/// whose rule reads a point outside the layout (or past the chart's cut).
-fn build<T: Weight>(
-    rules: &ButterflyRules<T>,
-    layout: &[TrianglePoint],
-    hull: &[(i64, i64)],
-    level: u32,
-) -> Result<Built<T>, String> {
-    let mut memo = RowMemo::new(rules, layout, level.max(1));
-    let a = layout
-        .iter()
-        .map(|&p| memo.row(1, p))
-        .collect::<Result<Vec<_>, _>>()?;
-    let TileSet {
-        regular_points,
-        tiles,
-    } = tile_set(hull, outer_half_tiles(level));
-    let rows = memo.chart_rows(level, &regular_points)?;
-    Ok(Built {
-        a,
-        regular_points,
-        rows,
-        tiles,
-    })
-}
-
-/// The smallest level `L >= 1` at which every triangle of the outer half `1/2 <= u + v <= 1`
-/// keeps `V` outside `T + int H` (module docs), i.e. `T ∩ int H` is empty.
-pub fn regular_tile_level(hull: &[(i64, i64)]) -> u32 {
-    (1..)
-        .find(|&level| {
-            outer_half_tiles(level)
-                .iter()
-                .all(|t| !interiors_meet(t, hull))
-        })
-        .unwrap_or(1)
-}
-
-impl ButterflyLocalMatrices {
-    /// Build the layout, `A` and the regular tiles of the modified butterfly (`butterfly`)
-    /// around an interior vertex of valence `valence >= 3`.
-    pub fn new(scheme: &TriangleScheme, valence: u32) -> Result<Self, UnsupportedNeighbourhood> {
-        Self::with_radius(scheme, valence, LAYOUT_RADIUS)
-    }
-
-    /// [`Self::new`] over the ball of graph radius `radius` (for checking that
-    /// [`LAYOUT_RADIUS`] is the smallest that works: smaller balls are errors).
-    pub fn with_radius(
-        scheme: &TriangleScheme,
-        valence: u32,
-        radius: u32,
-    ) -> Result<Self, UnsupportedNeighbourhood> {
-        let unsupported = |reason: String| UnsupportedNeighbourhood {
-            scheme: scheme.name.to_owned(),
-            reason,
-        };
-        if scheme.vertex != TriangleVertexRule::Interpolatory {
-            return Err(unsupported(
-                "these local matrices are the modified butterfly's (interpolatory rules)"
-                    .to_owned(),
-            ));
-        }
-        if valence < 3 {
-            return Err(unsupported(format!(
-                "an interior vertex needs valence >= 3, not {valence}"
-            )));
-        }
-        let layout = layout_ball(valence, radius);
-        let hull = scheme.regular_mask().hull();
-        let level = regular_tile_level(&hull);
-        let rules = ButterflyRules::<f64>::new(scheme, valence)
-            .ok_or_else(|| unsupported("the scheme is not a dyadic butterfly".to_owned()))?;
-        let fail = |e: String| unsupported(format!("valence {valence}, radius {radius}: {e}"));
-        let built = build(&rules, &layout, &hull, level).map_err(fail)?;
-        let exact = match ButterflyRules::<BigRational>::new(scheme, valence) {
-            Some(rules) => Some(build(&rules, &layout, &hull, level).map_err(fail)?),
-            None => None,
-        };
-        let (a_exact, regular_rows_exact) = match exact {
-            Some(e) => (Some(e.a), Some(e.rows)),
-            None => (None, None),
-        };
-        Ok(ButterflyLocalMatrices {
-            scheme: scheme.name.to_owned(),
-            valence,
-            layout,
-            a: built.a,
-            a_exact,
-            hull,
-            tile_level: level,
-            regular_points: built.regular_points,
-            regular_rows: built.rows,
-            regular_rows_exact,
-            tiles: built.tiles,
-        })
-    }
-
-    /// The number of control points `N = 3K + 9`.
-    pub fn size(&self) -> usize {
-        self.layout.len()
-    }
-
-    /// Whether every weight is rational (`a_exact` and `regular_rows_exact` are present).
-    pub fn is_rational(&self) -> bool {
-        self.a_exact.is_some()
-    }
-
-    /// Names of the layout's points ([`point_name`]).
-    pub fn names(&self) -> Vec<String> {
-        self.layout.iter().map(|&p| point_name(p)).collect()
-    }
-
-    /// The tile holding `(y_1/d, y_2/d)` in level-`L` coordinates (`1/2 <= u + v <= 1`), the
-    /// first in [`Self::tiles`] order.
-    pub fn tile_containing(&self, y: (i64, i64), d: i64) -> Option<usize> {
-        self.tiles.iter().position(|t| t.contains(y, d))
-    }
-
-    /// The layout index of the reflection `(a, b) -> (b, a)` of sector 0 (the patch's
-    /// `u <-> v` mirror) applied to layout point `i`: sector `s` goes to sector `1 - s` read
-    /// with its axes swapped, `(a, b)_s -> (b, a)_{-s}`.
-    pub fn mirror(&self, i: usize) -> Option<usize> {
-        let k = i64::from(self.valence);
-        let image = match self.layout.get(i)? {
-            TrianglePoint::Centre => TrianglePoint::Centre,
-            &TrianglePoint::Sector { s, a, b } => {
-                canonical_triangle_point(self.valence, (-i64::from(s)).rem_euclid(k), b, a)
-            }
-        };
-        self.layout.iter().position(|&p| p == image)
-    }
-}
+/// valence `K` (see the module docs): [`ConeLocalMatrices`] built by the butterfly's rules,
+/// dilation 2.
+pub type ButterflyLocalMatrices = ConeLocalMatrices;
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::cone::interiors_meet;
+    use num_rational::BigRational;
     use num_traits::One;
 
     fn butterfly() -> TriangleScheme {

@@ -78,297 +78,28 @@
 //! **Numbers.** f64 always; exactly ([`BigRational`]) when every weight is rational
 //! (`K = 3, 4, 6`).
 
-use num_rational::BigRational;
-
-use crate::butterfly_local::{
-    butterfly_layout, interiors_meet, layout_key, level0_reads, tile_set, ButterflyLocalMatrices,
-    ButterflyRules, ButterflyTile, RowMemo, TileSet, Weight,
+pub use crate::cone_regions::{
+    region_tile_level, region_triangles, ConeRegion, ConeRegions, RegionShape, RegionTriangle,
 };
-use crate::local_matrices::UnsupportedNeighbourhood;
-use crate::triangle_local::TrianglePoint;
-use crate::TriangleScheme;
 
-/// The two orientations of a triangle of the skew lattice.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum RegionShape {
-    /// `(a,b), (a+1,b), (a,b+1)`.
-    Up,
-    /// `(a+1,b), (a+1,b+1), (a,b+1)`.
-    Down,
-}
+/// One region of the butterfly: a triangle of sector 0 whose surface `V` affects, with what
+/// evaluating it needs (the shared type, [`ConeRegion`]).
+pub type ButterflyRegion = ConeRegion;
 
-/// A triangle of sector 0 by shape and lower-left cell `(a, b)`, `a, b >= 0`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct RegionTriangle {
-    /// Up or down.
-    pub shape: RegionShape,
-    /// The cell's first skew coordinate.
-    pub a: i64,
-    /// The cell's second skew coordinate.
-    pub b: i64,
-}
-
-impl RegionTriangle {
-    /// The corners in frame order: `c0` at `(u,v) = (0,0)`, `c1` at `(1,0)`, `c2` at `(0,1)`
-    /// (counter-clockwise), sector-0 chart coordinates.
-    pub fn corners(&self) -> [(i64, i64); 3] {
-        let (a, b) = (self.a, self.b);
-        match self.shape {
-            RegionShape::Up => [(a, b), (a + 1, b), (a, b + 1)],
-            RegionShape::Down => [(a + 1, b), (a + 1, b + 1), (a, b + 1)],
-        }
-    }
-
-    /// The chart vectors `c1 - c0` (the direction of `d/du`) and `c2 - c0` (`d/dv`).
-    pub fn axes(&self) -> [(i64, i64); 2] {
-        let [c0, c1, c2] = self.corners();
-        [(c1.0 - c0.0, c1.1 - c0.1), (c2.0 - c0.0, c2.1 - c0.1)]
-    }
-
-    /// The numerators over `d` of the chart point `c0 + u (c1 - c0) + v (c2 - c0)` at
-    /// `(u, v) = (i/d, j/d)`.
-    pub fn chart_point(&self, i: i64, j: i64, d: i64) -> (i64, i64) {
-        let [c0, _, _] = self.corners();
-        let [e1, e2] = self.axes();
-        (
-            d * c0.0 + i * e1.0 + j * e2.0,
-            d * c0.1 + i * e1.1 + j * e2.1,
-        )
-    }
-
-    /// The band: the ring `a + b` of the corner nearest `V` (0 for the corner triangle).
-    pub fn band(&self) -> i64 {
-        match self.shape {
-            RegionShape::Up => self.a + self.b,
-            RegionShape::Down => self.a + self.b + 1,
-        }
-    }
-
-    /// The level-`level` triangles covering this one, corners in level-`level` chart
-    /// coordinates: up triangles (by `b`, then `a`), then down triangles (same order).
-    pub fn sub_triangles(&self, level: u32) -> Vec<[(i64, i64); 3]> {
-        self.sub_triangles_scaled(1i64 << level)
-    }
-
-    /// The triangles of the lattice scaled by `1/m` covering this one (`m = 2^L` for a dyadic
-    /// level `L`, `3^L` for a ternary one: [`crate::sqrt3_regions`]), corners in those units,
-    /// in [`Self::sub_triangles`] order.
-    pub fn sub_triangles_scaled(&self, m: i64) -> Vec<[(i64, i64); 3]> {
-        let big = self.corners().map(|(x, y)| (m * x, m * y));
-        let inside = |p: (i64, i64), three: i64| {
-            // The centroid `p / 3` is inside `big` (strictly: tiles do not overlap).
-            (0..3).all(|e| {
-                let (s, t) = (big[e], big[(e + 1) % 3]);
-                (t.0 - s.0) * (p.1 - three * s.1) - (t.1 - s.1) * (p.0 - three * s.0) > 0
-            })
-        };
-        let lo = (
-            big.iter().map(|c| c.0).min().unwrap_or(0),
-            big.iter().map(|c| c.1).min().unwrap_or(0),
-        );
-        let hi = (
-            big.iter().map(|c| c.0).max().unwrap_or(0),
-            big.iter().map(|c| c.1).max().unwrap_or(0),
-        );
-        let mut up = Vec::new();
-        let mut down = Vec::new();
-        for y in lo.1..hi.1 {
-            for x in lo.0..hi.0 {
-                if inside((3 * x + 1, 3 * y + 1), 3) {
-                    up.push([(x, y), (x + 1, y), (x, y + 1)]);
-                }
-                if inside((3 * x + 2, 3 * y + 2), 3) {
-                    down.push([(x + 1, y), (x + 1, y + 1), (x, y + 1)]);
-                }
-            }
-        }
-        up.extend(down);
-        up
-    }
-}
-
-/// The regions of the mask hull `hull` in region order (module docs): the sector-0 triangles
-/// `T` with `V ∈ T + int H`, region 0 the corner `up(0,0)`.
-pub fn region_triangles(hull: &[(i64, i64)]) -> Vec<RegionTriangle> {
-    // V ∈ T + int H  <=>  T ∩ int(-H) ≠ ∅; -H is a rotation of H, so still counter-clockwise.
-    let minus: Vec<(i64, i64)> = hull.iter().map(|&(a, b)| (-a, -b)).collect();
-    let reach = hull
-        .iter()
-        .map(|&(a, b)| a.abs().max(b.abs()).max((a + b).abs()))
-        .max()
-        .unwrap_or(0);
-    let mut out = Vec::new();
-    for b in 0..=reach {
-        for a in 0..=reach {
-            for shape in [RegionShape::Up, RegionShape::Down] {
-                let t = RegionTriangle { shape, a, b };
-                if interiors_meet(&t.corners(), &minus) {
-                    out.push(t);
-                }
-            }
-        }
-    }
-    // Band, then counter-clockwise: along a band, up(a,b) sits at 2b and down(a,b) at 2b + 1.
-    out.sort_by_key(|t| (t.band(), 2 * t.b + i64::from(t.shape == RegionShape::Down)));
-    out
-}
-
-/// The smallest level `L >= 1` at which every level-`L` sub-triangle `T'` of `triangle` keeps
-/// `V` outside `T' + int H`; `None` when `V` is a corner (the sub-triangle at `V` always
-/// meets `int H`) or no level up to 8 does.
-pub fn region_tile_level(triangle: &RegionTriangle, hull: &[(i64, i64)]) -> Option<u32> {
-    if triangle.corners().contains(&(0, 0)) {
-        return None;
-    }
-    let minus: Vec<(i64, i64)> = hull.iter().map(|&(a, b)| (-a, -b)).collect();
-    (1..=8).find(|&level| {
-        triangle
-            .sub_triangles(level)
-            .iter()
-            .all(|t| !interiors_meet(t, &minus))
-    })
-}
-
-/// One region: a triangle of sector 0 whose surface `V` affects, with what evaluating it needs.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ButterflyRegion {
-    /// The triangle, which fixes the barycentric frame ([`RegionTriangle::corners`]).
-    pub triangle: RegionTriangle,
-    /// The level-0 control points, [`layout_key`] order. Region 0: [`butterfly_layout`].
-    pub layout: Vec<TrianglePoint>,
-    /// The tiles' level `L` (region 0: the corner's outer-half level, 3).
-    pub tile_level: u32,
-    /// The regular level-`L` tiles, corners in level-`L` sector-0 chart coordinates. They cover
-    /// the whole triangle, except for region 0, where they cover its outer half
-    /// `1/2 <= u + v <= 1` and `phi(x) = phi(2x) A` holds inside.
-    pub tiles: Vec<ButterflyTile>,
-    /// Every level-`L` lattice point a tile needs, sector-0 chart.
-    pub regular_points: Vec<(i64, i64)>,
-    /// Per `regular_points`, its level-0 weights over `layout`, f64.
-    pub regular_rows: Vec<Vec<f64>>,
-    /// The same exactly, when every weight is rational (`K = 3, 4, 6`).
-    pub regular_rows_exact: Option<Vec<Vec<BigRational>>>,
-}
-
-impl ButterflyRegion {
-    /// The number of control points.
-    pub fn size(&self) -> usize {
-        self.layout.len()
-    }
-
-    /// Whether this is the corner region (`V` a corner; `A` needed inside `u + v <= 1/2`).
-    pub fn is_corner(&self) -> bool {
-        self.triangle.band() == 0
-    }
-
-    /// The first tile holding the chart point `(y_1/d, y_2/d)` (level-`L` coordinates).
-    pub fn tile_containing(&self, y: (i64, i64), d: i64) -> Option<usize> {
-        self.tiles.iter().position(|t| t.contains(y, d))
-    }
-}
-
-/// Every region of the modified butterfly around an interior vertex of valence `K`.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ButterflyRegions {
-    /// The scheme's name.
-    pub scheme: String,
-    /// The valence `K`.
-    pub valence: u32,
-    /// The regular mask's hull `H`.
-    pub hull: Vec<(i64, i64)>,
-    /// The corner's local matrices (`A`, its outer half's tiles): region 0.
-    pub corner: ButterflyLocalMatrices,
-    /// The regions in region order; `regions[0]` is the corner.
-    pub regions: Vec<ButterflyRegion>,
-}
-
-impl ButterflyRegions {
-    /// Build every region of the modified butterfly (`butterfly`) at valence `valence >= 3`.
-    pub fn new(scheme: &TriangleScheme, valence: u32) -> Result<Self, UnsupportedNeighbourhood> {
-        let corner = ButterflyLocalMatrices::new(scheme, valence)?;
-        let unsupported = |reason: String| UnsupportedNeighbourhood {
-            scheme: scheme.name.to_owned(),
-            reason: format!("butterfly regions at valence {valence}: {reason}"),
-        };
-        let hull = corner.hull.clone();
-        let triangles = region_triangles(&hull);
-        if triangles.first().map(|t| t.band()) != Some(0) {
-            return Err(unsupported(
-                "the corner triangle is not a region".to_owned(),
-            ));
-        }
-        let rules = ButterflyRules::<f64>::new(scheme, valence)
-            .ok_or_else(|| unsupported("the scheme is not a dyadic butterfly".to_owned()))?;
-        let exact_rules = ButterflyRules::<BigRational>::new(scheme, valence);
-        let mut regions = vec![ButterflyRegion {
-            triangle: triangles[0],
-            layout: butterfly_layout(valence),
-            tile_level: corner.tile_level,
-            tiles: corner.tiles.clone(),
-            regular_points: corner.regular_points.clone(),
-            regular_rows: corner.regular_rows.clone(),
-            regular_rows_exact: corner.regular_rows_exact.clone(),
-        }];
-        for &triangle in &triangles[1..] {
-            let level = region_tile_level(&triangle, &hull)
-                .ok_or_else(|| unsupported(format!("{triangle:?} has no regular level")))?;
-            let TileSet {
-                regular_points,
-                tiles,
-            } = tile_set(&hull, triangle.sub_triangles(level));
-            let mut layout: Vec<TrianglePoint> = level0_reads(&rules, level, &regular_points)
-                .map_err(&unsupported)?
-                .into_iter()
-                .collect();
-            layout.sort_by_key(|&p| layout_key(p));
-            let regular_rows =
-                region_rows(&rules, &layout, level, &regular_points).map_err(&unsupported)?;
-            let regular_rows_exact = match &exact_rules {
-                Some(r) => {
-                    Some(region_rows(r, &layout, level, &regular_points).map_err(&unsupported)?)
-                }
-                None => None,
-            };
-            regions.push(ButterflyRegion {
-                triangle,
-                layout,
-                tile_level: level,
-                tiles,
-                regular_points,
-                regular_rows,
-                regular_rows_exact,
-            });
-        }
-        Ok(ButterflyRegions {
-            scheme: scheme.name.to_owned(),
-            valence,
-            hull,
-            corner,
-            regions,
-        })
-    }
-
-    /// Whether every weight is rational (every region has exact rows).
-    pub fn is_rational(&self) -> bool {
-        self.corner.is_rational()
-    }
-}
-
-/// The level-`level` chart points `points` in level-0 weights over `layout` (an unlisted
-/// level-0 point is an error).
-fn region_rows<T: Weight>(
-    rules: &ButterflyRules<T>,
-    layout: &[TrianglePoint],
-    level: u32,
-    points: &[(i64, i64)],
-) -> Result<Vec<Vec<T>>, String> {
-    RowMemo::new(rules, layout, level).chart_rows(level, points)
-}
+/// Every region of the modified butterfly around an interior vertex of valence `K`:
+/// [`ConeRegions`] built by the butterfly's rules (`ButterflyRegions::new(&butterfly, K)`).
+pub type ButterflyRegions = ConeRegions;
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::butterfly_local::ButterflyLocalMatrices;
+    use crate::cone::{interiors_meet, layout_key};
+    use crate::cone_local::ConeFamily;
     use crate::triangle_local::canonical_triangle_point;
+    use crate::triangle_local::TrianglePoint;
+    use crate::TriangleScheme;
+    use num_rational::BigRational;
     use num_traits::One;
 
     fn butterfly() -> TriangleScheme {
@@ -406,7 +137,7 @@ mod tests {
             up(0, 2),
         ];
         let hull = butterfly().regular_mask().hull();
-        assert_eq!(region_triangles(&hull), expected);
+        assert_eq!(region_triangles(ConeFamily::Butterfly, &hull), expected);
         // A brute search over a much larger sector (the centroid-free definition: V in
         // T + int H iff T meets int H, H symmetric) finds exactly these.
         let mut found = Vec::new();
@@ -423,7 +154,7 @@ mod tests {
         assert!(found.iter().all(|t| expected.contains(t)));
         let levels: Vec<Option<u32>> = expected
             .iter()
-            .map(|t| region_tile_level(t, &hull))
+            .map(|t| region_tile_level(ConeFamily::Butterfly, t, &hull))
             .collect();
         assert_eq!(levels[0], None);
         assert_eq!(&levels[1..4], [Some(2); 3]);

@@ -16,6 +16,10 @@ use crate::triangle::NEIGHBOURS;
 use crate::triangle_local::{canonical_triangle_point, TrianglePoint};
 use crate::TriangleWeight;
 
+/// The graph distance from `{V, E_0, E_1}` that every layout reaches: the smallest that works
+/// for the butterfly and for √3 (why: [`crate::butterfly_local`], [`crate::sqrt3_local`]).
+pub const LAYOUT_RADIUS: u32 = 2;
+
 /// The graph-distance ball of radius `radius` around `{V, E_0, E_1}` on the cone, ordered by
 /// ring (distance from `V`), then sector, then `b`.
 pub(crate) fn layout_ball(valence: u32, radius: u32) -> Vec<TrianglePoint> {
@@ -76,6 +80,25 @@ pub fn point_name(p: TrianglePoint) -> String {
         TrianglePoint::Centre => "V".to_owned(),
         TrianglePoint::Sector { s, a, b } => format!("({a},{b})_{s}"),
     }
+}
+
+/// The number of 60-degree chart sectors, counter-clockwise from `(1, 0)`, between the chart's
+/// first sector and the lattice point `(a, b) != (0, 0)`: `0` for `a >= 1, b >= 0`, `1` for the
+/// next wedge, `-1` for the one clockwise, ... in `-2..=3` (the chart's cut is the ray at 180
+/// degrees, sector 3). The rotation is the one [`canonical_triangle_point`] applies.
+pub fn chart_sector(a: i64, b: i64) -> i64 {
+    let (mut a, mut b, mut s) = (a, b, 0);
+    while !(a >= 1 && b >= 0) {
+        if a == 0 && b == 0 {
+            return 0;
+        }
+        if b < 0 {
+            (s, a, b) = (s - 1, -b, a + b);
+        } else {
+            (s, a, b) = (s + 1, a + b, -a);
+        }
+    }
+    s
 }
 
 /// The number fields the matrices are built in: f64 and exact rationals.

@@ -17,6 +17,8 @@ pub mod bivariate;
 pub mod butterfly_local;
 pub mod butterfly_regions;
 pub mod cone;
+pub mod cone_local;
+pub mod cone_regions;
 pub mod curve;
 pub mod local_matrices;
 pub mod loop_regular;

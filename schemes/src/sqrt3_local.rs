@@ -65,7 +65,7 @@
 //! points between (the mask is positive), is `V`, the only point with an irregular rule; and a
 //! convex region without `V` spans less than 180 degrees, so it develops into sector 0's chart
 //! without overlapping itself (the cone has at least 180 degrees). In integers: `2T` does not
-//! meet `int H`. [`Sqrt3LocalMatrices::tile_level`] is the smallest `L` for which every level-`L`
+//! meet `int H`. [`ConeLocalMatrices::tile_level`] is the smallest `L` for which every level-`L`
 //! triangle of `1/3 <= u + v <= 1` passes: `L = 2` (four √3 steps; the level-1 triangle
 //! `(1,0), (1,1), (0,1)` doubled meets `int H`), 72 tiles. Each tile's control points, the
 //! level-`L` lattice points `j` with `T ∩ (j + int S)` nonempty, are rows of level-0 layout
@@ -77,20 +77,16 @@
 //! The cone ball, its order, point names and the separating-axis test are
 //! [`crate::cone`]'s, shared with the butterfly.
 
-use std::collections::{BTreeMap, BTreeSet, HashMap};
+use std::collections::BTreeMap;
 
-use num_rational::BigRational;
+use crate::cone::{layout_ball, Weight};
+pub use crate::cone::{layout_key, point_name, LAYOUT_RADIUS};
+pub use crate::cone_local::{ConeLocalMatrices, RegularTile};
 
-use crate::cone::{interiors_meet, layout_ball, Weight};
-pub use crate::cone::{layout_key, point_name};
-use crate::local_matrices::UnsupportedNeighbourhood;
-use crate::triangle::{TriangleRefinement, NEIGHBOURS};
+use crate::cone_local::Combination;
+use crate::triangle::NEIGHBOURS;
 use crate::triangle_local::{canonical_triangle_point, TrianglePoint};
-use crate::{TriangleScheme, TriangleVertexRule, TriangleWeight};
-
-/// The graph distance from `{V, E_0, E_1}` that the layout reaches (the smallest that works,
-/// see the module docs).
-pub const LAYOUT_RADIUS: u32 = 2;
+use crate::{TriangleVertexRule, TriangleWeight};
 
 /// The six neighbours of a half-level point among the half-level points (level-`(k+1)`
 /// coordinates), counter-clockwise: the steps of the lattice `a = b (mod 3)` turned by 30
@@ -103,9 +99,6 @@ pub const HALF_LEVEL_STEPS: [(i64, i64); 6] =
 pub fn sqrt3_layout(valence: u32) -> Vec<TrianglePoint> {
     layout_ball(valence, LAYOUT_RADIUS)
 }
-
-/// A linear combination of coarser points making a finer point.
-type Combination<T> = Vec<(TrianglePoint, T)>;
 
 /// √3's rules at one valence, in one number field.
 #[derive(Clone, Debug)]
@@ -216,364 +209,22 @@ impl<T: Weight> Sqrt3Rules<T> {
     }
 }
 
-/// One regular tile of the patch's outer part at level [`Sqrt3LocalMatrices::tile_level`].
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Sqrt3Tile {
-    /// Its corners, level-`L` sector-0 skew coordinates, counter-clockwise.
-    pub corners: [(i64, i64); 3],
-    /// Its control points: indices into [`Sqrt3LocalMatrices::regular_points`], every
-    /// level-`L` lattice point `j` with `T ∩ (j + int S)` nonempty.
-    pub points: Vec<usize>,
-}
-
-impl Sqrt3Tile {
-    /// Whether `(y_1/d, y_2/d)` (level-`L` coordinates) lies in the closed tile.
-    pub fn contains(&self, y: (i64, i64), d: i64) -> bool {
-        (0..3).all(|e| {
-            let (p, q) = (self.corners[e], self.corners[(e + 1) % 3]);
-            let cross = (q.0 - p.0) * (y.1 - d * p.1) - (q.1 - p.1) * (y.0 - d * p.0);
-            cross >= 0
-        })
-    }
-}
+/// One regular tile of the patch's outer part at level [`ConeLocalMatrices::tile_level`]
+/// (the shared type, [`RegularTile`]).
+pub type Sqrt3Tile = RegularTile;
 
 /// The local subdivision matrices of √3 around an interior vertex of valence `K`, two √3
-/// steps at a time (see the module docs).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Sqrt3LocalMatrices {
-    /// The scheme's name.
-    pub scheme: String,
-    /// The valence `K`.
-    pub valence: u32,
-    /// The control points, in table order ([`sqrt3_layout`]).
-    pub layout: Vec<TrianglePoint>,
-    /// `A` (`N x N`, `N` = layout size), f64: row `i` is the level-1 (two √3 steps) layout
-    /// point `i` in level-0 layout weights, so `P_1 = A P_0` and `phi(x) = phi(3x) A`.
-    pub a: Vec<Vec<f64>>,
-    /// `A` exactly, when `alpha_K` is rational (`K = 3, 4, 6`).
-    pub a_exact: Option<Vec<Vec<BigRational>>>,
-    /// The hull `H` of the regular two-step mask's indices, counter-clockwise; the support
-    /// of the regular basis function `psi` is `S = H / 2`.
-    pub hull: Vec<(i64, i64)>,
-    /// The ternary level `L` of the regular tiles (2, i.e. four √3 steps).
-    pub tile_level: u32,
-    /// Every level-`L` lattice point some tile needs, unfolded in sector 0's chart.
-    pub regular_points: Vec<(i64, i64)>,
-    /// For each of `regular_points`, its level-0 weights over the layout (`L` steps), f64.
-    pub regular_rows: Vec<Vec<f64>>,
-    /// The same rows exactly, when every weight is rational.
-    pub regular_rows_exact: Option<Vec<Vec<BigRational>>>,
-    /// The regular tiles covering `1/3 <= u + v <= 1`: up triangles `(a,b),(a+1,b),(a,b+1)`
-    /// then down triangles `(a+1,b),(a+1,b+1),(a,b+1)`, each by `b`, then `a`.
-    pub tiles: Vec<Sqrt3Tile>,
-}
-
-/// The level-`level` triangles of `1/3 <= u + v <= 1` (`level >= 1`), in
-/// [`Sqrt3LocalMatrices::tiles`] order, by corners.
-fn outer_tiles(level: u32) -> Vec<[(i64, i64); 3]> {
-    let m = 3i64.pow(level);
-    let mut up = Vec::new();
-    let mut down = Vec::new();
-    for b in 0..m {
-        for a in 0..m - b {
-            if 3 * (a + b) >= m {
-                up.push([(a, b), (a + 1, b), (a, b + 1)]);
-            }
-            if 3 * (a + b + 1) >= m && a + b + 2 <= m {
-                down.push([(a + 1, b), (a + 1, b + 1), (a, b + 1)]);
-            }
-        }
-    }
-    up.extend(down);
-    up
-}
-
-/// `T` scaled by 2: the test `T ∩ (j + int H/2) != ∅` is `2T ∩ (2j + int H) != ∅`.
-pub(crate) fn doubled(t: &[(i64, i64); 3]) -> [(i64, i64); 3] {
-    t.map(|(a, b)| (2 * a, 2 * b))
-}
-
-/// What one build of the matrices needs: the rows of `A`, the tiles and their rows.
-struct Built<T> {
-    a: Vec<Vec<T>>,
-    regular_points: Vec<(i64, i64)>,
-    rows: Vec<Vec<T>>,
-    tiles: Vec<Sqrt3Tile>,
-}
-
-/// The rows of level-`k` points in level-0 layout weights, memoized per level: the one
-/// implementation of "apply the true rules `k` times" that the EV patch and every region
-/// ([`crate::sqrt3_regions`]) use. Reading a level-0 point outside the layout is an error,
-/// which is how every layout is checked.
-pub(crate) struct Rows<'a, T> {
-    rules: &'a Sqrt3Rules<T>,
-    index: HashMap<TrianglePoint, usize>,
-    memo: Vec<HashMap<TrianglePoint, Vec<T>>>,
-}
-
-impl<'a, T: Weight> Rows<'a, T> {
-    /// Rows over `layout`, for points of levels `0..=max_level`.
-    pub(crate) fn new(rules: &'a Sqrt3Rules<T>, layout: &[TrianglePoint], max_level: u32) -> Self {
-        Rows {
-            rules,
-            index: layout.iter().enumerate().map(|(i, &p)| (p, i)).collect(),
-            memo: vec![HashMap::new(); max_level as usize + 1],
-        }
-    }
-
-    /// The level-`k` point `p` in level-0 layout weights, or the first unlisted point read.
-    pub(crate) fn row(&mut self, k: usize, p: TrianglePoint) -> Result<Vec<T>, String> {
-        if let Some(r) = self.memo.get(k).and_then(|m| m.get(&p)) {
-            return Ok(r.clone());
-        }
-        if k >= self.memo.len() {
-            return Err(format!("level {k} is past the memo's deepest level"));
-        }
-        let size = self.index.len();
-        let mut r = vec![T::zero(); size];
-        if k == 0 {
-            let i = *self
-                .index
-                .get(&p)
-                .ok_or_else(|| format!("level-0 point {} is not in the layout", point_name(p)))?;
-            r[i] = T::one_weight();
-        } else {
-            for (parent, w) in self.rules.refine(p)? {
-                let pr = self.row(k - 1, parent)?;
-                for (x, y) in r.iter_mut().zip(pr) {
-                    if !y.is_zero() {
-                        *x = x.clone() + w.clone() * y;
-                    }
-                }
-            }
-        }
-        self.memo[k].insert(p, r.clone());
-        Ok(r)
-    }
-
-    /// The rows of the level-`k` points `points`, unfolded in sector 0's chart.
-    pub(crate) fn chart_rows(
-        &mut self,
-        k: u32,
-        points: &[(i64, i64)],
-    ) -> Result<Vec<Vec<T>>, String> {
-        points
-            .iter()
-            .map(|&(j1, j2)| {
-                let p = canonical_triangle_point(self.rules.valence, 0, j1, j2);
-                self.row(k as usize, p)
-            })
-            .collect()
-    }
-}
-
-/// Every level-0 point that the level-`level` points `points` (sector-0 chart) read through
-/// √3's rules: the closure a layout must hold (every rule weight is positive).
-pub(crate) fn level0_reads<T: Weight>(
-    rules: &Sqrt3Rules<T>,
-    level: u32,
-    points: &[(i64, i64)],
-) -> Result<BTreeSet<TrianglePoint>, String> {
-    let mut current: BTreeSet<TrianglePoint> = points
-        .iter()
-        .map(|&(j1, j2)| canonical_triangle_point(rules.valence, 0, j1, j2))
-        .collect();
-    for _ in 0..level {
-        let mut parents = BTreeSet::new();
-        for &p in &current {
-            for (parent, _) in rules.refine(p)? {
-                parents.insert(parent);
-            }
-        }
-        current = parents;
-    }
-    Ok(current)
-}
-
-/// The tiles with corners `tile_corners` (level-`L` chart coordinates) and the level-`L`
-/// lattice points they need, in first-use order: for each tile the `j` with
-/// `T ∩ (j + int S)` nonempty, `S = H/2` (tested as `2T ∩ (2j + int H)`), the only `j` whose
-/// `psi(. - j)` does not vanish on `T`.
-pub(crate) fn sqrt3_tile_set(
-    hull: &[(i64, i64)],
-    tile_corners: Vec<[(i64, i64); 3]>,
-) -> (Vec<(i64, i64)>, Vec<Sqrt3Tile>) {
-    let mut regular_points: Vec<(i64, i64)> = Vec::new();
-    let mut point_index: BTreeMap<(i64, i64), usize> = BTreeMap::new();
-    let mut tiles = Vec::new();
-    // Lattice points j with T ∩ (j + int H/2) nonempty are within hex radius / 2 of T.
-    let radius = hull
-        .iter()
-        .map(|&(a, b)| a.abs().max(b.abs()).max((a + b).abs()))
-        .max()
-        .unwrap_or(0)
-        / 2
-        + 1;
-    for corners in tile_corners {
-        let twice = doubled(&corners);
-        let mut points = Vec::new();
-        let range = |c: fn(&(i64, i64)) -> i64| {
-            let lo = corners.iter().map(c).min().unwrap_or(0) - radius;
-            let hi = corners.iter().map(c).max().unwrap_or(0) + radius;
-            lo..=hi
-        };
-        for j2 in range(|c| c.1) {
-            for j1 in range(|c| c.0) {
-                let shifted: Vec<(i64, i64)> = hull
-                    .iter()
-                    .map(|&(a, b)| (a + 2 * j1, b + 2 * j2))
-                    .collect();
-                if !interiors_meet(&twice, &shifted) {
-                    continue;
-                }
-                let next = regular_points.len();
-                let u = *point_index.entry((j1, j2)).or_insert(next);
-                if u == next {
-                    regular_points.push((j1, j2));
-                }
-                points.push(u);
-            }
-        }
-        tiles.push(Sqrt3Tile { corners, points });
-    }
-    (regular_points, tiles)
-}
-
-/// Build `A` and the tile rows over `layout` in the field `T`; `Err` names the first point
-/// whose rule reads a point outside the layout.
-fn build<T: Weight>(
-    rules: &Sqrt3Rules<T>,
-    layout: &[TrianglePoint],
-    hull: &[(i64, i64)],
-    level: u32,
-) -> Result<Built<T>, String> {
-    let mut rows = Rows::new(rules, layout, level.max(1));
-    let a = layout
-        .iter()
-        .map(|&p| rows.row(1, p))
-        .collect::<Result<Vec<_>, _>>()?;
-    let (regular_points, tiles) = sqrt3_tile_set(hull, outer_tiles(level));
-    let tile_rows = rows.chart_rows(level, &regular_points)?;
-    Ok(Built {
-        a,
-        regular_points,
-        rows: tile_rows,
-        tiles,
-    })
-}
-
-/// The smallest ternary level `L >= 1` at which every triangle `T` of `1/3 <= u + v <= 1`
-/// keeps `V` outside `T + int S`, `S = H/2` (module docs): `2T ∩ int H` is empty.
-pub fn regular_tile_level(hull: &[(i64, i64)]) -> u32 {
-    (1..)
-        .find(|&level| {
-            outer_tiles(level)
-                .iter()
-                .all(|t| !interiors_meet(&doubled(t), hull))
-        })
-        .unwrap_or(1)
-}
-
-impl Sqrt3LocalMatrices {
-    /// Build the layout, `A` and the regular tiles of √3 (`sqrt3`) around an interior vertex
-    /// of valence `valence >= 3`.
-    pub fn new(scheme: &TriangleScheme, valence: u32) -> Result<Self, UnsupportedNeighbourhood> {
-        Self::with_radius(scheme, valence, LAYOUT_RADIUS)
-    }
-
-    /// [`Self::new`] over the ball of graph radius `radius` (for checking that
-    /// [`LAYOUT_RADIUS`] is the smallest that works: smaller balls are errors).
-    pub fn with_radius(
-        scheme: &TriangleScheme,
-        valence: u32,
-        radius: u32,
-    ) -> Result<Self, UnsupportedNeighbourhood> {
-        let unsupported = |reason: String| UnsupportedNeighbourhood {
-            scheme: scheme.name.to_owned(),
-            reason,
-        };
-        if scheme.vertex != TriangleVertexRule::Sqrt3
-            || scheme.refinement != TriangleRefinement::Sqrt3
-        {
-            return Err(unsupported(
-                "these local matrices are √3's (Kobbelt 2000: centroids, edge flips)".to_owned(),
-            ));
-        }
-        if valence < 3 {
-            return Err(unsupported(format!(
-                "an interior vertex needs valence >= 3, not {valence}"
-            )));
-        }
-        let layout = layout_ball(valence, radius);
-        let hull = scheme.regular_mask().hull();
-        let level = regular_tile_level(&hull);
-        let fail = |e: String| unsupported(format!("valence {valence}, radius {radius}: {e}"));
-        let rules = Sqrt3Rules::<f64>::new(valence)
-            .ok_or_else(|| unsupported("f64 weights always exist".to_owned()))?;
-        let built = build(&rules, &layout, &hull, level).map_err(fail)?;
-        let exact = match Sqrt3Rules::<BigRational>::new(valence) {
-            Some(rules) => Some(build(&rules, &layout, &hull, level).map_err(fail)?),
-            None => None,
-        };
-        let (a_exact, regular_rows_exact) = match exact {
-            Some(e) => (Some(e.a), Some(e.rows)),
-            None => (None, None),
-        };
-        Ok(Sqrt3LocalMatrices {
-            scheme: scheme.name.to_owned(),
-            valence,
-            layout,
-            a: built.a,
-            a_exact,
-            hull,
-            tile_level: level,
-            regular_points: built.regular_points,
-            regular_rows: built.rows,
-            regular_rows_exact,
-            tiles: built.tiles,
-        })
-    }
-
-    /// The number of control points `N = 3K + 9`.
-    pub fn size(&self) -> usize {
-        self.layout.len()
-    }
-
-    /// Whether every weight is rational (`a_exact` and `regular_rows_exact` are present).
-    pub fn is_rational(&self) -> bool {
-        self.a_exact.is_some()
-    }
-
-    /// Names of the layout's points ([`point_name`]).
-    pub fn names(&self) -> Vec<String> {
-        self.layout.iter().map(|&p| point_name(p)).collect()
-    }
-
-    /// The tile holding `(y_1/d, y_2/d)` in level-`L` coordinates (`1/3 <= u + v <= 1`), the
-    /// first in [`Self::tiles`] order.
-    pub fn tile_containing(&self, y: (i64, i64), d: i64) -> Option<usize> {
-        self.tiles.iter().position(|t| t.contains(y, d))
-    }
-
-    /// The layout index of the reflection `(a, b) -> (b, a)` of sector 0 (the patch's
-    /// `u <-> v` mirror) applied to layout point `i`: `(a, b)_s -> (b, a)_{-s}`.
-    pub fn mirror(&self, i: usize) -> Option<usize> {
-        let k = i64::from(self.valence);
-        let image = match self.layout.get(i)? {
-            TrianglePoint::Centre => TrianglePoint::Centre,
-            &TrianglePoint::Sector { s, a, b } => {
-                canonical_triangle_point(self.valence, (-i64::from(s)).rem_euclid(k), b, a)
-            }
-        };
-        self.layout.iter().position(|&p| p == image)
-    }
-}
+/// steps at a time (see the module docs): [`ConeLocalMatrices`] built by √3's rules,
+/// dilation 3.
+pub type Sqrt3LocalMatrices = ConeLocalMatrices;
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cone::big;
-    use num_rational::Rational64;
+    use crate::cone::{big, interiors_meet};
+    use crate::cone_local::{support_scaled, ConeFamily};
+    use crate::TriangleScheme;
+    use num_rational::{BigRational, Rational64};
     use num_traits::One;
     use num_traits::Zero;
 
@@ -647,7 +298,10 @@ mod tests {
         assert_eq!(m.tile_level, 2);
         assert_eq!(m.tiles.len(), 72);
         // The level-1 triangle (1,0), (1,1), (0,1) has V in T + int S: level 1 is not regular.
-        assert!(interiors_meet(&doubled(&[(1, 0), (1, 1), (0, 1)]), &m.hull));
+        assert!(interiors_meet(
+            &support_scaled(ConeFamily::Sqrt3, &[(1, 0), (1, 1), (0, 1)]),
+            &m.hull
+        ));
         // Every point of the outer part, on the rate-27 grid, is in a tile.
         for j in 0..=27i64 {
             for i in 0..=27 - j {

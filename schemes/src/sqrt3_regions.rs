@@ -65,219 +65,29 @@
 //!
 //! **Numbers.** f64 always; exactly ([`BigRational`]) when `alpha_K` is rational (`K = 3, 4, 6`).
 
-use num_rational::BigRational;
-
-use crate::butterfly_local::chart_sector;
-pub use crate::butterfly_regions::{RegionShape, RegionTriangle};
-use crate::cone::{interiors_meet, layout_key, Weight};
-use crate::local_matrices::UnsupportedNeighbourhood;
-use crate::sqrt3_local::{
-    doubled, level0_reads, sqrt3_layout, sqrt3_tile_set, Rows, Sqrt3LocalMatrices, Sqrt3Rules,
-    Sqrt3Tile,
+pub use crate::cone_regions::{
+    region_tile_level, region_triangles, ConeRegion, ConeRegions, RegionShape, RegionTriangle,
 };
-use crate::triangle_local::TrianglePoint;
-use crate::TriangleScheme;
-
-/// The deepest ternary tile level searched (the regions need 1).
-const MAX_TILE_LEVEL: u32 = 4;
-
-/// `-H`, counter-clockwise (a point reflection keeps the orientation).
-fn minus(hull: &[(i64, i64)]) -> Vec<(i64, i64)> {
-    hull.iter().map(|&(a, b)| (-a, -b)).collect()
-}
-
-/// The regions of the two-step mask hull `hull` in region order (module docs): the sector-0
-/// triangles `T` with `V ∈ T + int S`, `S = H/2`, i.e. `2T ∩ int(-H) ≠ ∅`; region 0 the corner.
-pub fn region_triangles(hull: &[(i64, i64)]) -> Vec<RegionTriangle> {
-    let minus = minus(hull);
-    let reach = hull
-        .iter()
-        .map(|&(a, b)| a.abs().max(b.abs()).max((a + b).abs()))
-        .max()
-        .unwrap_or(0)
-        / 2
-        + 1;
-    let mut out = Vec::new();
-    for b in 0..=reach {
-        for a in 0..=reach {
-            for shape in [RegionShape::Up, RegionShape::Down] {
-                let t = RegionTriangle { shape, a, b };
-                if interiors_meet(&doubled(&t.corners()), &minus) {
-                    out.push(t);
-                }
-            }
-        }
-    }
-    out.sort_by_key(|t| (t.band(), 2 * t.b + i64::from(t.shape == RegionShape::Down)));
-    out
-}
-
-/// The smallest ternary level `L >= 1` at which every level-`L` sub-triangle `T'` of
-/// `triangle` keeps `V` outside `T' + int S` (`2T' ∩ int(-H)` empty); `None` when `V` is a
-/// corner or no level up to 4 does.
-pub fn region_tile_level(triangle: &RegionTriangle, hull: &[(i64, i64)]) -> Option<u32> {
-    if triangle.corners().contains(&(0, 0)) {
-        return None;
-    }
-    let minus = minus(hull);
-    (1..=MAX_TILE_LEVEL).find(|&level| {
-        triangle
-            .sub_triangles_scaled(3i64.pow(level))
-            .iter()
-            .all(|t| !interiors_meet(&doubled(t), &minus))
-    })
-}
 
 /// One region of √3: a triangle of sector 0 whose surface `V` affects, with what evaluating it
-/// needs.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Sqrt3Region {
-    /// The triangle, which fixes the barycentric frame ([`RegionTriangle::corners`]).
-    pub triangle: RegionTriangle,
-    /// The level-0 control points, [`layout_key`] order. Region 0: `sqrt3_layout`.
-    pub layout: Vec<TrianglePoint>,
-    /// The tiles' ternary level `L` (region 0: the corner's outer-part level, 2).
-    pub tile_level: u32,
-    /// The regular level-`L` tiles, corners in level-`L` sector-0 chart coordinates. They cover
-    /// the whole triangle, except for region 0, where they cover `1/3 <= u + v <= 1` and
-    /// `phi(x) = phi(3x) A` holds inside.
-    pub tiles: Vec<Sqrt3Tile>,
-    /// Every level-`L` lattice point a tile needs, sector-0 chart.
-    pub regular_points: Vec<(i64, i64)>,
-    /// Per `regular_points`, its level-0 weights over `layout`, f64.
-    pub regular_rows: Vec<Vec<f64>>,
-    /// The same exactly, when every weight is rational (`K = 3, 4, 6`).
-    pub regular_rows_exact: Option<Vec<Vec<BigRational>>>,
-}
+/// needs (the shared type, [`ConeRegion`]).
+pub type Sqrt3Region = ConeRegion;
 
-impl Sqrt3Region {
-    /// The number of control points.
-    pub fn size(&self) -> usize {
-        self.layout.len()
-    }
-
-    /// Whether this is the corner region (`V` a corner; `A` needed inside `u + v <= 1/3`).
-    pub fn is_corner(&self) -> bool {
-        self.triangle.band() == 0
-    }
-
-    /// The first tile holding the chart point `(y_1/d, y_2/d)` (level-`L` coordinates).
-    pub fn tile_containing(&self, y: (i64, i64), d: i64) -> Option<usize> {
-        self.tiles.iter().position(|t| t.contains(y, d))
-    }
-}
-
-/// Every region of √3 around an interior vertex of valence `K`.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Sqrt3Regions {
-    /// The scheme's name.
-    pub scheme: String,
-    /// The valence `K`.
-    pub valence: u32,
-    /// The two-step mask's hull `H` (`psi` is supported on `H/2`).
-    pub hull: Vec<(i64, i64)>,
-    /// The corner's local matrices (`A`, its outer part's tiles): region 0.
-    pub corner: Sqrt3LocalMatrices,
-    /// The regions in region order; `regions[0]` is the corner.
-    pub regions: Vec<Sqrt3Region>,
-}
-
-impl Sqrt3Regions {
-    /// Build every region of √3 (`sqrt3`) at valence `valence >= 3`.
-    pub fn new(scheme: &TriangleScheme, valence: u32) -> Result<Self, UnsupportedNeighbourhood> {
-        let corner = Sqrt3LocalMatrices::new(scheme, valence)?;
-        let unsupported = |reason: String| UnsupportedNeighbourhood {
-            scheme: scheme.name.to_owned(),
-            reason: format!("sqrt3 regions at valence {valence}: {reason}"),
-        };
-        let hull = corner.hull.clone();
-        let triangles = region_triangles(&hull);
-        if triangles.first().map(|t| t.band()) != Some(0) {
-            return Err(unsupported(
-                "the corner triangle is not a region".to_owned(),
-            ));
-        }
-        let rules = Sqrt3Rules::<f64>::new(valence)
-            .ok_or_else(|| unsupported("f64 weights always exist".to_owned()))?;
-        let exact_rules = Sqrt3Rules::<BigRational>::new(valence);
-        let mut regions = vec![Sqrt3Region {
-            triangle: triangles[0],
-            layout: sqrt3_layout(valence),
-            tile_level: corner.tile_level,
-            tiles: corner.tiles.clone(),
-            regular_points: corner.regular_points.clone(),
-            regular_rows: corner.regular_rows.clone(),
-            regular_rows_exact: corner.regular_rows_exact.clone(),
-        }];
-        for &triangle in &triangles[1..] {
-            let level = region_tile_level(&triangle, &hull)
-                .ok_or_else(|| unsupported(format!("{triangle:?} has no regular level")))?;
-            let (regular_points, tiles) =
-                sqrt3_tile_set(&hull, triangle.sub_triangles_scaled(3i64.pow(level)));
-            // The unfolding argument (module docs), checked: no tile point near the chart's cut.
-            if let Some(&(j1, j2)) = regular_points
-                .iter()
-                .find(|&&(j1, j2)| (j1, j2) != (0, 0) && !(-1..=2).contains(&chart_sector(j1, j2)))
-            {
-                return Err(unsupported(format!(
-                    "{triangle:?}: the level-{level} tile point ({j1}, {j2}) lies past chart \
-                     sector 2"
-                )));
-            }
-            let mut layout: Vec<TrianglePoint> = level0_reads(&rules, level, &regular_points)
-                .map_err(&unsupported)?
-                .into_iter()
-                .collect();
-            layout.sort_by_key(|&p| layout_key(p));
-            let regular_rows =
-                region_rows(&rules, &layout, level, &regular_points).map_err(&unsupported)?;
-            let regular_rows_exact = match &exact_rules {
-                Some(r) => {
-                    Some(region_rows(r, &layout, level, &regular_points).map_err(&unsupported)?)
-                }
-                None => None,
-            };
-            regions.push(Sqrt3Region {
-                triangle,
-                layout,
-                tile_level: level,
-                tiles,
-                regular_points,
-                regular_rows,
-                regular_rows_exact,
-            });
-        }
-        Ok(Sqrt3Regions {
-            scheme: scheme.name.to_owned(),
-            valence,
-            hull,
-            corner,
-            regions,
-        })
-    }
-
-    /// Whether every weight is rational (every region has exact rows).
-    pub fn is_rational(&self) -> bool {
-        self.corner.is_rational()
-    }
-}
-
-/// The level-`level` chart points `points` in level-0 weights over `layout` (an unlisted
-/// level-0 point is an error).
-fn region_rows<T: Weight>(
-    rules: &Sqrt3Rules<T>,
-    layout: &[TrianglePoint],
-    level: u32,
-    points: &[(i64, i64)],
-) -> Result<Vec<Vec<T>>, String> {
-    Rows::new(rules, layout, level).chart_rows(level, points)
-}
+/// Every region of √3 around an interior vertex of valence `K`: [`ConeRegions`] built by √3's
+/// rules (`Sqrt3Regions::new(&sqrt3, K)`).
+pub type Sqrt3Regions = ConeRegions;
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::cone::{interiors_meet, layout_key};
+    use crate::cone_local::{support_scaled, ConeFamily};
+    use crate::sqrt3_local::Sqrt3LocalMatrices;
     use crate::triangle::{apply_map, lattice_symmetries};
     use crate::triangle_local::canonical_triangle_point;
+    use crate::triangle_local::TrianglePoint;
+    use crate::TriangleScheme;
+    use num_rational::BigRational;
     use num_traits::One;
 
     fn sqrt3() -> TriangleScheme {
@@ -315,13 +125,13 @@ mod tests {
             up(0, 2),
         ];
         let hull = sqrt3().regular_mask().hull();
-        assert_eq!(region_triangles(&hull), expected);
+        assert_eq!(region_triangles(ConeFamily::Sqrt3, &hull), expected);
         // Brute force over a larger sector: T meets int S iff 2T meets int H (H = -H here).
         let mut found = 0;
         for b in 0..12 {
             for a in 0..12 {
                 for t in [up(a, b), down(a, b)] {
-                    if interiors_meet(&doubled(&t.corners()), &hull) {
+                    if interiors_meet(&support_scaled(ConeFamily::Sqrt3, &t.corners()), &hull) {
                         assert!(expected.contains(&t), "{t:?}");
                         found += 1;
                     }
@@ -331,7 +141,7 @@ mod tests {
         assert_eq!(found, expected.len());
         let levels: Vec<Option<u32>> = expected
             .iter()
-            .map(|t| region_tile_level(t, &hull))
+            .map(|t| region_tile_level(ConeFamily::Sqrt3, t, &hull))
             .collect();
         assert_eq!(levels[0], None);
         assert_eq!(&levels[1..], [Some(1); 8]);
