@@ -20,8 +20,7 @@ use schemes::TriangleScheme;
 use table_format::{Precision, SchemeId};
 
 use crate::butterfly_regions::{ButterflyBasis, ButterflyRegionStencils};
-use crate::region_table::{build_region_table, RegionStencilSet, RegionTableSpec, KINDS};
-use crate::regular_patch::StencilKind;
+use crate::region_table::{build_region_table, RegionTableSpec, KINDS};
 use crate::triangle_patch::triangle_scheme;
 use crate::StencilError;
 
@@ -45,32 +44,6 @@ impl RegionTableSpec {
 /// (deterministic: the same bytes on every run).
 pub fn default_butterfly_table() -> Result<Vec<u8>, StencilError> {
     build_butterfly_table(&RegionTableSpec::default_butterfly())
-}
-
-impl RegionStencilSet for ButterflyRegionStencils<f64> {
-    type Basis = ButterflyBasis<f64>;
-
-    fn valence(&self) -> u32 {
-        self.regions.valence
-    }
-
-    fn region_count(&self) -> usize {
-        self.regions.regions.len()
-    }
-
-    fn width(&self, r: usize) -> Result<usize, StencilError> {
-        Ok(self.region(r)?.size())
-    }
-
-    fn stencil(
-        &self,
-        r: usize,
-        basis: &Self::Basis,
-        point: (i64, i64),
-        kind: StencilKind,
-    ) -> Result<Vec<f64>, StencilError> {
-        ButterflyRegionStencils::stencil(self, r, basis, point, kind)
-    }
 }
 
 /// Generate and encode the butterfly table of `spec`.

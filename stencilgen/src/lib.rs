@@ -27,6 +27,8 @@ pub mod bivariate_system;
 pub mod butterfly_patch;
 pub mod butterfly_regions;
 pub mod butterfly_table;
+pub mod cone_patch;
+pub mod cone_regions;
 pub mod curve_stencils;
 pub mod curve_system;
 pub mod error;

@@ -24,8 +24,7 @@
 use schemes::TriangleScheme;
 use table_format::{Precision, SchemeId};
 
-use crate::region_table::{build_region_table, RegionStencilSet, RegionTableSpec, KINDS};
-use crate::regular_patch::StencilKind;
+use crate::region_table::{build_region_table, RegionTableSpec, KINDS};
 use crate::sqrt3_regions::{Sqrt3Basis, Sqrt3RegionStencils};
 use crate::triangle_patch::triangle_scheme;
 use crate::StencilError;
@@ -42,32 +41,6 @@ impl RegionTableSpec {
             rates: (1..=8).collect(),
             precision: Precision::F32,
         }
-    }
-}
-
-impl RegionStencilSet for Sqrt3RegionStencils<f64> {
-    type Basis = Sqrt3Basis<f64>;
-
-    fn valence(&self) -> u32 {
-        self.regions.valence
-    }
-
-    fn region_count(&self) -> usize {
-        self.regions.regions.len()
-    }
-
-    fn width(&self, r: usize) -> Result<usize, StencilError> {
-        Ok(self.region(r)?.size())
-    }
-
-    fn stencil(
-        &self,
-        r: usize,
-        basis: &Self::Basis,
-        point: (i64, i64),
-        kind: StencilKind,
-    ) -> Result<Vec<f64>, StencilError> {
-        Sqrt3RegionStencils::stencil(self, r, basis, point, kind)
     }
 }
 
