@@ -8,25 +8,22 @@
 //! across edges), compared at the dyadic points (i/2^k, j/2^k), which are level-k vertices
 //! because the scheme interpolates.
 
-use std::collections::{BTreeMap, HashMap};
-
 use num_rational::BigRational;
 use num_traits::{One, Zero};
 use schemes::butterfly_local::ButterflyLocalMatrices;
-use schemes::triangle::apply_map;
-use schemes::triangle::lattice_symmetries;
 use schemes::triangle_local::TrianglePoint;
 use schemes::TriangleScheme;
 use stencilgen::butterfly_patch::{
     butterfly_patch_stencils, butterfly_patch_stencils_at, regular_basis, ButterflyPatchStencils,
     ButterflySubstitution,
 };
-use stencilgen::regular_patch::StencilKind;
 use stencilgen::scalar::rational_to_f64;
 use stencilgen::triangle_patch::triangle_grid_points;
-use stencilgen::triangle_system::triangle_stencils;
 use subtess_tests::bspline::q;
 use subtess_tests::butterfly_fan::{name, FanMesh};
+
+mod common;
+use common::{name_of, PatchUnderTest};
 
 fn butterfly() -> TriangleScheme {
     TriangleScheme::by_name("butterfly").expect("catalogued")
@@ -44,6 +41,37 @@ fn layout(k: u32) -> Vec<TrianglePoint> {
     ButterflyLocalMatrices::new(&butterfly(), k)
         .expect("valid")
         .layout
+}
+
+/// This scheme's stencils for the checks shared with the other region scheme ([`common`]).
+fn under_test() -> PatchUnderTest {
+    PatchUnderTest {
+        scheme: butterfly(),
+        layout,
+        exact,
+        float,
+        name,
+    }
+}
+
+#[test]
+fn valence_six_is_the_regular_basis_function() {
+    common::valence_six_is_the_regular_basis_function(&under_test());
+}
+
+#[test]
+fn partition_of_unity() {
+    common::partition_of_unity(&under_test());
+}
+
+#[test]
+fn mirror_symmetry_u_v() {
+    common::mirror_symmetry_u_v(&under_test());
+}
+
+#[test]
+fn continuous_with_the_neighbouring_sector() {
+    common::continuous_with_the_neighbouring_sector(&under_test());
 }
 
 #[test]
@@ -97,41 +125,6 @@ fn f64_matches_exact_where_exact_exists() {
     }
 }
 
-/// The point of the plane where layout point `p` sits at valence 6: `(a, b)` of sector `s` is
-/// `R^s (a, b)`, `R` the rotation by 60 degrees.
-fn plane_position(p: TrianglePoint) -> (i64, i64) {
-    match p {
-        TrianglePoint::Centre => (0, 0),
-        TrianglePoint::Sector { s, a, b } => apply_map(lattice_symmetries()[s as usize], (a, b)),
-    }
-}
-
-#[test]
-fn valence_six_is_the_regular_basis_function() {
-    // At valence 6 the patch is a face of the regular lattice: the weight of the control point
-    // at p is psi(x - p), psi from the uniform system (triangle_system), which knows nothing of
-    // layouts, tiles or A.
-    let positions: Vec<(i64, i64)> = layout(6).into_iter().map(plane_position).collect();
-    let mask = butterfly().regular_mask();
-    for n in 1..=6u32 {
-        let psi =
-            triangle_stencils::<BigRational>(&mask, n, StencilKind::Position).expect("solvable");
-        let s = exact(6, n);
-        let ni = i64::from(n);
-        for (&(i, j), stencil) in s.points.iter().zip(&s.stencils) {
-            let expected: Vec<BigRational> = positions
-                .iter()
-                .map(|&(a, b)| psi.at(i - ni * a, j - ni * b))
-                .collect();
-            assert_eq!(stencil, &expected, "({i}/{n}, {j}/{n})");
-            // Every lattice point with a nonzero weight there is in the layout.
-            for (p, w) in psi.stencil_at((i, j)) {
-                assert!(positions.contains(&p), "({i}/{n}, {j}/{n}): {p:?} has {w}");
-            }
-        }
-    }
-}
-
 fn unit(size: usize, i: usize) -> Vec<BigRational> {
     let mut e = vec![BigRational::zero(); size];
     e[i] = BigRational::one();
@@ -171,115 +164,6 @@ fn interpolates_v_e0_e1() {
             for (c, x) in w.iter().enumerate() {
                 let e = if c == i { 1.0 } else { 0.0 };
                 assert!((x - e).abs() < 1e-12, "K = {k} at {p:?}: weight {c} = {x}");
-            }
-        }
-    }
-}
-
-#[test]
-fn partition_of_unity() {
-    for k in [3, 4, 6] {
-        for n in [2, 5] {
-            for w in &exact(k, n).stencils {
-                assert!(w.iter().sum::<BigRational>().is_one(), "K = {k}");
-            }
-        }
-    }
-    for k in 3..=8 {
-        for w in &float(k, 5).stencils {
-            assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-12, "K = {k}");
-        }
-    }
-}
-
-fn name_of(p: TrianglePoint) -> (u32, i64, i64) {
-    match p {
-        TrianglePoint::Centre => (0, 0, 0),
-        TrianglePoint::Sector { s, a, b } => (s, a, b),
-    }
-}
-
-#[test]
-fn mirror_symmetry_u_v() {
-    // Reflecting sector 0 across its bisector, (a, b) -> (b, a), maps sector s to sector -s
-    // with its axes swapped; the rules are symmetric, so stencil(i, j) = stencil(j, i) with the
-    // layout reflected.
-    for k in 3..=8u32 {
-        let lay = layout(k);
-        let index: HashMap<_, _> = lay
-            .iter()
-            .enumerate()
-            .map(|(i, &p)| (name_of(p), i))
-            .collect();
-        let mirror: Vec<usize> = lay
-            .iter()
-            .map(|&p| {
-                let (s, a, b) = name_of(p);
-                index[&name(k, -i64::from(s), b, a)]
-            })
-            .collect();
-        let check = |a: &[f64], b: &[f64], what: &str| {
-            for p in 0..a.len() {
-                assert!(
-                    (a[p] - b[mirror[p]]).abs() < 1e-12,
-                    "K = {k} {what} point {p}"
-                );
-            }
-        };
-        let s = float(k, 5);
-        for &(i, j) in &s.points {
-            check(
-                s.at(i, j).expect("grid"),
-                s.at(j, i).expect("grid"),
-                &format!("({i}, {j})"),
-            );
-        }
-        if matches!(k, 3 | 4) {
-            let e = exact(k, 5);
-            for &(i, j) in &e.points {
-                let (a, b) = (e.at(i, j).expect("grid"), e.at(j, i).expect("grid"));
-                for p in 0..a.len() {
-                    assert_eq!(a[p], b[mirror[p]], "K = {k} ({i}, {j}) point {p}");
-                }
-            }
-        }
-    }
-}
-
-#[test]
-fn continuous_with_the_neighbouring_sector() {
-    // The edge u = 0 (V to E_1) is the edge v = 0 of sector 1's patch, which is this patch
-    // turned by one sector: stencil(0, t) over the mesh = stencil(t, 0) turned.
-    for k in 3..=8u32 {
-        let lay = layout(k);
-        let as_map = |w: &[f64], turn: u32| {
-            let mut m: BTreeMap<(u32, i64, i64), f64> = BTreeMap::new();
-            for (p, x) in lay.iter().zip(w) {
-                let (s, a, b) = name_of(*p);
-                let key = if (a, b) == (0, 0) {
-                    (0, 0, 0)
-                } else {
-                    ((s + turn) % k, a, b)
-                };
-                *m.entry(key).or_insert(0.0) += x;
-            }
-            m
-        };
-        for n in [3, 5, 6] {
-            let s = float(k, n);
-            for t in 0..=i64::from(n) {
-                let here = as_map(s.at(0, t).expect("grid"), 0);
-                let there = as_map(s.at(t, 0).expect("grid"), 1);
-                for key in here.keys().chain(there.keys()) {
-                    let (a, b) = (
-                        here.get(key).copied().unwrap_or(0.0),
-                        there.get(key).copied().unwrap_or(0.0),
-                    );
-                    assert!(
-                        (a - b).abs() < 1e-12,
-                        "K = {k}, t = {t}/{n}, {key:?}: {a} vs {b}"
-                    );
-                }
             }
         }
     }
