@@ -52,7 +52,7 @@
 //! weights after `L` steps of the true rules.
 //!
 //! **Numbers.** Every matrix is kept in f64 (the weights' f64 values) and, when all weights are
-//! rational (`K = 3, 4, 6`), also exactly as [`BigRational`].
+//! rational (`K = 3, 4, 6`), also exactly as `BigRational`.
 
 pub use crate::cone::{chart_sector, layout_key, point_name, LAYOUT_RADIUS};
 use crate::cone::{layout_ball, Weight};

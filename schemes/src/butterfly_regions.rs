@@ -40,7 +40,8 @@
 //!
 //! Band 1 is the strip between rings 1 and 2 (3 triangles), band 2 the one between rings 2
 //! and 3 (5 triangles). Region 0 is the corner `V, E_0, E_1`: exactly
-//! the EV patch of [`ButterflyLocalMatrices`] (same frame, layout [`butterfly_layout`], `A`).
+//! the EV patch of [`crate::butterfly_local::ButterflyLocalMatrices`] (same frame, layout
+//! [`crate::butterfly_local::butterfly_layout`], `A`).
 //! No triangle of band 3 qualifies: `H` meets the line `a + b = 3` only at its vertices
 //! `(2,1), (1,2)`, so `int H` stays below it.
 //!
@@ -53,9 +54,10 @@
 //! [`crate::butterfly_local`] machinery as the corner's outer half.
 //!
 //! **Layouts.** A non-corner region's layout is the closure of what its rows read: every
-//! level-0 point reached through nonzero rule weights, ordered like [`butterfly_layout`]
-//! (`V` first if present, then ring `a + b`, sector, `b`: [`layout_key`]). The rows are then
-//! built over exactly that layout, so a point the rules read but the layout lacks is an error.
+//! level-0 point reached through nonzero rule weights, ordered like
+//! [`crate::butterfly_local::butterfly_layout`] (`V` first if present, then ring `a + b`,
+//! sector, `b`: [`crate::cone::layout_key`]). The rows are then built over exactly that
+//! layout, so a point the rules read but the layout lacks is an error.
 //!
 //! Sizes (layout points / level-`L` tile points / tiles), regions 0..=8:
 //!
@@ -75,7 +77,7 @@
 //! region `r` with every layout point `(a, b)_t` read as `(a, b)_{(t + s) mod K}` and `V` as
 //! `V`. The rules are invariant under rotation by a sector, so the weights are the same.
 //!
-//! **Numbers.** f64 always; exactly ([`BigRational`]) when every weight is rational
+//! **Numbers.** f64 always; exactly (`BigRational`) when every weight is rational
 //! (`K = 3, 4, 6`).
 
 pub use crate::cone_regions::{

@@ -72,7 +72,7 @@
 //! weights after `L` ternary steps of the true rules.
 //!
 //! **Numbers.** Every matrix is kept in f64 (the weights' f64 values) and, when `alpha_K` is
-//! rational (`K = 3, 4, 6`), also exactly as [`BigRational`].
+//! rational (`K = 3, 4, 6`), also exactly as `BigRational`.
 //!
 //! The cone ball, its order, point names and the separating-axis test are
 //! [`crate::cone`]'s, shared with the butterfly.

@@ -42,8 +42,8 @@
 //! after `L` ternary steps of the true rules — [`crate::sqrt3_local`]'s row machinery.
 //!
 //! **Layouts.** Region 0's is [`crate::sqrt3_local::sqrt3_layout`]. Every other region's is the
-//! closure of what its rows read, ordered by [`layout_key`] (`V` first, then ring `a + b`,
-//! sector, `b`); the rows are built over exactly that layout.
+//! closure of what its rows read, ordered by [`crate::cone::layout_key`] (`V` first, then
+//! ring `a + b`, sector, `b`); the rows are built over exactly that layout.
 //!
 //! Sizes (layout points / level-`L` tile points / tiles), regions 0..=8 (unit test
 //! `documented_sizes`):
@@ -63,7 +63,7 @@
 //! **Rotation contract.** As the butterfly's: region `r` in sector `s` reads layout point
 //! `(a, b)_t` as `(a, b)_{(t + s) mod K}` and `V` as `V`.
 //!
-//! **Numbers.** f64 always; exactly ([`BigRational`]) when `alpha_K` is rational (`K = 3, 4, 6`).
+//! **Numbers.** f64 always; exactly (`BigRational`) when `alpha_K` is rational (`K = 3, 4, 6`).
 
 pub use crate::cone_regions::{
     region_tile_level, region_triangles, ConeRegion, ConeRegions, RegionShape, RegionTriangle,

@@ -14,7 +14,7 @@
 //!   `R_T[j]` the level-0 weights of level-`L` point `j`;
 //! * the partition of unity `sum_j phi_j(x) = 1`.
 //!
-//! At the grid points `(i/n, j/n)`, `i + j <= n`, this is a [`ScalingSystem`] whose classes are
+//! At the grid points `(i/n, j/n)`, `i + j <= n`, this is a `ScalingSystem` whose classes are
 //! the grid points (`x -> 2x` maps the grid into itself): triangular except at `x = 0`, where
 //! `phi(0) = phi(0) A`, `sum phi(0) = 1` (the scheme interpolates, so the solution is `V`'s unit
 //! row — the tests check it, nothing assumes it). `y = 2^L x` has denominator `n`, so `psi` is

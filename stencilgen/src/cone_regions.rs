@@ -36,7 +36,7 @@ use schemes::cone_regions::{ConeRegion, ConeRegions};
 use schemes::TriangleScheme;
 
 use crate::butterfly_regions::butterfly_vertex_masks;
-use crate::cone_patch::{family_regular_basis_kind, irrational_weights};
+use crate::cone_patch::{entry, family_regular_basis_kind, irrational_weights};
 use crate::region_table::RegionStencilSet;
 use crate::regular_patch::StencilKind;
 use crate::sqrt3_regions::sqrt3_vertex_masks;
@@ -126,20 +126,8 @@ pub struct ConeRegionStencils<S> {
     pub vertex_tangents: [Vec<S>; 2],
 }
 
-/// An entry in `S`: the exact rational when there is one, else the f64.
-fn entry<S: Scalar>(
-    exact: Option<&BigRational>,
-    value: f64,
-    what: &str,
-) -> Result<S, StencilError> {
-    match exact {
-        Some(r) => Ok(S::from_rational(r)),
-        None => S::from_f64(value).ok_or_else(|| StencilError::Irrational {
-            what: what.to_owned(),
-        }),
-    }
-}
-
+/// A matrix in `S`, entry by entry ([`entry`]): exact where `exact` is given, else the f64
+/// `values`; `what` names it in the error of an exact field without exact entries.
 fn matrix<S: Scalar>(
     exact: Option<&Vec<Vec<BigRational>>>,
     values: &[Vec<f64>],
@@ -151,7 +139,11 @@ fn matrix<S: Scalar>(
         .map(|(i, row)| {
             row.iter()
                 .enumerate()
-                .map(|(j, &x)| entry(exact.map(|e| &e[i][j]), x, what))
+                .map(|(j, &x)| {
+                    entry(exact.map(|e| &e[i][j]), x).ok_or_else(|| StencilError::Irrational {
+                        what: what.to_owned(),
+                    })
+                })
                 .collect()
         })
         .collect()

@@ -14,7 +14,7 @@
 //!   weights of level-`L` point `j`;
 //! * the partition of unity `sum_j phi_j(x) = 1`.
 //!
-//! At the grid points `(i/n, j/n)`, `i + j <= n`, this is a [`ScalingSystem`] whose classes are
+//! At the grid points `(i/n, j/n)`, `i + j <= n`, this is a `ScalingSystem` whose classes are
 //! the grid points (`x -> 3x` maps the grid into itself inside `u + v <= 1/3`): triangular
 //! except at `x = 0`, where `phi(0) = phi(0) A`, `sum phi(0) = 1` gives the limit mask at `V`
 //! (√3 approximates, so it is not a unit row). `y = 9x` has denominator `n`, so `psi` is
