@@ -4,8 +4,8 @@
 //! The regular basis functions of the butterfly and of √3 (two steps) have supports wider than
 //! a one-ring (radius 3 and 2.5 in lattice units), so an extraordinary vertex `V` of valence
 //! `K` shapes not only its own `K` triangles but every triangle `T` with `V` in `T + int H`
-//! (`H` the support): the **regions** of `schemes::butterfly_regions` and
-//! `schemes::sqrt3_regions`, for both schemes the same nine per sector (the corner triangle,
+//! (`H` the support): the **regions** of `schemes::cone_regions` (`schemes::butterfly_regions`,
+//! `schemes::sqrt3_regions`), for both schemes the same nine per sector (the corner triangle,
 //! three in the next band, five in the one after), each a table patch of its own: section key
 //! `faces = K`, `sector = region`, with the region's layout in `V`'s cone coordinates
 //! ([`crate::cone_chart`]). The same region in sector `s` around `V` reads every layout point
@@ -23,8 +23,7 @@
 use std::collections::{BTreeMap, BTreeSet};
 
 use rayon::prelude::*;
-use schemes::butterfly_regions::ButterflyRegions;
-use schemes::sqrt3_regions::Sqrt3Regions;
+use schemes::cone_regions::ConeRegions;
 use schemes::triangle_local::{canonical_triangle_point, TrianglePoint};
 use schemes::TriangleScheme;
 
@@ -59,29 +58,16 @@ impl RegionScheme {
         let name = self.name();
         let scheme = TriangleScheme::by_name(name)
             .ok_or_else(|| RuntimeError::Unsupported(format!("{name} is not catalogued")))?;
-        let failed = |e: &dyn std::fmt::Display| {
-            RuntimeError::Unsupported(format!("{name} at valence {k}: {e}"))
-        };
-        Ok(match self {
-            RegionScheme::Butterfly => ButterflyRegions::new(&scheme, k)
-                .map_err(|e| failed(&e))?
-                .regions
-                .into_iter()
-                .map(|r| RegionShape {
-                    corners: r.triangle.corners(),
-                    layout: r.layout,
-                })
-                .collect(),
-            RegionScheme::Sqrt3 => Sqrt3Regions::new(&scheme, k)
-                .map_err(|e| failed(&e))?
-                .regions
-                .into_iter()
-                .map(|r| RegionShape {
-                    corners: r.triangle.corners(),
-                    layout: r.layout,
-                })
-                .collect(),
-        })
+        // `ConeRegions::new` reads the dilation (2 or 3) from the scheme's rules.
+        Ok(ConeRegions::new(&scheme, k)
+            .map_err(|e| RuntimeError::Unsupported(format!("{name} at valence {k}: {e}")))?
+            .regions
+            .into_iter()
+            .map(|r| RegionShape {
+                corners: r.triangle.corners(),
+                layout: r.layout,
+            })
+            .collect())
     }
 }
 
