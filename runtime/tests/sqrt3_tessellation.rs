@@ -11,10 +11,7 @@
 
 mod common;
 
-use std::collections::HashMap;
-
 use proptest::prelude::*;
-use runtime::cone_chart::ConeChart;
 use runtime::region_isolate::isolate_regions;
 use runtime::region_patch::RegionScheme;
 use runtime::sqrt3_refine::{sqrt3_limit_position, sqrt3_refine};
@@ -22,24 +19,13 @@ use runtime::stencil_table::StencilTable;
 use runtime::topology::Mesh;
 use runtime::triangle_dual_grid::TriangleDualGrid;
 use runtime::triangle_isolation::TriangleIsolation;
-use runtime::triangle_split::{ternary_child_to_parent, TriangleSplit};
+use runtime::triangle_split::ternary_child_to_parent;
 use runtime::triangle_topology::neighbours;
-use schemes::sqrt3_regions::Sqrt3Regions;
-use schemes::triangle_local::{canonical_triangle_point, TrianglePoint};
-use schemes::TriangleScheme;
 
-use common::{check_topology, icosahedron, load, models, octahedron, tetrahedron, torus};
-
-fn regions_of(iso: &TriangleIsolation) -> Vec<(u32, u32)> {
-    let mut kinds: Vec<(u32, u32)> = iso
-        .patches
-        .iter()
-        .map(|p| (p.kind.faces, p.kind.sector))
-        .collect();
-    kinds.sort_unstable();
-    kinds.dedup();
-    kinds
-}
+use common::{
+    check_rates_give_a_manifold, check_region_layouts, check_topology, icosahedron, load, models,
+    octahedron, region_kinds, ring_normal, tetrahedron, torus,
+};
 
 /// `m` ternary steps of `mesh`, every level kept.
 fn levels_of(mesh: &Mesh, m: usize) -> Vec<Mesh> {
@@ -76,106 +62,7 @@ fn isolation_separates_the_extraordinary_vertices() {
             expected.extend((0..9).map(|r| (k, r)));
         }
         expected.sort_unstable();
-        assert_eq!(regions_of(&iso), expected, "{name}");
-    }
-}
-
-/// The vertex one ternary step puts at the third of the edge `(v, e)` nearer `v`
-/// (`runtime::triangle_split`'s numbering).
-fn third_near(coarse: &Mesh, v: u32, e: u32) -> u32 {
-    let split = TriangleSplit::new(coarse);
-    let i = split
-        .edges
-        .iter()
-        .position(|&[a, b]| (a, b) == (v, e) || (a, b) == (e, v))
-        .expect("V's edge");
-    (coarse.positions.len() + 2 * i + usize::from(split.edges[i][0] != v)) as u32
-}
-
-/// The gathered layouts are the right vertices, in the right order and rotation: the level-`L`
-/// points a region's rows make from its layout (`schemes::sqrt3_regions`, built from the
-/// scheme's rules on the cone) equal the vertices that `L` more whole-mesh ternary steps of the
-/// runtime put there, named by a cone chart of the refined mesh. For the corner region the rows
-/// are `A`'s (level 1, the layout's own points); for the others their tiles' points.
-fn check_layouts_against_refinement(name: &str, iso: &TriangleIsolation) {
-    let scheme = TriangleScheme::by_name("sqrt3").expect("catalogued");
-    let levels = levels_of(&iso.mesh, 1);
-    let mut catalogue: HashMap<u32, Sqrt3Regions> = HashMap::new();
-    let mut checked = HashMap::new();
-    let scale = 1.0
-        + iso
-            .mesh
-            .positions
-            .iter()
-            .flatten()
-            .fold(0.0f64, |m, c| m.max(c.abs()));
-    for (f, patch) in iso.patches.iter().enumerate() {
-        let k = patch.kind.faces;
-        let r = patch.kind.sector as usize;
-        if *checked.entry((k, r)).or_insert(0) >= 3 {
-            continue;
-        }
-        let regions = catalogue
-            .entry(k)
-            .or_insert_with(|| Sqrt3Regions::new(&scheme, k).expect("regions"));
-        let region = &regions.regions[r];
-        let (level, points, rows): (usize, Vec<TrianglePoint>, &Vec<Vec<f64>>) = if r == 0 {
-            (1, region.layout.clone(), &regions.corner.a)
-        } else {
-            let points = region
-                .regular_points
-                .iter()
-                .map(|&(a, b)| canonical_triangle_point(k, 0, a, b))
-                .collect();
-            (region.tile_level as usize, points, &region.regular_rows)
-        };
-        assert_eq!(
-            level, 1,
-            "{name}: every √3 region but the corner's tiles is level 1"
-        );
-        let at = |q: TrianglePoint| {
-            let i = region.layout.iter().position(|&p| p == q);
-            i.map(|i| patch.points[i]).unwrap_or_else(|| {
-                panic!("{name}: region {r} at valence {k} lacks {q:?} in its layout")
-            })
-        };
-        let v = at(TrianglePoint::Centre);
-        let e = third_near(
-            &levels[0],
-            v,
-            at(TrianglePoint::Sector { s: 0, a: 1, b: 0 }),
-        );
-        let refined = &levels[1];
-        let radius = points
-            .iter()
-            .map(|p| match *p {
-                TrianglePoint::Centre => 0,
-                TrianglePoint::Sector { a, b, .. } => a + b,
-            })
-            .max()
-            .unwrap_or(1);
-        let chart = ConeChart::new(refined, v, e, radius).expect("a regular cone around V");
-        for (p, row) in points.iter().zip(rows) {
-            let w = chart.vertex(*p, 0).expect("within the chart");
-            let expect = refined.positions[w as usize];
-            let got = row
-                .iter()
-                .zip(&patch.points)
-                .fold([0.0; 3], |acc, (x, &c)| {
-                    let q = iso.mesh.positions[c as usize];
-                    [0, 1, 2].map(|i| acc[i] + x * q[i])
-                });
-            for i in 0..3 {
-                assert!(
-                    (got[i] - expect[i]).abs() < 1e-12 * scale,
-                    "{name}: triangle {f}, valence {k}, region {r}, point {p:?}: {got:?} != {expect:?}"
-                );
-            }
-        }
-        *checked.get_mut(&(k, r)).expect("counted") += 1;
-    }
-    for ((k, r), n) in &checked {
-        assert!(*n > 0, "{name}: valence {k} region {r} unchecked");
+        assert_eq!(region_kinds(&iso), expected, "{name}");
     }
 }
 
@@ -188,7 +75,7 @@ fn gathered_layouts_match_whole_mesh_refinement() {
     ] {
         let iso =
             isolate_regions(&m, RegionScheme::Sqrt3).unwrap_or_else(|e| panic!("{name}: {e}"));
-        check_layouts_against_refinement(name, &iso);
+        check_region_layouts(name, RegionScheme::Sqrt3, &iso);
     }
 }
 
@@ -296,28 +183,6 @@ fn the_surface_meets_the_limit_positions_of_refined_vertices() {
     }
 }
 
-/// A vertex normal of a fine mesh: the area-weighted average of the normals of the triangles
-/// around it (their cross products summed).
-fn ring_normal(mesh: &Mesh, v: usize) -> [f64; 3] {
-    let p = &mesh.positions;
-    let mut sum = [0.0; 3];
-    for h in mesh.fan(v) {
-        let (a, b) = (mesh.head(h) as usize, mesh.head(mesh.next(h)) as usize);
-        let (e, f) = (
-            [0, 1, 2].map(|c| p[a][c] - p[v][c]),
-            [0, 1, 2].map(|c| p[b][c] - p[v][c]),
-        );
-        let n = [
-            e[1] * f[2] - e[2] * f[1],
-            e[2] * f[0] - e[0] * f[2],
-            e[0] * f[1] - e[1] * f[0],
-        ];
-        sum = [0, 1, 2].map(|c| sum[c] + n[c]);
-    }
-    let length = sum.iter().map(|c| c * c).sum::<f64>().sqrt();
-    sum.map(|c| c / length)
-}
-
 /// The table's normals (from the d/du, d/dv stencils; at the extraordinary vertices Loop's
 /// eigenvector convention) against the ring normals of the mesh refined three more ternary
 /// steps at the same level-1 vertices; the normals of the convex shapes point out.
@@ -356,16 +221,6 @@ fn normals_follow_the_refined_surface() {
     }
 }
 
-/// Random per-face rates: the output is an oriented manifold with the input's Euler
-/// characteristic, whatever the neighbouring rates and patch kinds.
-fn check_random_rates(name: &str, iso: &TriangleIsolation, rates: &[u32]) {
-    let table = StencilTable::default_sqrt3().expect("embedded sqrt3 table");
-    let grid = TriangleDualGrid::new(&table, &iso.mesh, &iso.patches, rates)
-        .unwrap_or_else(|e| panic!("{name}: {e}"));
-    let out = grid.tessellate(&iso.mesh);
-    check_topology(&iso.mesh, &out, name);
-}
-
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(6))]
 
@@ -373,7 +228,8 @@ proptest! {
     fn random_rates_give_manifolds(rates in proptest::collection::vec(1u32..=8, 1620)) {
         let iso = isolate_regions(&icosahedron(), RegionScheme::Sqrt3).expect("isolates");
         prop_assert_eq!(iso.mesh.faces(), rates.len());
-        check_random_rates("icosahedron", &iso, &rates);
+        let table = StencilTable::default_sqrt3().expect("embedded table");
+        check_rates_give_a_manifold(&table, "icosahedron", &iso, &rates);
     }
 }
 
@@ -387,5 +243,6 @@ fn spot_tessellates_to_a_closed_manifold_at_mixed_rates() {
     let rates: Vec<u32> = (0..iso.mesh.faces())
         .map(|f| 1 + ((f / 7) % 2) as u32)
         .collect();
-    check_random_rates("spot", &iso, &rates);
+    let table = StencilTable::default_sqrt3().expect("embedded table");
+    check_rates_give_a_manifold(&table, "spot", &iso, &rates);
 }

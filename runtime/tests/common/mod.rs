@@ -2,12 +2,21 @@
 // Each test binary uses its own subset.
 #![allow(dead_code)]
 
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
+use runtime::cone_chart::ConeChart;
 use runtime::obj::read_obj;
+use runtime::region_patch::RegionScheme;
+use runtime::stencil_table::StencilTable;
 use runtime::topology::Mesh;
+use runtime::triangle_dual_grid::TriangleDualGrid;
+use runtime::triangle_isolation::TriangleIsolation;
 use runtime::triangle_mesh::TriangleMesh;
-use schemes::BoundaryMode;
+use runtime::triangle_split::{Split, TriangleSplit};
+use schemes::cone_regions::ConeRegions;
+use schemes::triangle_local::{canonical_triangle_point, TrianglePoint};
+use schemes::{BoundaryMode, TriangleScheme};
 
 pub fn mesh(positions: Vec<[f64; 3]>, faces: &[[i64; 3]]) -> Mesh {
     let faces: Vec<Vec<i64>> = faces.iter().map(|f| f.to_vec()).collect();
@@ -170,4 +179,158 @@ pub fn check_topology(input: &Mesh, out: &TriangleMesh, label: &str) {
         input.boundary_loops() == 0,
         "{label}: watertight"
     );
+}
+
+/// The distinct patch kinds `(valence, region)` of an isolated mesh, sorted.
+pub fn region_kinds(iso: &TriangleIsolation) -> Vec<(u32, u32)> {
+    let mut kinds: Vec<(u32, u32)> = iso
+        .patches
+        .iter()
+        .map(|p| (p.kind.faces, p.kind.sector))
+        .collect();
+    kinds.sort_unstable();
+    kinds.dedup();
+    kinds
+}
+
+/// A vertex normal of a fine mesh: the area-weighted average of the normals of the triangles
+/// around it (their cross products summed).
+pub fn ring_normal(mesh: &Mesh, v: usize) -> [f64; 3] {
+    let p = &mesh.positions;
+    let mut sum = [0.0; 3];
+    for h in mesh.fan(v) {
+        let (a, b) = (mesh.head(h) as usize, mesh.head(mesh.next(h)) as usize);
+        let (e, f) = (
+            [0, 1, 2].map(|c| p[a][c] - p[v][c]),
+            [0, 1, 2].map(|c| p[b][c] - p[v][c]),
+        );
+        let n = [
+            e[1] * f[2] - e[2] * f[1],
+            e[2] * f[0] - e[0] * f[2],
+            e[0] * f[1] - e[1] * f[0],
+        ];
+        sum = [0, 1, 2].map(|c| sum[c] + n[c]);
+    }
+    let length = sum.iter().map(|c| c * c).sum::<f64>().sqrt();
+    sum.map(|c| c / length)
+}
+
+/// The vertex one whole-mesh step of `split` puts on the edge `(v, e)` nearest `v`
+/// (`runtime::triangle_split`'s numbering: the midpoint, or the third nearer `v`).
+pub fn next_on_edge(split: Split, coarse: &Mesh, v: u32, e: u32) -> u32 {
+    let edges = TriangleSplit::new(coarse).edges;
+    let i = edges
+        .iter()
+        .position(|&[a, b]| (a, b) == (v, e) || (a, b) == (e, v))
+        .expect("V's edge");
+    let n = coarse.positions.len();
+    (match split {
+        Split::Dyadic => n + i,
+        Split::Ternary => n + 2 * i + usize::from(edges[i][0] != v),
+    }) as u32
+}
+
+/// The gathered layouts of a region scheme are the right vertices, in the right order and
+/// rotation: the level-`L` points a region's rows make from its layout (`schemes::cone_regions`,
+/// built from the scheme's rules on the cone) equal the vertices that `L` more whole-mesh steps
+/// of the runtime put there, named by a cone chart of the refined mesh. For the corner region the
+/// rows are `A`'s (level 1, the layout's own points); for the others their tiles' points. Up to
+/// three triangles of every patch kind are checked, and every kind at least once.
+pub fn check_region_layouts(name: &str, scheme: RegionScheme, iso: &TriangleIsolation) {
+    let rules = TriangleScheme::by_name(scheme.name()).expect("catalogued");
+    let mut levels = vec![iso.mesh.clone()];
+    for _ in 0..2 {
+        let next = scheme.refine(&levels[levels.len() - 1]).expect("refines");
+        levels.push(next);
+    }
+    let mut catalogue: HashMap<u32, ConeRegions> = HashMap::new();
+    let mut checked = HashMap::new();
+    let size = 1.0
+        + iso
+            .mesh
+            .positions
+            .iter()
+            .flatten()
+            .fold(0.0f64, |m, c| m.max(c.abs()));
+    for (f, patch) in iso.patches.iter().enumerate() {
+        let k = patch.kind.faces;
+        let r = patch.kind.sector as usize;
+        if *checked.entry((k, r)).or_insert(0) >= 3 {
+            continue;
+        }
+        let regions = catalogue
+            .entry(k)
+            .or_insert_with(|| ConeRegions::new(&rules, k).expect("regions"));
+        let region = &regions.regions[r];
+        let (level, points, rows): (usize, Vec<TrianglePoint>, &Vec<Vec<f64>>) = if r == 0 {
+            (1, region.layout.clone(), &regions.corner.a)
+        } else {
+            let points = region
+                .regular_points
+                .iter()
+                .map(|&(a, b)| canonical_triangle_point(k, 0, a, b))
+                .collect();
+            (region.tile_level as usize, points, &region.regular_rows)
+        };
+        assert!(
+            level < levels.len(),
+            "{name}: region {r} at tile level {level}"
+        );
+        let at = |q: TrianglePoint| {
+            let i = region.layout.iter().position(|&p| p == q);
+            i.map(|i| patch.points[i]).unwrap_or_else(|| {
+                panic!("{name}: region {r} at valence {k} lacks {q:?} in its layout")
+            })
+        };
+        let v = at(TrianglePoint::Centre);
+        let mut e = at(TrianglePoint::Sector { s: 0, a: 1, b: 0 });
+        for coarse in &levels[..level] {
+            e = next_on_edge(scheme.split(), coarse, v, e);
+        }
+        let refined = &levels[level];
+        let radius = points
+            .iter()
+            .map(|p| match *p {
+                TrianglePoint::Centre => 0,
+                TrianglePoint::Sector { a, b, .. } => a + b,
+            })
+            .max()
+            .unwrap_or(1);
+        let chart = ConeChart::new(refined, v, e, radius).expect("a regular cone around V");
+        for (p, row) in points.iter().zip(rows) {
+            let w = chart.vertex(*p, 0).expect("within the chart");
+            let expect = refined.positions[w as usize];
+            let got = row
+                .iter()
+                .zip(&patch.points)
+                .fold([0.0; 3], |acc, (x, &c)| {
+                    let q = iso.mesh.positions[c as usize];
+                    [0, 1, 2].map(|i| acc[i] + x * q[i])
+                });
+            for i in 0..3 {
+                assert!(
+                    (got[i] - expect[i]).abs() < 1e-12 * size,
+                    "{name}: triangle {f}, valence {k}, region {r}, point {p:?}: {got:?} != {expect:?}"
+                );
+            }
+        }
+        *checked.get_mut(&(k, r)).expect("counted") += 1;
+    }
+    for ((k, r), n) in &checked {
+        assert!(*n > 0, "{name}: valence {k} region {r} unchecked");
+    }
+}
+
+/// Per-face `rates` give an oriented manifold with the input's Euler characteristic, whatever
+/// the neighbouring rates and patch kinds.
+pub fn check_rates_give_a_manifold(
+    table: &StencilTable,
+    name: &str,
+    iso: &TriangleIsolation,
+    rates: &[u32],
+) {
+    let grid = TriangleDualGrid::new(table, &iso.mesh, &iso.patches, rates)
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+    let out = grid.tessellate(&iso.mesh);
+    check_topology(&iso.mesh, &out, name);
 }
