@@ -12,6 +12,24 @@ fn subtess(args: &str) -> Output {
         .expect("subtess runs")
 }
 
+/// Run `subtess args`, which must succeed (its stderr is the failure message).
+fn succeeds(args: &str) -> Output {
+    let out = subtess(args);
+    assert!(
+        out.status.success(),
+        "{args}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// Run `subtess args`, which must fail; its stderr.
+fn fails(args: &str) -> String {
+    let out = subtess(args);
+    assert!(!out.status.success(), "{args} succeeded");
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
 fn temp(name: &str) -> PathBuf {
     std::env::temp_dir().join(format!("subtess-cli-{}-{name}", std::process::id()))
 }
@@ -24,15 +42,10 @@ fn json(out: &Output) -> serde_json::Value {
 #[test]
 fn tessellate_prints_the_stats_contract() {
     let obj = temp("cube.obj");
-    let out = subtess(&format!(
+    let out = succeeds(&format!(
         "tessellate data/cube.obj -o {} --rate 5 --stats",
         obj.display()
     ));
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let stats = json(&out);
     for key in [
         "triangles",
@@ -62,16 +75,11 @@ fn per_face_rates_from_a_file() {
     // The cube has 6 faces; each becomes 4 after isolation.
     std::fs::write(&rates, "1 2 3\n4 5 24\n").expect("write");
     let obj = temp("rates.obj");
-    let out = subtess(&format!(
+    let out = succeeds(&format!(
         "tessellate data/cube.obj -o {} --rates {} --stats",
         obj.display(),
         rates.display()
     ));
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let stats = json(&out);
     let points: u64 = [1u64, 2, 3, 4, 5, 24].iter().map(|n| 4 * n * n).sum();
     assert_eq!(stats["vertices"], points);
@@ -131,12 +139,7 @@ fn output_formats_by_extension() {
 
 #[test]
 fn bench_reports_throughput() {
-    let out = subtess("bench data/cube.obj --refine 2 --rate 4 --threads 1 --frames 3");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = succeeds("bench data/cube.obj --refine 2 --rate 4 --threads 1 --frames 3");
     let report = json(&out);
     assert_eq!(report["threads"], 1);
     assert_eq!(report["faces"], 6 * 16);
@@ -224,12 +227,7 @@ fn tolerance_and_view_rates() {
 /// top face lies on the cube's z axis (symmetry); bad arguments are clear errors.
 #[test]
 fn eval_prints_the_limit_point() {
-    let out = subtess("eval data/cube.obj --scheme catmull-clark --face 1 --uv 1/2,1/2 --json");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = succeeds("eval data/cube.obj --scheme catmull-clark --face 1 --uv 1/2,1/2 --json");
     let point = json(&out);
     let p: Vec<f64> = point["position"]
         .as_array()
@@ -286,16 +284,11 @@ fn bezier_patches_from_the_command_line() {
         return;
     }
     let out_path = temp("teapot.ply");
-    let out = subtess(&format!(
+    let out = succeeds(&format!(
         "tessellate --bezier {} -o {} --test map4p --triangles 3000 --stats",
         teapot.display(),
         out_path.display()
     ));
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let stats = json(&out);
     let triangles = stats["triangles"].as_u64().expect("a count");
     assert!((2700..=3300).contains(&triangles), "{triangles}");
@@ -327,16 +320,11 @@ fn pinned_corners_work_out_of_the_box() {
         return;
     }
     let obj = temp("edgecorner.obj");
-    let out = subtess(&format!(
+    let out = succeeds(&format!(
         "tessellate {} -o {} --rate 3 --stats",
         shape.display(),
         obj.display()
     ));
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let stats = json(&out);
     assert!(stats["boundary_loops"].as_u64().is_some_and(|l| l > 0));
     assert!(stats["triangles"].as_u64().is_some_and(|t| t > 0));
@@ -348,15 +336,10 @@ fn pinned_corners_work_out_of_the_box() {
 #[test]
 fn adaptive_method_from_the_command_line() {
     let obj = temp("adaptive.obj");
-    let out = subtess(&format!(
+    let out = succeeds(&format!(
         "tessellate data/cube.obj -o {} --method adaptive --tolerance 0.02 --stats",
         obj.display()
     ));
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let stats = json(&out);
     assert_eq!(stats["watertight"], true);
     assert_eq!(stats["leaves_over_tolerance"], 0);
@@ -389,15 +372,10 @@ fn eval_evaluates_loop_surfaces_exactly() {
     let mesh = temp("octahedron-eval.obj");
     std::fs::write(&mesh, OCTAHEDRON).expect("written");
     let eval = |uv: &str| {
-        let out = subtess(&format!(
+        let out = succeeds(&format!(
             "eval {} --scheme loop --face 0 --uv {uv} --json",
             mesh.display()
         ));
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
         let point = json(&out);
         let get = |key: &str| -> Vec<f64> {
             point[key]
@@ -429,16 +407,11 @@ fn loop_scheme_takes_view_dependent_rates() {
     std::fs::write(&mesh, OCTAHEDRON).expect("written");
     let out_path = temp("octahedron-view.obj.out.obj");
     let stats = |view: &str| {
-        let out = subtess(&format!(
+        let out = succeeds(&format!(
             "tessellate {} -o {} --scheme loop --view {view} --stats",
             mesh.display(),
             out_path.display()
         ));
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
         json(&out)
     };
     let far = stats("0,0,40,0,0,0,45,1080,8");
@@ -463,16 +436,11 @@ fn loop_scheme_tessellates_triangles() {
     let mesh = temp("octahedron.obj");
     std::fs::write(&mesh, OCTAHEDRON).expect("written");
     let out_path = temp("octahedron-loop.ply");
-    let out = subtess(&format!(
+    let out = succeeds(&format!(
         "tessellate {} -o {} --scheme loop --rate 3 --stats",
         mesh.display(),
         out_path.display()
     ));
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let stats = json(&out);
     assert_eq!(stats["scheme"], "loop");
     assert!(stats["isolation_seconds"].as_f64().is_some());
@@ -486,32 +454,22 @@ fn loop_scheme_tessellates_triangles() {
     // Per-input-face rates, inherited by the four children of each triangle.
     let rates = temp("octahedron-rates.txt");
     std::fs::write(&rates, "1 2 3 4 5 6 7 8").expect("written");
-    let out = subtess(&format!(
+    let out = succeeds(&format!(
         "tessellate {} -o {} --scheme loop --rates {} --stats",
         mesh.display(),
         out_path.display(),
         rates.display()
     ));
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let stats = json(&out);
     assert_eq!(stats["watertight"], true);
     assert_eq!(
         (stats["rate_min"].clone(), stats["rate_max"].clone()),
         (1.into(), 8.into())
     );
-    let bench = subtess(&format!(
+    let bench = succeeds(&format!(
         "bench {} --scheme loop --rate 4 --frames 2",
         mesh.display()
     ));
-    assert!(
-        bench.status.success(),
-        "{}",
-        String::from_utf8_lossy(&bench.stderr)
-    );
     let report = json(&bench);
     assert_eq!(report["triangles"], 32 * (3 * 16 - 3 * 4 + 3));
     for path in [mesh, out_path, rates] {
@@ -524,16 +482,11 @@ fn butterfly_scheme_tessellates_closed_triangle_meshes() {
     let mesh = temp("octahedron-b.obj");
     std::fs::write(&mesh, OCTAHEDRON).expect("written");
     let out_path = temp("octahedron-butterfly.ply");
-    let out = subtess(&format!(
+    let out = succeeds(&format!(
         "tessellate {} -o {} --scheme butterfly --rate 2 --stats",
         mesh.display(),
         out_path.display()
     ));
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let stats = json(&out);
     assert_eq!(stats["scheme"], "butterfly");
     assert_eq!(stats["watertight"], true);
@@ -546,36 +499,27 @@ fn butterfly_scheme_tessellates_closed_triangle_meshes() {
     // 3n^2 - 3n + 3 triangles per triangle at rate n (9 at n = 2); genus 0: V = T/2 + 2.
     assert_eq!(stats["triangles"], 8 * 64 * 9);
     assert_eq!(stats["vertices"], 8 * 64 * 9 / 2 + 2);
-    let bench = subtess(&format!(
+    let bench = succeeds(&format!(
         "bench {} --scheme butterfly --rate 3 --frames 2",
         mesh.display()
     ));
-    assert!(
-        bench.status.success(),
-        "{}",
-        String::from_utf8_lossy(&bench.stderr)
-    );
     assert_eq!(json(&bench)["triangles"], 8 * 64 * 21);
     assert!(json(&bench)["isolation_seconds"].as_f64().is_some());
     // The embedded table stops at n = 8; the error names the missing section.
-    let out = subtess(&format!(
+    let err = fails(&format!(
         "tessellate {} -o {} --scheme butterfly --rate 9",
         mesh.display(),
         out_path.display()
     ));
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("n = 9"), "{err}");
     // A mesh with a boundary: the butterfly's boundary rules are not implemented.
     let open = temp("open-triangle.obj");
     std::fs::write(&open, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").expect("written");
-    let out = subtess(&format!(
+    let err = fails(&format!(
         "tessellate {} -o {} --scheme butterfly",
         open.display(),
         out_path.display()
     ));
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("boundary"), "{err}");
     for path in [mesh, out_path, open] {
         let _ = std::fs::remove_file(path);
@@ -587,16 +531,11 @@ fn sqrt3_scheme_tessellates_closed_triangle_meshes() {
     let mesh = temp("octahedron-s.obj");
     std::fs::write(&mesh, OCTAHEDRON).expect("written");
     let out_path = temp("octahedron-sqrt3.obj");
-    let out = subtess(&format!(
+    let out = succeeds(&format!(
         "tessellate {} -o {} --scheme sqrt3 --rate 3 --stats",
         mesh.display(),
         out_path.display()
     ));
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let stats = json(&out);
     assert_eq!(stats["scheme"], "sqrt3");
     assert!(stats["isolation_seconds"].as_f64().is_some());
@@ -607,42 +546,28 @@ fn sqrt3_scheme_tessellates_closed_triangle_meshes() {
     // 3n^2 - 3n + 3 triangles per triangle at rate n (21 at n = 3); genus 0: V = T/2 + 2.
     assert_eq!(stats["triangles"], 8 * 81 * 21);
     assert_eq!(stats["vertices"], 8 * 81 * 21 / 2 + 2);
-    let bench = subtess(&format!(
+    let bench = succeeds(&format!(
         "bench {} --scheme sqrt3 --rate 2 --frames 2",
         mesh.display()
     ));
-    assert!(
-        bench.status.success(),
-        "{}",
-        String::from_utf8_lossy(&bench.stderr)
-    );
     assert_eq!(json(&bench)["triangles"], 8 * 81 * 9);
     // The embedded table stops at n = 8; the error names the missing section.
-    let out = subtess(&format!(
+    let err = fails(&format!(
         "tessellate {} -o {} --scheme sqrt3 --rate 9",
         mesh.display(),
         out_path.display()
     ));
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("n = 9"), "{err}");
     // A mesh with a boundary: √3's boundary rules are not implemented.
     let open = temp("open-triangle-s.obj");
     std::fs::write(&open, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").expect("written");
-    let out = subtess(&format!(
+    let err = fails(&format!(
         "tessellate {} -o {} --scheme sqrt3",
         open.display(),
         out_path.display()
     ));
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("boundary"), "{err}");
-    let info = subtess("tables info --scheme sqrt3");
-    assert!(
-        info.status.success(),
-        "{}",
-        String::from_utf8_lossy(&info.stderr)
-    );
+    let info = succeeds("tables info --scheme sqrt3");
     assert!(String::from_utf8_lossy(&info.stdout).contains("sqrt3"));
     for path in [mesh, out_path, open] {
         let _ = std::fs::remove_file(path);
@@ -653,26 +578,20 @@ fn sqrt3_scheme_tessellates_closed_triangle_meshes() {
 fn loop_scheme_errors_name_the_problem() {
     let obj = temp("never.obj");
     // The cube's first face is a quad.
-    let out = subtess(&format!(
+    let err = fails(&format!(
         "tessellate data/cube.obj -o {} --scheme loop",
         obj.display()
     ));
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("face 0 has 4 vertices"), "{err}");
-    let out = subtess(&format!(
+    let err = fails(&format!(
         "tessellate data/cube.obj -o {} --scheme sqrt3",
         obj.display()
     ));
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("face 0 has 4 vertices"), "{err}");
-    let out = subtess(&format!(
+    let err = fails(&format!(
         "tessellate data/cube.obj -o {} --scheme sw-nonpoly-quad",
         obj.display()
     ));
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("no table for this scheme yet"), "{err}");
     assert!(err.contains("sw-nonpoly-quad"), "{err}");
     let out = subtess(&format!(
