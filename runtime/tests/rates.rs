@@ -2,6 +2,8 @@
 //! monotone in the tolerance and minimal (checked against a closed form), flat regions get
 //! rate 1; view rates follow the pinhole formula.
 
+mod common;
+
 use std::path::Path;
 use std::sync::OnceLock;
 
@@ -15,8 +17,9 @@ use runtime::rates::{
 };
 use runtime::stencil_table::StencilTable;
 use runtime::topology::Mesh;
-use runtime::triangle_mesh::TriangleMesh;
 use table_format::PointSet;
+
+use common::{brute_force_deviation, diagonal};
 
 fn table() -> &'static StencilTable {
     static TABLE: OnceLock<StencilTable> = OnceLock::new();
@@ -44,110 +47,6 @@ fn closed_meshes() -> Vec<(&'static str, Mesh)> {
         }
     }
     out
-}
-
-fn diagonal(mesh: &Mesh) -> f64 {
-    let (mut low, mut high) = ([f64::MAX; 3], [f64::MIN; 3]);
-    for p in &mesh.positions {
-        for c in 0..3 {
-            low[c] = low[c].min(p[c]);
-            high[c] = high[c].max(p[c]);
-        }
-    }
-    (0..3)
-        .map(|c| (high[c] - low[c]).powi(2))
-        .sum::<f64>()
-        .sqrt()
-}
-
-/// Distance from `p` to the segment `ab`.
-fn segment_distance(p: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
-    let ab: Vec<f64> = (0..3).map(|c| b[c] - a[c]).collect();
-    let ap: Vec<f64> = (0..3).map(|c| p[c] - a[c]).collect();
-    let len2: f64 = ab.iter().map(|x| x * x).sum();
-    let t = if len2 > 0.0 {
-        (ab.iter().zip(&ap).map(|(x, y)| x * y).sum::<f64>() / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (0..3)
-        .map(|c| (ap[c] - t * ab[c]).powi(2))
-        .sum::<f64>()
-        .sqrt()
-}
-
-/// Distance from `p` to a triangle, written independently of the library's: the distance to
-/// the plane when the projection falls inside (same-side tests), else the nearest edge.
-fn triangle_distance(p: [f64; 3], t: [[f64; 3]; 3]) -> f64 {
-    let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-    let cross = |a: [f64; 3], b: [f64; 3]| {
-        [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ]
-    };
-    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    let normal = cross(sub(t[1], t[0]), sub(t[2], t[0]));
-    let area2 = dot(normal, normal);
-    let edges = || {
-        (0..3)
-            .map(|k| segment_distance(p, t[k], t[(k + 1) % 3]))
-            .fold(f64::INFINITY, f64::min)
-    };
-    if area2 == 0.0 {
-        return edges();
-    }
-    let inside = (0..3).all(|k| {
-        let e = sub(t[(k + 1) % 3], t[k]);
-        dot(cross(e, sub(p, t[k])), normal) >= 0.0
-    });
-    if inside {
-        dot(sub(p, t[0]), normal).abs() / area2.sqrt()
-    } else {
-        edges()
-    }
-}
-
-/// The largest distance from the points to the nearest triangle of `out`, by brute force
-/// (every triangle is considered; a bounding-sphere bound only skips the exact test for
-/// triangles that cannot be nearer than one already found).
-fn brute_force_deviation(points: &[[f64; 3]], out: &TriangleMesh) -> f64 {
-    let triangles: Vec<[[f64; 3]; 3]> = out
-        .triangles
-        .iter()
-        .map(|t| t.map(|i| out.positions[i as usize].map(f64::from)))
-        .collect();
-    let spheres: Vec<([f64; 3], f64)> = triangles
-        .iter()
-        .map(|t| {
-            let c = [0, 1, 2].map(|k| (t[0][k] + t[1][k] + t[2][k]) / 3.0);
-            let r = t
-                .iter()
-                .map(|p| (0..3).map(|k| (p[k] - c[k]).powi(2)).sum::<f64>().sqrt())
-                .fold(0.0, f64::max);
-            (c, r)
-        })
-        .collect();
-    let centre_distance =
-        |p: [f64; 3], c: [f64; 3]| (0..3).map(|k| (p[k] - c[k]).powi(2)).sum::<f64>().sqrt();
-    points
-        .iter()
-        .map(|&p| {
-            // An upper bound first (the farthest point of the nearest sphere), then exact
-            // distances for every triangle whose sphere comes nearer than the bound.
-            let mut best = spheres
-                .iter()
-                .map(|&(c, r)| centre_distance(p, c) + r)
-                .fold(f64::INFINITY, f64::min);
-            for (t, &(c, r)) in triangles.iter().zip(&spheres) {
-                if centre_distance(p, c) - r <= best {
-                    best = best.min(triangle_distance(p, *t));
-                }
-            }
-            best
-        })
-        .fold(0.0, f64::max)
 }
 
 /// Limit samples on grids the selection does not use: the dual points at rates 23 and 19

@@ -22,7 +22,7 @@ use runtime::triangle_rates::{
     triangle_tolerance_rates, triangle_tolerance_rates_among,
 };
 
-use common::{icosahedron, load, models, octahedron, torus};
+use common::{brute_force_deviation, diagonal, icosahedron, load, models, octahedron, torus};
 
 fn loop_table() -> &'static StencilTable {
     static TABLE: OnceLock<StencilTable> = OnceLock::new();
@@ -32,87 +32,6 @@ fn loop_table() -> &'static StencilTable {
 fn butterfly_table() -> &'static StencilTable {
     static TABLE: OnceLock<StencilTable> = OnceLock::new();
     TABLE.get_or_init(|| StencilTable::default_butterfly().expect("embedded table"))
-}
-
-fn diagonal(mesh: &Mesh) -> f64 {
-    let (mut low, mut high) = ([f64::MAX; 3], [f64::MIN; 3]);
-    for p in &mesh.positions {
-        for c in 0..3 {
-            low[c] = low[c].min(p[c]);
-            high[c] = high[c].max(p[c]);
-        }
-    }
-    (0..3)
-        .map(|c| (high[c] - low[c]).powi(2))
-        .sum::<f64>()
-        .sqrt()
-}
-
-/// Distance from `p` to the segment `ab`.
-fn segment_distance(p: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
-    let ab: Vec<f64> = (0..3).map(|c| b[c] - a[c]).collect();
-    let ap: Vec<f64> = (0..3).map(|c| p[c] - a[c]).collect();
-    let len2: f64 = ab.iter().map(|x| x * x).sum();
-    let t = if len2 > 0.0 {
-        (ab.iter().zip(&ap).map(|(x, y)| x * y).sum::<f64>() / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (0..3)
-        .map(|c| (ap[c] - t * ab[c]).powi(2))
-        .sum::<f64>()
-        .sqrt()
-}
-
-/// Distance from `p` to a triangle, written independently of the library's: the distance to
-/// the plane when the projection falls inside (same-side tests), else the nearest edge.
-fn triangle_distance(p: [f64; 3], t: [[f64; 3]; 3]) -> f64 {
-    let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-    let cross = |a: [f64; 3], b: [f64; 3]| {
-        [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ]
-    };
-    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    let normal = cross(sub(t[1], t[0]), sub(t[2], t[0]));
-    let area2 = dot(normal, normal);
-    let edges = || {
-        (0..3)
-            .map(|k| segment_distance(p, t[k], t[(k + 1) % 3]))
-            .fold(f64::INFINITY, f64::min)
-    };
-    if area2 == 0.0 {
-        return edges();
-    }
-    let inside = (0..3).all(|k| {
-        let e = sub(t[(k + 1) % 3], t[k]);
-        dot(cross(e, sub(p, t[k])), normal) >= 0.0
-    });
-    if inside {
-        dot(sub(p, t[0]), normal).abs() / area2.sqrt()
-    } else {
-        edges()
-    }
-}
-
-/// The largest distance from the points to the nearest triangle of `out`, by brute force.
-fn brute_force_deviation(points: &[[f64; 3]], out: &TriangleMesh) -> f64 {
-    let triangles: Vec<[[f64; 3]; 3]> = out
-        .triangles
-        .iter()
-        .map(|t| t.map(|i| out.positions[i as usize].map(f64::from)))
-        .collect();
-    points
-        .iter()
-        .map(|&p| {
-            triangles
-                .iter()
-                .map(|&t| triangle_distance(p, t))
-                .fold(f64::INFINITY, f64::min)
-        })
-        .fold(0.0, f64::max)
 }
 
 /// Exact limit points of every input triangle at `(i/q, j/q)`, `i + j <= q`, by rational
