@@ -20,8 +20,8 @@ use runtime::triangle_isolation::TriangleIsolation;
 use runtime::triangle_split::child_to_parent;
 
 use common::{
-    check_rates_give_a_manifold, check_region_layouts, check_topology, icosahedron, load, models,
-    octahedron, region_kinds, ring_normal, tetrahedron, torus,
+    check_rates_give_a_manifold, check_region_layouts, check_spot_at_mixed_rates, check_topology,
+    icosahedron, octahedron, region_kinds, tetrahedron, torus, worst_normal_angle,
 };
 
 /// Three steps separate neighbouring extraordinary vertices (six edges apart, module docs of
@@ -180,21 +180,10 @@ fn normals_follow_the_refined_surface() {
         )
         .unwrap_or_else(|e| panic!("{name}: {e}"));
         let out = grid.tessellate(&iso.mesh);
-        let mut worst = 0.0f64;
-        for ((p, n), s) in out.positions.iter().zip(&out.normals).zip(&out.sources) {
-            let n = n.map(f64::from);
-            let outwards: f64 = (0..3).map(|c| n[c] * f64::from(p[c])).sum();
-            assert!(outwards > 0.0, "{name}: an inward normal at {p:?}");
-            if s.denominator != rate {
-                continue;
-            }
-            // The vertex at level 1 (rate 2) is the same vertex at every later level.
-            let w = refined_vertex(&levels, s.face as usize, s.u, s.v, 1);
-            let fine = ring_normal(&levels[extra], w as usize);
-            let cos: f64 = (0..3).map(|c| n[c] * fine[c]).sum();
-            worst = worst.max(cos.clamp(-1.0, 1.0).acos());
-        }
-        println!("{name}: worst normal angle {worst:.2e} rad");
+        // The vertex at level 1 (rate 2) is the same vertex at every later level.
+        let worst = worst_normal_angle(name, &out, &levels[extra], |s| {
+            (s.denominator == rate).then(|| refined_vertex(&levels, s.face as usize, s.u, s.v, 1))
+        });
         assert!(worst < 5e-3, "{name}: {worst}");
     }
 }
@@ -213,16 +202,8 @@ proptest! {
 
 #[test]
 fn spot_tessellates_to_a_closed_manifold_at_mixed_rates() {
-    let Some(dir) = models() else { return };
-    let m = load(&dir.join("crane/spot_triangulated.obj"));
-    let iso = isolate_regions(&m, RegionScheme::Butterfly).unwrap_or_else(|e| panic!("spot: {e}"));
-    assert_eq!(iso.steps, 3);
-    // Rates 1 and 2, alternating in runs of odd lengths so neighbours differ.
-    let rates: Vec<u32> = (0..iso.mesh.faces())
-        .map(|f| 1 + ((f / 7) % 2) as u32)
-        .collect();
     let table = StencilTable::default_butterfly().expect("embedded table");
-    check_rates_give_a_manifold(&table, "spot", &iso, &rates);
+    check_spot_at_mixed_rates(RegionScheme::Butterfly, &table, 3);
 }
 
 /// A full table written by `stencilgen tables --schemes butterfly --n 1..24` (named by the

@@ -23,8 +23,8 @@ use runtime::triangle_split::ternary_child_to_parent;
 use runtime::triangle_topology::neighbours;
 
 use common::{
-    check_rates_give_a_manifold, check_region_layouts, check_topology, icosahedron, load, models,
-    octahedron, region_kinds, ring_normal, tetrahedron, torus,
+    check_rates_give_a_manifold, check_region_layouts, check_spot_at_mixed_rates, check_topology,
+    icosahedron, octahedron, region_kinds, tetrahedron, torus, worst_normal_angle,
 };
 
 /// `m` ternary steps of `mesh`, every level kept.
@@ -202,21 +202,11 @@ fn normals_follow_the_refined_surface() {
         )
         .unwrap_or_else(|e| panic!("{name}: {e}"));
         let out = grid.tessellate(&iso.mesh);
-        let mut worst = 0.0f64;
-        for ((p, n), s) in out.positions.iter().zip(&out.normals).zip(&out.sources) {
-            let n = n.map(f64::from);
-            let outwards: f64 = (0..3).map(|c| n[c] * f64::from(p[c])).sum();
-            assert!(outwards > 0.0, "{name}: an inward normal at {p:?}");
-            let Some((1, u, v)) = ternary_point(s.u, s.v, s.denominator, 1) else {
-                continue;
-            };
-            // The level-1 vertex keeps its number at every later level.
-            let w = refined_vertex(&levels, s.face as usize, u, v, 1);
-            let fine = ring_normal(&levels[extra], w as usize);
-            let cos: f64 = (0..3).map(|c| n[c] * fine[c]).sum();
-            worst = worst.max(cos.clamp(-1.0, 1.0).acos());
-        }
-        println!("{name}: worst normal angle {worst:.2e} rad");
+        // The level-1 vertex keeps its number at every later level.
+        let worst = worst_normal_angle(name, &out, &levels[extra], |s| {
+            let (_, u, v) = ternary_point(s.u, s.v, s.denominator, 1).filter(|t| t.0 == 1)?;
+            Some(refined_vertex(&levels, s.face as usize, u, v, 1))
+        });
         assert!(worst < 5e-3, "{name}: {worst}");
     }
 }
@@ -235,14 +225,6 @@ proptest! {
 
 #[test]
 fn spot_tessellates_to_a_closed_manifold_at_mixed_rates() {
-    let Some(dir) = models() else { return };
-    let m = load(&dir.join("crane/spot_triangulated.obj"));
-    let iso = isolate_regions(&m, RegionScheme::Sqrt3).unwrap_or_else(|e| panic!("spot: {e}"));
-    assert_eq!(iso.steps, 2);
-    // Rates 1 and 2, alternating in runs of odd lengths so neighbours differ.
-    let rates: Vec<u32> = (0..iso.mesh.faces())
-        .map(|f| 1 + ((f / 7) % 2) as u32)
-        .collect();
     let table = StencilTable::default_sqrt3().expect("embedded table");
-    check_rates_give_a_manifold(&table, "spot", &iso, &rates);
+    check_spot_at_mixed_rates(RegionScheme::Sqrt3, &table, 2);
 }

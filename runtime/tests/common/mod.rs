@@ -12,7 +12,7 @@ use runtime::stencil_table::StencilTable;
 use runtime::topology::Mesh;
 use runtime::triangle_dual_grid::TriangleDualGrid;
 use runtime::triangle_isolation::TriangleIsolation;
-use runtime::triangle_mesh::TriangleMesh;
+use runtime::triangle_mesh::{TriangleMesh, VertexSource};
 use runtime::triangle_split::{Split, TriangleSplit};
 use schemes::cone_regions::ConeRegions;
 use schemes::triangle_local::{canonical_triangle_point, TrianglePoint};
@@ -438,4 +438,43 @@ pub fn brute_force_deviation(points: &[[f64; 3]], out: &TriangleMesh) -> f64 {
             best
         })
         .fold(0.0, f64::max)
+}
+
+/// The largest angle between the output's normals and the ring normals of the finer mesh `fine`
+/// at the vertices `locate` names for them (`None`: not compared). The shapes are convex around
+/// the origin, so every normal must also point outwards.
+pub fn worst_normal_angle(
+    name: &str,
+    out: &TriangleMesh,
+    fine: &Mesh,
+    locate: impl Fn(&VertexSource) -> Option<u32>,
+) -> f64 {
+    let mut worst = 0.0f64;
+    for ((p, n), s) in out.positions.iter().zip(&out.normals).zip(&out.sources) {
+        let n = n.map(f64::from);
+        let outwards: f64 = (0..3).map(|c| n[c] * f64::from(p[c])).sum();
+        assert!(outwards > 0.0, "{name}: an inward normal at {p:?}");
+        if let Some(w) = locate(s) {
+            let reference = ring_normal(fine, w as usize);
+            let cos: f64 = (0..3).map(|c| n[c] * reference[c]).sum();
+            worst = worst.max(cos.clamp(-1.0, 1.0).acos());
+        }
+    }
+    println!("{name}: worst normal angle {worst:.2e} rad");
+    worst
+}
+
+/// Spot isolated by `scheme` in `steps` steps, at rates 1 and 2 alternating in runs of odd
+/// lengths (so that neighbours differ), tessellates to a closed manifold. Skips with a notice
+/// without `../shared`.
+pub fn check_spot_at_mixed_rates(scheme: RegionScheme, table: &StencilTable, steps: usize) {
+    let Some(dir) = models() else { return };
+    let m = load(&dir.join("crane/spot_triangulated.obj"));
+    let iso = runtime::region_isolate::isolate_regions(&m, scheme)
+        .unwrap_or_else(|e| panic!("spot: {e}"));
+    assert_eq!(iso.steps, steps);
+    let rates: Vec<u32> = (0..iso.mesh.faces())
+        .map(|f| 1 + ((f / 7) % 2) as u32)
+        .collect();
+    check_rates_give_a_manifold(table, "spot", &iso, &rates);
 }
