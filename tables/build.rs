@@ -24,11 +24,10 @@ fn main() {
             "butterfly.subtess",
             stencilgen::butterfly_table::default_butterfly_table,
         ),
-        ("sqrt3.subtess", || {
-            stencilgen::sqrt3_table::build_sqrt3_table(
-                &stencilgen::region_table::RegionTableSpec::default_sqrt3(),
-            )
-        }),
+        (
+            "sqrt3.subtess",
+            stencilgen::sqrt3_table::default_sqrt3_table,
+        ),
     ];
     for (name, generate) in tables {
         match generate() {

@@ -126,7 +126,7 @@ struct TessellateArgs {
     rates: Option<PathBuf>,
     /// A distance T in the mesh's units. Dual grid: per face the smallest rate whose
     /// tessellation deviates from the limit surface by at most T, measured on the table's
-    /// rate-24 grid (docs/results.md); loop and butterfly: on the triangle grids of the table's
+    /// rate-24 grid (docs/results.md); loop, butterfly and sqrt3: on the triangle grids of the table's
     /// two largest rates, rates among the table's (docs/cli.md). Adaptive: the guaranteed
     /// bound every polygon meets.
     #[arg(long, conflicts_with = "view")]

@@ -4,9 +4,9 @@
 //!
 //! A step keeps every vertex's valence and makes every new vertex regular, so it doubles (the
 //! butterfly) or triples (√3's ternary step) the graph distance between extraordinary vertices.
-//! A region's layout reaches about five rings from its vertex (four for √3), so two
-//! extraordinary vertices need to be about six edges apart: three butterfly steps or two
-//! ternary √3 steps for neighbours, fewer for vertices already apart.
+//! A region's layout reaches five rings from its vertex, so two extraordinary vertices need to
+//! be about six edges apart: three butterfly steps or two ternary √3 steps for neighbours,
+//! fewer for vertices already apart.
 
 use std::collections::BTreeSet;
 
@@ -20,17 +20,23 @@ use crate::triangle_split::Split;
 use crate::triangle_topology::require_closed_triangles;
 use crate::RuntimeError;
 
-/// At most this many steps are taken (three butterfly steps separate neighbouring
-/// extraordinary vertices; one more covers meshes whose small size makes a chart close on
-/// itself).
-pub const MAX_REGION_STEPS: usize = MAX_ISOLATION_STEPS;
-
 impl RegionScheme {
     /// How one of the scheme's whole-mesh steps splits a triangle.
     pub fn split(self) -> Split {
         match self {
             RegionScheme::Butterfly => Split::Dyadic,
             RegionScheme::Sqrt3 => Split::Ternary,
+        }
+    }
+
+    /// At most this many steps are taken: three butterfly steps or two ternary √3 steps separate
+    /// neighbouring extraordinary vertices, and one more covers meshes whose small size makes a
+    /// chart close on itself. The cap bounds a failing isolation's memory: 4^4 = 256 or
+    /// 9^3 = 729 times the input's triangles.
+    pub fn max_steps(self) -> usize {
+        match self {
+            RegionScheme::Butterfly => MAX_ISOLATION_STEPS,
+            RegionScheme::Sqrt3 => 3,
         }
     }
 
@@ -60,7 +66,7 @@ pub fn isolate_regions(
     isolate_by_refinement(
         mesh,
         scheme.split(),
-        MAX_REGION_STEPS,
+        scheme.max_steps(),
         |m| scheme.refine(m),
         |m| Ok((gather_region_patches(m, &catalogue)?, Phantoms::new(m))),
     )

@@ -157,6 +157,8 @@ pub fn gather_region_patches(
 ) -> Result<Vec<TrianglePatch>, RuntimeError> {
     let valence = mesh.valences();
     let mut patches: Vec<Option<TrianglePatch>> = vec![None; mesh.faces()];
+    // The extraordinary vertex whose region every claimed triangle is.
+    let mut owner: Vec<u32> = vec![u32::MAX; mesh.faces()];
     let mut charts = ConeCharts::new(mesh);
     let not_isolated = |face: usize, reason: String| MeshError::NotIsolated { face, reason };
     for v in 0..mesh.positions.len() {
@@ -198,12 +200,17 @@ pub fn gather_region_patches(
                     })?;
                 let f = mesh.face_of[h] as usize;
                 if patches[f].is_some() {
-                    return Err(not_isolated(
-                        f,
-                        "it lies in the regions of two extraordinary vertices".to_owned(),
-                    )
-                    .into());
+                    let reason = if owner[f] == v as u32 {
+                        format!("it is two regions of vertex {v}: the mesh closes on itself there")
+                    } else {
+                        format!(
+                            "it lies in the regions of two extraordinary vertices, {} and {v}",
+                            owner[f]
+                        )
+                    };
+                    return Err(not_isolated(f, reason).into());
                 }
+                owner[f] = v as u32;
                 let points =
                     gather(&chart, &region.layout, s, &valence).map_err(|e| not_isolated(f, e))?;
                 patches[f] = Some(TrianglePatch {

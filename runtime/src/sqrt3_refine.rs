@@ -5,7 +5,7 @@
 //!
 //! One √3 step inserts every triangle's centroid `c_f = (a + b + c) / 3`, moves every old vertex
 //! of valence `k` to `(1 - alpha_k) p + (alpha_k / k) sum` of its neighbours,
-//! `alpha_k = (4 - 2 cos(2π/k)) / 9` (Kobbelt's eq. (2)), and flips every old edge, so that
+//! `alpha_k = (4 - 2 cos(2π/k)) / 9` (Kobbelt 2000), and flips every old edge, so that
 //! centroids of neighbouring triangles are joined. A second step does the same to that mesh:
 //! its triangles are `(a, c_g, c_f)` and `(b, c_f, c_g)` around the old edge `(a, b)` between
 //! triangles `f` and `g`, and their centroids lie on the old edge at its thirds. Composed, with
@@ -49,7 +49,7 @@ pub fn sqrt3_limit_position(p: [f64; 3], ring_average: [f64; 3], valence: usize)
 
 /// Refine the closed triangle mesh `mesh` by two √3 steps, one ternary step (module docs).
 pub fn sqrt3_refine(mesh: &Mesh) -> Result<Mesh, RuntimeError> {
-    require_closed_triangles(mesh, "√3")?;
+    require_closed_triangles(mesh, "sqrt3")?;
     let p = &mesh.positions;
     let nv = p.len();
     let centroid: Vec<[f64; 3]> = (0..mesh.faces())

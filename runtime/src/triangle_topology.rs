@@ -39,8 +39,8 @@ pub fn require_closed_triangles(mesh: &Mesh, scheme: &str) -> Result<(), Runtime
     require_triangles(mesh)?;
     if let Some(h) = mesh.twin.iter().position(|&t| t == NONE) {
         return Err(RuntimeError::Unsupported(format!(
-            "the {scheme} boundary rules are not implemented, and edge ({}, {}) is on the \
-             boundary: the {scheme} scheme tessellates closed triangle meshes",
+            "edge ({}, {}) is on the boundary, and the boundary rules of --scheme {scheme} are \
+             not implemented: it tessellates closed triangle meshes",
             mesh.face_vertices[h],
             mesh.head(h)
         )));

@@ -644,6 +644,13 @@ fn triangle_schemes_take_a_tolerance() {
         ("butterfly".into(), true.into())
     );
     assert!(s["rate_max"].as_u64().is_some_and(|n| n <= 8), "{s}");
+    let s = stats("--scheme sqrt3 --tolerance 0.01");
+    assert_eq!(
+        (s["scheme"].clone(), s["watertight"].clone()),
+        ("sqrt3".into(), true.into())
+    );
+    assert_eq!(s["faces_over_tolerance"], 0, "{s}");
+    assert!(s["rate_max"].as_u64().is_some_and(|n| n <= 8), "{s}");
     // Far below what the table's largest rate reaches: every triangle is reported.
     let out = run("--scheme loop --tolerance 1e-9");
     assert!(out.status.success());

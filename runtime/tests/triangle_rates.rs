@@ -29,6 +29,11 @@ fn loop_table() -> &'static StencilTable {
     TABLE.get_or_init(|| StencilTable::default_loop().expect("embedded table"))
 }
 
+fn sqrt3_table() -> &'static StencilTable {
+    static TABLE: OnceLock<StencilTable> = OnceLock::new();
+    TABLE.get_or_init(|| StencilTable::default_sqrt3().expect("embedded table"))
+}
+
 fn butterfly_table() -> &'static StencilTable {
     static TABLE: OnceLock<StencilTable> = OnceLock::new();
     TABLE.get_or_init(|| StencilTable::default_butterfly().expect("embedded table"))
@@ -107,6 +112,11 @@ fn tolerance_rates_meet_the_tolerance_on_other_grids() {
             butterfly_table(),
             isolate_regions(&octahedron(), RegionScheme::Butterfly).expect("isolates"),
         ),
+        (
+            "sqrt3 octahedron",
+            sqrt3_table(),
+            isolate_regions(&octahedron(), RegionScheme::Sqrt3).expect("isolates"),
+        ),
     ];
     let mut checked = 0;
     for (name, table, iso) in cases {
@@ -115,7 +125,7 @@ fn tolerance_rates_meet_the_tolerance_on_other_grids() {
             let t = relative * d;
             let chosen = triangle_tolerance_rates(table, &iso, t).expect("rates");
             if !chosen.unmet.is_empty() {
-                // Only where the table's largest rate cannot reach T (the butterfly's 8).
+                // Only where the table's largest rate cannot reach T (the butterfly's and √3's 8).
                 assert!(chosen.unmet.iter().all(|&f| chosen.rates[f] == 8), "{name}");
                 continue;
             }
@@ -129,7 +139,7 @@ fn tolerance_rates_meet_the_tolerance_on_other_grids() {
         }
     }
     assert_eq!(
-        checked, 6,
+        checked, 8,
         "every mesh meets both tolerances within the table's rates"
     );
 }

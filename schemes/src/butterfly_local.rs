@@ -2,7 +2,7 @@
 //! vertex of valence `K`: the patch layout, the local subdivision matrix `A` and the regular
 //! tiles of the patch's outer half with their control points as rows of level-0 weights
 //! (Schaefer–Warren sections 5.2–5.3 on the triangular lattice of section 5.1). Data only:
-//! `stencilgen::butterfly_patch` solves with them.
+//! `stencilgen::cone_patch` solves with them.
 //!
 //! **Sectors and the patch** are those of [`crate::triangle_local`]: sector `s` holds the points
 //! `(a, b)`, `a >= 1`, `b >= 0`, of its own skew chart, named by [`canonical_triangle_point`];

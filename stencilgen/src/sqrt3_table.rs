@@ -15,9 +15,9 @@
 //! once per rate on the grid `1/3n` (primal points are `3i/3n`, centroids `(3i+1)/3n`;
 //! [`crate::sqrt3_patch::sqrt3_regular_basis_kind`]: exactly and rounded, which at these rates, all
 //! multiples of 3, beats the f64 solve), the regions' matrices in f64 (`alpha_K` is irrational at
-//! `K = 5, 7, 8`), so f64 throughout; a test compares a small table with the exact path. Not
-//! embedded in `tables/`: written by `stencilgen tables --schemes sqrt3` (time and size in
-//! docs/table-format.md).
+//! `K = 5, 7, 8`), so f64 throughout; a test compares a small table with the exact path. `tables/`
+//! embeds [`default_sqrt3_table`] (n = 1..=8); `stencilgen tables --schemes sqrt3` writes any
+//! range (time and size in docs/table-format.md).
 //!
 //! The sections are built by the builder both region schemes share, [`crate::region_table`].
 
@@ -33,8 +33,8 @@ use crate::StencilError;
 pub type Sqrt3TableSpec = RegionTableSpec;
 
 impl RegionTableSpec {
-    /// The table `stencilgen tables --schemes sqrt3` writes by default: valences 3..=8,
-    /// n = 1..=8, f32 (the butterfly's embedded shape).
+    /// The table `subtess` embeds (`tables::default_sqrt3`): valences 3..=8, n = 1..=8, f32
+    /// (the butterfly's embedded shape).
     pub fn default_sqrt3() -> Self {
         RegionTableSpec {
             valences: (3..=8).collect(),
@@ -42,6 +42,12 @@ impl RegionTableSpec {
             precision: Precision::F32,
         }
     }
+}
+
+/// The √3 table `subtess` embeds ([`RegionTableSpec::default_sqrt3`]), encoded (deterministic:
+/// the same bytes on every run).
+pub fn default_sqrt3_table() -> Result<Vec<u8>, StencilError> {
+    build_sqrt3_table(&RegionTableSpec::default_sqrt3())
 }
 
 /// Generate and encode the √3 table of `spec`.

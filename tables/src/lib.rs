@@ -66,7 +66,7 @@ pub fn default_butterfly() -> &'static [u8] {
 /// The default √3 table's bytes (64-byte aligned): the nine regions of interior vertices of
 /// valence 3..=8 (region 0 only at valence 6, the regular patch) of two √3 steps taken as one
 /// ternary step, n = 1..=8, triangle primal and dual grids, positions and both derivatives, f32
-/// (`stencilgen::region_table::RegionTableSpec::default_sqrt3`; 5.3 MiB). Rates up to 24 need a
+/// (`stencilgen::sqrt3_table::default_sqrt3_table`; 5.3 MiB). Rates up to 24 need a
 /// table written by `stencilgen tables --schemes sqrt3`.
 pub fn default_sqrt3() -> &'static [u8] {
     &SQRT3.0

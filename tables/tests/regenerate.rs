@@ -75,10 +75,7 @@ fn regenerated_butterfly_table_is_byte_identical() {
 
 #[test]
 fn regenerated_sqrt3_table_is_byte_identical() {
-    let fresh = stencilgen::sqrt3_table::build_sqrt3_table(
-        &stencilgen::region_table::RegionTableSpec::default_sqrt3(),
-    )
-    .expect("the sqrt3 table generates");
+    let fresh = stencilgen::sqrt3_table::default_sqrt3_table().expect("the sqrt3 table generates");
     let embedded = tables::default_sqrt3();
     assert!(
         fresh == embedded,
