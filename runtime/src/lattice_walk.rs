@@ -141,6 +141,21 @@ impl LatticeWalk {
                 }
             }
         }
+        // The module docs' argument needs the layout's triangles to form a disc: they are
+        // connected (all reached from the first), and a connected planar region of triangles
+        // has no holes exactly when V - E + F = 1.
+        let mut vertices = BTreeSet::new();
+        let mut edges = BTreeSet::new();
+        for t in &seen {
+            for i in 0..3 {
+                let (a, b) = (t[i], t[(i + 1) % 3]);
+                vertices.insert(a);
+                edges.insert((a.min(b), a.max(b)));
+            }
+        }
+        if vertices.len() + seen.len() != edges.len() + 1 {
+            return None;
+        }
         let tails: Vec<usize> = points
             .iter()
             .map(|p| tail_of.get(p).copied())
@@ -288,5 +303,29 @@ mod tests {
             TrianglePoint::Sector { s: 3, a: 3, b: 0 },
         ];
         assert!(LatticeWalk::new(&layout).is_none());
+    }
+
+    /// The radius-4 hexagon without `(1, 1)` (two rings inside its rim): its triangles surround
+    /// a hole (V - E + F = 0), where turning around the missing vertex need not close on a mesh,
+    /// so there is no walk.
+    #[test]
+    fn a_layout_with_a_hole_has_no_walk() {
+        let mut layout = vec![TrianglePoint::Centre];
+        for m in 1..=4i64 {
+            for s in 0..6 {
+                for b in 0..m {
+                    let p = TrianglePoint::Sector { s, a: m - b, b };
+                    if lattice_point(p) != (1, 1) {
+                        layout.push(p);
+                    }
+                }
+            }
+        }
+        assert!(LatticeWalk::new(&layout).is_none());
+        layout.push(TrianglePoint::Sector { s: 0, a: 1, b: 1 });
+        assert!(
+            LatticeWalk::new(&layout).is_some(),
+            "the full hexagon is a disc"
+        );
     }
 }

@@ -52,6 +52,10 @@ pub fn require_closed_triangles(mesh: &Mesh, scheme: &str) -> Result<(), Runtime
 /// mesh (every half-edge has a twin): `E_0 = head(h)`, `E_{i+1}` the head of
 /// `twin(prev(.))` of the half-edge to `E_i`.
 pub fn ring_from(mesh: &Mesh, h: usize) -> Vec<u32> {
+    debug_assert!(
+        !mesh.is_boundary_vertex(mesh.face_vertices[h] as usize),
+        "ring_from needs an interior vertex"
+    );
     let mut ring = vec![mesh.head(h)];
     let mut g = mesh.twin[mesh.prev(h)] as usize;
     while g != h && ring.len() <= mesh.face_vertices.len() {
