@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Debian packages that `cargo bench -p subtess-runtime --features opensubdiv --bench opensubdiv`
+# Debian packages that `cargo bench -p subtess --features opensubdiv --bench opensubdiv`
 # needs: the `opensubdiv` feature pulls in opensubdiv-petite, whose -sys crate builds OpenSubdiv
 # 3.7 from C++ source with cmake and generates its bindings with bindgen (libclang).
 # The default build, the tests and CI need none of this.
@@ -26,4 +26,4 @@ $sudo apt-get update
 DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y "${missing[@]}"
 echo "installed: ${missing[*]}"
 echo "keep the C++ build gentle on a small machine:"
-echo "  CMAKE_BUILD_PARALLEL_LEVEL=2 CARGO_BUILD_JOBS=2 cargo bench -p subtess-runtime --features opensubdiv --bench opensubdiv"
+echo "  CMAKE_BUILD_PARALLEL_LEVEL=2 CARGO_BUILD_JOBS=2 cargo bench -p subtess --features opensubdiv --bench opensubdiv"

@@ -2,7 +2,7 @@
 //! in one run: a closed torus of 200 x 100 = 20,000 regular quads, per face the `n x n` dual
 //! points `((2i+1)/2n, (2j+1)/2n)`, position and both derivatives, n = 4, 8, 16.
 //!
-//! `scripts/install-opensubdiv-deps.sh && cargo bench -p subtess-runtime --features opensubdiv
+//! `scripts/install-opensubdiv-deps.sh && cargo bench -p subtess --features opensubdiv
 //! --bench opensubdiv` (the feature builds OpenSubdiv from C++ source; docs/benchmarks.md).
 //!
 //! Variants, all reported as triangles per second with subtess's triangle count for the points
@@ -36,10 +36,10 @@ use std::time::{Duration, Instant};
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode, Throughput};
 use opensubdiv_petite::bfr::{Surface, SurfaceFactory};
 use opensubdiv_petite::far;
-use runtime::dual_grid::DualGrid;
-use runtime::isolate::isolate;
-use runtime::stencil_table::StencilTable;
-use runtime::topology::Mesh;
+use subtess::mesh::topology::Mesh;
+use subtess::scheme::catmull_clark::isolate::isolate;
+use subtess::stencil_table::StencilTable;
+use subtess::tessellate::dual_grid::DualGrid;
 
 /// Quads around the torus's axis and around its tube.
 const AROUND: usize = 200;

@@ -1,10 +1,10 @@
 //! Loading (validating, checksum included) the embedded default table.
 //!
-//! `cargo bench -p subtess-runtime --bench table_load`
+//! `cargo bench -p subtess --bench table_load`
 #![allow(missing_docs)] // criterion_group! generates an undocumented function
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use runtime::stencil_table::StencilTable;
+use subtess::stencil_table::StencilTable;
 
 fn bench(c: &mut Criterion) {
     c.bench_function("load default table", |b| {

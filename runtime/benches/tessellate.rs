@@ -2,7 +2,7 @@
 //! all connectivity into preallocated buffers; topology, patches and the plan built once. Mesh: Crane's Spot refined to 11,712
 //! faces when `../shared/models` exists, else the shipped cube refined to 6,144 faces.
 //!
-//! `cargo bench -p subtess-runtime --bench tessellate`: one and two threads (a rayon pool of
+//! `cargo bench -p subtess --bench tessellate`: one and two threads (a rayon pool of
 //! each size), rates 4, 8, 16 and mixed.
 //!
 //! Loop (the triangle dual grid): Crane's triangulated Spot (5,856 triangles, 23,424 after the
@@ -16,15 +16,15 @@ mod common;
 use std::path::Path;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use runtime::dual_grid::DualGrid;
-use runtime::isolate::isolate;
-use runtime::loop_isolate::isolate_loop;
-use runtime::loop_refine::loop_refine;
-use runtime::obj::read_obj;
-use runtime::refine::refine;
-use runtime::stencil_table::StencilTable;
-use runtime::topology::Mesh;
-use runtime::triangle_dual_grid::TriangleDualGrid;
+use subtess::io::obj::read_obj;
+use subtess::mesh::topology::Mesh;
+use subtess::scheme::catmull_clark::isolate::isolate;
+use subtess::scheme::catmull_clark::refine::refine;
+use subtess::scheme::loop_scheme::isolate::isolate_loop;
+use subtess::scheme::loop_scheme::refine::loop_refine;
+use subtess::stencil_table::StencilTable;
+use subtess::tessellate::dual_grid::DualGrid;
+use subtess::tessellate::triangle_dual_grid::TriangleDualGrid;
 
 fn mesh() -> (String, Mesh) {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));

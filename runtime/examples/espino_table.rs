@@ -3,18 +3,18 @@
 //! surface evaluations each test made and saved. docs/espino.md quotes its output.
 //!
 //! ```text
-//! cargo run --release -p subtess-runtime --example espino_table [-- --max-depth N --samples N --budgets a,b,c]
+//! cargo run --release -p subtess --example espino_table [-- --max-depth N --samples N --budgets a,b,c]
 //! ```
 //!
 //! Skips with a notice when `../shared/models` is absent.
 
 use std::path::Path;
 
-use runtime::bezier::{
+use subtess::tessellate::bezier::{
     tessellate_bezier_full, BezierOptions, BezierPatches, EdgeTest, SharedCurves,
 };
 
-fn boundary_loops(mesh: &runtime::triangle_mesh::TriangleMesh) -> Option<usize> {
+fn boundary_loops(mesh: &subtess::tessellate::triangle_mesh::TriangleMesh) -> Option<usize> {
     let edges = mesh.boundary_edges()?;
     let mut next = std::collections::HashMap::new();
     for &(a, b) in &edges {
@@ -35,7 +35,7 @@ fn boundary_loops(mesh: &runtime::triangle_mesh::TriangleMesh) -> Option<usize> 
     Some(loops)
 }
 
-fn main() -> Result<(), runtime::RuntimeError> {
+fn main() -> Result<(), subtess::RuntimeError> {
     let args: Vec<String> = std::env::args().collect();
     let arg = |name: &str| {
         args.iter()

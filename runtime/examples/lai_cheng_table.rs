@@ -5,13 +5,13 @@
 //! docs/lai-cheng.md and docs/results.md quote its output.
 //!
 //! ```text
-//! cargo run --release -p subtess-runtime --example lai_cheng_table
+//! cargo run --release -p subtess --example lai_cheng_table
 //! ```
 //!
 //! Tolerances are absolute, as fractions of each model's bounding-box diagonal. Two independent
 //! measurements, neither using the bound's own arithmetic:
 //!
-//! * "measured" (Table 1) is [`runtime::rates::measure_deviation`]: the largest distance from
+//! * "measured" (Table 1) is [`subtess::tessellate::rates::measure_deviation`]: the largest distance from
 //!   the limit surface, sampled at the table's primal and dual points at rate 24 of every face,
 //!   to the nearest output triangle (any polygon);
 //! * the guarantee table samples every face of the isolated mesh with the f32 stencil table's
@@ -24,15 +24,17 @@
 
 use std::path::{Path, PathBuf};
 
-use runtime::dual_grid::tessellate;
-use runtime::isolate::{isolate_with_origins, Isolation};
-use runtime::lai_cheng::{tessellate_adaptive, AdaptiveMesh, AdaptiveOptions, AdaptivePolygon};
-use runtime::obj::read_obj;
-use runtime::rates::{
+use subtess::io::obj::read_obj;
+use subtess::mesh::topology::Mesh;
+use subtess::scheme::catmull_clark::isolate::{isolate_with_origins, Isolation};
+use subtess::stencil_table::StencilTable;
+use subtess::tessellate::dual_grid::tessellate;
+use subtess::tessellate::lai_cheng::{
+    tessellate_adaptive, AdaptiveMesh, AdaptiveOptions, AdaptivePolygon,
+};
+use subtess::tessellate::rates::{
     measure_deviation, point_triangle_distance, table_positions, tolerance_rates,
 };
-use runtime::stencil_table::StencilTable;
-use runtime::topology::Mesh;
 use table_format::PointSet;
 
 /// Sampling rate of the guarantee table (the embedded table's largest).
@@ -87,7 +89,7 @@ fn dense_check(
     iso: &Isolation,
     out: &AdaptiveMesh,
     slack: f64,
-) -> Result<Dense, runtime::RuntimeError> {
+) -> Result<Dense, subtess::RuntimeError> {
     let mut by_face: Vec<Vec<&AdaptivePolygon>> = vec![Vec::new(); iso.mesh.faces()];
     for p in &out.polygons {
         by_face[p.region.face as usize].push(p);
@@ -136,7 +138,7 @@ fn dense_check(
     Ok(dense)
 }
 
-fn main() -> Result<(), runtime::RuntimeError> {
+fn main() -> Result<(), subtess::RuntimeError> {
     let here = Path::new(env!("CARGO_MANIFEST_DIR"));
     let shared = here.join("../../shared/models");
     let osd = shared.join("opensubdiv");
@@ -252,7 +254,7 @@ fn main() -> Result<(), runtime::RuntimeError> {
 
 /// Every undirected edge of the triangle mesh is used by exactly two triangles, once in each
 /// direction.
-fn triangle_edges_paired(mesh: &runtime::triangle_mesh::TriangleMesh) -> bool {
+fn triangle_edges_paired(mesh: &subtess::tessellate::triangle_mesh::TriangleMesh) -> bool {
     let mut edges = std::collections::HashMap::new();
     for t in &mesh.triangles {
         for k in 0..3 {

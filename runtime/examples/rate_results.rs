@@ -2,24 +2,24 @@
 //! tessellations with per-face rational rates (`1..=24`), per-face powers of two
 //! (`1, 2, 4, 8, 16`) and one uniform rate, on closed meshes.
 //!
-//! `cargo run --release -p subtess-runtime --example rate_results` prints the markdown table.
+//! `cargo run --release -p subtess --example rate_results` prints the markdown table.
 //! Meshes from `../shared/models/` are skipped (and said so) when absent; arguments, if any,
 //! keep only the meshes whose names contain one of them.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use runtime::dual_grid::tessellate;
-use runtime::isolate::isolate;
-use runtime::obj::read_obj;
-use runtime::patch::FacePatch;
-use runtime::rates::{
+use subtess::io::obj::read_obj;
+use subtess::mesh::topology::Mesh;
+use subtess::scheme::catmull_clark::isolate::isolate;
+use subtess::scheme::patch::FacePatch;
+use subtess::stencil_table::StencilTable;
+use subtess::tessellate::dual_grid::tessellate;
+use subtess::tessellate::rates::{
     measure_deviation, tolerance_rates, tolerance_rates_among, ToleranceRates, MAX_SELECTED_RATE,
     POWER_OF_TWO_RATES,
 };
-use runtime::stencil_table::StencilTable;
-use runtime::topology::Mesh;
-use runtime::RuntimeError;
+use subtess::RuntimeError;
 
 /// Tolerances, as fractions of the bounding-box diagonal of the control mesh.
 const TOLERANCES: [f64; 4] = [1e-2, 3e-3, 1e-3, 3e-4];

@@ -1,42 +1,18 @@
-//! The subtess runtime: loads stencil tables (never runs the solver) and, as it grows,
-//! evaluates and tessellates subdivision surfaces from them.
+//! subtess: exact evaluation and watertight tessellation of subdivision surfaces from
+//! precomputed stencil tables (Schaefer and Warren's scaling-relation method).
 //!
-//! ```
-//! let table = runtime::stencil_table::StencilTable::default_catmull_clark().expect("embedded table");
-//! assert!(!table.index().entries.is_empty());
-//! ```
+//! The layers, bottom up (docs/architecture.md): [`mesh`] (topology and geometry), [`io`]
+//! (OBJ, PLY, glTF), [`stencil_table`] (the validated tables), [`scheme`] (refinement,
+//! isolation and patches per scheme), [`tessellate`] (the dual grids, rates, Lai–Cheng,
+//! Espino et al.) and [`eval`] (exact evaluation).
 
-pub mod bezier;
-pub mod butterfly_refine;
-pub mod cone_chart;
-pub mod dual_grid;
 pub mod error;
-pub mod exact_eval;
-pub mod geometry;
-pub mod isolate;
-pub mod lai_cheng;
-pub mod lattice_walk;
-pub mod loop_exact_eval;
-pub mod loop_isolate;
-pub mod loop_refine;
-pub mod mesh_output;
-pub mod obj;
-pub mod patch;
-pub mod rates;
-pub mod refine;
-pub mod region_isolate;
-pub mod region_patch;
-pub mod sqrt3_refine;
+pub mod eval;
+pub mod io;
+pub mod mesh;
+pub mod scheme;
 pub mod stencil_table;
-#[cfg(test)]
-mod test_meshes;
-pub mod topology;
-pub mod triangle_dual_grid;
-pub mod triangle_isolation;
-pub mod triangle_mesh;
-pub mod triangle_patch;
-pub mod triangle_rates;
-pub mod triangle_split;
-pub mod triangle_topology;
+pub mod tessellate;
 
 pub use error::{MeshError, RuntimeError};
+pub use mesh::Mesh;

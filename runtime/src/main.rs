@@ -6,26 +6,26 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use clap::{Parser, Subcommand};
-use runtime::bezier::{tessellate_bezier, BezierOptions, BezierPatches};
-use runtime::dual_grid::{tessellate, DualGrid};
-use runtime::exact_eval::{evaluate_subface, parse_rational};
-use runtime::isolate::{isolate_with_origins, Isolation};
-use runtime::lai_cheng::{tessellate_adaptive, write_obj_polygons, AdaptiveOptions};
-use runtime::loop_exact_eval::LoopExactEvaluator;
-use runtime::loop_isolate::isolate_loop;
-use runtime::loop_refine::loop_refine;
-use runtime::mesh_output::{write_mesh, MeshFormat};
-use runtime::obj::read_obj;
-use runtime::rates::{tolerance_rates, view_rates, ViewCamera};
-use runtime::refine::refine;
-use runtime::region_isolate::isolate_regions;
-use runtime::region_patch::RegionScheme;
-use runtime::stencil_table::StencilTable;
-use runtime::topology::Mesh;
-use runtime::triangle_dual_grid::{tessellate_triangles, TriangleDualGrid};
-use runtime::triangle_isolation::TriangleIsolation;
-use runtime::triangle_rates::triangle_tolerance_rates;
-use runtime::RuntimeError;
+use subtess::eval::exact_eval::{evaluate_subface, parse_rational};
+use subtess::eval::loop_exact_eval::LoopExactEvaluator;
+use subtess::io::mesh_output::{write_mesh, MeshFormat};
+use subtess::io::obj::read_obj;
+use subtess::mesh::topology::Mesh;
+use subtess::scheme::catmull_clark::isolate::{isolate_with_origins, Isolation};
+use subtess::scheme::catmull_clark::refine::refine;
+use subtess::scheme::loop_scheme::isolate::isolate_loop;
+use subtess::scheme::loop_scheme::refine::loop_refine;
+use subtess::scheme::triangle::isolation::TriangleIsolation;
+use subtess::scheme::triangle::region_isolate::isolate_regions;
+use subtess::scheme::triangle::region_patch::RegionScheme;
+use subtess::stencil_table::StencilTable;
+use subtess::tessellate::bezier::{tessellate_bezier, BezierOptions, BezierPatches};
+use subtess::tessellate::dual_grid::{tessellate, DualGrid};
+use subtess::tessellate::lai_cheng::{tessellate_adaptive, write_obj_polygons, AdaptiveOptions};
+use subtess::tessellate::rates::{tolerance_rates, view_rates, ViewCamera};
+use subtess::tessellate::triangle_dual_grid::{tessellate_triangles, TriangleDualGrid};
+use subtess::tessellate::triangle_rates::triangle_tolerance_rates;
+use subtess::RuntimeError;
 
 #[derive(Parser)]
 #[command(
@@ -424,7 +424,7 @@ fn parse_scheme(name: &str) -> Result<Scheme, RuntimeError> {
 }
 
 /// `subtess tessellate MESH --scheme loop|butterfly|sqrt3`: the triangle dual grid at `--rate`,
-/// `--rates`, `--tolerance` (per triangle, `runtime::triangle_rates`) or `--view` (the
+/// `--rates`, `--tolerance` (per triangle, `subtess::tessellate::triangle_rates`) or `--view` (the
 /// projected-edge rule is the same for triangles).
 fn triangle_command(
     args: &TessellateArgs,

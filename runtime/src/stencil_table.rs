@@ -122,7 +122,15 @@ impl StencilTable {
     }
 }
 
-impl crate::triangle_dual_grid::TriangleStencils for StencilTable {
+/// Where the triangle tessellator gets its stencils: `points x K` f32 weights, point-major, of
+/// one section on a triangle point set ([`table_format::PointSet::TrianglePrimal`], [`table_format::PointSet::TriangleDual`]);
+/// a Loop [`StencilTable`], or any other source of the same layout.
+pub trait TriangleStencils: Sync {
+    /// The weights of `key`, or an error naming what the source covers.
+    fn triangle_weights(&self, key: &SectionKey) -> Result<&[f32], RuntimeError>;
+}
+
+impl TriangleStencils for StencilTable {
     /// Triangle sections of a triangle-scheme (Loop) table; a quad table is refused by name
     /// rather than read at the wrong layout.
     fn triangle_weights(&self, key: &SectionKey) -> Result<&[f32], RuntimeError> {

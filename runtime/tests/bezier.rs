@@ -1,5 +1,5 @@
 //! Bézier patch input, bicubic evaluation, displacement maps, edge tests and the adaptive
-//! tessellator of Espino et al. (`runtime::bezier`). Tests on the Utah teapot and teacup are
+//! tessellator of Espino et al. (`subtess::tessellate::bezier`). Tests on the Utah teapot and teacup are
 //! skipped, with a notice, where `../shared/models` is absent.
 //!
 //! Where expected numbers come from: the patch counts and the open seams are those of
@@ -12,16 +12,16 @@ use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
 use proptest::prelude::*;
-use runtime::bezier::bicubic::bernstein;
-use runtime::bezier::displacement_map::{signed_distance, DistanceCase};
-use runtime::bezier::edge_tests::{map4p_points, map8p_points, map_test};
-use runtime::bezier::mesh_error::{point_triangle_distance, TriangleGrid};
-use runtime::bezier::{
+use subtess::tessellate::bezier::bicubic::bernstein;
+use subtess::tessellate::bezier::displacement_map::{signed_distance, DistanceCase};
+use subtess::tessellate::bezier::edge_tests::{map4p_points, map8p_points, map_test};
+use subtess::tessellate::bezier::mesh_error::{point_triangle_distance, TriangleGrid};
+use subtess::tessellate::bezier::{
     tessellate_bezier, tessellate_bezier_full, BezierOptions, BezierPatches, BicubicPatch,
     DisplacementMap, EdgeTest,
 };
-use runtime::triangle_mesh::TriangleMesh;
-use runtime::RuntimeError;
+use subtess::tessellate::triangle_mesh::TriangleMesh;
+use subtess::RuntimeError;
 
 type P3 = [f64; 3];
 

@@ -4,11 +4,11 @@
 //! per input boundary loop.
 
 use proptest::prelude::*;
-use runtime::dual_grid::tessellate;
-use runtime::isolate::isolate;
-use runtime::stencil_table::StencilTable;
-use runtime::topology::Mesh;
-use runtime::triangle_mesh::TriangleMesh;
+use subtess::mesh::topology::Mesh;
+use subtess::scheme::catmull_clark::isolate::isolate;
+use subtess::stencil_table::StencilTable;
+use subtess::tessellate::dual_grid::tessellate;
+use subtess::tessellate::triangle_mesh::TriangleMesh;
 
 /// A 3 x 3 grid of quads over `[0,3]^2` with bumpy heights; face `(i, j)` is `3j + i` and runs
 /// `u` along `x`, `v` along `y`.

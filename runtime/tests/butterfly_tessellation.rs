@@ -3,21 +3,21 @@
 //!
 //! The butterfly interpolates, so its limit surface passes through every vertex of every
 //! refinement level: at a dyadic parameter `(i/2^m, j/2^m)` of a triangle the surface is the
-//! vertex that `m` whole-mesh butterfly steps (`runtime::butterfly_refine`, the rules written
+//! vertex that `m` whole-mesh butterfly steps (`subtess::scheme::butterfly::refine`, the rules written
 //! out) put there. That checks the table's stencils, the region layouts and their rotations,
 //! and the triangle dual grid's point maps together, without the solver that made the table.
 
 mod common;
 
 use proptest::prelude::*;
-use runtime::butterfly_refine::butterfly_refine;
-use runtime::region_isolate::isolate_regions;
-use runtime::region_patch::RegionScheme;
-use runtime::stencil_table::StencilTable;
-use runtime::topology::Mesh;
-use runtime::triangle_dual_grid::TriangleDualGrid;
-use runtime::triangle_isolation::TriangleIsolation;
-use runtime::triangle_split::child_to_parent;
+use subtess::mesh::topology::Mesh;
+use subtess::scheme::butterfly::refine::butterfly_refine;
+use subtess::scheme::triangle::isolation::TriangleIsolation;
+use subtess::scheme::triangle::region_isolate::isolate_regions;
+use subtess::scheme::triangle::region_patch::RegionScheme;
+use subtess::scheme::triangle::split::child_to_parent;
+use subtess::stencil_table::StencilTable;
+use subtess::tessellate::triangle_dual_grid::TriangleDualGrid;
 
 use common::{
     check_rates_give_a_manifold, check_region_layouts, check_spot_at_mixed_rates, check_topology,
@@ -25,7 +25,7 @@ use common::{
 };
 
 /// Three steps separate neighbouring extraordinary vertices (six edges apart, module docs of
-/// `runtime::region_isolate`); a regular torus needs none. Every region of the valence shows
+/// `subtess::scheme::triangle::region_isolate`); a regular torus needs none. Every region of the valence shows
 /// up, and nothing else.
 #[test]
 fn isolation_separates_the_extraordinary_vertices() {
@@ -208,7 +208,7 @@ fn spot_tessellates_to_a_closed_manifold_at_mixed_rates() {
 
 /// A full table written by `stencilgen tables --schemes butterfly --n 1..24` (named by the
 /// environment variable `BUTTERFLY_TABLE`): the same check at rate 16, and the manifold and
-/// outward-normal checks at every rate from 9 to 24. `BUTTERFLY_TABLE=FILE cargo test --release -p subtess-runtime --test
+/// outward-normal checks at every rate from 9 to 24. `BUTTERFLY_TABLE=FILE cargo test --release -p subtess --test
 /// butterfly_tessellation -- --ignored`.
 #[test]
 #[ignore]

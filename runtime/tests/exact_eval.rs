@@ -1,4 +1,4 @@
-//! Exact evaluation (`runtime::exact_eval`) against independent references:
+//! Exact evaluation (`subtess::eval::exact_eval`) against independent references:
 //!
 //! * `stencilgen`'s exact substitution stencils (`Substitution<BigRational>`, Schaefer–Warren
 //!   section 5.2) applied in rationals to the same control points — the oracle — around interior
@@ -14,15 +14,15 @@ use std::collections::HashMap;
 
 use num_rational::BigRational;
 use num_traits::{ToPrimitive, Zero};
-use runtime::exact_eval::{evaluate, ExactEvaluator, LimitPoint};
-use runtime::patch::face_patch;
-use runtime::refine::refine;
-use runtime::stencil_table::StencilTable;
-use runtime::topology::Mesh;
 use schemes::{BoundaryMode, QuadScheme};
 use stencilgen::extraordinary_patch::{canonical, GridPoint, Neighbourhood};
 use stencilgen::regular_patch::StencilKind as Kind;
 use stencilgen::substitution::Substitution;
+use subtess::eval::exact_eval::{evaluate, ExactEvaluator, LimitPoint};
+use subtess::mesh::topology::Mesh;
+use subtess::scheme::catmull_clark::refine::refine;
+use subtess::scheme::patch::face_patch;
+use subtess::stencil_table::StencilTable;
 use table_format::{PointSet, SectionKey, StencilKind};
 
 fn q(p: i64, d: i64) -> BigRational {
@@ -468,7 +468,7 @@ fn check_edges(mesh: &Mesh, limit: usize) -> f64 {
     let mut checked = 0;
     for h in 0..mesh.face_vertices.len() {
         let t = mesh.twin[h];
-        if t == runtime::topology::NONE || (t as usize) < h || checked >= limit {
+        if t == subtess::mesh::topology::NONE || (t as usize) < h || checked >= limit {
             continue;
         }
         let (fa, fb) = (mesh.face_of[h] as usize, mesh.face_of[t as usize] as usize);
@@ -829,7 +829,7 @@ fn real_models_evaluate_consistently_with_their_isolated_meshes() {
             println!("notice: {} is missing; skipped", path.display());
             continue;
         }
-        let obj = runtime::obj::read_obj(&path).expect("reads");
+        let obj = subtess::io::obj::read_obj(&path).expect("reads");
         let (mesh, _) = Mesh::from_obj(&obj).expect("valid");
         // A subset of the faces on a big model.
         let step = (mesh.faces() / 40).max(1);

@@ -1,4 +1,4 @@
-//! Lai–Cheng adaptive tessellation (`runtime::lai_cheng`): the error guarantee measured
+//! Lai–Cheng adaptive tessellation (`subtess::tessellate::lai_cheng`): the error guarantee measured
 //! independently of the bound (table stencils at rate 24 and exact evaluation, to the output
 //! polygon's own triangles), watertightness by global ids, relative flatness, flat regions.
 //!
@@ -10,15 +10,17 @@ use std::path::{Path, PathBuf};
 
 use num_bigint::BigInt;
 use num_rational::BigRational;
-use runtime::exact_eval::ExactEvaluator;
-use runtime::isolate::{isolate_with_origins, Isolation};
-use runtime::lai_cheng::{tessellate_adaptive, AdaptiveMesh, AdaptiveOptions, AdaptivePolygon};
-use runtime::obj::read_obj;
-use runtime::rates::{point_triangle_distance, table_positions};
-use runtime::stencil_table::StencilTable;
-use runtime::topology::Mesh;
-use runtime::RuntimeError;
 use schemes::BoundaryMode;
+use subtess::eval::exact_eval::ExactEvaluator;
+use subtess::io::obj::read_obj;
+use subtess::mesh::topology::Mesh;
+use subtess::scheme::catmull_clark::isolate::{isolate_with_origins, Isolation};
+use subtess::stencil_table::StencilTable;
+use subtess::tessellate::lai_cheng::{
+    tessellate_adaptive, AdaptiveMesh, AdaptiveOptions, AdaptivePolygon,
+};
+use subtess::tessellate::rates::{point_triangle_distance, table_positions};
+use subtess::RuntimeError;
 use table_format::PointSet;
 
 fn load(path: &Path) -> Mesh {

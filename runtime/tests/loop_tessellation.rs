@@ -20,14 +20,14 @@ mod common;
 use std::collections::HashMap;
 
 use proptest::prelude::*;
-use runtime::loop_isolate::isolate_loop;
-use runtime::loop_refine::loop_refine;
-use runtime::topology::Mesh;
-use runtime::triangle_dual_grid::{TriangleDualGrid, TriangleStencils};
-use runtime::triangle_isolation::TriangleIsolation;
-use runtime::triangle_mesh::TriangleMesh;
-use runtime::{MeshError, RuntimeError};
 use schemes::BoundaryMode;
+use subtess::mesh::topology::Mesh;
+use subtess::scheme::loop_scheme::isolate::isolate_loop;
+use subtess::scheme::loop_scheme::refine::loop_refine;
+use subtess::scheme::triangle::isolation::TriangleIsolation;
+use subtess::tessellate::triangle_dual_grid::{TriangleDualGrid, TriangleStencils};
+use subtess::tessellate::triangle_mesh::TriangleMesh;
+use subtess::{MeshError, RuntimeError};
 use table_format::{PointSet, SectionKey, StencilKind};
 
 use common::{check_topology, icosahedron, load, mesh, models, octahedron, tetrahedron, torus};
@@ -501,7 +501,7 @@ mod with_the_table {
     use super::*;
     use num_rational::BigRational;
     use num_traits::ToPrimitive;
-    use runtime::stencil_table::StencilTable;
+    use subtess::stencil_table::StencilTable;
     use subtess_tests::box_spline::{box_spline, DIRECTIONS};
 
     fn table() -> StencilTable {
@@ -736,8 +736,8 @@ mod boundary_with_the_table {
     use num_bigint::BigInt;
     use num_rational::BigRational;
     use num_traits::ToPrimitive;
-    use runtime::stencil_table::StencilTable;
-    use runtime::topology::NONE;
+    use subtess::mesh::topology::NONE;
+    use subtess::stencil_table::StencilTable;
     use subtess_tests::bspline::uniform_bspline;
 
     /// The centred uniform cubic B-spline `N(x) = B_3(x + 2)` (support `[-2, 2]`) at the
@@ -831,7 +831,7 @@ mod boundary_with_the_table {
     fn on_side(
         stencils: &dyn TriangleStencils,
         mesh: &Mesh,
-        patch: &runtime::triangle_patch::TrianglePatch,
+        patch: &subtess::scheme::triangle::patch::TrianglePatch,
         side: usize,
         i: u32,
         n: u32,
@@ -853,7 +853,7 @@ mod boundary_with_the_table {
         };
         let weights = stencils.triangle_weights(&key).expect("covered");
         let k = patch.points.len();
-        let control = runtime::triangle_patch::Phantoms::new(mesh).extend(&mesh.positions);
+        let control = subtess::scheme::triangle::patch::Phantoms::new(mesh).extend(&mesh.positions);
         let mut out = [0.0; 3];
         for (weight, &v) in weights[at * k..(at + 1) * k].iter().zip(&patch.points) {
             for (o, x) in out.iter_mut().zip(control[v as usize]) {
@@ -915,12 +915,12 @@ mod boundary_with_the_table {
     }
 
     /// Every `stride`-th output vertex (mixed rates) against exact evaluation at its source on
-    /// the input triangle (`runtime::loop_exact_eval`: substitution with exact local matrices
+    /// the input triangle (`subtess::eval::loop_exact_eval`: substitution with exact local matrices
     /// and the regular patch from subdivision; no stencil system): positions to f32 rounding,
     /// normals within 1e-4.
     fn check_exact_evaluation(m: &Mesh, label: &str, stride: usize) {
         let out = tessellate_with_boundary(m, label);
-        let eval = runtime::loop_exact_eval::LoopExactEvaluator::new(m)
+        let eval = subtess::eval::loop_exact_eval::LoopExactEvaluator::new(m)
             .unwrap_or_else(|e| panic!("{label}: {e}"));
         let scale = m
             .positions

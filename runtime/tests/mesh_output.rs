@@ -11,15 +11,15 @@
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use runtime::dual_grid::tessellate_uniform;
-use runtime::isolate::isolate;
-use runtime::mesh_output::{write_glb, write_gltf, write_mesh, write_obj, write_ply};
-use runtime::obj::read_obj;
-use runtime::stencil_table::StencilTable;
-use runtime::topology::Mesh;
-use runtime::triangle_mesh::{TriangleMesh, VertexSource};
-use runtime::RuntimeError;
 use serde_json::Value;
+use subtess::io::mesh_output::{write_glb, write_gltf, write_mesh, write_obj, write_ply};
+use subtess::io::obj::read_obj;
+use subtess::mesh::topology::Mesh;
+use subtess::scheme::catmull_clark::isolate::isolate;
+use subtess::stencil_table::StencilTable;
+use subtess::tessellate::dual_grid::tessellate_uniform;
+use subtess::tessellate::triangle_mesh::{TriangleMesh, VertexSource};
+use subtess::RuntimeError;
 
 // ---------------------------------------------------------------------------------------------
 // Meshes and temporary files
@@ -321,7 +321,7 @@ fn check_ply(mesh: &TriangleMesh, bytes: &[u8], what: &str) {
             PlyProperty::List(..) => unreachable!(),
         })
         .sum();
-    assert_eq!(record, runtime::mesh_output::PLY_VERTEX_BYTES);
+    assert_eq!(record, subtess::io::mesh_output::PLY_VERTEX_BYTES);
     let header_len = bytes.len() - 37 * mesh.positions.len() - 13 * mesh.triangles.len();
     assert!(bytes[..header_len].ends_with(b"end_header\n"));
 

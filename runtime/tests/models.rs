@@ -4,12 +4,12 @@
 
 use std::path::{Path, PathBuf};
 
-use runtime::dual_grid::tessellate;
-use runtime::isolate::isolate;
-use runtime::obj::read_obj;
-use runtime::refine::refine;
-use runtime::stencil_table::StencilTable;
-use runtime::topology::Mesh;
+use subtess::io::obj::read_obj;
+use subtess::mesh::topology::Mesh;
+use subtess::scheme::catmull_clark::isolate::isolate;
+use subtess::scheme::catmull_clark::refine::refine;
+use subtess::stencil_table::StencilTable;
+use subtess::tessellate::dual_grid::tessellate;
 
 fn models() -> Option<PathBuf> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/models");
@@ -74,9 +74,9 @@ fn every_opensubdiv_shape_is_read_or_refused_clearly() {
                 assert!(
                     matches!(
                         e,
-                        runtime::MeshError::NonManifoldEdge { .. }
-                            | runtime::MeshError::NonManifoldVertex { .. }
-                            | runtime::MeshError::BadFace { .. }
+                        subtess::MeshError::NonManifoldEdge { .. }
+                            | subtess::MeshError::NonManifoldVertex { .. }
+                            | subtess::MeshError::BadFace { .. }
                     ),
                     "{name} refused: {e}"
                 );
@@ -132,7 +132,7 @@ fn every_accepted_opensubdiv_shape_tessellates_watertight() {
         for rates in [vec![3; patches.len()], mixed] {
             let out = match tessellate(table, &isolated, &patches, &rates) {
                 Ok((out, _)) => out,
-                Err(e @ runtime::RuntimeError::Table(_)) => {
+                Err(e @ subtess::RuntimeError::Table(_)) => {
                     refused.push(format!("{name}: {e}"));
                     break;
                 }

@@ -4,11 +4,11 @@
 
 use std::path::Path;
 
-use runtime::obj::read_obj;
-use runtime::patch::{dual_positions, face_patch};
-use runtime::refine::refine;
-use runtime::stencil_table::StencilTable;
-use runtime::topology::Mesh;
+use subtess::io::obj::read_obj;
+use subtess::mesh::topology::Mesh;
+use subtess::scheme::catmull_clark::refine::refine;
+use subtess::scheme::patch::{dual_positions, face_patch};
+use subtess::stencil_table::StencilTable;
 
 fn model(relative: &str) -> Option<Mesh> {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -7,16 +7,16 @@ mod common;
 use std::path::Path;
 use std::sync::OnceLock;
 
-use runtime::dual_grid::{tessellate, tessellate_uniform};
-use runtime::isolate::isolate;
-use runtime::obj::read_obj;
-use runtime::patch::{dual_positions, FacePatch};
-use runtime::rates::{
+use subtess::io::obj::read_obj;
+use subtess::mesh::topology::Mesh;
+use subtess::scheme::catmull_clark::isolate::isolate;
+use subtess::scheme::patch::{dual_positions, FacePatch};
+use subtess::stencil_table::StencilTable;
+use subtess::tessellate::dual_grid::{tessellate, tessellate_uniform};
+use subtess::tessellate::rates::{
     face_deviation, measure_deviation, table_positions, tolerance_rates, tolerance_rates_among,
     view_rates, ViewCamera, POWER_OF_TWO_RATES,
 };
-use runtime::stencil_table::StencilTable;
-use runtime::topology::Mesh;
 use table_format::PointSet;
 
 use common::{brute_force_deviation, diagonal};
@@ -72,7 +72,10 @@ fn tolerance_rates_meet_the_tolerance_on_independent_samples() {
         let dual19 = independent_samples(&isolated, &patches, &[19]);
         for relative in [1e-2, 3e-3] {
             let t = relative * diagonal(&mesh);
-            for candidates in [&runtime::rates::RATIONAL_RATES[..], &POWER_OF_TWO_RATES[..]] {
+            for candidates in [
+                &subtess::tessellate::rates::RATIONAL_RATES[..],
+                &POWER_OF_TWO_RATES[..],
+            ] {
                 let chosen = tolerance_rates_among(table(), &isolated, &patches, t, candidates)
                     .expect("rates");
                 assert!(chosen.unmet.is_empty(), "{name} T = {t}");

@@ -2,25 +2,25 @@
 //! the tessellation from the default √3 table.
 //!
 //! √3 approximates, so the independent reference is Kobbelt's limit-position rule
-//! (`runtime::sqrt3_refine::sqrt3_limit_position`, a closed form checked there to be invariant
+//! (`subtess::scheme::sqrt3::refine::sqrt3_limit_position`, a closed form checked there to be invariant
 //! under the step): at a ternary parameter `(i/3^m, j/3^m)` of a triangle the limit surface is
 //! the limit position of the vertex that `m` whole-mesh ternary steps (two √3 steps each, the
-//! rules written out in `runtime::sqrt3_refine`) put there. That checks the table's stencils,
+//! rules written out in `subtess::scheme::sqrt3::refine`) put there. That checks the table's stencils,
 //! the region layouts and their rotations, and the triangle dual grid's point maps together,
 //! without the solver that made the table.
 
 mod common;
 
 use proptest::prelude::*;
-use runtime::region_isolate::isolate_regions;
-use runtime::region_patch::RegionScheme;
-use runtime::sqrt3_refine::{sqrt3_limit_position, sqrt3_refine};
-use runtime::stencil_table::StencilTable;
-use runtime::topology::Mesh;
-use runtime::triangle_dual_grid::TriangleDualGrid;
-use runtime::triangle_isolation::TriangleIsolation;
-use runtime::triangle_split::ternary_child_to_parent;
-use runtime::triangle_topology::neighbours;
+use subtess::mesh::topology::Mesh;
+use subtess::mesh::triangle_topology::neighbours;
+use subtess::scheme::sqrt3::refine::{sqrt3_limit_position, sqrt3_refine};
+use subtess::scheme::triangle::isolation::TriangleIsolation;
+use subtess::scheme::triangle::region_isolate::isolate_regions;
+use subtess::scheme::triangle::region_patch::RegionScheme;
+use subtess::scheme::triangle::split::ternary_child_to_parent;
+use subtess::stencil_table::StencilTable;
+use subtess::tessellate::triangle_dual_grid::TriangleDualGrid;
 
 use common::{
     check_rates_give_a_manifold, check_region_layouts, check_spot_at_mixed_rates, check_topology,

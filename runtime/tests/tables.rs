@@ -4,8 +4,6 @@
 use std::process::Command;
 
 use num_rational::BigRational;
-use runtime::stencil_table::StencilTable;
-use runtime::RuntimeError;
 use schemes::QuadScheme;
 use stencilgen::extraordinary_patch::Neighbourhood;
 use stencilgen::regular_patch::StencilKind as Kind;
@@ -13,6 +11,8 @@ use stencilgen::scalar::rational_to_f64;
 use stencilgen::stencil_set::StencilSetSpec;
 use stencilgen::substitution::Substitution;
 use stencilgen::table::{build_table, TableSpec};
+use subtess::stencil_table::StencilTable;
+use subtess::RuntimeError;
 use table_format::{PointSet, SectionKey, StencilKind};
 
 fn key(

@@ -4,12 +4,12 @@
 use std::path::Path;
 
 use proptest::prelude::*;
-use runtime::dual_grid::{tessellate, tessellate_uniform};
-use runtime::isolate::isolate;
-use runtime::obj::read_obj;
-use runtime::patch::dual_positions;
-use runtime::stencil_table::StencilTable;
-use runtime::topology::Mesh;
+use subtess::io::obj::read_obj;
+use subtess::mesh::topology::Mesh;
+use subtess::scheme::catmull_clark::isolate::isolate;
+use subtess::scheme::patch::dual_positions;
+use subtess::stencil_table::StencilTable;
+use subtess::tessellate::dual_grid::{tessellate, tessellate_uniform};
 
 fn load(path: &Path) -> Mesh {
     let obj = read_obj(path).unwrap_or_else(|e| panic!("{e}"));
@@ -123,9 +123,13 @@ fn regular_faces_are_evaluated_as_tensor_products() {
     let (isolated, patches, _) = isolate(&mesh).expect("isolates");
     let irregular = patches.iter().filter(|p| p.kind.faces != 4).count();
     for n in [1, 2, 7, 24] {
-        let grid =
-            runtime::dual_grid::DualGrid::new(&table, &isolated, &patches, &vec![n; patches.len()])
-                .expect("plans");
+        let grid = subtess::tessellate::dual_grid::DualGrid::new(
+            &table,
+            &isolated,
+            &patches,
+            &vec![n; patches.len()],
+        )
+        .expect("plans");
         assert_eq!(grid.separable_faces(), patches.len() - irregular, "n = {n}");
     }
 }
@@ -247,8 +251,8 @@ fn valence_4_regions_reproduce_the_bicubic_b_spline() {
 fn output_vertices_are_exact_evaluation_at_their_input_sources() {
     use num_bigint::BigInt;
     use num_rational::BigRational;
-    use runtime::exact_eval::ExactEvaluator;
-    use runtime::isolate::isolate_with_origins;
+    use subtess::eval::exact_eval::ExactEvaluator;
+    use subtess::scheme::catmull_clark::isolate::isolate_with_origins;
     let table = StencilTable::default_catmull_clark().expect("embedded table");
     // A pyramid with a pentagonal base (an n-gon) and a boundary: five triangles around the apex
     // with one removed.

@@ -1,4 +1,4 @@
-//! Tolerance rates for the triangle schemes (`runtime::triangle_rates`): the output meets the
+//! Tolerance rates for the triangle schemes (`subtess::tessellate::triangle_rates`): the output meets the
 //! tolerance on samples the selection never saw (Loop: exact rational evaluation, an
 //! independent method), rates are monotone in the tolerance and minimal, faces that cannot meet
 //! it are reported. The closed forms on a quadratic lattice are unit tests of the module.
@@ -8,16 +8,16 @@ mod common;
 use std::sync::OnceLock;
 
 use num_rational::BigRational;
-use runtime::loop_exact_eval::LoopExactEvaluator;
-use runtime::loop_isolate::isolate_loop;
-use runtime::region_isolate::isolate_regions;
-use runtime::region_patch::RegionScheme;
-use runtime::stencil_table::StencilTable;
-use runtime::topology::Mesh;
-use runtime::triangle_dual_grid::tessellate_triangles;
-use runtime::triangle_isolation::TriangleIsolation;
-use runtime::triangle_mesh::TriangleMesh;
-use runtime::triangle_rates::{
+use subtess::eval::loop_exact_eval::LoopExactEvaluator;
+use subtess::mesh::topology::Mesh;
+use subtess::scheme::loop_scheme::isolate::isolate_loop;
+use subtess::scheme::triangle::isolation::TriangleIsolation;
+use subtess::scheme::triangle::region_isolate::isolate_regions;
+use subtess::scheme::triangle::region_patch::RegionScheme;
+use subtess::stencil_table::StencilTable;
+use subtess::tessellate::triangle_dual_grid::tessellate_triangles;
+use subtess::tessellate::triangle_mesh::TriangleMesh;
+use subtess::tessellate::triangle_rates::{
     measure_triangle_deviation, triangle_face_deviation, triangle_table_rates,
     triangle_tolerance_rates, triangle_tolerance_rates_among,
 };
@@ -216,7 +216,7 @@ fn unmet_faces_are_reported_and_bad_input_refused() {
 }
 
 /// Spot (`../shared/models/crane`): rates and the measured deviation for a few tolerances
-/// (`cargo test -p subtess-runtime --test triangle_rates -- --ignored --nocapture`; the numbers
+/// (`cargo test -p subtess --test triangle_rates -- --ignored --nocapture`; the numbers
 /// are in docs/cli.md).
 #[test]
 #[ignore = "a report on a real model: about a minute"]

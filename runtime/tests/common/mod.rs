@@ -5,18 +5,18 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use runtime::cone_chart::ConeChart;
-use runtime::obj::read_obj;
-use runtime::region_patch::RegionScheme;
-use runtime::stencil_table::StencilTable;
-use runtime::topology::Mesh;
-use runtime::triangle_dual_grid::TriangleDualGrid;
-use runtime::triangle_isolation::TriangleIsolation;
-use runtime::triangle_mesh::{TriangleMesh, VertexSource};
-use runtime::triangle_split::{Split, TriangleSplit};
 use schemes::cone_regions::ConeRegions;
 use schemes::triangle_local::{canonical_triangle_point, TrianglePoint};
 use schemes::{BoundaryMode, TriangleScheme};
+use subtess::io::obj::read_obj;
+use subtess::mesh::topology::Mesh;
+use subtess::scheme::triangle::cone_chart::ConeChart;
+use subtess::scheme::triangle::isolation::TriangleIsolation;
+use subtess::scheme::triangle::region_patch::RegionScheme;
+use subtess::scheme::triangle::split::{Split, TriangleSplit};
+use subtess::stencil_table::StencilTable;
+use subtess::tessellate::triangle_dual_grid::TriangleDualGrid;
+use subtess::tessellate::triangle_mesh::{TriangleMesh, VertexSource};
 
 pub fn mesh(positions: Vec<[f64; 3]>, faces: &[[i64; 3]]) -> Mesh {
     let faces: Vec<Vec<i64>> = faces.iter().map(|f| f.to_vec()).collect();
@@ -161,7 +161,7 @@ pub fn check_topology(input: &Mesh, out: &TriangleMesh, label: &str) {
     let used = surface
         .vertex_halfedge
         .iter()
-        .filter(|&&h| h != runtime::topology::NONE)
+        .filter(|&&h| h != subtess::mesh::topology::NONE)
         .count();
     assert_eq!(used, out.positions.len(), "{label}: unused output vertices");
     assert_eq!(
@@ -216,7 +216,7 @@ pub fn ring_normal(mesh: &Mesh, v: usize) -> [f64; 3] {
 }
 
 /// The vertex one whole-mesh step of `split` puts on the edge `(v, e)` nearest `v`
-/// (`runtime::triangle_split`'s numbering: the midpoint, or the third nearer `v`).
+/// (`subtess::scheme::triangle::split`'s numbering: the midpoint, or the third nearer `v`).
 pub fn next_on_edge(split: Split, coarse: &Mesh, v: u32, e: u32) -> u32 {
     let edges = TriangleSplit::new(coarse).edges;
     let i = edges
@@ -474,7 +474,7 @@ pub fn worst_normal_angle(
 pub fn check_spot_at_mixed_rates(scheme: RegionScheme, table: &StencilTable, steps: usize) {
     let Some(dir) = models() else { return };
     let m = load(&dir.join("crane/spot_triangulated.obj"));
-    let iso = runtime::region_isolate::isolate_regions(&m, scheme)
+    let iso = subtess::scheme::triangle::region_isolate::isolate_regions(&m, scheme)
         .unwrap_or_else(|e| panic!("spot: {e}"));
     assert_eq!(iso.steps, steps);
     let rates: Vec<u32> = (0..iso.mesh.faces())

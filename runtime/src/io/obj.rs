@@ -1,0 +1,239 @@
+//! Wavefront OBJ input: positions, polygonal faces (triangles, quads, n-gons) and
+//! OpenSubdiv-style `t` tag lines.
+//!
+//! Read: `v x y z [w]`, `f a a/b a/b/c a//c ...` (1-based, or negative = relative to the vertices
+//! read so far), `t name i/f/s ints... floats... strings...` (OpenSubdiv's `shape_utils`
+//! convention; indices in tags are 0-based). Ignored as irrelevant to the surface: `vt`, `vn`,
+//! `vp`, `g`, `o`, `s`, `mtllib`, `usemtl`, `l` and comments. Anything else is an error naming the
+//! line, so a file in another dialect is not silently misread.
+
+use std::path::Path;
+
+use schemes::BoundaryMode;
+
+use crate::mesh::Mesh;
+use crate::{MeshError, RuntimeError};
+
+/// One `t` tag line.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Tag {
+    /// The tag's name (`crease`, `corner`, `interpolateboundary`, `hole`, ...).
+    pub name: String,
+    /// Its integer arguments.
+    pub ints: Vec<i64>,
+    /// Its float arguments.
+    pub floats: Vec<f64>,
+    /// Its string arguments.
+    pub strings: Vec<String>,
+    /// 1-based line number.
+    pub line: usize,
+}
+
+/// What an OBJ file says, before any topological check.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ObjMesh {
+    /// Vertex positions.
+    pub positions: Vec<[f64; 3]>,
+    /// Faces as 0-based vertex indices (not yet checked against `positions`).
+    pub faces: Vec<Vec<i64>>,
+    /// The 1-based line of each face, for messages.
+    pub face_lines: Vec<usize>,
+    /// Tag lines.
+    pub tags: Vec<Tag>,
+}
+
+/// Parse OBJ text.
+pub fn parse_obj(text: &str) -> Result<ObjMesh, RuntimeError> {
+    let mut mesh = ObjMesh::default();
+    for (index, raw) in text.lines().enumerate() {
+        let line = index + 1;
+        let content = raw.split('#').next().unwrap_or("").trim();
+        let mut words = content.split_whitespace();
+        let Some(keyword) = words.next() else {
+            continue;
+        };
+        let err = |message: String| RuntimeError::Obj { line, message };
+        match keyword {
+            "v" => {
+                let coords: Vec<f64> = words
+                    .map(|w| {
+                        w.parse::<f64>()
+                            .map_err(|_| err(format!("`{w}` is not a number")))
+                    })
+                    .collect::<Result<_, _>>()?;
+                if !(3..=4).contains(&coords.len()) {
+                    return Err(err(format!(
+                        "a vertex needs 3 coordinates, this one has {}",
+                        coords.len()
+                    )));
+                }
+                mesh.positions.push([coords[0], coords[1], coords[2]]);
+            }
+            "f" => {
+                let count = mesh.positions.len() as i64;
+                let corners: Vec<i64> = words
+                    .map(|w| {
+                        let first = w.split('/').next().unwrap_or("");
+                        let i: i64 = first
+                            .parse()
+                            .map_err(|_| err(format!("`{w}` is not a vertex reference")))?;
+                        match i {
+                            0 => Err(err("vertex index 0 (OBJ indices start at 1)".to_owned())),
+                            i if i > 0 => Ok(i - 1),
+                            i => Ok(count + i),
+                        }
+                    })
+                    .collect::<Result<_, _>>()?;
+                mesh.faces.push(corners);
+                mesh.face_lines.push(line);
+            }
+            "t" => mesh.tags.push(parse_tag(words.collect(), line)?),
+            "vt" | "vn" | "vp" | "g" | "o" | "s" | "mtllib" | "usemtl" | "l" => {}
+            other => return Err(err(format!("unknown OBJ statement `{other}`"))),
+        }
+    }
+    Ok(mesh)
+}
+
+fn parse_tag(words: Vec<&str>, line: usize) -> Result<Tag, RuntimeError> {
+    let err = |message: String| RuntimeError::Obj { line, message };
+    let (Some(name), Some(counts)) = (words.first(), words.get(1)) else {
+        return Err(err(
+            "a tag needs a name and counts `ints/floats/strings`".to_owned()
+        ));
+    };
+    let counts: Vec<usize> = counts
+        .split('/')
+        .map(|c| {
+            c.parse()
+                .map_err(|_| err(format!("tag counts `{counts}` are not `i/f/s`")))
+        })
+        .collect::<Result<_, _>>()?;
+    let [ni, nf, ns] = counts[..] else {
+        return Err(err(format!("tag counts `{}` are not `i/f/s`", words[1])));
+    };
+    let args = &words[2..];
+    if args.len() != ni + nf + ns {
+        return Err(err(format!(
+            "tag `{name}` announces {} arguments and has {}",
+            ni + nf + ns,
+            args.len()
+        )));
+    }
+    let ints = args[..ni]
+        .iter()
+        .map(|w| {
+            w.parse()
+                .map_err(|_| err(format!("`{w}` is not an integer")))
+        })
+        .collect::<Result<_, _>>()?;
+    let floats = args[ni..ni + nf]
+        .iter()
+        .map(|w| w.parse().map_err(|_| err(format!("`{w}` is not a number"))))
+        .collect::<Result<_, _>>()?;
+    let strings = args[ni + nf..].iter().map(|s| (*s).to_owned()).collect();
+    Ok(Tag {
+        name: (*name).to_owned(),
+        ints,
+        floats,
+        strings,
+        line,
+    })
+}
+
+/// Read and parse an OBJ file.
+pub fn read_obj(path: &Path) -> Result<ObjMesh, RuntimeError> {
+    let text = std::fs::read_to_string(path).map_err(|source| RuntimeError::Io {
+        path: path.display().to_string(),
+        source,
+    })?;
+    parse_obj(&text).map_err(|e| match e {
+        RuntimeError::Obj { line, message } => RuntimeError::ParseFile {
+            path: path.display().to_string(),
+            line,
+            message,
+        },
+        other => other,
+    })
+}
+
+impl Mesh {
+    /// Build from a parsed OBJ file; also returns one warning per tag name this runtime does not
+    /// honour yet (creases, corners, holes, ...), and reads `interpolateboundary`.
+    pub fn from_obj(obj: &ObjMesh) -> Result<(Self, Vec<String>), MeshError> {
+        let mut boundary = BoundaryMode::EdgeOnly;
+        let mut unsupported: Vec<(String, usize)> = Vec::new();
+        for tag in &obj.tags {
+            match (tag.name.as_str(), tag.ints.first()) {
+                ("interpolateboundary", Some(1)) => boundary = BoundaryMode::EdgeAndCorner,
+                ("interpolateboundary", Some(2)) => boundary = BoundaryMode::EdgeOnly,
+                // Face-varying data does not affect positions.
+                ("facevaryinginterpolateboundary" | "facevaryingpropagatecorners", _) => {}
+                (name, _) => match unsupported.iter_mut().find(|(n, _)| n == name) {
+                    Some((_, count)) => *count += 1,
+                    None => unsupported.push((name.to_owned(), 1)),
+                },
+            }
+        }
+        let warnings = unsupported
+            .into_iter()
+            .map(|(name, count)| {
+                format!("tag `{name}` ({count} line(s)) is not supported yet and is ignored")
+            })
+            .collect();
+        let mesh = Mesh::new(obj.positions.clone(), &obj.faces, &obj.face_lines, boundary)?;
+        Ok((mesh, warnings))
+    }
+
+    /// Read an OBJ file (with its `t` tags) into a mesh; tags this runtime does not honour yet
+    /// are ignored (see [`Mesh::read_obj_with_warnings`] for the list).
+    pub fn read_obj(path: impl AsRef<Path>) -> Result<Mesh, RuntimeError> {
+        Ok(Self::read_obj_with_warnings(path)?.0)
+    }
+
+    /// [`Mesh::read_obj`], and one warning per tag name it ignores.
+    pub fn read_obj_with_warnings(
+        path: impl AsRef<Path>,
+    ) -> Result<(Mesh, Vec<String>), RuntimeError> {
+        let obj = read_obj(path.as_ref())?;
+        Ok(Mesh::from_obj(&obj)?)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reads_faces_tags_and_relative_indices() {
+        let text = "# a quad\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nf 1/1 2/1 3/1 -1//1\nt crease 2/1/0 0 1 2.5\ng x\n";
+        let m = parse_obj(text).expect("valid");
+        assert_eq!(m.positions.len(), 4);
+        assert_eq!(m.faces, vec![vec![0, 1, 2, 3]]);
+        assert_eq!(m.tags[0].name, "crease");
+        assert_eq!(m.tags[0].ints, vec![0, 1]);
+        assert_eq!(m.tags[0].floats, vec![2.5]);
+    }
+
+    #[test]
+    fn bad_lines_name_their_line() {
+        for (text, line, message) in [
+            ("v 0 0\n", 1, "3 coordinates"),
+            ("v 0 0 0\nf 1 x 2\n", 2, "`x`"),
+            ("v 0 0 0\nf 0 1 2\n", 2, "index 0"),
+            ("\n\nwat 1 2\n", 3, "unknown OBJ statement"),
+            ("t crease 2/1/0 0 1\n", 1, "announces 3 arguments"),
+        ] {
+            match parse_obj(text) {
+                Err(RuntimeError::Obj {
+                    line: l,
+                    message: m,
+                }) => {
+                    assert_eq!(l, line, "{text}");
+                    assert!(m.contains(message), "{m}");
+                }
+                other => panic!("{text}: {other:?}"),
+            }
+        }
+    }
+}

@@ -1,0 +1,13 @@
+//! The mesh layer: polygon and triangle topology (half-edges, fans, boundaries), geometry
+//! helpers on `[f64; 3]` points, and the sample locations (face and exact parameters) every
+//! tessellator reports. Nothing here knows a subdivision scheme or a file format.
+
+pub mod geometry;
+pub mod source;
+#[cfg(test)]
+pub(crate) mod test_meshes;
+pub mod topology;
+pub mod triangle_topology;
+
+pub use source::VertexSource;
+pub use topology::{Mesh, NONE};

@@ -1,0 +1,367 @@
+//! Polygon-mesh topology: a compact half-edge structure over face-vertex lists, with the
+//! validation a subdivision surface needs.
+//!
+//! Half-edge `h` is corner `h` of the flattened face-vertex array: it runs from
+//! `face_vertices[h]` to the next corner of the same face. `twin[h]` is the half-edge running
+//! the other way in the neighbouring face, or [`NONE`] on the boundary. A mesh is accepted when
+//! every face has at least three distinct, existing vertices, every coordinate is finite, every
+//! edge has one or two faces traversing it in opposite directions, and the faces around every
+//! vertex form a single fan (a disc, or a half-disc at the boundary).
+
+use schemes::BoundaryMode;
+
+use crate::MeshError;
+
+/// "No half-edge": the twin of a boundary half-edge.
+pub const NONE: u32 = u32::MAX;
+
+/// A validated polygon mesh.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mesh {
+    /// Vertex positions.
+    pub positions: Vec<[f64; 3]>,
+    /// Face `f` owns half-edges `face_offsets[f]..face_offsets[f + 1]`.
+    pub face_offsets: Vec<u32>,
+    /// The vertex each half-edge starts at.
+    pub face_vertices: Vec<u32>,
+    /// The opposite half-edge, or [`NONE`].
+    pub twin: Vec<u32>,
+    /// The face of each half-edge.
+    pub face_of: Vec<u32>,
+    /// One outgoing half-edge per vertex (on the boundary: the one with no twin, so that turning
+    /// from it visits the whole fan); [`NONE`] for unused vertices.
+    pub vertex_halfedge: Vec<u32>,
+    /// The boundary rule.
+    pub boundary: BoundaryMode,
+}
+
+impl Mesh {
+    /// Build and validate from faces given as vertex indices. `lines` (the faces' OBJ lines)
+    /// only labels errors.
+    pub fn new(
+        positions: Vec<[f64; 3]>,
+        faces: &[Vec<i64>],
+        lines: &[usize],
+        boundary: BoundaryMode,
+    ) -> Result<Self, MeshError> {
+        if faces.is_empty() {
+            return Err(MeshError::Empty);
+        }
+        if let Some((vertex, p)) = positions
+            .iter()
+            .enumerate()
+            .find(|(_, p)| p.iter().any(|c| !c.is_finite()))
+        {
+            return Err(MeshError::NonFinite {
+                vertex,
+                position: *p,
+            });
+        }
+        let mut face_offsets = vec![0u32];
+        let mut face_vertices = Vec::new();
+        let mut face_of = Vec::new();
+        for (f, face) in faces.iter().enumerate() {
+            let bad = |reason: String| MeshError::BadFace {
+                face: f,
+                line: lines.get(f).copied().unwrap_or(0),
+                reason,
+            };
+            if face.len() < 3 {
+                return Err(bad(format!(
+                    "it has {} vertices; a face needs at least 3",
+                    face.len()
+                )));
+            }
+            for (i, &v) in face.iter().enumerate() {
+                if v < 0 || v as usize >= positions.len() {
+                    return Err(bad(format!(
+                        "vertex index {} is out of range (the mesh has {} vertices)",
+                        v + 1,
+                        positions.len()
+                    )));
+                }
+                if face[..i].contains(&v) {
+                    return Err(bad(format!("vertex {v} appears twice")));
+                }
+                face_vertices.push(v as u32);
+                face_of.push(f as u32);
+            }
+            face_offsets.push(face_vertices.len() as u32);
+        }
+        let mut mesh = Mesh {
+            vertex_halfedge: vec![NONE; positions.len()],
+            positions,
+            face_offsets,
+            twin: vec![NONE; face_vertices.len()],
+            face_vertices,
+            face_of,
+            boundary,
+        };
+        mesh.link_twins()?;
+        mesh.check_fans()?;
+        Ok(mesh)
+    }
+
+    /// Number of faces.
+    pub fn faces(&self) -> usize {
+        self.face_offsets.len() - 1
+    }
+
+    /// The half-edges of face `f`.
+    pub fn face_halfedges(&self, f: usize) -> std::ops::Range<usize> {
+        self.face_offsets[f] as usize..self.face_offsets[f + 1] as usize
+    }
+
+    /// The vertices of face `f`.
+    pub fn face(&self, f: usize) -> &[u32] {
+        &self.face_vertices[self.face_halfedges(f)]
+    }
+
+    /// The next half-edge in the same face.
+    pub fn next(&self, h: usize) -> usize {
+        let f = self.face_of[h] as usize;
+        if h + 1 == self.face_offsets[f + 1] as usize {
+            self.face_offsets[f] as usize
+        } else {
+            h + 1
+        }
+    }
+
+    /// The previous half-edge in the same face.
+    pub fn prev(&self, h: usize) -> usize {
+        let f = self.face_of[h] as usize;
+        if h == self.face_offsets[f] as usize {
+            self.face_offsets[f + 1] as usize - 1
+        } else {
+            h - 1
+        }
+    }
+
+    /// The vertex half-edge `h` ends at.
+    pub fn head(&self, h: usize) -> u32 {
+        self.face_vertices[self.next(h)]
+    }
+
+    /// Outgoing half-edges of vertex `v` in fan order (counter-clockwise for faces listed
+    /// counter-clockwise), starting at [`Mesh::vertex_halfedge`]; empty for unused vertices.
+    pub fn fan(&self, v: usize) -> Vec<usize> {
+        let start = self.vertex_halfedge[v];
+        if start == NONE {
+            return Vec::new();
+        }
+        let mut out = vec![start as usize];
+        let mut h = start as usize;
+        loop {
+            // The half-edge into v in this face, then across to the next face's outgoing one.
+            let t = self.twin[self.prev(h)];
+            if t == NONE || t == start {
+                return out;
+            }
+            h = t as usize;
+            out.push(h);
+        }
+    }
+
+    /// The number of faces around every vertex (`fan(v).len()`, 0 for unused vertices), in
+    /// one pass over the faces: validation made the faces around a vertex one fan, so they are
+    /// the faces it appears in.
+    pub fn valences(&self) -> Vec<usize> {
+        let mut valence = vec![0; self.positions.len()];
+        for &v in &self.face_vertices {
+            valence[v as usize] += 1;
+        }
+        valence
+    }
+
+    /// Whether vertex `v` is on the boundary.
+    pub fn is_boundary_vertex(&self, v: usize) -> bool {
+        let h = self.vertex_halfedge[v];
+        h != NONE && self.twin[h as usize] == NONE
+    }
+
+    fn link_twins(&mut self) -> Result<(), MeshError> {
+        // Half-edges grouped by tail (counting sort): a twin is found among its head's few
+        // outgoing half-edges, without hashing every directed edge.
+        let halfedges = self.face_vertices.len();
+        let mut start = vec![0u32; self.positions.len() + 1];
+        for &v in &self.face_vertices {
+            start[v as usize + 1] += 1;
+        }
+        for v in 0..self.positions.len() {
+            start[v + 1] += start[v];
+        }
+        let mut fill = start.clone();
+        let mut outgoing = vec![0u32; halfedges];
+        for (h, &v) in self.face_vertices.iter().enumerate() {
+            outgoing[fill[v as usize] as usize] = h as u32;
+            fill[v as usize] += 1;
+        }
+        let leaving =
+            |v: u32| &outgoing[start[v as usize] as usize..start[v as usize + 1] as usize];
+        for h in 0..halfedges {
+            let (a, b) = (self.face_vertices[h], self.head(h));
+            // The same directed edge twice: the first earlier copy, as a scan in order finds it.
+            if let Some(&other) = leaving(a)
+                .iter()
+                .find(|&&g| (g as usize) < h && self.head(g as usize) == b)
+            {
+                return Err(MeshError::NonManifoldEdge {
+                    a: a as usize,
+                    b: b as usize,
+                    faces: vec![
+                        self.face_of[other as usize] as usize,
+                        self.face_of[h] as usize,
+                    ],
+                });
+            }
+            if let Some(&t) = leaving(b).iter().find(|&&g| self.head(g as usize) == a) {
+                self.twin[h] = t;
+            }
+        }
+        Ok(())
+    }
+
+    fn check_fans(&mut self) -> Result<(), MeshError> {
+        let mut outgoing = vec![0usize; self.positions.len()];
+        for (h, &v) in self.face_vertices.iter().enumerate() {
+            outgoing[v as usize] += 1;
+            let current = self.vertex_halfedge[v as usize];
+            // Prefer a boundary half-edge (no twin) as the start of the fan.
+            if current == NONE || (self.twin[h] == NONE && self.twin[current as usize] != NONE) {
+                self.vertex_halfedge[v as usize] = h as u32;
+            }
+        }
+        for (v, &count) in outgoing.iter().enumerate() {
+            if count > 0 && self.fan(v).len() != count {
+                return Err(MeshError::NonManifoldVertex {
+                    vertex: v,
+                    faces: count,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Number of boundary loops: cycles of boundary half-edges, each followed to the boundary
+    /// half-edge leaving its head (a manifold vertex has at most one).
+    pub fn boundary_loops(&self) -> usize {
+        let mut seen = vec![false; self.face_vertices.len()];
+        let mut loops = 0;
+        for h in 0..self.face_vertices.len() {
+            if self.twin[h] != NONE || seen[h] {
+                continue;
+            }
+            loops += 1;
+            let mut e = h;
+            while !seen[e] {
+                seen[e] = true;
+                e = self.vertex_halfedge[self.head(e) as usize] as usize;
+            }
+        }
+        loops
+    }
+
+    /// Euler characteristic V - E + F (unused vertices not counted).
+    pub fn euler_characteristic(&self) -> i64 {
+        let used = self.vertex_halfedge.iter().filter(|&&h| h != NONE).count() as i64;
+        let halfedges = self.face_vertices.len() as i64;
+        let boundary = self.twin.iter().filter(|&&t| t == NONE).count() as i64;
+        let edges = (halfedges + boundary) / 2;
+        used - edges + self.faces() as i64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn grid(n: i64) -> (Vec<[f64; 3]>, Vec<Vec<i64>>) {
+        let positions = (0..=n)
+            .flat_map(|j| (0..=n).map(move |i| [i as f64, j as f64, 0.0]))
+            .collect();
+        let faces = (0..n)
+            .flat_map(|j| {
+                (0..n).map(move |i| {
+                    let v = j * (n + 1) + i;
+                    vec![v, v + 1, v + n + 2, v + n + 1]
+                })
+            })
+            .collect();
+        (positions, faces)
+    }
+
+    #[test]
+    fn a_grid_has_boundary_fans_and_euler_characteristic_one() {
+        let (p, f) = grid(3);
+        let m = Mesh::new(p, &f, &[], BoundaryMode::EdgeOnly).expect("valid");
+        assert_eq!(m.euler_characteristic(), 1);
+        assert_eq!(m.fan(5).len(), 4); // interior
+        assert_eq!(m.fan(1).len(), 2); // boundary edge vertex
+        assert_eq!(m.fan(0).len(), 1); // corner
+        assert!(m.is_boundary_vertex(1) && !m.is_boundary_vertex(5));
+    }
+
+    #[test]
+    fn each_defect_is_named() {
+        let (p, f) = grid(1);
+        assert_eq!(
+            Mesh::new(p.clone(), &[], &[], BoundaryMode::EdgeOnly),
+            Err(MeshError::Empty)
+        );
+        let mut bad = p.clone();
+        bad[2][1] = f64::NAN;
+        assert!(matches!(
+            Mesh::new(bad, &f, &[], BoundaryMode::EdgeOnly),
+            Err(MeshError::NonFinite { vertex: 2, .. })
+        ));
+        let e = Mesh::new(p.clone(), &[vec![0, 1]], &[7], BoundaryMode::EdgeOnly)
+            .expect_err("two vertices");
+        assert!(matches!(
+            e,
+            MeshError::BadFace {
+                face: 0,
+                line: 7,
+                ..
+            }
+        ));
+        let e = Mesh::new(p.clone(), &[vec![0, 1, 9]], &[], BoundaryMode::EdgeOnly)
+            .expect_err("out of range");
+        assert!(e.to_string().contains("out of range"), "{e}");
+        let e = Mesh::new(p.clone(), &[vec![0, 1, 1, 2]], &[], BoundaryMode::EdgeOnly)
+            .expect_err("repeated");
+        assert!(e.to_string().contains("appears twice"), "{e}");
+        // Three faces on edge (0, 1).
+        let mut p3 = p.clone();
+        p3.push([0.5, -1.0, 0.0]);
+        p3.push([0.5, 0.0, 1.0]);
+        let faces = vec![vec![0, 1, 3, 2], vec![1, 0, 4], vec![0, 1, 5]];
+        let e =
+            Mesh::new(p3, &faces, &[], BoundaryMode::EdgeOnly).expect_err("three faces on an edge");
+        assert!(matches!(e, MeshError::NonManifoldEdge { .. }), "{e}");
+        // Two triangles touching at one vertex only.
+        let p2 = vec![
+            [0.0; 3],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, -1.0, 0.0],
+        ];
+        let e = Mesh::new(
+            p2,
+            &[vec![0, 1, 2], vec![0, 3, 4]],
+            &[],
+            BoundaryMode::EdgeOnly,
+        )
+        .expect_err("bowtie");
+        assert!(
+            matches!(
+                e,
+                MeshError::NonManifoldVertex {
+                    vertex: 0,
+                    faces: 2
+                }
+            ),
+            "{e}"
+        );
+    }
+}

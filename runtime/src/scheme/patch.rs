@@ -1,0 +1,280 @@
+//! Which table stencils and which mesh vertices evaluate one quad face.
+//!
+//! A face of an isolated mesh (all quads, at most one irregular corner per face) is a patch of
+//! the tables (`docs/algorithms/extraordinary-stencils.md`): its irregular corner — or, on the
+//! boundary, a boundary corner; or any corner of a regular face — is the patch's vertex `V` at
+//! `(0,0)`, and its control points are gathered in the table's layout order
+//! `V, E_1.., F_1.., O_1..O_7` by walking the half-edges:
+//!
+//! * `E_i`, `F_i` around `V`: the fan of `V` in order, starting at the patch face (interior) or
+//!   at the boundary (boundary vertex; the patch face is then sector `s` of the fan);
+//! * the outer points, in the patch face's own coordinates: across its edge `E_1-F_1` lies the
+//!   cell holding `O_2 = (2,0)` and `O_3 = (2,1)`, below that cell's edge `E_1-O_2` the one with
+//!   `O_1 = (2,-1)`, above its edge `F_1-O_3` the one with `O_4`, `O_5`, then `O_6`, `O_7`.
+//!
+//! Face parameters map to patch parameters by the rotation that brings the chosen corner to
+//! `(0,0)`: corner `k` of the face `(c_0, c_1, c_2, c_3)` gives
+//! `(u', v') = (u, v), (v, 1-u), (1-u, 1-v), (1-v, u)` for `k = 0, 1, 2, 3`.
+
+use table_format::{PointSet, SectionKey, StencilKind};
+
+use crate::mesh::topology::{Mesh, NONE};
+use crate::stencil_table::StencilTable;
+use crate::{MeshError, RuntimeError};
+
+/// Which table patch a face is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct PatchKind {
+    /// Whether the patch vertex is on the boundary.
+    pub boundary: bool,
+    /// Its valence (interior) or number of faces (boundary).
+    pub faces: u32,
+    /// Which of a boundary vertex's patches (0 for interior).
+    pub sector: u32,
+}
+
+/// A face's patch: its kind, its control points (mesh vertices in layout order), and which face
+/// corner is the patch's `(0,0)`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FacePatch {
+    /// The table patch.
+    pub kind: PatchKind,
+    /// Mesh vertex of every layout entry.
+    pub points: Vec<u32>,
+    /// The face corner at the patch's `(0,0)`.
+    pub corner: usize,
+}
+
+/// Gather the patch of every face; the first face that is not one is an error.
+pub fn gather_patches(mesh: &Mesh) -> Result<Vec<FacePatch>, MeshError> {
+    (0..mesh.faces()).map(|f| face_patch(mesh, f)).collect()
+}
+
+/// Whether vertex `v` is irregular: interior valence other than 4, or a boundary vertex with
+/// other than two faces.
+pub fn is_irregular(mesh: &Mesh, v: usize) -> bool {
+    let faces = mesh.fan(v).len();
+    if mesh.is_boundary_vertex(v) {
+        faces != 2
+    } else {
+        faces != 4
+    }
+}
+
+/// The patch of quad face `face`.
+pub fn face_patch(mesh: &Mesh, face: usize) -> Result<FacePatch, MeshError> {
+    let not_isolated = |reason: String| MeshError::NotIsolated { face, reason };
+    let corners = mesh.face(face);
+    if corners.len() != 4 {
+        return Err(not_isolated(format!(
+            "it has {} sides; patches are quads",
+            corners.len()
+        )));
+    }
+    let special: Vec<usize> = (0..4)
+        .filter(|&k| {
+            is_irregular(mesh, corners[k] as usize) || mesh.is_boundary_vertex(corners[k] as usize)
+        })
+        .collect();
+    let irregular = (0..4)
+        .filter(|&k| is_irregular(mesh, corners[k] as usize))
+        .count();
+    if irregular > 1 {
+        return Err(not_isolated(format!(
+            "{irregular} of its corners are irregular"
+        )));
+    }
+    // The irregular corner if any, else a boundary corner, else corner 0.
+    let corner = (0..4)
+        .find(|&k| is_irregular(mesh, corners[k] as usize))
+        .or_else(|| special.first().copied())
+        .unwrap_or(0);
+    let h0 = mesh.face_halfedges(face).start + corner;
+    let centre = mesh.face_vertices[h0] as usize;
+    if special
+        .iter()
+        .any(|&k| k != corner && is_irregular(mesh, corners[k] as usize))
+    {
+        return Err(not_isolated("two irregular corners".to_owned()));
+    }
+    if (0..4).any(|k| k != corner && mesh.is_boundary_vertex(corners[k] as usize))
+        && !mesh.is_boundary_vertex(centre)
+    {
+        return Err(not_isolated(
+            "an interior irregular corner and a boundary corner".to_owned(),
+        ));
+    }
+    let fan = mesh.fan(centre);
+    let boundary = mesh.is_boundary_vertex(centre);
+    let position = fan
+        .iter()
+        .position(|&h| h == h0)
+        .ok_or_else(|| not_isolated("the face is not in its corner's fan".to_owned()))?;
+    // Interior: the fan starts at the patch face. Boundary: at the boundary, the face is sector s.
+    let (fan, sector) = if boundary {
+        (fan, position)
+    } else {
+        let mut rotated = fan[position..].to_vec();
+        rotated.extend_from_slice(&fan[..position]);
+        (rotated, 0)
+    };
+    let quad = |h: usize| -> Result<usize, MeshError> {
+        let f = mesh.face_of[h] as usize;
+        if mesh.face(f).len() == 4 {
+            Ok(h)
+        } else {
+            Err(not_isolated(format!("face {f} next to it is not a quad")))
+        }
+    };
+    let mut points = vec![centre as u32];
+    for &h in &fan {
+        points.push(mesh.head(quad(h)?));
+    }
+    if boundary {
+        // E_{f+1}: the start of the last face's edge into the centre.
+        let last = *fan
+            .last()
+            .ok_or_else(|| not_isolated("isolated vertex".to_owned()))?;
+        points.push(mesh.face_vertices[mesh.prev(last)]);
+    }
+    for &h in &fan {
+        points.push(mesh.head(mesh.next(h)));
+    }
+    // Outer points, walking cells from the patch face. `across(h)` is the twin, if any.
+    let across = |h: usize| -> Result<Option<usize>, MeshError> {
+        match mesh.twin[h] {
+            NONE => Ok(None),
+            t => quad(t as usize).map(Some),
+        }
+    };
+    let (next, head) = (|h: usize| mesh.next(h), |h: usize| mesh.head(h));
+    // g1 = F_1 -> E_1 in the cell [1,2] x [0,1].
+    let g1 = across(next(h0))?;
+    let mut outer: [Option<u32>; 7] = [None; 7];
+    if let Some(g1) = g1 {
+        outer[1] = Some(head(next(g1)));
+        outer[2] = Some(head(next(next(g1))));
+        // Below the edge E_1 -> O_2: the cell [1,2] x [-1,0], where O_1 -> O_2 precedes O_2 -> E_1.
+        if let Some(g0) = across(next(g1))? {
+            outer[0] = Some(mesh.face_vertices[mesh.prev(g0)]);
+        }
+        // Above the edge O_3 -> F_1: the cell [1,2] x [1,2] = (F_1, O_3, O_4, O_5).
+        if let Some(g2) = across(next(next(next(g1))))? {
+            outer[3] = Some(head(next(g2)));
+            outer[4] = Some(head(next(next(g2))));
+            // Left of O_5 -> F_1: the cell [0,1] x [1,2] = (E_2, F_1, O_5, O_6).
+            if let Some(g3) = across(next(next(next(g2))))? {
+                outer[5] = Some(head(next(g3)));
+                // Left of O_6 -> E_2: the cell [-1,0] x [1,2] = (F_2, E_2, O_6, O_7).
+                if let Some(g4) = across(next(next(g3)))? {
+                    outer[6] = Some(head(next(g4)));
+                }
+            }
+        }
+    }
+    // A boundary patch lacks exactly O_1 in sector 0 and O_7 in the last sector; all else exists.
+    let faces = fan.len() as u32;
+    for (i, point) in outer.iter().enumerate() {
+        let absent = boundary && ((i == 0 && sector == 0) || (i == 6 && sector + 1 == fan.len()));
+        match (point, absent) {
+            (Some(p), false) => points.push(*p),
+            (None, true) => {}
+            (Some(_), true) => {
+                return Err(not_isolated(format!(
+                    "outer point O{} exists beyond the boundary",
+                    i + 1
+                )))
+            }
+            (None, false) => {
+                return Err(not_isolated(format!(
+                    "outer point O{} is missing (a boundary too close)",
+                    i + 1
+                )))
+            }
+        }
+    }
+    Ok(FacePatch {
+        kind: PatchKind {
+            boundary,
+            faces,
+            sector: sector as u32,
+        },
+        points,
+        corner,
+    })
+}
+
+/// The patch parameters of face parameters `(u, v)` for a patch at face corner `corner`.
+pub fn to_patch(corner: usize, u: f64, v: f64) -> (f64, f64) {
+    match corner {
+        0 => (u, v),
+        1 => (v, 1.0 - u),
+        2 => (1.0 - u, 1.0 - v),
+        _ => (1.0 - v, u),
+    }
+}
+
+/// The patch indices of the face's dual point `(i, j)` at rate `n` (the rotation of
+/// [`to_patch`] on the dual grid).
+pub fn dual_index_in_patch(corner: usize, i: usize, j: usize, n: usize) -> (usize, usize) {
+    let last = n - 1;
+    match corner {
+        0 => (i, j),
+        1 => (j, last - i),
+        2 => (last - i, last - j),
+        _ => (last - j, i),
+    }
+}
+
+/// The limit positions at the dual points `((2i+1)/2n, (2j+1)/2n)` of the face, in the face's
+/// own parameters, row by row (`j` outer): a direct table evaluation, one weighted sum of the
+/// patch's control points per point.
+pub fn dual_positions(
+    table: &StencilTable,
+    mesh: &Mesh,
+    patch: &FacePatch,
+    n: u32,
+) -> Result<Vec<[f64; 3]>, RuntimeError> {
+    let key = SectionKey {
+        kind: StencilKind::Position,
+        points: PointSet::Dual,
+        boundary: patch.kind.boundary,
+        faces: patch.kind.faces,
+        sector: patch.kind.sector,
+        n,
+    };
+    // A one-face boundary vertex is smooth in "edge only" mode and pinned in "edge and corner"
+    // mode: its stencils must come from a table made for the mesh's mode.
+    let corners = mesh.boundary == schemes::BoundaryMode::EdgeAndCorner;
+    if patch.kind.boundary && patch.kind.faces == 1 && table.pins_corners() != corners {
+        return Err(RuntimeError::BoundaryModeMismatch {
+            mesh_corners: corners,
+        });
+    }
+    let weights = table.weights(&key)?;
+    let k = patch.points.len();
+    let nu = n as usize;
+    if weights.len() != nu * nu * k {
+        return Err(RuntimeError::LayoutMismatch {
+            key,
+            table: weights.len() / (nu * nu).max(1),
+            patch: k,
+        });
+    }
+    let mut out = Vec::with_capacity(nu * nu);
+    for j in 0..nu {
+        for i in 0..nu {
+            let (pi, pj) = dual_index_in_patch(patch.corner, i, j, nu);
+            let row = &weights[(pj * nu + pi) * k..][..k];
+            let mut p = [0.0; 3];
+            for (w, &v) in row.iter().zip(&patch.points) {
+                let q = mesh.positions[v as usize];
+                for c in 0..3 {
+                    p[c] += f64::from(*w) * q[c];
+                }
+            }
+            out.push(p);
+        }
+    }
+    Ok(out)
+}

@@ -1,0 +1,75 @@
+//! Isolation for the region schemes (the butterfly, √3): whole-mesh steps until every triangle
+//! is a table patch ([`crate::scheme::triangle::region_patch`]), the children tracked by
+//! [`crate::scheme::triangle::isolation`].
+//!
+//! A step keeps every vertex's valence and makes every new vertex regular, so it doubles (the
+//! butterfly) or triples (√3's ternary step) the graph distance between extraordinary vertices.
+//! A region's layout reaches five rings from its vertex, so two extraordinary vertices need to
+//! be about six edges apart: three butterfly steps or two ternary √3 steps for neighbours,
+//! fewer for vertices already apart.
+
+use std::collections::BTreeSet;
+
+use crate::mesh::topology::Mesh;
+use crate::mesh::triangle_topology::require_closed_triangles;
+use crate::scheme::butterfly::refine::butterfly_refine;
+use crate::scheme::sqrt3::refine::sqrt3_refine;
+use crate::scheme::triangle::isolation::{
+    isolate_by_refinement, TriangleIsolation, MAX_ISOLATION_STEPS,
+};
+use crate::scheme::triangle::patch::Phantoms;
+use crate::scheme::triangle::region_patch::{gather_region_patches, RegionCatalogue, RegionScheme};
+use crate::scheme::triangle::split::Split;
+use crate::RuntimeError;
+
+impl RegionScheme {
+    /// How one of the scheme's whole-mesh steps splits a triangle.
+    pub fn split(self) -> Split {
+        match self {
+            RegionScheme::Butterfly => Split::Dyadic,
+            RegionScheme::Sqrt3 => Split::Ternary,
+        }
+    }
+
+    /// At most this many steps are taken: three butterfly steps or two ternary √3 steps separate
+    /// neighbouring extraordinary vertices, and one more covers meshes whose small size makes a
+    /// chart close on itself. The cap bounds a failing isolation's memory: 4^4 = 256 or
+    /// 9^3 = 729 times the input's triangles.
+    pub fn max_steps(self) -> usize {
+        match self {
+            RegionScheme::Butterfly => MAX_ISOLATION_STEPS,
+            RegionScheme::Sqrt3 => 3,
+        }
+    }
+
+    /// One whole-mesh step: a butterfly step, or two √3 steps.
+    pub fn refine(self, mesh: &Mesh) -> Result<Mesh, RuntimeError> {
+        match self {
+            RegionScheme::Butterfly => Ok(butterfly_refine(mesh)?.mesh),
+            RegionScheme::Sqrt3 => sqrt3_refine(mesh),
+        }
+    }
+}
+
+/// Check that `mesh` is a closed triangle mesh, refine it by `scheme` until every triangle is a
+/// table patch, and gather every triangle's patch.
+pub fn isolate_regions(
+    mesh: &Mesh,
+    scheme: RegionScheme,
+) -> Result<TriangleIsolation, RuntimeError> {
+    require_closed_triangles(mesh, scheme.name())?;
+    let valences: BTreeSet<u32> = mesh
+        .valences()
+        .into_iter()
+        .filter(|&k| k != 0)
+        .map(|k| k as u32)
+        .collect();
+    let catalogue = RegionCatalogue::new(scheme, valences)?;
+    isolate_by_refinement(
+        mesh,
+        scheme.split(),
+        scheme.max_steps(),
+        |m| scheme.refine(m),
+        |m| Ok((gather_region_patches(m, &catalogue)?, Phantoms::new(m))),
+    )
+}

@@ -1,0 +1,969 @@
+//! The dual-grid watertight tessellator (Schaefer–Warren section 5.5), per-face rates, closed
+//! meshes and meshes with boundary.
+//!
+//! Every face at rate `n` gets the `n x n` dual points `((2i+1)/2n, (2j+1)/2n)` of its
+//! parameter domain, evaluated once from the table. Polygons connect them:
+//!
+//! * face interiors: the `(n-1)^2` quads of the dual grid, two triangles each;
+//! * interior edges: the strip between the two faces' dual rows nearest the shared edge, merged
+//!   by their parameter along the edge when the rates differ (`n_a + n_b - 2` triangles);
+//! * boundary edges: the strip between the face's dual row and the `n + 1` points
+//!   `t/n` of the limit boundary curve over that edge (`2n - 1` triangles); the curve's interior
+//!   points belong to the edge, its end points (the limit positions of the boundary vertices) to
+//!   the vertices, each made once;
+//! * vertices: the polygon of the surrounding faces' dual points nearest the vertex (a v-gon),
+//!   closed on a boundary vertex by the vertex's limit position.
+//!
+//! Every output vertex is made exactly once and every polygon refers to it by index, so the
+//! output is watertight by construction; nothing is welded by distance.
+//!
+//! The work splits into a [`DualGrid`] plan, built once per mesh and rates (patches, table
+//! sections, separable factors, connectivity records), and the per-frame work: evaluating every
+//! point from the current control points ([`DualGrid::evaluate`]) and writing the triangles
+//! ([`DualGrid::connect`]), both in parallel with rayon. Regular interior faces, most of any
+//! isolated mesh, are evaluated as tensor products: their table stencils factor into the cubic
+//! B-spline weights of the two directions (checked when the plan is built), so a point costs 12
+//! multiply-adds per quantity instead of 48.
+
+use std::ops::Range;
+use std::time::Instant;
+
+use rayon::prelude::*;
+use table_format::{PointSet, SectionKey, StencilKind};
+
+use crate::mesh::topology::{Mesh, NONE};
+use crate::scheme::patch::{dual_index_in_patch, FacePatch};
+use crate::stencil_table::StencilTable;
+use crate::tessellate::triangle_mesh::{TriangleMesh, VertexSource};
+use crate::RuntimeError;
+
+/// The largest patch (control points) the evaluator takes: an interior vertex of valence `v`
+/// has `2v + 8`, a boundary vertex with `k` faces `2k + 8`.
+pub(crate) const MAX_PATCH: usize = 40;
+
+/// The largest rate of the tables the evaluator takes.
+pub const MAX_RATE: u32 = 64;
+
+/// Timings of one tessellation.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TessellationTime {
+    /// Seconds spent building the plan (table lookups, patches' connectivity records).
+    pub plan_seconds: f64,
+    /// Seconds spent evaluating and connecting (the per-frame work).
+    pub seconds: f64,
+}
+
+/// The three stencils of one point set of one patch: `points x K` weights each, point-major.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Stencils<'t> {
+    pub(crate) position: &'t [f32],
+    pub(crate) du: &'t [f32],
+    pub(crate) dv: &'t [f32],
+}
+
+/// The cubic B-spline factors of the regular patch at rate `n`, recovered from the table:
+/// `x[a][i]` is the weight of control column `a` (`u = -1, 0, 1, 2`) at the dual point
+/// `(2i+1)/2n`, `dx` its derivative; `y`, `dy` the same for rows.
+#[derive(Clone, Debug)]
+struct SeparableBasis {
+    x: [Vec<f32>; 4],
+    dx: [Vec<f32>; 4],
+    y: [Vec<f32>; 4],
+    dy: [Vec<f32>; 4],
+    /// `x` and `dx` transposed: the four weights of point `i` together.
+    x_rows: Vec<[f32; 4]>,
+    dx_rows: Vec<[f32; 4]>,
+}
+
+/// Grid coordinates `(a, b)` (each in -1..=2) of the regular patch's layout entries
+/// `V, E_1..E_4, F_1..F_4, O_1..O_7` (docs/algorithms/extraordinary-stencils.md).
+const REGULAR_LAYOUT: [(i32, i32); 16] = [
+    (0, 0),
+    (1, 0),
+    (0, 1),
+    (-1, 0),
+    (0, -1),
+    (1, 1),
+    (-1, 1),
+    (-1, -1),
+    (1, -1),
+    (2, -1),
+    (2, 0),
+    (2, 1),
+    (2, 2),
+    (1, 2),
+    (0, 2),
+    (-1, 2),
+];
+
+impl SeparableBasis {
+    /// Factor the regular patch's stencils at rate `n`: the marginals of a tensor product are
+    /// its factors (the other direction's weights sum to one, and its derivative's to zero), and
+    /// the factorization is accepted only if it reproduces every weight to 1e-6.
+    fn from_stencils(s: &Stencils, n: usize) -> Option<Self> {
+        let k = REGULAR_LAYOUT.len();
+        if s.position.len() != n * n * k {
+            return None;
+        }
+        let marginal = |w: &[f32], point: usize, along_u: bool| -> [f32; 4] {
+            let mut out = [0.0f64; 4];
+            for (l, &(a, b)) in REGULAR_LAYOUT.iter().enumerate() {
+                let c = if along_u { a } else { b };
+                out[(c + 1) as usize] += f64::from(w[point * k + l]);
+            }
+            out.map(|x| x as f32)
+        };
+        let column = |w: &[f32], along_u: bool| -> [Vec<f32>; 4] {
+            let mut out: [Vec<f32>; 4] = Default::default();
+            for t in 0..n {
+                let point = if along_u { t } else { t * n };
+                let m = marginal(w, point, along_u);
+                for a in 0..4 {
+                    out[a].push(m[a]);
+                }
+            }
+            out
+        };
+        let (x, dx) = (column(s.position, true), column(s.du, true));
+        let rows = |f: &[Vec<f32>; 4]| {
+            (0..n)
+                .map(|i| [f[0][i], f[1][i], f[2][i], f[3][i]])
+                .collect()
+        };
+        let basis = SeparableBasis {
+            x_rows: rows(&x),
+            dx_rows: rows(&dx),
+            x,
+            dx,
+            y: column(s.position, false),
+            dy: column(s.dv, false),
+        };
+        let check = |w: &[f32], fx: &[Vec<f32>; 4], fy: &[Vec<f32>; 4]| {
+            (0..n * n).all(|p| {
+                let (i, j) = (p % n, p / n);
+                REGULAR_LAYOUT.iter().enumerate().all(|(l, &(a, b))| {
+                    let product = fx[(a + 1) as usize][i] * fy[(b + 1) as usize][j];
+                    (w[p * k + l] - product).abs() <= 1e-6
+                })
+            })
+        };
+        (check(s.position, &basis.x, &basis.y)
+            && check(s.du, &basis.dx, &basis.y)
+            && check(s.dv, &basis.x, &basis.dy))
+        .then_some(basis)
+    }
+}
+
+/// How one face's dual points are evaluated.
+#[derive(Clone, Debug)]
+enum FaceEval<'t> {
+    /// A regular interior face: the 4 x 4 control grid (`grid[a][b]`, columns along `u`) and the
+    /// separable factors of its rate.
+    Separable { grid: [[u32; 4]; 4] },
+    /// Any other patch: its table stencils, its control points, and the face corner at the
+    /// patch's `(0,0)`.
+    Table {
+        stencils: Stencils<'t>,
+        control: Range<u32>,
+        corner: u8,
+    },
+}
+
+/// A point evaluated on its own (the boundary curve): one row of each stencil.
+#[derive(Clone, Debug)]
+pub(crate) struct PointPlan<'t> {
+    pub(crate) stencils: Stencils<'t>,
+    pub(crate) control: Range<u32>,
+    pub(crate) source: VertexSource,
+}
+
+/// A row of output vertices `start + t * step`, `t = 0..len`, at parameters
+/// `(offset + 2t) / denominator` along an edge.
+#[derive(Clone, Copy, Debug)]
+struct DualRow {
+    start: u32,
+    step: i32,
+    len: u32,
+}
+
+impl DualRow {
+    fn at(&self, t: u32) -> u32 {
+        (self.start as i64 + i64::from(self.step) * i64::from(t)) as u32
+    }
+}
+
+/// One edge's strip.
+#[derive(Clone, Copy, Debug)]
+enum Strip {
+    /// Between two faces: both rows run along the edge in the same direction, the second lies to
+    /// its right.
+    Interior { left: DualRow, right: DualRow },
+    /// Along the boundary: the face's row and the curve points `t/n`: `tail`, the edge's own
+    /// `n - 1` points from `first`, `head`.
+    Boundary {
+        row: DualRow,
+        tail: u32,
+        first: u32,
+        head: u32,
+    },
+}
+
+/// The per-mesh plan of a dual-grid tessellation: build once, then [`DualGrid::evaluate`] and
+/// [`DualGrid::connect`] per frame.
+#[derive(Clone, Debug)]
+pub struct DualGrid<'t> {
+    rates: Vec<u32>,
+    /// First dual vertex of every face, and the total after the last.
+    first: Vec<u32>,
+    faces: Vec<FaceEval<'t>>,
+    /// Separable factors by rate (index `n`).
+    bases: Vec<Option<SeparableBasis>>,
+    /// Control points of the table-evaluated patches, concatenated.
+    control: Vec<u32>,
+    /// Boundary-curve points (vertex limit points first, then edges' interior points).
+    boundary_points: Vec<PointPlan<'t>>,
+    strips: Vec<Strip>,
+    /// Vertex polygons, concatenated; `polygon_offsets[v]..polygon_offsets[v+1]`.
+    polygons: Vec<u32>,
+    polygon_offsets: Vec<u32>,
+    /// Triangle offsets: faces, then strips, then polygons (prefix sums, one past each item).
+    face_triangles: Vec<usize>,
+    strip_triangles: Vec<usize>,
+    polygon_triangles: Vec<usize>,
+    vertex_count: usize,
+    boundary: bool,
+}
+
+fn section(patch: &FacePatch, kind: StencilKind, points: PointSet, n: u32) -> SectionKey {
+    SectionKey {
+        kind,
+        points,
+        boundary: patch.kind.boundary,
+        faces: patch.kind.faces,
+        sector: patch.kind.sector,
+        n,
+    }
+}
+
+fn stencils<'t>(
+    table: &'t StencilTable,
+    patch: &FacePatch,
+    points: PointSet,
+    n: u32,
+) -> Result<Stencils<'t>, RuntimeError> {
+    let [position, du, dv] = [
+        StencilKind::Position,
+        StencilKind::DerivativeU,
+        StencilKind::DerivativeV,
+    ]
+    .map(|kind| table.weights(&section(patch, kind, points, n)));
+    let (position, du, dv) = (position?, du?, dv?);
+    let count = points.count(n) as usize;
+    let k = patch.points.len();
+    if position.len() != count * k || du.len() != position.len() || dv.len() != du.len() {
+        return Err(RuntimeError::LayoutMismatch {
+            key: section(patch, StencilKind::Position, points, n),
+            table: position.len() / count.max(1),
+            patch: k,
+        });
+    }
+    Ok(Stencils { position, du, dv })
+}
+
+/// Triangles of a strip merging rows of `a` and `b` points.
+fn strip_triangle_count(a: u32, b: u32) -> usize {
+    (a + b - 2) as usize
+}
+
+impl<'t> DualGrid<'t> {
+    /// Plan the tessellation of an isolated mesh (closed or with boundary) with rate `rates[f]`
+    /// on face `f` (any rates the table holds, not only powers of two).
+    pub fn new(
+        table: &'t StencilTable,
+        mesh: &Mesh,
+        patches: &[FacePatch],
+        rates: &[u32],
+    ) -> Result<Self, RuntimeError> {
+        if rates.len() != patches.len() || patches.len() != mesh.faces() {
+            return Err(RuntimeError::Unsupported(format!(
+                "{} rates and {} patches for {} faces",
+                rates.len(),
+                patches.len(),
+                mesh.faces()
+            )));
+        }
+        if let Some(f) = rates.iter().position(|&n| n == 0 || n > MAX_RATE) {
+            return Err(RuntimeError::Unsupported(format!(
+                "rate {} on face {f} (rates run from 1 to the table's largest)",
+                rates[f]
+            )));
+        }
+        // A one-face boundary vertex is smooth in "edge only" mode and pinned in "edge and
+        // corner" mode: its stencils must come from a table made for the mesh's mode.
+        let corners = mesh.boundary == schemes::BoundaryMode::EdgeAndCorner;
+        if table.pins_corners() != corners
+            && patches.iter().any(|p| p.kind.boundary && p.kind.faces == 1)
+        {
+            return Err(RuntimeError::BoundaryModeMismatch {
+                mesh_corners: corners,
+            });
+        }
+        let mut first = Vec::with_capacity(patches.len() + 1);
+        first.push(0u32);
+        for &n in rates {
+            first.push(first[first.len() - 1] + n * n);
+        }
+        let mut grid = DualGrid {
+            rates: rates.to_vec(),
+            first,
+            faces: Vec::with_capacity(patches.len()),
+            bases: vec![None; MAX_RATE as usize + 1],
+            control: Vec::new(),
+            boundary_points: Vec::new(),
+            strips: Vec::new(),
+            polygons: Vec::new(),
+            polygon_offsets: vec![0],
+            face_triangles: Vec::new(),
+            strip_triangles: Vec::new(),
+            polygon_triangles: Vec::new(),
+            vertex_count: 0,
+            boundary: false,
+        };
+        let regular = |p: &FacePatch| !p.kind.boundary && p.kind.faces == 4 && p.corner == 0;
+        let mut factored = vec![false; MAX_RATE as usize + 1];
+        for (patch, &n) in patches.iter().zip(rates) {
+            // A valence beyond the table's is refused here, by the table naming its coverage.
+            let s = stencils(table, patch, PointSet::Dual, n)?;
+            if patch.points.len() > MAX_PATCH {
+                return Err(RuntimeError::Unsupported(format!(
+                    "a patch of {} control points (valence {}); at most {MAX_PATCH}",
+                    patch.points.len(),
+                    patch.kind.faces
+                )));
+            }
+            if regular(patch) && !factored[n as usize] {
+                factored[n as usize] = true;
+                grid.bases[n as usize] = SeparableBasis::from_stencils(&s, n as usize);
+            }
+            if regular(patch) && grid.bases[n as usize].is_some() {
+                let mut cells = [[0u32; 4]; 4];
+                for (&(a, b), &v) in REGULAR_LAYOUT.iter().zip(&patch.points) {
+                    cells[(a + 1) as usize][(b + 1) as usize] = v;
+                }
+                grid.faces.push(FaceEval::Separable { grid: cells });
+            } else {
+                let start = grid.control.len() as u32;
+                grid.control.extend_from_slice(&patch.points);
+                grid.faces.push(FaceEval::Table {
+                    stencils: s,
+                    control: start..grid.control.len() as u32,
+                    corner: patch.corner as u8,
+                });
+            }
+        }
+        grid.plan_connectivity(table, mesh, patches)?;
+        Ok(grid)
+    }
+
+    fn face_vertex(&self, f: usize, i: u32, j: u32) -> u32 {
+        self.first[f] + j * self.rates[f] + i
+    }
+
+    /// The dual row of face `f` nearest its side `side`, in the side's direction.
+    fn row(&self, f: usize, side: usize) -> DualRow {
+        let n = self.rates[f];
+        let last = n - 1;
+        let (start, step) = match side {
+            0 => (self.face_vertex(f, 0, 0), 1),
+            1 => (self.face_vertex(f, last, 0), n as i32),
+            2 => (self.face_vertex(f, last, last), -1),
+            _ => (self.face_vertex(f, 0, last), -(n as i32)),
+        };
+        DualRow {
+            start,
+            step,
+            len: n,
+        }
+    }
+
+    /// The face's dual point nearest its corner `corner`.
+    fn corner_point(&self, f: usize, corner: usize) -> u32 {
+        self.row(f, corner).start
+    }
+
+    /// A point on the boundary curve: the primal point `(i, j)` of face `f` at rate `n`, in the
+    /// face's own indices.
+    fn boundary_point(
+        &mut self,
+        table: &'t StencilTable,
+        patch: &FacePatch,
+        f: usize,
+        n: u32,
+        (i, j): (u32, u32),
+    ) -> Result<(), RuntimeError> {
+        let s = stencils(table, patch, PointSet::Primal, n)?;
+        // The primal grid's rotation into the patch: as for dual points, with n + 1 points a row.
+        let (pi, pj) = dual_index_in_patch(patch.corner, i as usize, j as usize, n as usize + 1);
+        let k = patch.points.len();
+        let row = (pj * (n as usize + 1) + pi) * k..(pj * (n as usize + 1) + pi + 1) * k;
+        let start = self.control.len() as u32;
+        self.control.extend_from_slice(&patch.points);
+        self.boundary_points.push(PointPlan {
+            stencils: Stencils {
+                position: &s.position[row.clone()],
+                du: &s.du[row.clone()],
+                dv: &s.dv[row],
+            },
+            control: start..self.control.len() as u32,
+            source: VertexSource {
+                face: f as u32,
+                u: i,
+                v: j,
+                denominator: n,
+                subface: 0,
+            },
+        });
+        Ok(())
+    }
+
+    fn plan_connectivity(
+        &mut self,
+        table: &'t StencilTable,
+        mesh: &Mesh,
+        patches: &[FacePatch],
+    ) -> Result<(), RuntimeError> {
+        let dual_total = self.first[patches.len()];
+        // Boundary vertices' limit points, evaluated at the corner of the first face of their
+        // fan (the face whose outgoing half-edge is the boundary edge).
+        let mut limit_point = vec![NONE; mesh.positions.len()];
+        for (v, limit) in limit_point.iter_mut().enumerate() {
+            if !mesh.is_boundary_vertex(v) {
+                continue;
+            }
+            self.boundary = true;
+            let h = mesh.vertex_halfedge[v] as usize;
+            let f = mesh.face_of[h] as usize;
+            let corner = (h - mesh.face_halfedges(f).start) as u32;
+            // The corner of the primal grid at the face's own rate (present in any table that
+            // has the face's dual grid).
+            let n = self.rates[f];
+            let (i, j) = [(0, 0), (n, 0), (n, n), (0, n)][corner as usize];
+            *limit = dual_total + self.boundary_points.len() as u32;
+            self.boundary_point(table, &patches[f], f, n, (i, j))?;
+        }
+        // Edges, each once: interior ones from their lower half-edge, boundary ones from theirs.
+        for h in 0..mesh.face_vertices.len() {
+            let t = mesh.twin[h];
+            let f = mesh.face_of[h] as usize;
+            let side = h - mesh.face_halfedges(f).start;
+            let row = self.row(f, side);
+            if t == NONE {
+                let n = self.rates[f];
+                let first = dual_total + self.boundary_points.len() as u32;
+                for s in 1..n {
+                    let ij = match side {
+                        0 => (s, 0),
+                        1 => (n, s),
+                        2 => (n - s, n),
+                        _ => (0, n - s),
+                    };
+                    self.boundary_point(table, &patches[f], f, n, ij)?;
+                }
+                self.strips.push(Strip::Boundary {
+                    row,
+                    tail: limit_point[mesh.face_vertices[h] as usize],
+                    first,
+                    head: limit_point[mesh.head(h) as usize],
+                });
+            } else if (t as usize) > h {
+                let t = t as usize;
+                let g = mesh.face_of[t] as usize;
+                let other = self.row(g, t - mesh.face_halfedges(g).start);
+                // Reversed, so that both rows run along h.
+                let right = DualRow {
+                    start: other.at(other.len - 1),
+                    step: -other.step,
+                    len: other.len,
+                };
+                self.strips.push(Strip::Interior { left: row, right });
+            }
+        }
+        // Vertex polygons: corner points in fan order, after the limit point on the boundary.
+        for (v, &limit) in limit_point.iter().enumerate() {
+            if limit != NONE {
+                self.polygons.push(limit);
+            }
+            for h in mesh.fan(v) {
+                let f = mesh.face_of[h] as usize;
+                let corner = self.corner_point(f, h - mesh.face_halfedges(f).start);
+                self.polygons.push(corner);
+            }
+            self.polygon_offsets.push(self.polygons.len() as u32);
+        }
+        self.vertex_count = (dual_total as usize) + self.boundary_points.len();
+        let prefix = |counts: &mut dyn Iterator<Item = usize>| -> Vec<usize> {
+            let mut total = 0;
+            counts
+                .map(|c| {
+                    total += c;
+                    total
+                })
+                .collect()
+        };
+        self.face_triangles = prefix(&mut self.rates.iter().map(|&n| 2 * (n as usize - 1).pow(2)));
+        let strip_count = |s: &Strip| match *s {
+            Strip::Interior { left, right } => strip_triangle_count(left.len, right.len),
+            Strip::Boundary { row, .. } => strip_triangle_count(row.len, row.len + 1),
+        };
+        self.strip_triangles = prefix(&mut self.strips.iter().map(strip_count));
+        self.polygon_triangles = prefix(
+            &mut self
+                .polygon_offsets
+                .windows(2)
+                .map(|w| (w[1] - w[0]).saturating_sub(2) as usize),
+        );
+        Ok(())
+    }
+
+    /// Output vertices per frame.
+    pub fn vertex_count(&self) -> usize {
+        self.vertex_count
+    }
+
+    /// Output triangles per frame.
+    pub fn triangle_count(&self) -> usize {
+        [
+            &self.face_triangles,
+            &self.strip_triangles,
+            &self.polygon_triangles,
+        ]
+        .iter()
+        .map(|v| v.last().copied().unwrap_or(0))
+        .sum()
+    }
+
+    /// Whether the mesh has a boundary (its output then has boundary loops).
+    pub fn has_boundary(&self) -> bool {
+        self.boundary
+    }
+
+    /// How many faces take the separable (tensor-product) path.
+    pub fn separable_faces(&self) -> usize {
+        self.faces
+            .iter()
+            .filter(|f| matches!(f, FaceEval::Separable { .. }))
+            .count()
+    }
+
+    /// Where every output vertex is evaluated, in output order.
+    pub fn sources(&self) -> Vec<VertexSource> {
+        let mut out = Vec::with_capacity(self.vertex_count);
+        for (f, &n) in self.rates.iter().enumerate() {
+            for j in 0..n {
+                for i in 0..n {
+                    out.push(VertexSource {
+                        face: f as u32,
+                        u: 2 * i + 1,
+                        v: 2 * j + 1,
+                        denominator: 2 * n,
+                        subface: 0,
+                    });
+                }
+            }
+        }
+        out.extend(self.boundary_points.iter().map(|p| p.source));
+        out
+    }
+
+    /// Evaluate every output vertex from the control points `control` (the mesh's vertex
+    /// positions): limit positions and unit normals, `vertex_count()` each.
+    pub fn evaluate(
+        &self,
+        control: &[[f32; 3]],
+        positions: &mut [[f32; 3]],
+        normals: &mut [[f32; 3]],
+    ) {
+        let dual = self.first[self.rates.len()] as usize;
+        let (face_positions, curve_positions) = positions.split_at_mut(dual);
+        let (face_normals, curve_normals) = normals.split_at_mut(dual);
+        let vertex_offsets: Vec<usize> = self.first[1..].iter().map(|&x| x as usize).collect();
+        for_each_range(
+            &vertex_offsets,
+            (face_positions, face_normals),
+            |f, (p, q)| self.evaluate_face(f, control, p, q),
+        );
+        evaluate_points(
+            &self.boundary_points,
+            &self.control,
+            control,
+            curve_positions,
+            curve_normals,
+        );
+    }
+
+    fn evaluate_face(
+        &self,
+        f: usize,
+        control: &[[f32; 3]],
+        positions: &mut [[f32; 3]],
+        normals: &mut [[f32; 3]],
+    ) {
+        let n = self.rates[f] as usize;
+        match &self.faces[f] {
+            FaceEval::Separable { grid } => {
+                let g = grid.map(|column| column.map(|v| control[v as usize]));
+                if let Some(basis) = &self.bases[n] {
+                    evaluate_separable(&g, basis, n, positions, normals);
+                }
+            }
+            FaceEval::Table {
+                stencils,
+                control: range,
+                corner,
+            } => {
+                let points = &self.control[range.start as usize..range.end as usize];
+                let mut local = [[0.0f32; 3]; MAX_PATCH];
+                for (l, &v) in local.iter_mut().zip(points) {
+                    *l = control[v as usize];
+                }
+                let local = &local[..points.len()];
+                for j in 0..n {
+                    for i in 0..n {
+                        let (pi, pj) = dual_index_in_patch(*corner as usize, i, j, n);
+                        let at = j * n + i;
+                        (positions[at], normals[at]) = weighted_point(stencils, local, pj * n + pi);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Write every triangle (`triangle_count()` of them).
+    pub fn connect(&self, triangles: &mut [[u32; 3]]) {
+        let faces_end = self.face_triangles.last().copied().unwrap_or(0);
+        let strips_end = faces_end + self.strip_triangles.last().copied().unwrap_or(0);
+        let (faces, rest) = triangles.split_at_mut(faces_end);
+        let (strips, polygons) = rest.split_at_mut(strips_end - faces_end);
+        rayon::join(
+            || {
+                for_each_range(&self.face_triangles, faces, |f, out| {
+                    self.connect_face(f, out)
+                })
+            },
+            || {
+                rayon::join(
+                    || {
+                        for_each_range(&self.strip_triangles, strips, |s, out| {
+                            connect_strip(&self.strips[s], out)
+                        })
+                    },
+                    || {
+                        for_each_range(&self.polygon_triangles, polygons, |v, out| {
+                            let ring = &self.polygons[self.polygon_offsets[v] as usize
+                                ..self.polygon_offsets[v + 1] as usize];
+                            for (i, t) in out.iter_mut().enumerate() {
+                                *t = [ring[0], ring[i + 1], ring[i + 2]];
+                            }
+                        })
+                    },
+                )
+            },
+        );
+    }
+
+    fn connect_face(&self, f: usize, out: &mut [[u32; 3]]) {
+        let n = self.rates[f];
+        let mut k = 0;
+        for j in 0..n.saturating_sub(1) {
+            let row = self.first[f] + j * n;
+            for i in 0..n - 1 {
+                let (a, b, c, d) = (row + i, row + i + 1, row + n + i + 1, row + n + i);
+                out[k] = [a, b, c];
+                out[k + 1] = [a, c, d];
+                k += 2;
+            }
+        }
+    }
+
+    /// Plan and evaluate in one go into a fresh [`TriangleMesh`] (with sources).
+    pub fn tessellate(&self, mesh: &Mesh) -> TriangleMesh {
+        let control: Vec<[f32; 3]> = mesh.positions.iter().map(|p| p.map(|c| c as f32)).collect();
+        let mut out = TriangleMesh {
+            positions: vec![[0.0; 3]; self.vertex_count],
+            normals: vec![[0.0; 3]; self.vertex_count],
+            sources: self.sources(),
+            triangles: vec![[0; 3]; self.triangle_count()],
+        };
+        self.evaluate(&control, &mut out.positions, &mut out.normals);
+        self.connect(&mut out.triangles);
+        out
+    }
+}
+
+/// Run `work(item, slice)` for every item in parallel, where item `i` owns
+/// `out[ends[i-1]..ends[i]]` (`ends` are prefix sums). Items are grouped into contiguous chunks of
+/// about equal output so that the split costs little next to the work.
+pub(crate) fn for_each_range<T: SplitSlices + Send>(
+    ends: &[usize],
+    out: T,
+    work: impl Fn(usize, T) + Sync + Send,
+) {
+    let total = ends.last().copied().unwrap_or(0);
+    let chunks = (rayon::current_num_threads() * 16).max(1);
+    let target = total.div_ceil(chunks).max(1);
+    // Chunk boundaries in items: [item_start, item_end), with their output ranges.
+    let mut pieces = Vec::with_capacity(chunks + 1);
+    let mut rest = out;
+    let (mut item, mut consumed) = (0usize, 0usize);
+    while item < ends.len() {
+        let start_item = item;
+        let start = consumed;
+        while item < ends.len() && (ends[item] - start < target || item == start_item) {
+            item += 1;
+        }
+        let end = ends[item - 1];
+        let (piece, tail) = rest.split_at(end - start);
+        rest = tail;
+        consumed = end;
+        pieces.push((start_item..item, start, piece));
+    }
+    pieces
+        .into_par_iter()
+        .for_each(|(items, start, mut piece)| {
+            let mut at = start;
+            for i in items {
+                let (mine, tail) = piece.split_at(ends[i] - at);
+                piece = tail;
+                at = ends[i];
+                work(i, mine);
+            }
+        });
+}
+
+/// Mutable slices (or tuples of them, split in step) that [`for_each_range`] hands out.
+pub(crate) trait SplitSlices: Sized {
+    fn split_at(self, mid: usize) -> (Self, Self);
+}
+
+impl<T> SplitSlices for &mut [T] {
+    fn split_at(self, mid: usize) -> (Self, Self) {
+        self.split_at_mut(mid)
+    }
+}
+
+impl<A, B> SplitSlices for (&mut [A], &mut [B]) {
+    fn split_at(self, mid: usize) -> (Self, Self) {
+        let (a0, a1) = self.0.split_at_mut(mid);
+        let (b0, b1) = self.1.split_at_mut(mid);
+        ((a0, b0), (a1, b1))
+    }
+}
+
+/// Merge two rows running along an edge into triangles, in order of their parameters
+/// `param_a(i) / den_a` and `param_b(j) / den_b`; `b` lies to the right of the edge.
+pub(crate) fn merge_rows(
+    a: impl Fn(u32) -> u32,
+    na: u32,
+    param_a: impl Fn(u32) -> u64,
+    b: impl Fn(u32) -> u32,
+    nb: u32,
+    param_b: impl Fn(u32) -> u64,
+    out: &mut [[u32; 3]],
+) {
+    let (mut i, mut j, mut k) = (0, 0, 0);
+    while i + 1 < na || j + 1 < nb {
+        let advance_a = j + 1 == nb || (i + 1 < na && param_a(i + 1) <= param_b(j + 1));
+        if advance_a {
+            out[k] = [b(j), a(i + 1), a(i)];
+            i += 1;
+        } else {
+            out[k] = [b(j), b(j + 1), a(i)];
+            j += 1;
+        }
+        k += 1;
+    }
+}
+
+fn connect_strip(strip: &Strip, out: &mut [[u32; 3]]) {
+    match *strip {
+        Strip::Interior { left, right } => {
+            // Point t of a row of n sits at (2t + 1)/2n: compare (2t + 1) n_other.
+            let (na, nb) = (u64::from(left.len), u64::from(right.len));
+            merge_rows(
+                |i| left.at(i),
+                left.len,
+                |i| (2 * u64::from(i) + 1) * nb,
+                |j| right.at(j),
+                right.len,
+                |j| (2 * u64::from(j) + 1) * na,
+                out,
+            );
+        }
+        Strip::Boundary {
+            row,
+            tail,
+            first,
+            head,
+        } => {
+            let n = row.len;
+            // Dual points at (2t + 1)/2n, curve points at t/n = 2t/2n.
+            merge_rows(
+                |i| row.at(i),
+                n,
+                |i| 2 * u64::from(i) + 1,
+                |j| match j {
+                    0 => tail,
+                    j if j == n => head,
+                    j => first + j - 1,
+                },
+                n + 1,
+                |j| 2 * u64::from(j),
+                out,
+            );
+        }
+    }
+}
+
+pub(crate) fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+pub(crate) fn unit(v: [f32; 3]) -> [f32; 3] {
+    let length = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    if length > 0.0 {
+        v.map(|x| x / length)
+    } else {
+        [0.0; 3]
+    }
+}
+
+/// Evaluate points planned one by one (`plans[i]` into `positions[i]`, `normals[i]`), in
+/// parallel: each plan's control points are `indices[plan.control]`, vertices of `control`.
+pub(crate) fn evaluate_points(
+    plans: &[PointPlan],
+    indices: &[u32],
+    control: &[[f32; 3]],
+    positions: &mut [[f32; 3]],
+    normals: &mut [[f32; 3]],
+) {
+    positions
+        .par_iter_mut()
+        .zip(normals.par_iter_mut())
+        .zip(plans.par_iter())
+        .for_each(|((p, q), plan)| {
+            let points = &indices[plan.control.start as usize..plan.control.end as usize];
+            let mut local = [[0.0f32; 3]; MAX_PATCH];
+            for (l, &v) in local.iter_mut().zip(points) {
+                *l = control[v as usize];
+            }
+            (*p, *q) = weighted_point(&plan.stencils, &local[..points.len()], 0);
+        });
+}
+
+/// Position and unit normal of table point `point` (row of the stencils) from the patch's
+/// control points.
+pub(crate) fn weighted_point(
+    s: &Stencils,
+    control: &[[f32; 3]],
+    point: usize,
+) -> ([f32; 3], [f32; 3]) {
+    let k = control.len();
+    let rows = point * k..(point + 1) * k;
+    let (wp, wu, wv) = (&s.position[rows.clone()], &s.du[rows.clone()], &s.dv[rows]);
+    let mut p = [[0.0f32; 3]; 3];
+    for l in 0..k {
+        let q = control[l];
+        for x in 0..3 {
+            p[0][x] += wp[l] * q[x];
+            p[1][x] += wu[l] * q[x];
+            p[2][x] += wv[l] * q[x];
+        }
+    }
+    (p[0], unit(cross(p[1], p[2])))
+}
+
+/// The tensor-product evaluation of a regular face: per row `j`, contract the 4 x 4 grid with the
+/// row's weights into four points (and their `v` derivatives), then every point of the row is a
+/// 4-term combination of those.
+fn evaluate_separable(
+    g: &[[[f32; 3]; 4]; 4],
+    basis: &SeparableBasis,
+    n: usize,
+    positions: &mut [[f32; 3]],
+    normals: &mut [[f32; 3]],
+) {
+    for j in 0..n {
+        let y = [basis.y[0][j], basis.y[1][j], basis.y[2][j], basis.y[3][j]];
+        let dy = [
+            basis.dy[0][j],
+            basis.dy[1][j],
+            basis.dy[2][j],
+            basis.dy[3][j],
+        ];
+        // r[a] = sum_b y_b g[a][b]; s[a] = sum_b dy_b g[a][b].
+        let mut r = [[0.0f32; 3]; 4];
+        let mut s = [[0.0f32; 3]; 4];
+        for a in 0..4 {
+            for b in 0..4 {
+                for c in 0..3 {
+                    r[a][c] += y[b] * g[a][b][c];
+                    s[a][c] += dy[b] * g[a][b][c];
+                }
+            }
+        }
+        let row = j * n..(j + 1) * n;
+        for (((q, m), x), d) in positions[row.clone()]
+            .iter_mut()
+            .zip(&mut normals[row])
+            .zip(&basis.x_rows)
+            .zip(&basis.dx_rows)
+        {
+            let mut p = [0.0f32; 3];
+            let mut du = [0.0f32; 3];
+            let mut dv = [0.0f32; 3];
+            for a in 0..4 {
+                for c in 0..3 {
+                    p[c] += x[a] * r[a][c];
+                    du[c] += d[a] * r[a][c];
+                    dv[c] += x[a] * s[a][c];
+                }
+            }
+            *q = p;
+            *m = unit(cross(du, dv));
+        }
+    }
+}
+
+/// Tessellate an isolated mesh at rate `n` on every face.
+pub fn tessellate_uniform(
+    table: &StencilTable,
+    mesh: &Mesh,
+    patches: &[FacePatch],
+    n: u32,
+) -> Result<(TriangleMesh, TessellationTime), RuntimeError> {
+    tessellate(table, mesh, patches, &vec![n; patches.len()])
+}
+
+/// Tessellate an isolated mesh (closed or with boundary) with rate `rates[f]` on face `f`.
+pub fn tessellate(
+    table: &StencilTable,
+    mesh: &Mesh,
+    patches: &[FacePatch],
+    rates: &[u32],
+) -> Result<(TriangleMesh, TessellationTime), RuntimeError> {
+    let started = Instant::now();
+    let grid = DualGrid::new(table, mesh, patches, rates)?;
+    let planned = Instant::now();
+    let out = grid.tessellate(mesh);
+    Ok((
+        out,
+        TessellationTime {
+            plan_seconds: (planned - started).as_secs_f64(),
+            seconds: planned.elapsed().as_secs_f64(),
+        },
+    ))
+}

@@ -1,0 +1,892 @@
+//! Error-bounded adaptive tessellation of Catmull–Clark surfaces (S. Lai, F. Cheng,
+//! "Near-optimum adaptive tessellation of general Catmull–Clark subdivision surfaces";
+//! `../shared/papers/lai-cheng-adaptive-ccss.txt`). `docs/lai-cheng.md` has the method as built,
+//! what is guaranteed and the results.
+//!
+//! * **Recursive midpoint subdivision** (section 2): each patch's `(u, v)` square is split into
+//!   four until every square passes the flatness test ([`tessellate_adaptive`]).
+//! * **Evaluation** (section 3): a regular patch is a bicubic; its Bézier net (converted once
+//!   from the B-spline net) is split exactly by de Casteljau, and the net's corners are the
+//!   limit points at the square's corners. A patch at an extraordinary vertex (EV) is descended
+//!   with the local subdivision matrix `A`: at depth `k` the square `[0, 2^-k]^2` at the EV has
+//!   the layout `A^k P`, and the three other quarters of it are regular bicubics `R_b A^k P`.
+//! * **Flatness** (section 4, eq. 4–8): on a regular square, the guaranteed bound of
+//!   [`bezier_net::flatness_bound`] (Bernstein coefficients of `S - Q` and the linear
+//!   interpolation error of `Q`), the direction-free form of the two-sided test eq. (8), so
+//!   that the polygon replacing the base quadrilateral meets it too (section 4.2). On the
+//!   square at the EV, the counterpart of section 4.1's `m_eps` (the patch within an
+//!   `eps`-sphere): with non-negative subdivision rules, the surface over `[0, 2^-k]^2`, its
+//!   boundary points and so any polygon through them lie in the convex hull of `A^k P`, so
+//!   `|S - L| <= diam(A^k P)`, which decays like `lambda^k` (the subdominant eigenvalue); and
+//!   in the tighter hull of `ev_enclosure` (the Bézier nets of the regular quarters of three
+//!   levels and the innermost layout): the bound is the smaller of the two diameters.
+//! * **Globalization** (section 5): every marked point gets one id, keyed by its exact place in
+//!   a shared parameterization (a mesh vertex; a canonical half-edge and the dyadic parameter
+//!   along it; a face and its dyadic `(u, v)`). Each leaf square becomes the polygon through
+//!   every marked point on its sides, so the output is watertight by construction.
+//! * **Absolute and relative flatness** (section 6): [`AdaptiveOptions::relative`].
+//!
+//! ```
+//! use subtess::scheme::catmull_clark::isolate::isolate_with_origins;
+//! use subtess::tessellate::lai_cheng::{tessellate_adaptive, AdaptiveOptions};
+//! use subtess::io::obj::parse_obj;
+//! use subtess::stencil_table::StencilTable;
+//! use subtess::mesh::topology::Mesh;
+//! let obj = parse_obj("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
+//!     f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n")?;
+//! let (mesh, _) = Mesh::from_obj(&obj)?;
+//! let iso = isolate_with_origins(&mesh)?;
+//! let table = StencilTable::default_catmull_clark()?;
+//! let options = AdaptiveOptions { tolerance: 0.01, ..Default::default() };
+//! let (out, stats) = tessellate_adaptive(&table, &iso.mesh, &iso.patches, &options)?;
+//! assert!(out.to_triangle_mesh().is_watertight());
+//! assert_eq!(stats.leaves_over_tolerance, 0);
+//! # Ok::<(), subtess::RuntimeError>(())
+//! ```
+
+pub mod bezier_net;
+mod operators;
+mod polygons;
+
+use std::collections::HashMap;
+use std::time::Instant;
+
+use rayon::prelude::*;
+use serde_json::{json, Value};
+use table_format::{PointSet, SectionKey, StencilKind};
+
+use crate::mesh::topology::{Mesh, NONE};
+use crate::scheme::patch::{FacePatch, PatchKind};
+use crate::stencil_table::StencilTable;
+use crate::tessellate::triangle_mesh::{TriangleMesh, VertexSource};
+use crate::RuntimeError;
+use bezier_net::{
+    corner_normals, corners, cross, flatness_bound, longer_diagonal, unit, Net, Point,
+};
+use operators::Operators;
+pub use polygons::write_obj_polygons;
+
+/// The deepest subdivision: parameters are multiples of `2^-MAX_DEPTH` of a patch side.
+pub const MAX_DEPTH: u32 = 24;
+
+/// The parameter grid every point lies on: `GRID = 2^MAX_DEPTH` steps per patch side.
+const GRID: u32 = 1 << MAX_DEPTH;
+
+/// How to tessellate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AdaptiveOptions {
+    /// The error tolerance `eps` of eq. (7)–(8): a distance in the mesh's units, or with
+    /// `relative` a ratio (finite, `> 0`).
+    pub tolerance: f64,
+    /// Relative flatness RF (section 6): a square is flat when its bound is at most
+    /// `tolerance` times the longer diagonal `max{D_1, D_2}` of its own base quadrilateral.
+    /// The square at an extraordinary vertex uses the diagonal of its whole patch's base
+    /// quadrilateral instead (its bound is a sphere bound, of the order of its size, so its own
+    /// ratio cannot fall below a constant; see `docs/lai-cheng.md`).
+    pub relative: bool,
+    /// Whether the output primitives are triangles (the "T" rows of Table 1) rather than
+    /// polygons; [`AdaptiveMesh`] carries both, this picks what [`AdaptiveStats`] reports as
+    /// `primitives` and what a caller writes.
+    pub triangulate: bool,
+    /// Squares are not split below this depth (`<= MAX_DEPTH`); a square still over the
+    /// tolerance there is kept and counted in [`AdaptiveStats::leaves_over_tolerance`].
+    pub max_depth: u32,
+    /// Squares are always split down to this depth (`<= max_depth`); 0 for the adaptive
+    /// method, `= max_depth` for the uniform tessellation the A/U ratio compares with.
+    pub min_depth: u32,
+}
+
+impl Default for AdaptiveOptions {
+    fn default() -> Self {
+        AdaptiveOptions {
+            tolerance: 1e-3,
+            relative: false,
+            triangulate: false,
+            max_depth: 16,
+            min_depth: 0,
+        }
+    }
+}
+
+/// The parameter square a polygon replaces: face `face` (of the tessellated mesh) on
+/// `[u0, u0 + size] x [v0, v0 + size] / denominator`, in the face's own parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PolygonRegion {
+    /// The face.
+    pub face: u32,
+    /// Lower-left `u` numerator.
+    pub u0: u32,
+    /// Lower-left `v` numerator.
+    pub v0: u32,
+    /// Side numerator.
+    pub size: u32,
+    /// Common denominator (`2^MAX_DEPTH`).
+    pub denominator: u32,
+    /// Subdivision depth of the square (0: the whole face).
+    pub depth: u32,
+    /// Whether this is the square at an extraordinary vertex (the sphere bound).
+    pub extraordinary: bool,
+    /// The guaranteed bound on `|S - L|` over the square for any triangulation `L` of the
+    /// polygon in parameter space ([`bezier_net::flatness_bound`], or the EV hull diameter).
+    pub bound: f64,
+    /// The absolute tolerance the square had to meet (`tolerance`, or `tolerance` times a
+    /// diagonal in relative mode).
+    pub tolerance: f64,
+    /// The longer diagonal `max{D_1, D_2}` of the square's base quadrilateral.
+    pub diagonal: f64,
+}
+
+/// One output polygon: the base quadrilateral with every marked point on its sides.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AdaptivePolygon {
+    /// Global vertex ids, counter-clockwise in the face's parameters.
+    pub vertices: Vec<u32>,
+    /// Its triangulation (ids), every triangle of positive area in parameter space.
+    pub triangles: Vec<[u32; 3]>,
+    /// The parameter square it replaces, with its bound.
+    pub region: PolygonRegion,
+}
+
+/// The adaptive tessellation: one vertex per global id, and the polygons.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct AdaptiveMesh {
+    /// Limit positions.
+    pub positions: Vec<[f64; 3]>,
+    /// Unit normals (zero where the tangents are degenerate).
+    pub normals: Vec<[f64; 3]>,
+    /// Where each vertex was evaluated (faces of the tessellated mesh; map them to the input
+    /// with [`crate::scheme::catmull_clark::isolate::Isolation::input_source`]).
+    pub sources: Vec<VertexSource>,
+    /// The polygons, face by face.
+    pub polygons: Vec<AdaptivePolygon>,
+}
+
+impl AdaptiveMesh {
+    /// The triangulated output as the runtime's triangle mesh (f32).
+    pub fn to_triangle_mesh(&self) -> TriangleMesh {
+        let f32s = |p: &[f64; 3]| p.map(|c| c as f32);
+        TriangleMesh {
+            positions: self.positions.iter().map(f32s).collect(),
+            normals: self.normals.iter().map(f32s).collect(),
+            sources: self.sources.clone(),
+            triangles: self
+                .polygons
+                .iter()
+                .flat_map(|p| p.triangles.iter().copied())
+                .collect(),
+        }
+    }
+
+    /// Number of triangles of the triangulated output.
+    pub fn triangle_count(&self) -> usize {
+        self.polygons.iter().map(|p| p.triangles.len()).sum()
+    }
+
+    /// Whether every polygon edge is shared by exactly two polygons traversing it in opposite
+    /// directions (closed inputs).
+    pub fn is_watertight(&self) -> bool {
+        let mut directed = std::collections::HashSet::new();
+        for p in &self.polygons {
+            let n = p.vertices.len();
+            for k in 0..n {
+                if !directed.insert((p.vertices[k], p.vertices[(k + 1) % n])) {
+                    return false;
+                }
+            }
+        }
+        directed.iter().all(|&(a, b)| directed.contains(&(b, a)))
+    }
+}
+
+/// What a tessellation did (Table 1 of the paper: polygons, depth, A/U ratio).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct AdaptiveStats {
+    /// Output polygons (leaf squares).
+    pub polygons: usize,
+    /// Triangles of the triangulated output.
+    pub triangles: usize,
+    /// Output vertices (global ids).
+    pub vertices: usize,
+    /// Whether the primitives written are triangles.
+    pub triangulated: bool,
+    /// The deepest leaf, in midpoint subdivisions of the tessellated mesh's faces.
+    pub max_depth: u32,
+    /// The uniform depth compared with: Table 1's "Depth", the adaptive tessellation's
+    /// deepest level (a uniform tessellation needs that level wherever the adaptive one
+    /// reached it). Add the isolation steps for the depth below the input control mesh.
+    pub uniform_depth: u32,
+    /// Polygons of the uniform tessellation at `uniform_depth`: faces times `4^depth`.
+    pub uniform_polygons: f64,
+    /// Table 1's A/U ratio: `polygons / uniform_polygons` (or triangles over it when
+    /// triangulated, as in the paper's "T" rows).
+    pub au_ratio: f64,
+    /// Leaves kept at `max_depth` although their bound exceeds their tolerance.
+    pub leaves_over_tolerance: usize,
+    /// The largest guaranteed bound over all leaves (absolute).
+    pub max_bound: f64,
+    /// The largest ratio of a leaf's bound to its base quadrilateral's longer diagonal (RF,
+    /// section 6), over the leaves not at an extraordinary vertex (whose sphere bound is of
+    /// the order of their size).
+    pub max_relative_bound: f64,
+    /// Leaves at extraordinary vertices.
+    pub extraordinary_leaves: usize,
+    /// Seconds (evaluation, flatness tests, globalization, triangulation).
+    pub seconds: f64,
+}
+
+impl AdaptiveStats {
+    /// The stats as JSON (the CLI's `--stats`).
+    pub fn to_json(&self) -> Value {
+        json!({
+            "method": "adaptive",
+            "polygons": self.polygons,
+            "triangles": self.triangles,
+            "vertices": self.vertices,
+            "triangulated": self.triangulated,
+            "max_depth": self.max_depth,
+            "uniform_depth": self.uniform_depth,
+            "uniform_polygons": self.uniform_polygons,
+            "au_ratio": self.au_ratio,
+            "leaves_over_tolerance": self.leaves_over_tolerance,
+            "max_bound": self.max_bound,
+            "max_relative_bound": self.max_relative_bound,
+            "extraordinary_leaves": self.extraordinary_leaves,
+            "seconds": self.seconds,
+        })
+    }
+}
+
+/// A leaf square of one face, in the face's own grid coordinates.
+#[derive(Clone, Copy, Debug)]
+struct Leaf {
+    u0: u32,
+    v0: u32,
+    size: u32,
+    depth: u32,
+    bound: f64,
+    tolerance: f64,
+    diagonal: f64,
+    extraordinary: bool,
+}
+
+/// A corner of a leaf: a marked point (section 5), with its evaluated position and normal.
+#[derive(Clone, Copy, Debug)]
+struct Marked {
+    u: u32,
+    v: u32,
+    position: Point,
+    normal: Point,
+}
+
+/// The recursion over one face (section 5's `AdaptiveMarking`).
+struct FaceWork<'a> {
+    options: &'a AdaptiveOptions,
+    /// The face corner at the patch's `(0,0)`.
+    corner: usize,
+    leaves: Vec<Leaf>,
+    marked: Vec<Marked>,
+}
+
+impl FaceWork<'_> {
+    /// Face grid coordinates of patch grid coordinates (the inverse of [`crate::scheme::patch::to_patch`]).
+    fn to_face(&self, p: u32, q: u32) -> (u32, u32) {
+        match self.corner {
+            0 => (p, q),
+            1 => (GRID - q, p),
+            2 => (GRID - p, GRID - q),
+            _ => (q, GRID - p),
+        }
+    }
+
+    fn tolerance(&self, diagonal: f64) -> f64 {
+        if self.options.relative {
+            self.options.tolerance * diagonal
+        } else {
+            self.options.tolerance
+        }
+    }
+
+    fn done(&self, depth: u32, bound: f64, tolerance: f64) -> bool {
+        depth >= self.options.min_depth && (bound <= tolerance || depth >= self.options.max_depth)
+    }
+
+    /// Record the leaf `[p0, p0 + size] x [q0, q0 + size]` (patch coordinates) and mark its
+    /// corners (`MarkBlack`).
+    #[allow(clippy::too_many_arguments)]
+    fn leaf(
+        &mut self,
+        (p0, q0, depth): (u32, u32, u32),
+        points: [Point; 4],
+        normals: [Point; 4],
+        bound: f64,
+        tolerance: f64,
+        extraordinary: bool,
+    ) {
+        let size = GRID >> depth;
+        let patch_corners = [
+            (p0, q0),
+            (p0 + size, q0),
+            (p0 + size, q0 + size),
+            (p0, q0 + size),
+        ];
+        let mut u0 = GRID;
+        let mut v0 = GRID;
+        for (k, &(p, q)) in patch_corners.iter().enumerate() {
+            let (u, v) = self.to_face(p, q);
+            u0 = u0.min(u);
+            v0 = v0.min(v);
+            self.marked.push(Marked {
+                u,
+                v,
+                position: points[k],
+                normal: normals[k],
+            });
+        }
+        self.leaves.push(Leaf {
+            u0,
+            v0,
+            size,
+            depth,
+            bound,
+            tolerance,
+            diagonal: longer_diagonal(&points),
+            extraordinary,
+        });
+    }
+
+    /// A regular square with Bézier net `net` at patch coordinates `(p0, q0)`, depth `depth`.
+    fn regular(&mut self, net: &Net, p0: u32, q0: u32, depth: u32) {
+        let points = corners(net);
+        let bound = flatness_bound(net);
+        let tolerance = self.tolerance(longer_diagonal(&points));
+        if self.done(depth, bound, tolerance) {
+            self.leaf(
+                (p0, q0, depth),
+                points,
+                corner_normals(net),
+                bound,
+                tolerance,
+                false,
+            );
+            return;
+        }
+        let half = (GRID >> depth) / 2;
+        let origins = [(0, 0), (half, 0), (half, half), (0, half)];
+        for (child, (dp, dq)) in bezier_net::split(net).iter().zip(origins) {
+            self.regular(child, p0 + dp, q0 + dq, depth + 1);
+        }
+    }
+
+    /// The patch at an extraordinary vertex with layout `points`: descend with `A` (section
+    /// 4.1), the three regular quarters of each level as Bézier squares.
+    fn extraordinary(&mut self, ops: &Operators, mut points: Vec<Point>, vertex_normal: Point) {
+        let mut depth = 0;
+        let mut root_diagonal = 0.0;
+        loop {
+            let nets: [Net; 3] = std::array::from_fn(|b| ops.sub_patch(b, &points));
+            let corner_points = [
+                ops.vertex_position(&points),
+                nets[0][3],
+                nets[1][15],
+                nets[2][12],
+            ];
+            let diagonal = longer_diagonal(&corner_points);
+            if depth == 0 {
+                root_diagonal = diagonal;
+            }
+            let bound = if ops.nonnegative {
+                diameter(&points).min(diameter(&ev_enclosure(ops, &nets, &points)))
+            } else {
+                f64::INFINITY
+            };
+            let tolerance = self.tolerance(root_diagonal);
+            if self.done(depth, bound, tolerance) {
+                let normals = [
+                    vertex_normal,
+                    corner_normals(&nets[0])[1],
+                    corner_normals(&nets[1])[2],
+                    corner_normals(&nets[2])[3],
+                ];
+                self.leaf(
+                    (0, 0, depth),
+                    corner_points,
+                    normals,
+                    bound,
+                    tolerance,
+                    true,
+                );
+                return;
+            }
+            let half = (GRID >> depth) / 2;
+            self.regular(&nets[0], half, 0, depth + 1);
+            self.regular(&nets[1], half, half, depth + 1);
+            self.regular(&nets[2], 0, half, depth + 1);
+            points = ops.a.apply(&points);
+            depth += 1;
+        }
+    }
+}
+
+/// Levels of the extraordinary enclosure ([`ev_enclosure`]).
+const EV_ENCLOSURE_LEVELS: usize = 3;
+
+/// Points whose convex hull contains the surface over the extraordinary square with layout
+/// `points` (`nets`: its three regular quarters, `ops.sub_patch(b, points)`): the Bézier nets
+/// of the regular quarters of [`EV_ENCLOSURE_LEVELS`] levels and the layout `A^levels P` of the
+/// innermost square. Each regular quarter lies in the hull of its own Bézier net (Bernstein
+/// polynomials are non-negative and sum to one), the innermost square in the hull of its layout
+/// (`A >= 0`, the extraordinary bound's condition), and the squares tile the extraordinary one.
+/// The hull is inside that of `points` when the quarters' operators are non-negative too, and
+/// shrinks towards the surface piece itself as the levels grow.
+fn ev_enclosure(ops: &Operators, nets: &[Net; 3], points: &[Point]) -> Vec<Point> {
+    let mut out: Vec<Point> = nets.iter().flat_map(|n| n.iter().copied()).collect();
+    let mut layout = ops.a.apply(points);
+    for _ in 1..EV_ENCLOSURE_LEVELS {
+        for b in 0..3 {
+            out.extend_from_slice(&ops.sub_patch(b, &layout));
+        }
+        layout = ops.a.apply(&layout);
+    }
+    out.extend_from_slice(&layout);
+    out
+}
+
+/// The largest distance between two of the points (the diameter of their convex hull).
+fn diameter(points: &[Point]) -> f64 {
+    let mut best: f64 = 0.0;
+    for (i, a) in points.iter().enumerate() {
+        for b in &points[i + 1..] {
+            best = best.max(bezier_net::norm(bezier_net::sub(*a, *b)));
+        }
+    }
+    best
+}
+
+/// The normal at the patch's extraordinary vertex from the table's tangent stencils at
+/// `(0,0)` (primal grid, `n = 1`), in patch coordinates (a rotation of the face's).
+fn vertex_normal(table: &StencilTable, patch: &FacePatch, points: &[Point]) -> Option<Point> {
+    let tangent = |kind| -> Option<Point> {
+        let key = SectionKey {
+            kind,
+            points: PointSet::Primal,
+            boundary: patch.kind.boundary,
+            faces: patch.kind.faces,
+            sector: patch.kind.sector,
+            n: 1,
+        };
+        let weights = table.weights(&key).ok()?;
+        let row = weights.get(..points.len())?;
+        let mut t = [0.0; 3];
+        for (w, q) in row.iter().zip(points) {
+            for c in 0..3 {
+                t[c] += f64::from(*w) * q[c];
+            }
+        }
+        Some(t)
+    };
+    Some(unit(cross(
+        tangent(StencilKind::DerivativeU)?,
+        tangent(StencilKind::DerivativeV)?,
+    )))
+}
+
+/// The shared key of a point (section 5's global index): a mesh vertex, a point on a mesh
+/// edge (the half-edge with the smaller index of the pair, and the parameter along it), or a
+/// point inside a face.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+enum PointKey {
+    Vertex(u32),
+    Edge(u32, u32),
+    Face(u32, u32, u32),
+}
+
+/// Side `side` of a face (counter-clockwise from corner `side`) and the own parameter `t` along
+/// it of the face point `(u, v)`, if it is on that side's interior.
+fn on_side(u: u32, v: u32) -> Option<(usize, u32)> {
+    match (u, v) {
+        (_, 0) => Some((0, u)),
+        (GRID, _) => Some((1, v)),
+        (_, GRID) => Some((2, GRID - u)),
+        (0, _) => Some((3, GRID - v)),
+        _ => None,
+    }
+}
+
+/// The canonical half-edge of side `side` of face `face`, and whether parameters flip on it.
+fn canonical_edge(mesh: &Mesh, face: usize, side: usize) -> (u32, bool) {
+    let h = mesh.face_halfedges(face).start + side;
+    let t = mesh.twin[h];
+    if t != NONE && (t as usize) < h {
+        (t, true)
+    } else {
+        (h as u32, false)
+    }
+}
+
+fn point_key(mesh: &Mesh, face: usize, u: u32, v: u32) -> PointKey {
+    let corner = match (u, v) {
+        (0, 0) => Some(0),
+        (GRID, 0) => Some(1),
+        (GRID, GRID) => Some(2),
+        (0, GRID) => Some(3),
+        _ => None,
+    };
+    if let Some(k) = corner {
+        return PointKey::Vertex(mesh.face(face)[k]);
+    }
+    match on_side(u, v) {
+        Some((side, t)) => {
+            let (h, flip) = canonical_edge(mesh, face, side);
+            PointKey::Edge(h, if flip { GRID - t } else { t })
+        }
+        None => PointKey::Face(face as u32, u, v),
+    }
+}
+
+/// The values of a sorted list strictly between `lo` and `hi`.
+fn between(sorted: &[u32], lo: u32, hi: u32) -> &[u32] {
+    let a = sorted.partition_point(|&x| x <= lo);
+    let b = sorted.partition_point(|&x| x < hi);
+    &sorted[a..b.max(a)]
+}
+
+/// Every marked point, grouped for the polygon walk: per canonical mesh edge the parameters
+/// along it; per face the interior points on each horizontal (`v` fixed) and vertical line.
+struct MarkedSets {
+    edges: HashMap<u32, Vec<u32>>,
+    lines: Vec<HashMap<(bool, u32), Vec<u32>>>,
+}
+
+impl MarkedSets {
+    /// The marked points strictly inside side `side` of face `face` between own parameters
+    /// `lo` and `hi`, ascending (the walking order of the side).
+    fn on_edge(&self, mesh: &Mesh, face: usize, side: usize, lo: u32, hi: u32) -> Vec<u32> {
+        let (h, flip) = canonical_edge(mesh, face, side);
+        let Some(all) = self.edges.get(&h) else {
+            return Vec::new();
+        };
+        if flip {
+            let mut out: Vec<u32> = between(all, GRID - hi, GRID - lo)
+                .iter()
+                .map(|&t| GRID - t)
+                .collect();
+            out.reverse();
+            out
+        } else {
+            between(all, lo, hi).to_vec()
+        }
+    }
+
+    /// The marked points strictly inside `(lo, hi)` on a face line, ascending.
+    fn on_line(&self, face: usize, horizontal: bool, at: u32, lo: u32, hi: u32) -> &[u32] {
+        match self.lines[face].get(&(horizontal, at)) {
+            Some(all) => between(all, lo, hi),
+            None => &[],
+        }
+    }
+}
+
+/// The ring of face grid points around a leaf: its corners and every marked point on its
+/// sides, counter-clockwise (section 5: "output in order all the marked points between corners
+/// of the base quadrilateral").
+fn leaf_ring(mesh: &Mesh, sets: &MarkedSets, face: usize, leaf: &Leaf) -> Vec<(u32, u32)> {
+    let (u0, v0) = (leaf.u0, leaf.v0);
+    let (u1, v1) = (u0 + leaf.size, v0 + leaf.size);
+    let mut ring = vec![(u0, v0)];
+    if v0 == 0 {
+        ring.extend(sets.on_edge(mesh, face, 0, u0, u1).iter().map(|&t| (t, 0)));
+    } else {
+        ring.extend(
+            sets.on_line(face, true, v0, u0, u1)
+                .iter()
+                .map(|&u| (u, v0)),
+        );
+    }
+    ring.push((u1, v0));
+    if u1 == GRID {
+        ring.extend(
+            sets.on_edge(mesh, face, 1, v0, v1)
+                .iter()
+                .map(|&t| (GRID, t)),
+        );
+    } else {
+        ring.extend(
+            sets.on_line(face, false, u1, v0, v1)
+                .iter()
+                .map(|&v| (u1, v)),
+        );
+    }
+    ring.push((u1, v1));
+    if v1 == GRID {
+        ring.extend(
+            sets.on_edge(mesh, face, 2, GRID - u1, GRID - u0)
+                .iter()
+                .map(|&t| (GRID - t, GRID)),
+        );
+    } else {
+        ring.extend(
+            sets.on_line(face, true, v1, u0, u1)
+                .iter()
+                .rev()
+                .map(|&u| (u, v1)),
+        );
+    }
+    ring.push((u0, v1));
+    if u0 == 0 {
+        ring.extend(
+            sets.on_edge(mesh, face, 3, GRID - v1, GRID - v0)
+                .iter()
+                .map(|&t| (0, GRID - t)),
+        );
+    } else {
+        ring.extend(
+            sets.on_line(face, false, u0, v0, v1)
+                .iter()
+                .rev()
+                .map(|&v| (u0, v)),
+        );
+    }
+    ring
+}
+
+fn check_options(options: &AdaptiveOptions) -> Result<(), RuntimeError> {
+    let bad = |name: &str, reason: String| RuntimeError::InvalidParameter {
+        name: name.to_owned(),
+        reason,
+    };
+    if !(options.tolerance.is_finite() && options.tolerance > 0.0) {
+        return Err(bad(
+            "tolerance",
+            format!(
+                "{} (it must be a positive {})",
+                options.tolerance,
+                if options.relative {
+                    "ratio"
+                } else {
+                    "distance"
+                }
+            ),
+        ));
+    }
+    if options.max_depth > MAX_DEPTH {
+        return Err(bad(
+            "max_depth",
+            format!("{} (it must be at most {MAX_DEPTH})", options.max_depth),
+        ));
+    }
+    if options.min_depth > options.max_depth {
+        return Err(bad(
+            "min_depth",
+            format!(
+                "{} (it must be at most max_depth = {})",
+                options.min_depth, options.max_depth
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Tessellate an isolated mesh (every face a table patch, [`crate::scheme::catmull_clark::isolate`]) adaptively with
+/// the guaranteed error of Lai–Cheng (sections 2, 4, 5, 6; module documentation): every leaf
+/// square passes the flatness test (eq. 7–8 in the bound of [`bezier_net::flatness_bound`], or
+/// the extraordinary vertex's hull bound) unless `max_depth` stops it (then it is counted in
+/// [`AdaptiveStats::leaves_over_tolerance`]); the polygons share one vertex per marked point.
+///
+/// `table` supplies the tangent stencils for the normals at extraordinary vertices.
+/// Cost: one Bézier subdivision and one 16-point bound per square, faces in parallel.
+pub fn tessellate_adaptive(
+    table: &StencilTable,
+    mesh: &Mesh,
+    patches: &[FacePatch],
+    options: &AdaptiveOptions,
+) -> Result<(AdaptiveMesh, AdaptiveStats), RuntimeError> {
+    let started = Instant::now();
+    check_options(options)?;
+    if patches.len() != mesh.faces() {
+        return Err(RuntimeError::Unsupported(format!(
+            "{} patches for {} faces",
+            patches.len(),
+            mesh.faces()
+        )));
+    }
+    // The operators of every patch kind, built once.
+    let mut kinds: Vec<PatchKind> = patches.iter().map(|p| p.kind).collect();
+    kinds.sort_by_key(|k| (k.boundary, k.faces, k.sector));
+    kinds.dedup();
+    let mut operators: HashMap<PatchKind, Operators> = HashMap::new();
+    for kind in kinds {
+        let ops = Operators::new(mesh, kind)?;
+        operators.insert(kind, ops);
+    }
+    // Pass 1 (parallel): the adaptive marking of every face.
+    let work: Vec<(Vec<Leaf>, Vec<Marked>)> = patches
+        .par_iter()
+        .map(|patch| -> Result<(Vec<Leaf>, Vec<Marked>), RuntimeError> {
+            let ops = operators.get(&patch.kind).ok_or_else(|| {
+                RuntimeError::Unsupported(format!("no operators for {:?}", patch.kind))
+            })?;
+            if ops.size != patch.points.len() {
+                return Err(RuntimeError::Unsupported(format!(
+                    "a patch {:?} has {} control points, its layout {}",
+                    patch.kind,
+                    patch.points.len(),
+                    ops.size
+                )));
+            }
+            let points: Vec<Point> = patch
+                .points
+                .iter()
+                .map(|&v| mesh.positions[v as usize])
+                .collect();
+            let mut face = FaceWork {
+                options,
+                corner: patch.corner,
+                leaves: Vec::new(),
+                marked: Vec::new(),
+            };
+            match ops.regular_patch(&points) {
+                Some(net) => face.regular(&net, 0, 0, 0),
+                None => {
+                    let normal = vertex_normal(table, patch, &points).unwrap_or([0.0; 3]);
+                    face.extraordinary(ops, points, normal);
+                }
+            }
+            Ok((face.leaves, face.marked))
+        })
+        .collect::<Result<_, _>>()?;
+    // Pass 2: global ids (section 5), first evaluation wins, in face order.
+    let mut ids: HashMap<PointKey, u32> = HashMap::new();
+    let mut out = AdaptiveMesh::default();
+    let mut sets = MarkedSets {
+        edges: HashMap::new(),
+        lines: vec![HashMap::new(); mesh.faces()],
+    };
+    for (face, (_, marked)) in work.iter().enumerate() {
+        for m in marked {
+            let key = point_key(mesh, face, m.u, m.v);
+            if ids.contains_key(&key) {
+                continue;
+            }
+            ids.insert(key, out.positions.len() as u32);
+            out.positions.push(m.position);
+            out.normals.push(m.normal);
+            let shift = (m.u | m.v | GRID).trailing_zeros();
+            out.sources.push(VertexSource {
+                face: face as u32,
+                u: m.u >> shift,
+                v: m.v >> shift,
+                denominator: GRID >> shift,
+                subface: 0,
+            });
+            match key {
+                PointKey::Vertex(_) => {}
+                PointKey::Edge(h, t) => sets.edges.entry(h).or_default().push(t),
+                PointKey::Face(..) => {
+                    sets.lines[face].entry((true, m.v)).or_default().push(m.u);
+                    sets.lines[face].entry((false, m.u)).or_default().push(m.v);
+                }
+            }
+        }
+    }
+    for list in sets.edges.values_mut() {
+        list.sort_unstable();
+    }
+    for lines in &mut sets.lines {
+        for list in lines.values_mut() {
+            list.sort_unstable();
+        }
+    }
+    // Pass 3 (parallel): the polygons (base quadrilateral replacement) and their triangles.
+    let polygons: Vec<Vec<AdaptivePolygon>> = work
+        .par_iter()
+        .enumerate()
+        .map(
+            |(face, (leaves, _))| -> Result<Vec<AdaptivePolygon>, RuntimeError> {
+                leaves
+                    .iter()
+                    .map(|leaf| {
+                        let ring = leaf_ring(mesh, &sets, face, leaf);
+                        let vertices = ring
+                            .iter()
+                            .map(|&(u, v)| {
+                                ids.get(&point_key(mesh, face, u, v))
+                                    .copied()
+                                    .ok_or_else(|| {
+                                        RuntimeError::Unsupported(format!(
+                                    "internal: face {face} point ({u}, {v}) / {GRID} has no id"
+                                ))
+                                    })
+                            })
+                            .collect::<Result<Vec<u32>, _>>()?;
+                        let params: Vec<(i64, i64)> = ring
+                            .iter()
+                            .map(|&(u, v)| (i64::from(u), i64::from(v)))
+                            .collect();
+                        let positions: Vec<Point> = vertices
+                            .iter()
+                            .map(|&i| out.positions[i as usize])
+                            .collect();
+                        let triangles = polygons::triangulate(&params, &positions)
+                            .into_iter()
+                            .map(|t| t.map(|k| vertices[k]))
+                            .collect();
+                        Ok(AdaptivePolygon {
+                            vertices,
+                            triangles,
+                            region: PolygonRegion {
+                                face: face as u32,
+                                u0: leaf.u0,
+                                v0: leaf.v0,
+                                size: leaf.size,
+                                denominator: GRID,
+                                depth: leaf.depth,
+                                extraordinary: leaf.extraordinary,
+                                bound: leaf.bound,
+                                tolerance: leaf.tolerance,
+                                diagonal: leaf.diagonal,
+                            },
+                        })
+                    })
+                    .collect()
+            },
+        )
+        .collect::<Result<_, _>>()?;
+    out.polygons = polygons.into_iter().flatten().collect();
+    let stats = statistics(&out, mesh.faces(), options, started);
+    Ok((out, stats))
+}
+
+fn statistics(
+    out: &AdaptiveMesh,
+    faces: usize,
+    options: &AdaptiveOptions,
+    started: Instant,
+) -> AdaptiveStats {
+    let regions = || out.polygons.iter().map(|p| &p.region);
+    let max_depth = regions().map(|r| r.depth).max().unwrap_or(0);
+    let triangles = out.triangle_count();
+    let uniform_polygons = faces as f64 * 4f64.powi(max_depth as i32);
+    let primitives = if options.triangulate {
+        triangles
+    } else {
+        out.polygons.len()
+    };
+    AdaptiveStats {
+        polygons: out.polygons.len(),
+        triangles,
+        vertices: out.positions.len(),
+        triangulated: options.triangulate,
+        max_depth,
+        uniform_depth: max_depth,
+        uniform_polygons,
+        au_ratio: primitives as f64 / uniform_polygons,
+        leaves_over_tolerance: regions().filter(|r| r.bound > r.tolerance).count(),
+        max_bound: regions().map(|r| r.bound).fold(0.0, f64::max),
+        max_relative_bound: regions()
+            .filter(|r| !r.extraordinary)
+            .map(|r| r.bound / r.diagonal)
+            .fold(0.0, f64::max),
+        extraordinary_leaves: regions().filter(|r| r.extraordinary).count(),
+        seconds: started.elapsed().as_secs_f64(),
+    }
+}

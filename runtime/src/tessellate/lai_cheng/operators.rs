@@ -1,0 +1,150 @@
+//! The local subdivision operators of one patch kind in f64: `A`, the sub-patch nets `R_b`,
+//! the regular net, the limit mask. Converted once per kind from the exact rationals of
+//! [`schemes::local_matrices::LocalMatrices`].
+
+use num_rational::BigRational;
+use num_traits::ToPrimitive;
+use schemes::local_matrices::{LocalMatrices, Neighbourhood};
+use schemes::QuadScheme;
+
+use super::bezier_net::{bspline_to_bezier, Net, Point};
+use crate::mesh::topology::Mesh;
+use crate::scheme::patch::PatchKind;
+use crate::RuntimeError;
+
+/// A dense row-major matrix.
+#[derive(Clone, Debug)]
+pub(crate) struct Matrix {
+    rows: usize,
+    cols: usize,
+    data: Vec<f64>,
+}
+
+impl Matrix {
+    fn from_exact(m: &[Vec<BigRational>]) -> Result<Self, RuntimeError> {
+        let rows = m.len();
+        let cols = m.first().map_or(0, Vec::len);
+        let mut data = Vec::with_capacity(rows * cols);
+        for row in m {
+            for x in row {
+                data.push(x.to_f64().ok_or_else(|| {
+                    RuntimeError::Unsupported(format!("a subdivision weight {x} has no f64 value"))
+                })?);
+            }
+        }
+        Ok(Matrix { rows, cols, data })
+    }
+
+    /// `M P` for a column of points.
+    pub(crate) fn apply(&self, points: &[Point]) -> Vec<Point> {
+        (0..self.rows)
+            .map(|r| {
+                let row = &self.data[r * self.cols..][..self.cols];
+                let mut p = [0.0; 3];
+                for (w, q) in row.iter().zip(points) {
+                    for c in 0..3 {
+                        p[c] += w * q[c];
+                    }
+                }
+                p
+            })
+            .collect()
+    }
+
+    /// `M P` as a 4 x 4 net (`M` has 16 rows).
+    fn apply_net(&self, points: &[Point]) -> Net {
+        let v = self.apply(points);
+        std::array::from_fn(|k| v[k])
+    }
+}
+
+/// One patch kind's operators.
+#[derive(Clone, Debug)]
+pub(crate) struct Operators {
+    /// Control points `K`.
+    pub(crate) size: usize,
+    /// `A` (K x K); `P_{k+1} = A P_k` is the layout one level down, around the same vertex.
+    pub(crate) a: Matrix,
+    /// `R_b` (16 x K): B-spline nets of the sub-patches `[1/2,1]x[0,1/2]`, `[1/2,1]^2`,
+    /// `[0,1/2]x[1/2,1]`.
+    pub(crate) sub_patches: [Matrix; 3],
+    /// The B-spline net of a regular patch (phantom points included), else `None`.
+    pub(crate) regular: Option<Matrix>,
+    /// The limit mask `l` (`l A = l`, `sum l = 1`): the position at the vertex.
+    pub(crate) limit: Vec<f64>,
+    /// Whether every entry of `A` and every subdivision rule is non-negative, which puts the
+    /// patch over `[0, 2^-k]^2` inside the convex hull of `A^k P` (the extraordinary bound).
+    pub(crate) nonnegative: bool,
+}
+
+impl Operators {
+    /// Build the operators of `kind` for a mesh with `mesh`'s boundary rule.
+    pub(crate) fn new(mesh: &Mesh, kind: PatchKind) -> Result<Self, RuntimeError> {
+        let scheme = QuadScheme::by_name("catmull-clark")
+            .ok_or_else(|| RuntimeError::Unsupported("catmull-clark is not catalogued".into()))?;
+        let nb = if kind.boundary {
+            Neighbourhood::boundary(kind.faces, mesh.boundary)
+        } else {
+            Neighbourhood::interior(kind.faces)
+        };
+        let exact = LocalMatrices::new(&scheme, nb, kind.sector)
+            .map_err(|e| RuntimeError::Unsupported(e.to_string()))?;
+        let a = Matrix::from_exact(&exact.a)?;
+        let sub_patches = [
+            Matrix::from_exact(&exact.sub_patches[0])?,
+            Matrix::from_exact(&exact.sub_patches[1])?,
+            Matrix::from_exact(&exact.sub_patches[2])?,
+        ];
+        let regular = match exact.regular_net() {
+            Some(n) => Some(Matrix::from_exact(&n)?),
+            None => None,
+        };
+        let size = exact.size();
+        // Power iteration for the left eigenvector of eigenvalue 1; the others are below 0.7
+        // for Catmull–Clark, so 200 steps leave far less than f64 rounding.
+        let mut limit = vec![0.0; size];
+        limit[0] = 1.0;
+        for _ in 0..200 {
+            let mut next = vec![0.0; size];
+            for (r, &l) in limit.iter().enumerate() {
+                for (c, x) in next.iter_mut().enumerate() {
+                    *x += l * a.data[r * size + c];
+                }
+            }
+            let sum: f64 = next.iter().sum();
+            limit = next.iter().map(|x| x / sum).collect();
+        }
+        let nonnegative = a.data.iter().all(|&x| x >= 0.0);
+        Ok(Operators {
+            size,
+            a,
+            sub_patches,
+            regular,
+            limit,
+            nonnegative,
+        })
+    }
+
+    /// The Bézier net of sub-patch `b` of the layout `points`.
+    pub(crate) fn sub_patch(&self, b: usize, points: &[Point]) -> Net {
+        bspline_to_bezier(&self.sub_patches[b].apply_net(points))
+    }
+
+    /// The Bézier net of the whole (regular) patch.
+    pub(crate) fn regular_patch(&self, points: &[Point]) -> Option<Net> {
+        self.regular
+            .as_ref()
+            .map(|r| bspline_to_bezier(&r.apply_net(points)))
+    }
+
+    /// The limit position at the patch vertex.
+    pub(crate) fn vertex_position(&self, points: &[Point]) -> Point {
+        let mut p = [0.0; 3];
+        for (w, q) in self.limit.iter().zip(points) {
+            for c in 0..3 {
+                p[c] += w * q[c];
+            }
+        }
+        p
+    }
+}

@@ -1,0 +1,1014 @@
+//! Rate selection for the dual-grid tessellator (Schaefer–Warren section 5.5): per-face rates
+//! from a tolerance on the deviation from the limit surface ([`tolerance_rates`]) or from a
+//! camera ([`view_rates`]), and the measured deviation of a finished tessellation
+//! ([`measure_deviation`]).
+//!
+//! # Tolerance: what is measured
+//!
+//! Face `f` of an isolated mesh has the limit surface `S_f(u, v)` on `[0,1]^2` (its own
+//! parameters, DESIGN.md conventions). At rate `n` the tessellator places the dual points
+//! `D_ij = S_f((2i+1)/2n, (2j+1)/2n)` and connects them (dual_grid.rs). Let `L_{f,n}` be the
+//! part of the output of the *uniform* rate-`n` tessellation that covers face `f`, with the
+//! tessellator's own triangles:
+//!
+//! * the face's interior quads over `[h, 1-h]^2`, `h = 1/2n`, split along `D_ij – D_{i+1,j+1}`;
+//! * over each side rectangle (`[h, 1-h] x [0, h]` and its rotations) the half of the edge
+//!   strip between the face's outer dual row and the neighbour's (both at rate `n`, so the
+//!   strip is a row of quads split as the tessellator's merge splits them), or on a boundary
+//!   edge the strip to the limit curve at `t/n`;
+//! * over each corner square `[0, h]^2` (and rotations) the vertex polygon (the corner dual
+//!   points of every face around the vertex, plus the vertex's limit point on the boundary,
+//!   fanned from its first point), with the two ends of the adjacent strips and the face's
+//!   corner cell.
+//!
+//! The deviation at a sample `(u, v)` is the parametric distance `|S_f(u, v) - L_{f,n}(u, v)|`
+//! in the interior and the side rectangles, where `L_{f,n}` is linear in `(u, v)` on every
+//! triangle (across an edge, in the chart `(s, d)`: position `s` along the edge, which both
+//! faces share, and signed distance `d` from it); and in a corner square, where faces around an
+//! extraordinary vertex have no common planar chart, the Euclidean distance from `S_f(u, v)` to
+//! the nearest of those corner triangles. The **deviation of face `f` at rate `n`** is
+//!
+//! ```text
+//! e_f(n) = max over (u, v) in G of deviation(u, v)
+//! ```
+//!
+//! over the dense rational grid `G` = the table's primal and dual points at rate
+//! [`SELECTION_GRID`] (`k/24` and `(2k+1)/48`: 1,201 points a face), evaluated exactly from the
+//! table. Both kinds of distance are at least the distance from the sample to the output mesh,
+//! so `e_f(n)` bounds the geometric error of the uniform tessellation at those samples. The
+//! parametric part also counts tangential distortion (a flat patch whose parameterization is
+//! not affine deviates): what texture coordinates and shading see.
+//!
+//! On a uniform grid on `z = a x^2` this is the closed form `e_f(n) = a / 4n^2` whenever `n`
+//! divides 24 (the midpoints of the cells are samples); `runtime/tests/rates.rs` checks it.
+//!
+//! The **tolerance rate** of face `f` is the smallest allowed `n` with `e_f(n) <= T`
+//! ([`tolerance_rates`]: `n` in `1..=24`; [`tolerance_rates_among`]: any set, e.g. the powers of
+//! two of subdivision-based tessellators). Because `e_f` depends on `f` and `n` alone (not on
+//! the rates chosen elsewhere), the rates are monotone in `T` (a smaller `T` never lowers a
+//! rate) and minimal (every smaller allowed rate exceeds `T` on `G`). Faces with no allowed rate
+//! meeting `T` get the largest one and are listed in [`ToleranceRates::unmet`].
+//!
+//! # What is and is not guaranteed
+//!
+//! * Guaranteed on `G`: a face's interior quads depend on its own rate only, so over
+//!   `[h, 1-h]^2` the output *is* `L_{f,n}` and deviates by at most `T` at every sample of `G`;
+//!   where neighbours share the face's rate, so is the rest.
+//! * Not guaranteed, measured: where rates differ, the tessellator's strips merge rows of
+//!   different lengths and its vertex polygons join corner points at different distances from
+//!   the vertex. These triangles lie between those of the uniform tessellations at the two
+//!   (or more) rates, each of which meets `T` around its own face, but no bound is proved for
+//!   them. [`measure_deviation`] measures the finished output; `docs/results.md` reports it next
+//!   to `T` for every mesh and tolerance: at most `T` in 19 of 20 cases, 1.002 `T` once
+//!   (Spot, rates 1 and 2 side by side).
+//! * Between samples of `G`: `e_f` is a maximum over samples, not over the continuum; the tests
+//!   measure the output again on other grids (dual points at rates 23 and 19).
+
+use std::collections::HashMap;
+
+use rayon::prelude::*;
+use table_format::{PointSet, SectionKey, StencilKind};
+
+use crate::mesh::topology::{Mesh, NONE};
+use crate::scheme::patch::{dual_index_in_patch, FacePatch};
+use crate::stencil_table::StencilTable;
+use crate::tessellate::triangle_mesh::TriangleMesh;
+use crate::RuntimeError;
+
+/// The largest rate selected: the largest of the default table (`n = 1..=24`).
+pub const MAX_SELECTED_RATE: u32 = 24;
+
+/// Every rate of the default table, `1..=24`: the rational rates of Schaefer–Warren.
+pub const RATIONAL_RATES: [u32; 24] = [
+    1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 21, 22, 23, 24,
+];
+
+/// The powers of two of the default table, the rates a subdivision-based tessellator can reach
+/// (`1/2^k` grids).
+pub const POWER_OF_TWO_RATES: [u32; 5] = [1, 2, 4, 8, 16];
+
+/// The rate of the dense grid the deviation is measured on during selection: the table's
+/// primal points `k/24` and dual points `(2k+1)/48` of every face.
+pub const SELECTION_GRID: u32 = 24;
+
+/// Per-face rates chosen for a tolerance.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ToleranceRates {
+    /// The rate of every face.
+    pub rates: Vec<u32>,
+    /// `e_f(rates[f])`, the deviation of the face-local tessellation at the chosen rate
+    /// (module docs).
+    pub deviations: Vec<f64>,
+    /// Faces where no allowed rate met the tolerance (they got the largest allowed rate).
+    pub unmet: Vec<usize>,
+}
+
+/// The control points of a patch and the table lookups that evaluate it.
+struct PatchPoints<'a> {
+    table: &'a StencilTable,
+    patch: &'a FacePatch,
+    control: Vec<[f64; 3]>,
+}
+
+impl<'a> PatchPoints<'a> {
+    fn new(
+        table: &'a StencilTable,
+        mesh: &Mesh,
+        patch: &'a FacePatch,
+    ) -> Result<Self, RuntimeError> {
+        // A one-face boundary vertex is smooth in "edge only" mode and pinned in "edge and
+        // corner" mode: its stencils must come from a table made for the mesh's mode.
+        let corners = mesh.boundary == schemes::BoundaryMode::EdgeAndCorner;
+        if patch.kind.boundary && patch.kind.faces == 1 && table.pins_corners() != corners {
+            return Err(RuntimeError::BoundaryModeMismatch {
+                mesh_corners: corners,
+            });
+        }
+        let control = patch
+            .points
+            .iter()
+            .map(|&v| {
+                mesh.positions.get(v as usize).copied().ok_or_else(|| {
+                    RuntimeError::Unsupported(format!("patch control point {v} is not in the mesh"))
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(PatchPoints {
+            table,
+            patch,
+            control,
+        })
+    }
+
+    /// The position weights of a grid and its side (`n` or `n + 1` points).
+    fn grid(&self, points: PointSet, n: u32) -> Result<Grid<'a>, RuntimeError> {
+        let key = SectionKey {
+            kind: StencilKind::Position,
+            points,
+            boundary: self.patch.kind.boundary,
+            faces: self.patch.kind.faces,
+            sector: self.patch.kind.sector,
+            n,
+        };
+        let weights = self.table.weights(&key)?;
+        let side = match points {
+            PointSet::Primal => n as usize + 1,
+            PointSet::Dual => n as usize,
+            PointSet::TrianglePrimal | PointSet::TriangleDual => {
+                return Err(RuntimeError::Unsupported(format!(
+                    "tolerance rates on triangle grids ({key})"
+                )))
+            }
+        };
+        let k = self.patch.points.len();
+        if weights.len() != side * side * k {
+            return Err(RuntimeError::LayoutMismatch {
+                key,
+                table: weights.len() / (side * side).max(1),
+                patch: k,
+            });
+        }
+        Ok(Grid {
+            weights,
+            side,
+            corner: self.patch.corner,
+        })
+    }
+
+    /// The limit position at grid point `(i, j)` of `grid`, in the face's own indices.
+    fn at(&self, grid: &Grid, i: usize, j: usize) -> [f64; 3] {
+        let (pi, pj) = dual_index_in_patch(grid.corner, i, j, grid.side);
+        let k = self.control.len();
+        let row = &grid.weights[(pj * grid.side + pi) * k..][..k];
+        let mut p = [0.0; 3];
+        for (w, q) in row.iter().zip(&self.control) {
+            for c in 0..3 {
+                p[c] += f64::from(*w) * q[c];
+            }
+        }
+        p
+    }
+
+    /// Every point of a grid, row by row (`j` outer).
+    fn all(&self, points: PointSet, n: u32) -> Result<Vec<[f64; 3]>, RuntimeError> {
+        let grid = self.grid(points, n)?;
+        let mut out = Vec::with_capacity(grid.side * grid.side);
+        for j in 0..grid.side {
+            for i in 0..grid.side {
+                out.push(self.at(&grid, i, j));
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// One table section of one patch, with the rotation into the patch.
+struct Grid<'t> {
+    weights: &'t [f32],
+    side: usize,
+    corner: usize,
+}
+
+/// The limit positions of face `patch` at the table's grid `points` at rate `n` (primal:
+/// `(i/n, j/n)`, `(n+1)^2` points; dual: `((2i+1)/2n, (2j+1)/2n)`, `n^2` points), in the face's
+/// own parameters, row by row (`j` outer): one weighted sum of the patch's control points per
+/// point. ([`crate::scheme::patch::dual_positions`] is the dual case.)
+pub fn table_positions(
+    table: &StencilTable,
+    mesh: &Mesh,
+    patch: &FacePatch,
+    points: PointSet,
+    n: u32,
+) -> Result<Vec<[f64; 3]>, RuntimeError> {
+    PatchPoints::new(table, mesh, patch)?.all(points, n)
+}
+
+/// Limit-surface samples of one face: parameters and positions.
+struct Samples {
+    uv: Vec<[f64; 2]>,
+    positions: Vec<[f64; 3]>,
+}
+
+impl Samples {
+    /// The primal and dual points of the face at rate `grid`.
+    fn new(points: &PatchPoints, grid: u32) -> Result<Self, RuntimeError> {
+        let mut uv = Vec::new();
+        let mut positions = Vec::new();
+        for set in [PointSet::Primal, PointSet::Dual] {
+            let g = points.grid(set, grid)?;
+            let n = f64::from(grid);
+            for j in 0..g.side {
+                for i in 0..g.side {
+                    // `grid` refused the triangle point sets; only the quad ones reach here.
+                    let (u, v) = if set == PointSet::Primal {
+                        (i as f64 / n, j as f64 / n)
+                    } else {
+                        (
+                            (2 * i + 1) as f64 / (2.0 * n),
+                            (2 * j + 1) as f64 / (2.0 * n),
+                        )
+                    };
+                    uv.push([u, v]);
+                    positions.push(points.at(&g, i, j));
+                }
+            }
+        }
+        Ok(Samples { uv, positions })
+    }
+}
+
+/// Dual-grid index `(i, j)` of point `t` of the row next to side `side` of a face at rate `n`,
+/// in the side's direction (sides run counter-clockwise: 0 `v = 0`, 1 `u = 1`, 2 `v = 1`,
+/// 3 `u = 0`); `t = 0` is the point nearest corner `side`.
+fn row_index(side: usize, t: usize, n: usize) -> (usize, usize) {
+    let last = n - 1;
+    match side {
+        0 => (t, 0),
+        1 => (last, t),
+        2 => (last - t, last),
+        _ => (0, last - t),
+    }
+}
+
+/// Primal index of point `t/n` along side `side` (counter-clockwise, from corner `side`).
+fn curve_index(side: usize, t: usize, n: usize) -> (usize, usize) {
+    match side {
+        0 => (t, 0),
+        1 => (n, t),
+        2 => (n - t, n),
+        _ => (0, n - t),
+    }
+}
+
+/// What lies beyond one side of the face in `L_{f,n}`.
+enum Beyond {
+    /// The neighbour's dual row at rate `n`, running along this side.
+    Face(Vec<[f64; 3]>),
+    /// The limit boundary curve at `t/n`, `t = 0..=n`, along this side.
+    Curve(Vec<[f64; 3]>),
+}
+
+/// The uniform-rate tessellation around one face, `L_{f,n}` (module docs): the face's dual
+/// points, what lies beyond each side, and the triangles around each corner.
+struct FaceLocal {
+    n: usize,
+    /// `n x n` dual points, `j` outer.
+    dual: Vec<[f64; 3]>,
+    beyond: Vec<Beyond>,
+    /// Per corner: the vertex polygon's triangles, the two ends of the adjacent strips, and the
+    /// face's corner cell.
+    corners: Vec<Vec<[[f64; 3]; 3]>>,
+}
+
+/// The triangles of a strip merging row `a` (`na` points at `(2i+1)/2na`) with row `b` (`nb`
+/// points at `(2j+1)/2nb`) along an edge, or with a boundary curve (`b` at `j/na`): the
+/// tessellator's merge order (dual_grid.rs).
+fn strip_triangles(a: &[[f64; 3]], b: &[[f64; 3]], curve: bool) -> Vec<[[f64; 3]; 3]> {
+    let (na, nb) = (a.len(), b.len());
+    let param_a = |i: usize| if curve { 2 * i + 1 } else { (2 * i + 1) * nb };
+    let param_b = |j: usize| if curve { 2 * j } else { (2 * j + 1) * na };
+    let (mut i, mut j) = (0, 0);
+    let mut out = Vec::with_capacity(na + nb);
+    while i + 1 < na || j + 1 < nb {
+        if j + 1 == nb || (i + 1 < na && param_a(i + 1) <= param_b(j + 1)) {
+            out.push([b[j], a[i + 1], a[i]]);
+            i += 1;
+        } else {
+            out.push([b[j], b[j + 1], a[i]]);
+            j += 1;
+        }
+    }
+    out
+}
+
+impl FaceLocal {
+    fn new(ctx: &Context, f: usize, n: u32) -> Result<Self, RuntimeError> {
+        let m = n as usize;
+        let own = PatchPoints::new(ctx.table, ctx.mesh, &ctx.patches[f])?;
+        let dual = own.all(PointSet::Dual, n)?;
+        let primal = own.grid(PointSet::Primal, n)?;
+        let mesh = ctx.mesh;
+        let first = mesh.face_halfedges(f).start;
+        let mut beyond = Vec::with_capacity(4);
+        for side in 0..4 {
+            let t = mesh.twin[first + side];
+            beyond.push(if t == NONE {
+                Beyond::Curve(
+                    (0..=m)
+                        .map(|t| {
+                            let (i, j) = curve_index(side, t, m);
+                            own.at(&primal, i, j)
+                        })
+                        .collect(),
+                )
+            } else {
+                let t = t as usize;
+                let g = mesh.face_of[t] as usize;
+                let other = t - mesh.face_halfedges(g).start;
+                // The neighbour's row runs the other way along the shared edge.
+                let points = PatchPoints::new(ctx.table, mesh, &ctx.patches[g])?;
+                let grid = points.grid(PointSet::Dual, n)?;
+                Beyond::Face(
+                    (0..m)
+                        .map(|t| {
+                            let (i, j) = row_index(other, m - 1 - t, m);
+                            points.at(&grid, i, j)
+                        })
+                        .collect(),
+                )
+            });
+        }
+        let mut local = FaceLocal {
+            n: m,
+            dual,
+            beyond,
+            corners: Vec::with_capacity(4),
+        };
+        let strips: Vec<Vec<[[f64; 3]; 3]>> = (0..4)
+            .map(|side| {
+                let row: Vec<[f64; 3]> = (0..m).map(|t| local.row(side, t)).collect();
+                match &local.beyond[side] {
+                    Beyond::Face(other) => strip_triangles(&row, other, false),
+                    Beyond::Curve(curve) => strip_triangles(&row, curve, true),
+                }
+            })
+            .collect();
+        // The dual point (i, j) of face g at rate n.
+        let dual_of = |g: usize, (i, j): (usize, usize)| -> Result<[f64; 3], RuntimeError> {
+            if g == f {
+                return Ok(local.d(i, j));
+            }
+            let points = PatchPoints::new(ctx.table, mesh, &ctx.patches[g])?;
+            let grid = points.grid(PointSet::Dual, n)?;
+            Ok(points.at(&grid, i, j))
+        };
+        let mut corners = Vec::with_capacity(4);
+        for corner in 0..4 {
+            let v = mesh.face_vertices[first + corner] as usize;
+            let mut ring = Vec::new();
+            if mesh.is_boundary_vertex(v) {
+                let (i, j) = curve_index(corner, 0, m);
+                ring.push(own.at(&primal, i, j));
+            }
+            for h in mesh.fan(v) {
+                let g = mesh.face_of[h] as usize;
+                let c = h - mesh.face_halfedges(g).start;
+                ring.push(dual_of(g, row_index(c, 0, m))?);
+            }
+            let mut triangles: Vec<[[f64; 3]; 3]> = (1..ring.len().saturating_sub(1))
+                .map(|i| [ring[0], ring[i], ring[i + 1]])
+                .collect();
+            // Side `corner` starts at this corner, side `corner - 1` ends at it.
+            let (starting, ending) = (&strips[corner], &strips[(corner + 3) % 4]);
+            triangles.extend(starting.iter().take(2));
+            triangles.extend(ending.iter().rev().take(2));
+            if m >= 2 {
+                let (i, j) = row_index(corner, 0, m);
+                let (i1, j1) = (i.min(m - 2), j.min(m - 2));
+                let (p, q, r, s) = (
+                    local.d(i1, j1),
+                    local.d(i1 + 1, j1),
+                    local.d(i1 + 1, j1 + 1),
+                    local.d(i1, j1 + 1),
+                );
+                triangles.extend([[p, q, r], [p, r, s]]);
+            }
+            corners.push(triangles);
+        }
+        local.corners = corners;
+        Ok(local)
+    }
+
+    fn d(&self, i: usize, j: usize) -> [f64; 3] {
+        self.dual[j * self.n + i]
+    }
+
+    /// Dual point `t` of the row next to side `side`, in the side's direction.
+    fn row(&self, side: usize, t: usize) -> [f64; 3] {
+        let (i, j) = row_index(side, t, self.n);
+        self.d(i, j)
+    }
+
+    /// The deviation at one sample: `|S - L_{f,n}(u, v)|` in the interior and the side
+    /// rectangles, the distance to the nearest triangle around the corner in a corner square.
+    fn deviation_at(&self, u: f64, v: f64, p: [f64; 3]) -> f64 {
+        let n = self.n as f64;
+        let h = 0.5 / n;
+        let (low_u, high_u, low_v, high_v) = (u <= h, u >= 1.0 - h, v <= h, v >= 1.0 - h);
+        if (low_u || high_u) && (low_v || high_v) {
+            let corner = match (low_u, low_v) {
+                (true, true) => 0,
+                (false, true) => 1,
+                (false, false) => 2,
+                (true, false) => 3,
+            };
+            return self.corners[corner]
+                .iter()
+                .map(|t| point_triangle_distance(p, t))
+                .fold(f64::INFINITY, f64::min);
+        }
+        distance(p, self.at(u, v))
+    }
+
+    /// `L_{f,n}(u, v)` outside the corner squares.
+    fn at(&self, u: f64, v: f64) -> [f64; 3] {
+        let n = self.n as f64;
+        let h = 0.5 / n;
+        let distances = [v, 1.0 - u, 1.0 - v, u];
+        let (side, nearest) =
+            distances
+                .iter()
+                .copied()
+                .enumerate()
+                .fold(
+                    (0, f64::INFINITY),
+                    |best, (s, d)| {
+                        if d < best.1 {
+                            (s, d)
+                        } else {
+                            best
+                        }
+                    },
+                );
+        if nearest >= h || self.n == 1 {
+            // Interior: cell (i, j) of the dual grid, local (a, b) in [0,1]^2, split along a = b.
+            if self.n == 1 {
+                return self.d(0, 0);
+            }
+            let cell = |x: f64| -> (usize, f64) {
+                let t = (x * n - 0.5).clamp(0.0, n - 1.0);
+                let i = (t.floor() as usize).min(self.n - 2);
+                (i, t - i as f64)
+            };
+            let ((i, a), (j, b)) = (cell(u), cell(v));
+            let (p, q, r, s) = (
+                self.d(i, j),
+                self.d(i + 1, j),
+                self.d(i + 1, j + 1),
+                self.d(i, j + 1),
+            );
+            return if a >= b {
+                combine(&[(1.0 - a, p), (a - b, q), (b, r)])
+            } else {
+                combine(&[(1.0 - b, p), (b - a, s), (a, r)])
+            };
+        }
+        // A side's strip, in scaled side coordinates: the face's row point t at (2t + 1, 1),
+        // the curve point t at (2t, 0), the neighbour's row point t at (2t + 1, -1).
+        let s = match side {
+            0 => u,
+            1 => v,
+            2 => 1.0 - u,
+            _ => 1.0 - v,
+        };
+        let sigma = (2.0 * n * s).clamp(1.0, 2.0 * n - 1.0);
+        let delta = (2.0 * n * nearest).clamp(0.0, 1.0);
+        match &self.beyond[side] {
+            Beyond::Face(other) => {
+                // Cell i between the rows: quad (F_i, F_i+1, G_i+1, G_i) split as
+                // [G_i, F_i+1, F_i], [G_i, G_i+1, F_i+1]; alpha along, beta from G (0) to F (1).
+                let x = (sigma - 1.0) / 2.0;
+                let i = (x.floor() as usize).min(self.n - 2);
+                let alpha = x - i as f64;
+                let beta = (1.0 + delta) / 2.0;
+                let (f0, f1) = (self.row(side, i), self.row(side, i + 1));
+                let (g0, g1) = (other[i], other[i + 1]);
+                if beta >= alpha {
+                    combine(&[(1.0 - beta, g0), (alpha, f1), (beta - alpha, f0)])
+                } else {
+                    combine(&[(1.0 - alpha, g0), (alpha - beta, g1), (beta, f1)])
+                }
+            }
+            Beyond::Curve(c) => {
+                let j = ((sigma / 2.0).floor() as usize).min(self.n - 1);
+                let centre = (2 * j + 1) as f64;
+                if (sigma - centre).abs() <= 1.0 - delta {
+                    // [C_j, C_{j+1}, D_j].
+                    let w1 = (sigma - 2.0 * j as f64 - delta) / 2.0;
+                    combine(&[
+                        (1.0 - delta - w1, c[j]),
+                        (w1, c[j + 1]),
+                        (delta, self.row(side, j)),
+                    ])
+                } else {
+                    // [C_k, D_k, D_{k-1}], k = 1..n-1 the curve point nearest sigma.
+                    let k = if sigma < centre { j } else { j + 1 }.clamp(1, self.n - 1);
+                    let x = sigma - 2.0 * k as f64;
+                    combine(&[
+                        (1.0 - delta, c[k]),
+                        ((delta + x) / 2.0, self.row(side, k)),
+                        ((delta - x) / 2.0, self.row(side, k - 1)),
+                    ])
+                }
+            }
+        }
+    }
+
+    /// `e_f(n)` over the samples.
+    fn deviation(&self, samples: &Samples) -> f64 {
+        samples
+            .uv
+            .iter()
+            .zip(&samples.positions)
+            .map(|(&[u, v], &p)| self.deviation_at(u, v, p))
+            .fold(0.0, f64::max)
+    }
+}
+
+/// The mesh, its patches and the table: what evaluates any face.
+struct Context<'a> {
+    table: &'a StencilTable,
+    mesh: &'a Mesh,
+    patches: &'a [FacePatch],
+}
+
+fn combine(terms: &[(f64, [f64; 3])]) -> [f64; 3] {
+    let mut out = [0.0; 3];
+    for (w, p) in terms {
+        for c in 0..3 {
+            out[c] += w * p[c];
+        }
+    }
+    out
+}
+
+fn check_faces(mesh: &Mesh, patches: &[FacePatch]) -> Result<(), RuntimeError> {
+    if patches.len() != mesh.faces() {
+        return Err(RuntimeError::Unsupported(format!(
+            "{} patches for {} faces",
+            patches.len(),
+            mesh.faces()
+        )));
+    }
+    Ok(())
+}
+
+/// `e_f(n)` of face `face` (module docs): the deviation, over the table's primal and dual
+/// points at rate [`SELECTION_GRID`], of the limit surface from the tessellation of the face's
+/// neighbourhood with every face at rate `n`.
+pub fn face_deviation(
+    table: &StencilTable,
+    mesh: &Mesh,
+    patches: &[FacePatch],
+    face: usize,
+    n: u32,
+) -> Result<f64, RuntimeError> {
+    check_faces(mesh, patches)?;
+    let patch = patches
+        .get(face)
+        .ok_or_else(|| RuntimeError::InvalidParameter {
+            name: "face".to_owned(),
+            reason: format!("{face} (the mesh has {} faces)", patches.len()),
+        })?;
+    let ctx = Context {
+        table,
+        mesh,
+        patches,
+    };
+    let samples = Samples::new(&PatchPoints::new(table, mesh, patch)?, SELECTION_GRID)?;
+    Ok(FaceLocal::new(&ctx, face, n)?.deviation(&samples))
+}
+
+/// Per face the smallest rate `n` in `1..=24` with `e_f(n) <= tolerance` (module docs):
+/// [`tolerance_rates_among`] with [`RATIONAL_RATES`].
+pub fn tolerance_rates(
+    table: &StencilTable,
+    mesh: &Mesh,
+    patches: &[FacePatch],
+    tolerance: f64,
+) -> Result<ToleranceRates, RuntimeError> {
+    tolerance_rates_among(table, mesh, patches, tolerance, &RATIONAL_RATES)
+}
+
+/// Per face the smallest rate `n` of `candidates` with `e_f(n) <= tolerance` (module docs), or
+/// the largest candidate (and the face listed in [`ToleranceRates::unmet`]) when none meets it.
+/// `tolerance` is in the mesh's units; `candidates` must be non-empty, each in `1..=24`.
+///
+/// Cost: per face, the 1,201 samples once, then for each candidate tried `n^2 + 4(n + 1)` table
+/// points and one interpolation per sample; faces run in parallel.
+pub fn tolerance_rates_among(
+    table: &StencilTable,
+    mesh: &Mesh,
+    patches: &[FacePatch],
+    tolerance: f64,
+    candidates: &[u32],
+) -> Result<ToleranceRates, RuntimeError> {
+    check_faces(mesh, patches)?;
+    check_tolerance(tolerance)?;
+    let sorted = sorted_candidates(candidates, &RATIONAL_RATES)?;
+    let ctx = Context {
+        table,
+        mesh,
+        patches,
+    };
+    select_rates(
+        patches.len(),
+        tolerance,
+        &sorted,
+        |f| Samples::new(&PatchPoints::new(table, mesh, &patches[f])?, SELECTION_GRID),
+        |f, samples, n| Ok(FaceLocal::new(&ctx, f, n)?.deviation(samples)),
+    )
+}
+
+/// A tolerance is a positive, finite distance.
+pub(crate) fn check_tolerance(tolerance: f64) -> Result<(), RuntimeError> {
+    if tolerance.is_finite() && tolerance > 0.0 {
+        Ok(())
+    } else {
+        Err(RuntimeError::InvalidParameter {
+            name: "tolerance".to_owned(),
+            reason: format!("{tolerance} (it must be a positive distance)"),
+        })
+    }
+}
+
+/// `candidates` sorted and deduplicated: at least one, each one of `allowed` (sorted).
+pub(crate) fn sorted_candidates(
+    candidates: &[u32],
+    allowed: &[u32],
+) -> Result<Vec<u32>, RuntimeError> {
+    let mut sorted = candidates.to_vec();
+    sorted.sort_unstable();
+    sorted.dedup();
+    if sorted.is_empty() || sorted.iter().any(|n| allowed.binary_search(n).is_err()) {
+        let (first, last) = (allowed.first(), allowed.last());
+        let contiguous =
+            matches!((first, last), (Some(&a), Some(&b)) if (b - a) as usize + 1 == allowed.len());
+        let range = match (first, last) {
+            (Some(a), Some(b)) if contiguous => format!("{a}..={b}"),
+            _ => format!("{allowed:?}"),
+        };
+        return Err(RuntimeError::InvalidParameter {
+            name: "candidate rates".to_owned(),
+            reason: format!("{candidates:?} (they must be {range}, at least one)"),
+        });
+    }
+    Ok(sorted)
+}
+
+/// The selection shared by the quad and triangle tolerance rates: per face `f` (in parallel)
+/// the smallest `n` of `sorted` (ascending, non-empty) with `deviation(f, &prepare(f), n) <=
+/// tolerance`, trying them in order, or the largest (and `f` listed as unmet). `prepare` is
+/// what every rate reuses (the face's samples).
+pub(crate) fn select_rates<S>(
+    faces: usize,
+    tolerance: f64,
+    sorted: &[u32],
+    prepare: impl Fn(usize) -> Result<S, RuntimeError> + Sync,
+    deviation: impl Fn(usize, &S, u32) -> Result<f64, RuntimeError> + Sync,
+) -> Result<ToleranceRates, RuntimeError> {
+    let largest = *sorted
+        .last()
+        .ok_or_else(|| RuntimeError::InvalidParameter {
+            name: "candidate rates".to_owned(),
+            reason: "none given".to_owned(),
+        })?;
+    let chosen = (0..faces)
+        .into_par_iter()
+        .map(|f| -> Result<(u32, f64, bool), RuntimeError> {
+            let prepared = prepare(f)?;
+            let mut last = 0.0;
+            for &n in sorted {
+                last = deviation(f, &prepared, n)?;
+                if last <= tolerance {
+                    return Ok((n, last, true));
+                }
+            }
+            Ok((largest, last, false))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(ToleranceRates {
+        rates: chosen.iter().map(|c| c.0).collect(),
+        deviations: chosen.iter().map(|c| c.1).collect(),
+        unmet: chosen
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| !c.2)
+            .map(|(f, _)| f)
+            .collect(),
+    })
+}
+
+/// The measured deviation of a finished tessellation: the largest Euclidean distance from the
+/// limit surface, sampled at the table's primal and dual points at rate `grid` of every face
+/// (`(grid+1)^2 + grid^2` a face), to the nearest triangle of `tessellation` (the one-sided
+/// Hausdorff distance from the surface to the mesh, at those samples).
+///
+/// This is the error a viewer sees, measured independently of how the rates were chosen (no
+/// parametric correspondence, the whole output, edge strips and vertex polygons included); it
+/// is at most the parametric deviation at the same samples. The nearest triangle is found with
+/// a uniform grid of cells about twice the mean triangle size, searched in growing shells.
+pub fn measure_deviation(
+    table: &StencilTable,
+    mesh: &Mesh,
+    patches: &[FacePatch],
+    tessellation: &TriangleMesh,
+    grid: u32,
+) -> Result<f64, RuntimeError> {
+    check_faces(mesh, patches)?;
+    if tessellation.triangles.is_empty() {
+        return Err(RuntimeError::InvalidParameter {
+            name: "tessellation".to_owned(),
+            reason: "it has no triangles".to_owned(),
+        });
+    }
+    let cells = TriangleCells::new(tessellation);
+    let per_face = patches
+        .par_iter()
+        .map(|patch| -> Result<f64, RuntimeError> {
+            let points = PatchPoints::new(table, mesh, patch)?;
+            let samples = Samples::new(&points, grid)?;
+            Ok(samples
+                .positions
+                .iter()
+                .map(|&p| cells.distance(p))
+                .fold(0.0, f64::max))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(per_face.into_iter().fold(0.0, f64::max))
+}
+
+/// Triangles bucketed in a uniform grid of cubic cells (by bounding box).
+pub(crate) struct TriangleCells {
+    triangles: Vec<[[f64; 3]; 3]>,
+    size: f64,
+    cells: HashMap<[i64; 3], Vec<u32>>,
+    /// Cell-index bounds of all triangles.
+    low: [i64; 3],
+    high: [i64; 3],
+}
+
+impl TriangleCells {
+    /// Bucket the triangles of `mesh` (cells about twice the mean triangle size).
+    pub(crate) fn new(mesh: &TriangleMesh) -> Self {
+        let position = |i: u32| mesh.positions[i as usize].map(f64::from);
+        let triangles: Vec<[[f64; 3]; 3]> = mesh
+            .triangles
+            .iter()
+            .map(|t| [position(t[0]), position(t[1]), position(t[2])])
+            .collect();
+        let extent = |t: &[[f64; 3]; 3]| {
+            (0..3)
+                .map(|c| {
+                    let (lo, hi) = bounds(t, c);
+                    hi - lo
+                })
+                .fold(0.0, f64::max)
+        };
+        let mean = triangles.iter().map(extent).sum::<f64>() / triangles.len() as f64;
+        let size = if mean > 0.0 { 2.0 * mean } else { 1.0 };
+        let mut cells: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+        let (mut low, mut high) = ([i64::MAX; 3], [i64::MIN; 3]);
+        for (k, t) in triangles.iter().enumerate() {
+            let mut range = [(0i64, 0i64); 3];
+            for (c, r) in range.iter_mut().enumerate() {
+                let (lo, hi) = bounds(t, c);
+                *r = ((lo / size).floor() as i64, (hi / size).floor() as i64);
+                low[c] = low[c].min(r.0);
+                high[c] = high[c].max(r.1);
+            }
+            for x in range[0].0..=range[0].1 {
+                for y in range[1].0..=range[1].1 {
+                    for z in range[2].0..=range[2].1 {
+                        cells.entry([x, y, z]).or_default().push(k as u32);
+                    }
+                }
+            }
+        }
+        TriangleCells {
+            triangles,
+            size,
+            cells,
+            low,
+            high,
+        }
+    }
+
+    /// The distance from `p` to the nearest triangle: cells in shells of growing Chebyshev
+    /// radius `r` around `p`'s cell, until the best distance found is at most the distance from
+    /// `p` to the searched block's surface (nothing outside the block can be nearer).
+    pub(crate) fn distance(&self, p: [f64; 3]) -> f64 {
+        let home = p.map(|x| (x / self.size).floor() as i64);
+        let reach = (0..3)
+            .map(|c| {
+                (home[c] - self.low[c])
+                    .abs()
+                    .max((self.high[c] - home[c]).abs())
+            })
+            .max()
+            .unwrap_or(0);
+        let mut best = f64::INFINITY;
+        for r in 0..=reach {
+            for x in home[0] - r..=home[0] + r {
+                for y in home[1] - r..=home[1] + r {
+                    for z in home[2] - r..=home[2] + r {
+                        let shell = (x - home[0])
+                            .abs()
+                            .max((y - home[1]).abs())
+                            .max((z - home[2]).abs());
+                        if shell != r {
+                            continue;
+                        }
+                        if let Some(list) = self.cells.get(&[x, y, z]) {
+                            for &t in list {
+                                best = best
+                                    .min(point_triangle_distance(p, &self.triangles[t as usize]));
+                            }
+                        }
+                    }
+                }
+            }
+            // Everything within the distance from p to the searched block's surface was seen.
+            let gap = (0..3)
+                .map(|c| {
+                    let low = (home[c] - r) as f64 * self.size;
+                    let high = (home[c] + r + 1) as f64 * self.size;
+                    (p[c] - low).min(high - p[c])
+                })
+                .fold(f64::INFINITY, f64::min);
+            if best <= gap {
+                break;
+            }
+        }
+        best
+    }
+}
+
+fn bounds(t: &[[f64; 3]; 3], c: usize) -> (f64, f64) {
+    (
+        t[0][c].min(t[1][c]).min(t[2][c]),
+        t[0][c].max(t[1][c]).max(t[2][c]),
+    )
+}
+
+pub use crate::mesh::geometry::point_triangle_distance;
+use crate::mesh::geometry::{cross, distance, dot, sub};
+
+/// A pinhole camera for view-dependent rates (Schaefer–Warren section 5.5: "projecting each quad
+/// from the base subdivision surface onto the screen, computing its maximal edge length and
+/// dividing by the maximal number of pixels we would like edges on the adaptively tessellated
+/// surface to be").
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ViewCamera {
+    /// The eye.
+    pub position: [f64; 3],
+    /// The point looked at (the view direction is `target - position`).
+    pub target: [f64; 3],
+    /// The full vertical field of view, degrees, in `(0, 180)`.
+    pub vertical_fov_degrees: f64,
+    /// The image height in pixels.
+    pub image_height_px: f64,
+    /// The longest edge wanted in the output, in pixels.
+    pub target_edge_px: f64,
+}
+
+impl ViewCamera {
+    fn check(&self) -> Result<(), RuntimeError> {
+        let bad = |reason: String| {
+            Err(RuntimeError::InvalidParameter {
+                name: "camera".to_owned(),
+                reason,
+            })
+        };
+        let axis = sub(self.target, self.position);
+        if self
+            .position
+            .iter()
+            .chain(&self.target)
+            .any(|c| !c.is_finite())
+            || dot(axis, axis) == 0.0
+        {
+            return bad(format!(
+                "position {:?} and target {:?} must be finite and distinct",
+                self.position, self.target
+            ));
+        }
+        if !(self.vertical_fov_degrees > 0.0 && self.vertical_fov_degrees < 180.0) {
+            return bad(format!(
+                "vertical field of view {} degrees (it must be in (0, 180))",
+                self.vertical_fov_degrees
+            ));
+        }
+        if !(self.image_height_px.is_finite() && self.image_height_px > 0.0) {
+            return bad(format!("image height {} px", self.image_height_px));
+        }
+        if !(self.target_edge_px.is_finite() && self.target_edge_px > 0.0) {
+            return bad(format!("target edge length {} px", self.target_edge_px));
+        }
+        Ok(())
+    }
+
+    /// The focal length in pixels, `F = (H / 2) / tan(fov / 2)`.
+    pub fn focal_px(&self) -> f64 {
+        0.5 * self.image_height_px / (0.5 * self.vertical_fov_degrees.to_radians()).tan()
+    }
+
+    /// The view frame: unit forward `w`, and two unit vectors `r`, `s` across it (any pair: the
+    /// projected lengths do not depend on the roll).
+    fn frame(&self) -> [[f64; 3]; 3] {
+        let w = sub(self.target, self.position);
+        let w = w.map(|x| x / dot(w, w).sqrt());
+        let helper = if w[0].abs() < 0.9 {
+            [1.0, 0.0, 0.0]
+        } else {
+            [0.0, 1.0, 0.0]
+        };
+        let r = cross(w, helper);
+        let r = r.map(|x| x / dot(r, r).sqrt());
+        [w, r, cross(w, r)]
+    }
+
+    /// The depth `w . (p - eye)` and the image position in pixels from the image centre,
+    /// `F (r . (p - eye), s . (p - eye)) / depth` (defined for depth > 0).
+    fn project(&self, frame: &[[f64; 3]; 3], p: [f64; 3]) -> (f64, [f64; 2]) {
+        let d = sub(p, self.position);
+        let depth = dot(frame[0], d);
+        let f = self.focal_px() / depth;
+        (depth, [f * dot(frame[1], d), f * dot(frame[2], d)])
+    }
+}
+
+/// The view-dependent rate of every face (Schaefer–Warren section 5.5): the face's control
+/// polygon is projected through `camera` and
+///
+/// ```text
+/// rate_f = clamp(ceil(L_f / E), 1, 24),   L_f = max over the face's edges of |x(a) - x(b)|,
+/// x(p) = F (r . (p - eye), s . (p - eye)) / (w . (p - eye)),   F = (H / 2) / tan(fov / 2),
+/// ```
+///
+/// with `w` the unit view direction, `r`, `s` unit vectors across it, `H` the image height and
+/// `E` the target edge length in pixels. A face wholly behind the camera (every corner at depth
+/// `<= 0`) gets rate 1; a face crossing the camera's plane (some corners in front, some not)
+/// projects to an unbounded polygon and gets 24. Faces outside the image are not culled.
+pub fn view_rates(mesh: &Mesh, camera: &ViewCamera) -> Result<Vec<u32>, RuntimeError> {
+    camera.check()?;
+    let frame = camera.frame();
+    Ok((0..mesh.faces())
+        .map(|f| {
+            let corners = mesh.face(f);
+            let projected: Vec<(f64, [f64; 2])> = corners
+                .iter()
+                .map(|&v| camera.project(&frame, mesh.positions[v as usize]))
+                .collect();
+            let in_front = projected.iter().filter(|(depth, _)| *depth > 0.0).count();
+            if in_front == 0 {
+                return 1;
+            }
+            if in_front < projected.len() {
+                return MAX_SELECTED_RATE;
+            }
+            let longest = (0..projected.len())
+                .map(|k| {
+                    let (a, b) = (projected[k].1, projected[(k + 1) % projected.len()].1);
+                    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt()
+                })
+                .fold(0.0, f64::max);
+            let rate = (longest / camera.target_edge_px).ceil();
+            if rate >= f64::from(MAX_SELECTED_RATE) {
+                MAX_SELECTED_RATE
+            } else {
+                (rate as u32).max(1)
+            }
+        })
+        .collect())
+}
