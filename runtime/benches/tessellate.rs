@@ -1,13 +1,17 @@
-//! Per-frame tessellation throughput: evaluation of every point (positions and normals) and
-//! all connectivity into preallocated buffers; topology, patches and the plan built once. Mesh: Crane's Spot refined to 11,712
-//! faces when `../shared/models` exists, else the shipped cube refined to 6,144 faces.
+//! Per-frame tessellation throughput through the library facade, **from the input control
+//! points**: `Surface::new` (isolation) and `Surface::tessellator` (the plan: table lookups,
+//! separable factors, connectivity and triangles) run once; every frame is
+//! `Tessellator::evaluate(&input_positions)`: the isolation's refinement stencils (when it took
+//! steps), then every output vertex's position and unit normal.
 //!
-//! `cargo bench -p subtess --bench tessellate`: one and two threads (a rayon pool of
-//! each size), rates 4, 8, 16 and mixed.
-//!
-//! Loop (the triangle dual grid): Crane's triangulated Spot (5,856 triangles, 23,424 after the
-//! one isolating Loop step) when `../shared/models` exists, else an icosahedron refined to
-//! 5,120 triangles; the same threads and rates.
+//! `cargo bench -p subtess --bench tessellate`: one and two threads (a rayon pool of each
+//! size), rates 4, 8, 16 and mixed, on
+//! * Catmull–Clark, no isolation needed: Crane's Spot refined three times (11,712 faces) when
+//!   `../shared/models` exists, else the shipped cube refined five times (6,144 faces);
+//! * Catmull–Clark, isolation needed: Spot triangulated (5,856 triangles: one step, 17,568
+//!   quads; this group needs `../shared/models`);
+//! * Loop: Spot triangulated (one isolating step, 23,424 triangles), else an icosahedron
+//!   refined four times by Loop.
 #![allow(missing_docs)] // criterion_group! generates an undocumented function
 
 #[path = "../tests/common/mod.rs"]
@@ -16,140 +20,110 @@ mod common;
 use std::path::Path;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use subtess::io::obj::read_obj;
-use subtess::mesh::topology::Mesh;
-use subtess::scheme::catmull_clark::isolate::isolate;
-use subtess::scheme::catmull_clark::refine::refine;
-use subtess::scheme::loop_scheme::isolate::isolate_loop;
-use subtess::scheme::loop_scheme::refine::loop_refine;
-use subtess::stencil_table::StencilTable;
-use subtess::tessellate::dual_grid::DualGrid;
-use subtess::tessellate::triangle_dual_grid::TriangleDualGrid;
+use subtess::{Mesh, Rates, Scheme, Surface};
 
-fn mesh() -> (String, Mesh) {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let spot = root.join("../../shared/models/crane/spot_control_mesh.obj");
-    let (name, path, steps) = if spot.exists() {
-        ("spot", spot, 3)
-    } else {
-        ("cube", root.join("data/cube.obj"), 5)
-    };
-    let obj = read_obj(&path).unwrap_or_else(|e| panic!("{e}"));
-    let mut m = Mesh::from_obj(&obj).unwrap_or_else(|e| panic!("{e}")).0;
-    for _ in 0..steps {
-        m = refine(&m).mesh;
+fn shared(relative: &str) -> Option<Mesh> {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../shared/models")
+        .join(relative);
+    if !path.exists() {
+        eprintln!("SKIPPED: {} is absent", path.display());
+        return None;
     }
-    (name.to_owned(), m)
+    Some(Mesh::read_obj(&path).unwrap_or_else(|e| panic!("{e}")))
+}
+
+fn refined(mut mesh: Mesh, scheme: Scheme, steps: usize) -> Mesh {
+    for _ in 0..steps {
+        mesh = scheme.refine(&mesh).unwrap_or_else(|e| panic!("{e}"));
+    }
+    mesh
+}
+
+/// The meshes: (group label, mesh, scheme).
+fn cases() -> Vec<(String, Mesh, Scheme)> {
+    let mut cases = Vec::new();
+    let cube = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/cube.obj");
+    match shared("crane/spot_control_mesh.obj") {
+        Some(spot) => cases.push((
+            "dual grid, spot refined 3x (no isolation)".to_owned(),
+            refined(spot, Scheme::CatmullClark, 3),
+            Scheme::CatmullClark,
+        )),
+        None => cases.push((
+            "dual grid, cube refined 5x (no isolation)".to_owned(),
+            refined(
+                Mesh::read_obj(&cube).unwrap_or_else(|e| panic!("{e}")),
+                Scheme::CatmullClark,
+                5,
+            ),
+            Scheme::CatmullClark,
+        )),
+    }
+    match shared("crane/spot_triangulated.obj") {
+        Some(spot) => {
+            cases.push((
+                "dual grid, spot triangulated (one isolating step)".to_owned(),
+                spot.clone(),
+                Scheme::CatmullClark,
+            ));
+            cases.push((
+                "loop dual grid, spot triangulated".to_owned(),
+                spot,
+                Scheme::Loop,
+            ));
+        }
+        None => cases.push((
+            "loop dual grid, icosahedron refined 4x".to_owned(),
+            refined(common::icosahedron(), Scheme::Loop, 4),
+            Scheme::Loop,
+        )),
+    }
+    cases
 }
 
 fn bench(c: &mut Criterion) {
-    let table = StencilTable::default_catmull_clark().unwrap_or_else(|e| panic!("{e}"));
-    let (name, m) = mesh();
-    let (isolated, patches, _) = isolate(&m).unwrap_or_else(|e| panic!("{e}"));
-    let mixed: Vec<u32> = (0..patches.len())
-        .map(|f| [3, 5, 8, 12, 7, 16][f % 6])
-        .collect();
-    let control: Vec<[f32; 3]> = isolated
-        .positions
-        .iter()
-        .map(|p| p.map(|c| c as f32))
-        .collect();
-    for threads in [1, 2] {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap_or_else(|e| panic!("{e}"));
-        let mut group = c.benchmark_group(format!(
-            "dual grid, {name}, {} faces, {threads} thread(s)",
-            patches.len()
-        ));
-        group.sample_size(20);
-        for (label, rates) in [
-            ("rate 4", vec![4; patches.len()]),
-            ("rate 8", vec![8; patches.len()]),
-            ("rate 16", vec![16; patches.len()]),
-            ("mixed 3..16", mixed.clone()),
-        ] {
-            let grid = DualGrid::new(&table, &isolated, &patches, &rates)
+    for (name, mesh, scheme) in cases() {
+        let surface = Surface::new(&mesh, scheme).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let control = mesh.positions_f32();
+        let mixed: Vec<u32> = (0..mesh.faces())
+            .map(|f| [3, 5, 8, 12, 7, 16][f % 6])
+            .collect();
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
                 .unwrap_or_else(|e| panic!("{e}"));
-            let mut positions = vec![[0.0f32; 3]; grid.vertex_count()];
-            let mut normals = positions.clone();
-            let mut triangles = vec![[0u32; 3]; grid.triangle_count()];
-            group.throughput(Throughput::Elements(grid.triangle_count() as u64));
-            group.bench_function(label, |b| {
-                pool.install(|| {
-                    b.iter(|| {
-                        grid.evaluate(&control, &mut positions, &mut normals);
-                        grid.connect(&mut triangles);
+            let mut group = c.benchmark_group(format!(
+                "{name}, {} faces, {threads} thread(s)",
+                surface.faces()
+            ));
+            group.sample_size(20);
+            for (label, rates) in [
+                ("rate 4", Rates::Uniform(4)),
+                ("rate 8", Rates::Uniform(8)),
+                ("rate 16", Rates::Uniform(16)),
+                ("mixed 3..16", Rates::PerFace(mixed.clone())),
+            ] {
+                let mut tessellator = pool
+                    .install(|| surface.tessellator(&rates))
+                    .unwrap_or_else(|e| panic!("{e}"));
+                group.throughput(Throughput::Elements(tessellator.triangle_count() as u64));
+                group.bench_function(label, |b| {
+                    pool.install(|| {
+                        b.iter(|| {
+                            tessellator
+                                .evaluate(&control)
+                                .map(|f| f.positions().len())
+                                .unwrap_or(0)
+                        })
                     })
-                })
-            });
+                });
+            }
+            group.finish();
         }
-        group.finish();
     }
 }
 
-/// Spot triangulated, or an icosahedron refined four times by Loop.
-fn triangle_mesh() -> (String, Mesh) {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let spot = root.join("../../shared/models/crane/spot_triangulated.obj");
-    if spot.exists() {
-        let obj = read_obj(&spot).unwrap_or_else(|e| panic!("{e}"));
-        let m = Mesh::from_obj(&obj).unwrap_or_else(|e| panic!("{e}")).0;
-        return ("spot triangulated".to_owned(), m);
-    }
-    let mut m = common::icosahedron();
-    for _ in 0..4 {
-        m = loop_refine(&m).unwrap_or_else(|e| panic!("{e}")).mesh;
-    }
-    ("icosahedron".to_owned(), m)
-}
-
-fn bench_loop(c: &mut Criterion) {
-    let table = StencilTable::default_loop().unwrap_or_else(|e| panic!("{e}"));
-    let (name, m) = triangle_mesh();
-    let iso = isolate_loop(&m).unwrap_or_else(|e| panic!("{e}"));
-    let faces = iso.patches.len();
-    let mixed: Vec<u32> = (0..faces).map(|f| [3, 5, 8, 12, 7, 16][f % 6]).collect();
-    let control: Vec<[f32; 3]> = iso
-        .mesh
-        .positions
-        .iter()
-        .map(|p| p.map(|c| c as f32))
-        .collect();
-    for threads in [1, 2] {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap_or_else(|e| panic!("{e}"));
-        let mut group = c.benchmark_group(format!(
-            "loop dual grid, {name}, {faces} triangles, {threads} thread(s)"
-        ));
-        group.sample_size(20);
-        for (label, rates) in [
-            ("rate 4", vec![4; faces]),
-            ("rate 8", vec![8; faces]),
-            ("rate 16", vec![16; faces]),
-            ("mixed 3..16", mixed.clone()),
-        ] {
-            let grid = TriangleDualGrid::new(&table, &iso.mesh, &iso.patches, &rates)
-                .unwrap_or_else(|e| panic!("{e}"));
-            let mut positions = vec![[0.0f32; 3]; grid.vertex_count()];
-            let mut normals = positions.clone();
-            let mut triangles = vec![[0u32; 3]; grid.triangle_count()];
-            group.throughput(Throughput::Elements(grid.triangle_count() as u64));
-            group.bench_function(label, |b| {
-                pool.install(|| {
-                    b.iter(|| {
-                        grid.evaluate(&control, &mut positions, &mut normals);
-                        grid.connect(&mut triangles);
-                    })
-                })
-            });
-        }
-        group.finish();
-    }
-}
-
-criterion_group!(benches, bench, bench_loop);
+criterion_group!(benches, bench);
 criterion_main!(benches);

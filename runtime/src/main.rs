@@ -1,31 +1,17 @@
-//! `subtess`: the runtime's command line: `subtess tessellate`, `subtess eval`, `subtess bench`,
-//! `subtess tables info` (docs/cli.md).
+//! `subtess`: the command line, a thin client of the library's facade (`subtess::Surface`):
+//! `subtess tessellate`, `subtess eval`, `subtess bench`, `subtess tables info` (docs/cli.md).
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
-use clap::{Parser, Subcommand};
-use subtess::eval::exact_eval::{evaluate_subface, parse_rational};
-use subtess::eval::loop_exact_eval::LoopExactEvaluator;
-use subtess::io::mesh_output::{write_mesh, MeshFormat};
-use subtess::io::obj::read_obj;
-use subtess::mesh::topology::Mesh;
-use subtess::scheme::catmull_clark::isolate::{isolate_with_origins, Isolation};
-use subtess::scheme::catmull_clark::refine::refine;
-use subtess::scheme::loop_scheme::isolate::isolate_loop;
-use subtess::scheme::loop_scheme::refine::loop_refine;
-use subtess::scheme::triangle::isolation::TriangleIsolation;
-use subtess::scheme::triangle::region_isolate::isolate_regions;
-use subtess::scheme::triangle::region_patch::RegionScheme;
-use subtess::stencil_table::StencilTable;
-use subtess::tessellate::bezier::{tessellate_bezier, BezierOptions, BezierPatches};
-use subtess::tessellate::dual_grid::{tessellate, DualGrid};
-use subtess::tessellate::lai_cheng::{tessellate_adaptive, write_obj_polygons, AdaptiveOptions};
-use subtess::tessellate::rates::{tolerance_rates, view_rates, ViewCamera};
-use subtess::tessellate::triangle_dual_grid::{tessellate_triangles, TriangleDualGrid};
-use subtess::tessellate::triangle_rates::triangle_tolerance_rates;
-use subtess::RuntimeError;
+use clap::{Parser, Subcommand, ValueEnum};
+use subtess::io::mesh_output::write_mesh;
+use subtess::tessellate::lai_cheng::write_obj_polygons;
+use subtess::{
+    eval, parse_rational, tessellate_bezier, AdaptiveOptions, BezierOptions, BezierPatches, Mesh,
+    MeshFormat, Rates, RuntimeError, Scheme, StencilTable, Surface, Tessellator, ViewCamera,
+};
 
 #[derive(Parser)]
 #[command(
@@ -38,27 +24,44 @@ struct Cli {
     command: Command,
 }
 
+/// `--scheme`: a scheme with a table; a catalogued scheme without one is named as such.
+fn scheme_arg(name: &str) -> Result<Scheme, String> {
+    name.parse::<Scheme>().map_err(|e| e.to_string())
+}
+
+/// `--method`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum Method {
+    /// Schaefer–Warren's dual grid, one rate per face.
+    DualGrid,
+    /// Lai–Cheng: recursive subdivision of each face's domain until a guaranteed bound meets
+    /// `--tolerance`.
+    Adaptive,
+}
+
 #[derive(Subcommand)]
 enum Command {
-    /// Tessellate a Catmull-Clark mesh (OBJ) with the dual-grid or the adaptive method, or
-    /// Bezier patches with Espino et al.'s method.
+    /// Tessellate a mesh (OBJ) with the dual-grid or the adaptive method, or Bezier patches
+    /// with Espino et al.'s method.
     Tessellate(Box<TessellateArgs>),
-    /// Measure per-frame tessellation throughput: the plan (topology, patches, stencil
-    /// lookups) is built once, then every frame evaluates all positions and normals and writes
-    /// all triangles. Prints one JSON object with the median over the frames.
+    /// Measure per-frame throughput from the input control points: the surface (isolation)
+    /// and the plan (table lookups, connectivity, triangles) are built once, then every frame
+    /// maps the input control points through the isolation's refinement stencils and evaluates
+    /// all positions and normals. Prints one JSON object with the median over the frames.
     Bench {
         /// Input mesh (OBJ).
         mesh: PathBuf,
         /// Dual points per face side on every face.
         #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=24))]
         rate: u32,
-        /// Mixed per-face rates instead (3, 5, 8, 12, 7, 16 in turn).
+        /// Mixed per-input-face rates instead (3, 5, 8, 12, 7, 16 in turn).
         #[arg(long, conflicts_with = "rate")]
         mixed: bool,
         /// Worker threads (default: one per core).
         #[arg(long)]
         threads: Option<usize>,
-        /// Catmull-Clark steps applied to the input first (to reach a given face count).
+        /// Subdivision steps of the scheme applied to the input first (to reach a given face
+        /// count; two √3 steps each for sqrt3).
         #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=6))]
         refine: u32,
         /// Frames to time.
@@ -67,10 +70,9 @@ enum Command {
         /// A stencil table file instead of the embedded default.
         #[arg(long)]
         table: Option<PathBuf>,
-        /// Subdivision scheme: catmull-clark, or loop, butterfly or sqrt3 (a triangle mesh;
-        /// --refine then takes steps of that scheme, two √3 steps each for sqrt3).
-        #[arg(long, default_value = "catmull-clark")]
-        scheme: String,
+        /// Subdivision scheme: catmull-clark, loop, butterfly or sqrt3.
+        #[arg(long, default_value = "catmull-clark", value_parser = scheme_arg)]
+        scheme: Scheme,
     },
     /// Exact limit position and first derivatives of face F at rational (u, v), in the face's
     /// own parameters (rounded once to f64).
@@ -79,8 +81,8 @@ enum Command {
         mesh: PathBuf,
         /// Subdivision scheme: catmull-clark, or loop (a mesh of triangles, barycentric U,V
         /// with U + V <= 1).
-        #[arg(long, default_value = "catmull-clark")]
-        scheme: String,
+        #[arg(long, default_value = "catmull-clark", value_parser = scheme_arg)]
+        scheme: Scheme,
         /// Face number, 0-based, in OBJ order.
         #[arg(long)]
         face: usize,
@@ -114,8 +116,8 @@ struct TessellateArgs {
     /// Subdivision scheme: catmull-clark (any polygons), loop (triangles), butterfly or sqrt3
     /// (closed triangle meshes); the triangle schemes take --rate, --rates, --tolerance or
     /// --view.
-    #[arg(long, default_value = "catmull-clark")]
-    scheme: String,
+    #[arg(long, default_value = "catmull-clark", value_parser = scheme_arg)]
+    scheme: Scheme,
     /// Dual points per face side, 1..=24, on every face.
     #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=24), conflicts_with_all = ["rates", "tolerance", "view"])]
     rate: u32,
@@ -158,8 +160,8 @@ struct TessellateArgs {
     triangles: Option<usize>,
     /// `dual-grid` (Schaefer-Warren, one rate per face) or `adaptive` (Lai-Cheng: recursive
     /// subdivision of each face's domain until a guaranteed bound meets `--tolerance`).
-    #[arg(long, default_value = "dual-grid", value_parser = ["dual-grid", "adaptive"])]
-    method: String,
+    #[arg(long, value_enum, default_value_t = Method::DualGrid)]
+    method: Method,
     /// Adaptive: the tolerance is relative to each square's base quadrilateral's longer
     /// diagonal (Lai-Cheng section 6) instead of a distance.
     #[arg(long)]
@@ -176,8 +178,8 @@ enum TablesCommand {
         /// A table file written by `stencilgen tables`.
         file: Option<PathBuf>,
         /// Without a file: which embedded default (catmull-clark, loop, butterfly or sqrt3).
-        #[arg(long, default_value = "catmull-clark", conflicts_with = "file")]
-        scheme: String,
+        #[arg(long, default_value = "catmull-clark", conflicts_with = "file", value_parser = scheme_arg)]
+        scheme: Scheme,
     },
 }
 
@@ -191,28 +193,29 @@ fn main() -> ExitCode {
     }
 }
 
-/// The table file, or the embedded default for the mesh's boundary rule.
-fn load_table(
-    table: &Option<PathBuf>,
-    mode: schemes::BoundaryMode,
-) -> Result<StencilTable, RuntimeError> {
-    match table {
-        Some(path) => StencilTable::read(path),
-        None => StencilTable::default_for(mode),
-    }
-}
-
+/// The mesh, its ignored tags reported on stderr.
 fn load_mesh(path: &Path) -> Result<Mesh, RuntimeError> {
-    let obj = read_obj(path)?;
-    let (mesh, warnings) = Mesh::from_obj(&obj)?;
+    let (mesh, warnings) = Mesh::read_obj_with_warnings(path)?;
     for w in warnings {
         eprintln!("warning: {}: {w}", path.display());
     }
     Ok(mesh)
 }
 
-/// Per-input-face rates from a text file, spread to the isolated faces.
-fn read_rates(path: &Path, input_faces: usize, origin: &[u32]) -> Result<Vec<u32>, RuntimeError> {
+/// The surface of `mesh`, with the table file or the scheme's embedded default.
+fn load_surface(
+    mesh: &Mesh,
+    scheme: Scheme,
+    table: &Option<PathBuf>,
+) -> Result<Surface, RuntimeError> {
+    match table {
+        Some(path) => Surface::with_table(mesh, scheme, StencilTable::read(path)?),
+        None => Surface::new(mesh, scheme),
+    }
+}
+
+/// Per-input-face rates from a text file.
+fn read_rates(path: &Path, input_faces: usize) -> Result<Vec<u32>, RuntimeError> {
     let text = std::fs::read_to_string(path).map_err(|source| RuntimeError::Io {
         path: path.display().to_string(),
         source,
@@ -235,7 +238,7 @@ fn read_rates(path: &Path, input_faces: usize, origin: &[u32]) -> Result<Vec<u32
             rates.len()
         )));
     }
-    Ok(origin.iter().map(|&f| rates[f as usize]).collect())
+    Ok(rates)
 }
 
 /// `--view PX,PY,PZ,TX,TY,TZ,FOV,HEIGHT,EDGE`.
@@ -279,16 +282,15 @@ fn tessellate_command(args: TessellateArgs) -> Result<(), RuntimeError> {
         }
     };
     let input = load_mesh(mesh)?;
-    let scheme = parse_scheme(&args.scheme)?;
-    if scheme.is_triangle() {
-        return triangle_command(&args, &input, scheme);
+    if args.method == Method::Adaptive && args.scheme.is_triangle() {
+        return Err(RuntimeError::Unsupported(format!(
+            "--scheme {} tessellates with the dual grid at --rate, --rates, --tolerance or --view (no --method adaptive yet)",
+            args.scheme
+        )));
     }
-    let table = load_table(&args.table, input.boundary)?;
-    let started = Instant::now();
-    let iso = isolate_with_origins(&input)?;
-    let isolation_seconds = started.elapsed().as_secs_f64();
-    if args.method == "adaptive" {
-        return adaptive_command(&args, &input, &table, &iso, isolation_seconds);
+    let surface = load_surface(&input, args.scheme, &args.table)?;
+    if args.method == Method::Adaptive {
+        return adaptive_command(&args, &surface);
     }
     if args.relative || args.triangulate {
         return Err(RuntimeError::InvalidParameter {
@@ -296,198 +298,68 @@ fn tessellate_command(args: TessellateArgs) -> Result<(), RuntimeError> {
             reason: "they belong to --method adaptive".to_owned(),
         });
     }
-    let mut unmet = None;
     let rates = if let Some(path) = &args.rates {
-        read_rates(path, input.faces(), &iso.origin)?
+        Rates::PerFace(read_rates(path, input.faces())?)
     } else if let Some(t) = args.tolerance {
-        let chosen = tolerance_rates(&table, &iso.mesh, &iso.patches, t)?;
-        if !chosen.unmet.is_empty() {
-            eprintln!(
-                "warning: {} faces do not meet the tolerance {t} at rate 24; they get 24",
-                chosen.unmet.len()
-            );
-        }
-        unmet = Some(chosen.unmet.len());
-        chosen.rates
+        Rates::Tolerance(t)
     } else if let Some(camera) = &args.view {
-        view_rates(&iso.mesh, camera)?
+        Rates::View(*camera)
     } else {
-        vec![args.rate; iso.patches.len()]
+        Rates::Uniform(args.rate)
     };
-    let (mut triangles, time) = tessellate(&table, &iso.mesh, &iso.patches, &rates)?;
-    // Sources in the user's own faces and parameters.
-    for source in &mut triangles.sources {
-        *source = iso.input_source(*source);
+    let mut tessellator = surface.tessellator(&rates)?;
+    if let (Some(unmet @ 1..), Some(t), Some(largest)) = (
+        tessellator.faces_over_tolerance(),
+        args.tolerance,
+        tessellator.rates().iter().max(),
+    ) {
+        let what = if args.scheme.is_triangle() {
+            "triangles"
+        } else {
+            "faces"
+        };
+        eprintln!(
+            "warning: {unmet} {what} do not meet the tolerance {t} at rate {largest}; they get {largest}"
+        );
     }
-    write_mesh(&triangles, &args.output)?;
-    if args.stats {
-        let count = triangles.triangles.len();
-        let loops = input.boundary_loops();
-        let stats = serde_json::json!({
-            "triangles": count,
-            "vertices": triangles.positions.len(),
-            "seconds": time.seconds,
-            "plan_seconds": time.plan_seconds,
-            "triangles_per_second": count as f64 / time.seconds.max(1e-12),
-            "watertight": loops == 0 && triangles.is_watertight(),
-            "boundary_loops": loops,
-            "input_faces": input.faces(),
-            "faces": iso.mesh.faces(),
-            "isolation_steps": iso.steps,
-            "isolation_seconds": isolation_seconds,
-            "rate_min": rates.iter().min(),
-            "rate_max": rates.iter().max(),
-            "tolerance": args.tolerance,
-            "faces_over_tolerance": unmet,
-            "threads": rayon::current_num_threads(),
-        });
-        println!("{stats}");
-    }
-    Ok(())
-}
-
-/// The schemes the runtime has tables for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Scheme {
-    CatmullClark,
-    Loop,
-    Butterfly,
-    Sqrt3,
-}
-
-impl Scheme {
-    fn name(self) -> &'static str {
-        match self {
-            Scheme::CatmullClark => "catmull-clark",
-            Scheme::Loop => "loop",
-            Scheme::Butterfly => "butterfly",
-            Scheme::Sqrt3 => "sqrt3",
-        }
-    }
-
-    /// Whether the scheme subdivides triangles (the triangle dual grid tessellates it).
-    fn is_triangle(self) -> bool {
-        self != Scheme::CatmullClark
-    }
-
-    /// The triangle scheme's table: a file (which must be this scheme's), or the embedded
-    /// default.
-    fn triangle_table(self, table: &Option<PathBuf>) -> Result<StencilTable, RuntimeError> {
-        match (table, self) {
-            (Some(path), _) => StencilTable::read(path),
-            (None, Scheme::Butterfly) => StencilTable::default_butterfly(),
-            (None, Scheme::Sqrt3) => StencilTable::default_sqrt3(),
-            (None, _) => StencilTable::default_loop(),
-        }
-    }
-
-    /// Isolate a triangle mesh for this scheme's table.
-    fn isolate_triangles(self, mesh: &Mesh) -> Result<TriangleIsolation, RuntimeError> {
-        match self {
-            Scheme::Butterfly => isolate_regions(mesh, RegionScheme::Butterfly),
-            Scheme::Sqrt3 => isolate_regions(mesh, RegionScheme::Sqrt3),
-            _ => isolate_loop(mesh),
-        }
-    }
-
-    /// One subdivision step of a triangle mesh by this scheme's rules (two for √3).
-    fn refine_triangles(self, mesh: &Mesh) -> Result<Mesh, RuntimeError> {
-        match self {
-            Scheme::Butterfly => RegionScheme::Butterfly.refine(mesh),
-            Scheme::Sqrt3 => RegionScheme::Sqrt3.refine(mesh),
-            _ => Ok(loop_refine(mesh)?.mesh),
-        }
-    }
-}
-
-/// `--scheme NAME`: a scheme with a table, or an error saying which schemes exist and which
-/// have no table yet.
-fn parse_scheme(name: &str) -> Result<Scheme, RuntimeError> {
-    match name {
-        "catmull-clark" => Ok(Scheme::CatmullClark),
-        "loop" => Ok(Scheme::Loop),
-        "butterfly" => Ok(Scheme::Butterfly),
-        "sqrt3" => Ok(Scheme::Sqrt3),
-        other
-            if schemes::triangle::TRIANGLE_SCHEME_NAMES.contains(&other)
-                || schemes::quad::QUAD_SCHEME_NAMES.contains(&other) =>
-        {
-            Err(RuntimeError::Unsupported(format!(
-                "scheme `{other}`: no table for this scheme yet (the runtime has tables for catmull-clark, loop, butterfly and sqrt3)"
-            )))
-        }
-        other => Err(RuntimeError::InvalidParameter {
-            name: format!("--scheme `{other}`"),
-            reason: "not a scheme; catmull-clark, loop, butterfly or sqrt3".to_owned(),
-        }),
-    }
-}
-
-/// `subtess tessellate MESH --scheme loop|butterfly|sqrt3`: the triangle dual grid at `--rate`,
-/// `--rates`, `--tolerance` (per triangle, `subtess::tessellate::triangle_rates`) or `--view` (the
-/// projected-edge rule is the same for triangles).
-fn triangle_command(
-    args: &TessellateArgs,
-    input: &Mesh,
-    scheme: Scheme,
-) -> Result<(), RuntimeError> {
-    if args.method != "dual-grid" {
-        return Err(RuntimeError::Unsupported(format!(
-            "--scheme {} tessellates with the dual grid at --rate, --rates, --tolerance or --view (no --method adaptive yet)",
-            scheme.name()
-        )));
-    }
-    let table = scheme.triangle_table(&args.table)?;
     let started = Instant::now();
-    let iso = scheme.isolate_triangles(input)?;
-    let isolation_seconds = started.elapsed().as_secs_f64();
-    let mut unmet = None;
-    let rates = match (&args.rates, &args.view, args.tolerance) {
-        (Some(path), _, _) => read_rates(path, input.faces(), &iso.origin)?,
-        (None, Some(camera), _) => view_rates(&iso.mesh, camera)?,
-        (None, None, Some(t)) => {
-            let chosen = triangle_tolerance_rates(&table, &iso, t)?;
-            if let (false, Some(largest)) = (chosen.unmet.is_empty(), chosen.rates.iter().max()) {
-                eprintln!(
-                    "warning: {} triangles do not meet the tolerance {t} at rate {largest}; they get {largest}",
-                    chosen.unmet.len()
-                );
-            }
-            unmet = Some(chosen.unmet.len());
-            chosen.rates
-        }
-        (None, None, None) => vec![args.rate; iso.patches.len()],
-    };
-    let (mut triangles, time) = tessellate_triangles(&table, &iso.mesh, &iso.patches, &rates)?;
-    for source in &mut triangles.sources {
-        *source = iso.input_source(*source);
-    }
-    write_mesh(&triangles, &args.output)?;
+    let frame = tessellator.evaluate(&input.positions_f32())?;
+    let seconds = started.elapsed().as_secs_f64();
+    let output = frame.to_triangle_mesh();
+    write_mesh(&output, &args.output)?;
     if args.stats {
-        let count = triangles.triangles.len();
-        let loops = input.boundary_loops();
-        let stats = serde_json::json!({
-            "scheme": scheme.name(),
-            "triangles": count,
-            "vertices": triangles.positions.len(),
-            "seconds": time.seconds,
-            "plan_seconds": time.plan_seconds,
-            "triangles_per_second": count as f64 / time.seconds.max(1e-12),
-            "watertight": loops == 0 && triangles.is_watertight(),
-            "boundary_loops": loops,
-            "input_faces": input.faces(),
-            "faces": iso.mesh.faces(),
-            "isolation_steps": iso.steps,
-            "isolation_seconds": isolation_seconds,
-            "rate_min": rates.iter().min(),
-            "rate_max": rates.iter().max(),
-            "tolerance": args.tolerance,
-            "faces_over_tolerance": unmet,
-            "threads": rayon::current_num_threads(),
-        });
+        let watertight = surface.boundary_loops() == 0 && output.is_watertight();
+        let mut stats = plan_stats(&surface, &tessellator);
+        stats["seconds"] = seconds.into();
+        stats["triangles_per_second"] =
+            (tessellator.triangle_count() as f64 / seconds.max(1e-12)).into();
+        stats["watertight"] = watertight.into();
+        stats["tolerance"] = args.tolerance.into();
         println!("{stats}");
     }
     Ok(())
+}
+
+/// The statistics every dual-grid run reports (docs/cli.md), less the timings of frames.
+fn plan_stats(surface: &Surface, tessellator: &Tessellator<'_>) -> serde_json::Value {
+    let rates = tessellator.rates();
+    serde_json::json!({
+        "scheme": surface.scheme().name(),
+        "triangles": tessellator.triangle_count(),
+        "vertices": tessellator.vertex_count(),
+        "plan_seconds": tessellator.plan_seconds(),
+        "boundary_loops": surface.boundary_loops(),
+        "input_faces": surface.input_faces(),
+        "faces": surface.faces(),
+        "isolation_steps": surface.isolation_steps(),
+        "isolation_seconds": surface.isolation_seconds(),
+        "refinement_weights": surface.refinement_weights(),
+        "separable_faces": tessellator.separable_faces(),
+        "rate_min": rates.iter().min(),
+        "rate_max": rates.iter().max(),
+        "faces_over_tolerance": tessellator.faces_over_tolerance(),
+        "threads": rayon::current_num_threads(),
+    })
 }
 
 /// `subtess tessellate --bezier FILE`.
@@ -514,13 +386,7 @@ fn bezier_command(file: &Path, args: &TessellateArgs) -> Result<(), RuntimeError
 }
 
 /// `subtess tessellate MESH --method adaptive --tolerance T`.
-fn adaptive_command(
-    args: &TessellateArgs,
-    input: &Mesh,
-    table: &StencilTable,
-    iso: &Isolation,
-    isolation_seconds: f64,
-) -> Result<(), RuntimeError> {
+fn adaptive_command(args: &TessellateArgs, surface: &Surface) -> Result<(), RuntimeError> {
     let tolerance = args
         .tolerance
         .ok_or_else(|| RuntimeError::InvalidParameter {
@@ -533,10 +399,7 @@ fn adaptive_command(
         triangulate: args.triangulate,
         ..AdaptiveOptions::default()
     };
-    let (mut adaptive, stats) = tessellate_adaptive(table, &iso.mesh, &iso.patches, &options)?;
-    for source in &mut adaptive.sources {
-        *source = iso.input_source(*source);
-    }
+    let (adaptive, stats) = surface.tessellate_adaptive(&options)?;
     if MeshFormat::from_path(&args.output)? == MeshFormat::Obj && !args.triangulate {
         write_obj_polygons(&adaptive, &args.output)?;
     } else {
@@ -545,25 +408,11 @@ fn adaptive_command(
     if args.stats {
         let mut report = stats.to_json();
         report["watertight"] =
-            serde_json::json!(input.boundary_loops() == 0 && adaptive.is_watertight());
-        report["isolation_seconds"] = serde_json::json!(isolation_seconds);
+            serde_json::json!(surface.boundary_loops() == 0 && adaptive.is_watertight());
+        report["isolation_seconds"] = serde_json::json!(surface.isolation_seconds());
         println!("{report}");
     }
     Ok(())
-}
-
-/// The bench's rates: `rate` everywhere, or 3, 5, 8, 12, 7, 16 in turn.
-fn bench_rates(faces: usize, rate: u32, mixed: bool) -> Vec<u32> {
-    if mixed {
-        (0..faces).map(|f| [3, 5, 8, 12, 7, 16][f % 6]).collect()
-    } else {
-        vec![rate; faces]
-    }
-}
-
-/// A mesh's vertices as the evaluators' f32 control points.
-fn f32_positions(mesh: &Mesh) -> Vec<[f32; 3]> {
-    mesh.positions.iter().map(|p| p.map(|c| c as f32)).collect()
 }
 
 /// Run `frame` once untimed (it brings the buffers and the table into memory), then `frames`
@@ -583,6 +432,138 @@ fn time_frames(pool: &rayon::ThreadPool, frames: u32, mut frame: impl FnMut() + 
     seconds
 }
 
+/// `subtess bench`'s settings.
+struct BenchArgs {
+    mesh: PathBuf,
+    rate: u32,
+    mixed: bool,
+    threads: Option<usize>,
+    steps: u32,
+    frames: u32,
+    table: Option<PathBuf>,
+    scheme: Scheme,
+}
+
+/// `subtess bench`: per-frame work from the input control points.
+fn bench_command(args: BenchArgs) -> Result<(), RuntimeError> {
+    let mut input = load_mesh(&args.mesh)?;
+    for _ in 0..args.steps {
+        input = args.scheme.refine(&input)?;
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads.unwrap_or(0))
+        .build()
+        .map_err(|e| RuntimeError::Unsupported(format!("a pool of threads: {e}")))?;
+    let (rates, rates_label) = if args.mixed {
+        let per_face = (0..input.faces())
+            .map(|f| [3, 5, 8, 12, 7, 16][f % 6])
+            .collect();
+        (Rates::PerFace(per_face), "mixed 3..16".to_owned())
+    } else {
+        (Rates::Uniform(args.rate), args.rate.to_string())
+    };
+    let surface = pool.install(|| load_surface(&input, args.scheme, &args.table))?;
+    let mut tessellator = pool.install(|| surface.tessellator(&rates))?;
+    let control = input.positions_f32();
+    // The input is valid (it was evaluated into the surface), so a frame cannot fail.
+    tessellator.evaluate(&control)?;
+    let seconds = time_frames(&pool, args.frames, || {
+        let _ = tessellator.evaluate(&control);
+    });
+    let median = seconds[seconds.len() / 2];
+    let mut report = plan_stats(&surface, &tessellator);
+    report["mesh"] = args.mesh.display().to_string().into();
+    report["rates"] = rates_label.into();
+    report["threads"] = pool.current_num_threads().into();
+    report["frames"] = args.frames.into();
+    report["per_frame"] =
+        "from the input control points: refinement stencils, then positions and normals (triangles are connected once, in the plan)".into();
+    report["median_seconds"] = median.into();
+    report["min_seconds"] = seconds[0].into();
+    report["max_seconds"] = seconds[seconds.len() - 1].into();
+    report["triangles_per_second"] =
+        (tessellator.triangle_count() as f64 / median.max(1e-12)).into();
+    println!("{report}");
+    Ok(())
+}
+
+/// `subtess eval`.
+fn eval_command(
+    mesh: &Path,
+    scheme: Scheme,
+    face: usize,
+    uv: &str,
+    corner: usize,
+    json: bool,
+) -> Result<(), RuntimeError> {
+    let (u, v) = uv
+        .split_once(',')
+        .ok_or_else(|| RuntimeError::InvalidParameter {
+            name: format!("--uv `{uv}`"),
+            reason: "two rationals `U,V` wanted".to_owned(),
+        })?;
+    let (u, v) = (parse_rational(u.trim())?, parse_rational(v.trim())?);
+    let input = load_mesh(mesh)?;
+    let point = eval::limit_point(&input, scheme, face, corner, &u, &v)?;
+    if json {
+        let report = serde_json::json!({
+            "position": point.position,
+            "du": point.du,
+            "dv": point.dv,
+        });
+        println!("{report}");
+    } else {
+        println!("position {:?}", point.position);
+        println!("du       {:?}", point.du);
+        println!("dv       {:?}", point.dv);
+    }
+    Ok(())
+}
+
+/// `subtess tables info`.
+fn tables_info(file: Option<PathBuf>, scheme: Scheme) -> Result<(), RuntimeError> {
+    let (name, table) = match &file {
+        Some(path) => (path.display().to_string(), StencilTable::read(path)?),
+        None => (
+            format!("(embedded default, {scheme})"),
+            scheme.default_table(schemes::BoundaryMode::EdgeOnly)?,
+        ),
+    };
+    let index = table.index();
+    let weights: u64 = index
+        .entries
+        .iter()
+        .map(|e| u64::from(e.points) * u64::from(e.width))
+        .sum();
+    println!("table:      {name}");
+    println!(
+        "format:     version {}, little-endian, checksum {:#018x} (verified)",
+        index.version, index.checksum
+    );
+    println!("scheme:     {}", index.meta.scheme.name());
+    println!(
+        "boundary:   {}",
+        if index.meta.corners {
+            "edge and corner (one-face vertices pinned)"
+        } else {
+            "edge only"
+        }
+    );
+    println!("precision:  {}", index.meta.precision);
+    println!("covers:     {}", index.coverage());
+    println!(
+        "sections:   {} (primal and dual grids; positions, d/du, d/dv)",
+        index.entries.len()
+    );
+    println!("weights:    {weights}");
+    println!(
+        "size:       {} bytes ({:.1} MiB)",
+        table.bytes().len(),
+        table.bytes().len() as f64 / (1024.0 * 1024.0)
+    );
+    Ok(())
+}
+
 fn run(cli: Cli) -> Result<(), RuntimeError> {
     match cli.command {
         Command::Tessellate(args) => tessellate_command(*args),
@@ -591,102 +572,20 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
             rate,
             mixed,
             threads,
-            refine: steps,
+            refine,
             frames,
             table,
             scheme,
-        } => {
-            let mut input = load_mesh(&mesh)?;
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads.unwrap_or(0))
-                .build()
-                .map_err(|e| RuntimeError::Unsupported(format!("a pool of threads: {e}")))?;
-            let rates_label = if mixed {
-                "mixed 3..16".to_owned()
-            } else {
-                rate.to_string()
-            };
-            let scheme = parse_scheme(&scheme)?;
-            if scheme.is_triangle() {
-                let table = scheme.triangle_table(&table)?;
-                for _ in 0..steps {
-                    input = scheme.refine_triangles(&input)?;
-                }
-                let started = Instant::now();
-                let iso = scheme.isolate_triangles(&input)?;
-                let isolation_seconds = started.elapsed().as_secs_f64();
-                let faces = iso.patches.len();
-                let rates = bench_rates(faces, rate, mixed);
-                let (grid, control) = pool.install(|| {
-                    let grid = TriangleDualGrid::new(&table, &iso.mesh, &iso.patches, &rates)?;
-                    Ok::<_, RuntimeError>((grid, f32_positions(&iso.mesh)))
-                })?;
-                let mut positions = vec![[0.0f32; 3]; grid.vertex_count()];
-                let mut normals = positions.clone();
-                let mut triangles = vec![[0u32; 3]; grid.triangle_count()];
-                let seconds = time_frames(&pool, frames, || {
-                    grid.evaluate(&control, &mut positions, &mut normals);
-                    grid.connect(&mut triangles);
-                });
-                let count = grid.triangle_count();
-                let report = serde_json::json!({
-                    "mesh": mesh.display().to_string(),
-                    "scheme": scheme.name(),
-                    "faces": faces,
-                    "rates": rates_label,
-                    "threads": pool.current_num_threads(),
-                    "frames": frames,
-                    "triangles": count,
-                    "vertices": grid.vertex_count(),
-                    "median_seconds": seconds[seconds.len() / 2],
-                    "min_seconds": seconds[0],
-                    "max_seconds": seconds[seconds.len() - 1],
-                    "triangles_per_second": count as f64 / seconds[seconds.len() / 2].max(1e-12),
-                    "isolation_seconds": isolation_seconds,
-                });
-                println!("{report}");
-                return Ok(());
-            }
-            let table = load_table(&table, input.boundary)?;
-            for _ in 0..steps {
-                input = refine(&input).mesh;
-            }
-            let started = Instant::now();
-            let iso = isolate_with_origins(&input)?;
-            let isolation_seconds = started.elapsed().as_secs_f64();
-            let faces = iso.patches.len();
-            let rates = bench_rates(faces, rate, mixed);
-            let (grid, control) = pool.install(|| {
-                let grid = DualGrid::new(&table, &iso.mesh, &iso.patches, &rates)?;
-                Ok::<_, RuntimeError>((grid, f32_positions(&iso.mesh)))
-            })?;
-            let mut positions = vec![[0.0f32; 3]; grid.vertex_count()];
-            let mut normals = positions.clone();
-            let mut triangles = vec![[0u32; 3]; grid.triangle_count()];
-            let seconds = time_frames(&pool, frames, || {
-                grid.evaluate(&control, &mut positions, &mut normals);
-                grid.connect(&mut triangles);
-            });
-            let median = seconds[seconds.len() / 2];
-            let count = grid.triangle_count();
-            let report = serde_json::json!({
-                "mesh": mesh.display().to_string(),
-                "faces": faces,
-                "rates": rates_label,
-                "threads": pool.current_num_threads(),
-                "frames": frames,
-                "triangles": count,
-                "vertices": grid.vertex_count(),
-                "separable_faces": grid.separable_faces(),
-                "median_seconds": median,
-                "min_seconds": seconds[0],
-                "max_seconds": seconds[seconds.len() - 1],
-                "triangles_per_second": count as f64 / median.max(1e-12),
-                "isolation_seconds": isolation_seconds,
-            });
-            println!("{report}");
-            Ok(())
-        }
+        } => bench_command(BenchArgs {
+            mesh,
+            rate,
+            mixed,
+            threads,
+            steps: refine,
+            frames,
+            table,
+            scheme,
+        }),
         Command::Eval {
             mesh,
             scheme,
@@ -694,87 +593,9 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
             uv,
             corner,
             json,
-        } => {
-            let scheme = parse_scheme(&scheme)?;
-            let (u, v) = uv
-                .split_once(',')
-                .ok_or_else(|| RuntimeError::InvalidParameter {
-                    name: format!("--uv `{uv}`"),
-                    reason: "two rationals `U,V` wanted".to_owned(),
-                })?;
-            let (u, v) = (parse_rational(u.trim())?, parse_rational(v.trim())?);
-            let input = load_mesh(&mesh)?;
-            let point = match scheme {
-                Scheme::CatmullClark => evaluate_subface(&input, face, corner, &u, &v)?,
-                Scheme::Loop => LoopExactEvaluator::new(&input)?.evaluate(face, &u, &v)?,
-                Scheme::Butterfly | Scheme::Sqrt3 => {
-                    return Err(RuntimeError::Unsupported(format!(
-                        "exact evaluation of {0} is not implemented yet (`subtess tessellate --scheme {0}` evaluates it from the table)",
-                        scheme.name()
-                    )))
-                }
-            };
-            if json {
-                let report = serde_json::json!({
-                    "position": point.position,
-                    "du": point.du,
-                    "dv": point.dv,
-                });
-                println!("{report}");
-            } else {
-                println!("position {:?}", point.position);
-                println!("du       {:?}", point.du);
-                println!("dv       {:?}", point.dv);
-            }
-            Ok(())
-        }
+        } => eval_command(&mesh, scheme, face, &uv, corner, json),
         Command::Tables {
             command: TablesCommand::Info { file, scheme },
-        } => {
-            let name = match &file {
-                Some(path) => path.display().to_string(),
-                None => format!("(embedded default, {scheme})"),
-            };
-            let table = match parse_scheme(&scheme)? {
-                Scheme::Loop if file.is_none() => StencilTable::default_loop()?,
-                scheme @ (Scheme::Butterfly | Scheme::Sqrt3) if file.is_none() => {
-                    scheme.triangle_table(&None)?
-                }
-                _ => load_table(&file, schemes::BoundaryMode::EdgeOnly)?,
-            };
-            let index = table.index();
-            let weights: u64 = index
-                .entries
-                .iter()
-                .map(|e| u64::from(e.points) * u64::from(e.width))
-                .sum();
-            println!("table:      {name}");
-            println!(
-                "format:     version {}, little-endian, checksum {:#018x} (verified)",
-                index.version, index.checksum
-            );
-            println!("scheme:     {}", index.meta.scheme.name());
-            println!(
-                "boundary:   {}",
-                if index.meta.corners {
-                    "edge and corner (one-face vertices pinned)"
-                } else {
-                    "edge only"
-                }
-            );
-            println!("precision:  {}", index.meta.precision);
-            println!("covers:     {}", index.coverage());
-            println!(
-                "sections:   {} (primal and dual grids; positions, d/du, d/dv)",
-                index.entries.len()
-            );
-            println!("weights:    {weights}");
-            println!(
-                "size:       {} bytes ({:.1} MiB)",
-                table.bytes().len(),
-                table.bytes().len() as f64 / (1024.0 * 1024.0)
-            );
-            Ok(())
-        }
+        } => tables_info(file, scheme),
     }
 }

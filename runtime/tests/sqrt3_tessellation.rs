@@ -31,7 +31,9 @@ use common::{
 fn levels_of(mesh: &Mesh, m: usize) -> Vec<Mesh> {
     let mut levels = vec![mesh.clone()];
     for _ in 0..m {
-        let next = sqrt3_refine(&levels[levels.len() - 1]).expect("refines");
+        let next = sqrt3_refine(&levels[levels.len() - 1])
+            .expect("refines")
+            .mesh;
         levels.push(next);
     }
     levels

@@ -87,13 +87,14 @@ use num_integer::Integer;
 use num_rational::BigRational;
 use num_traits::{One, Signed, ToPrimitive, Zero};
 use schemes::local_matrices::{LocalMatrices, Neighbourhood, SUB_PATCH_ORIGINS};
-use schemes::{BoundaryMode, QuadScheme};
+use schemes::QuadScheme;
 
-use crate::mesh::topology::{Mesh, NONE};
+use crate::mesh::topology::Mesh;
 use crate::scheme::catmull_clark::isolate::MAX_STEPS;
-use crate::scheme::catmull_clark::refine::refine;
+use crate::scheme::catmull_clark::refine::{refine, refined_vertex, EdgeIds};
 use crate::scheme::patch::face_patch;
 use crate::scheme::patch::gather_patches;
+use crate::scheme::stencil::Weight;
 use crate::RuntimeError;
 
 /// The limit surface at one point: position and first derivatives, in the face's own `(u, v)`
@@ -206,31 +207,6 @@ pub fn evaluate_subface(
     ExactEvaluator::new(mesh).evaluate_subface(face, corner, u, v)
 }
 
-/// Edge numbering of one refinement step, as [`crate::scheme::catmull_clark::refine::refine`] numbers edge points.
-#[derive(Clone, Debug)]
-struct EdgeIds {
-    /// One half-edge per edge.
-    halfedge: Vec<usize>,
-}
-
-impl EdgeIds {
-    fn new(mesh: &Mesh) -> Self {
-        let mut of_halfedge = vec![NONE; mesh.face_vertices.len()];
-        let mut halfedge = Vec::new();
-        for h in 0..of_halfedge.len() {
-            if of_halfedge[h] != NONE {
-                continue;
-            }
-            of_halfedge[h] = halfedge.len() as u32;
-            if mesh.twin[h] != NONE {
-                of_halfedge[mesh.twin[h] as usize] = halfedge.len() as u32;
-            }
-            halfedge.push(h);
-        }
-        EdgeIds { halfedge }
-    }
-}
-
 /// Evaluates faces of one mesh exactly; refines it (in f64, for the topology) once, up to the
 /// steps [`crate::scheme::catmull_clark::isolate`] would take, and reuses that for every call.
 #[derive(Debug)]
@@ -271,6 +247,10 @@ fn mul(a: [[i64; 2]; 2], b: [[i64; 2]; 2]) -> [[i64; 2]; 2] {
         }
     }
     c
+}
+
+fn ratio(p: i64, q: i64) -> BigRational {
+    BigRational::ratio(p, q)
 }
 
 fn int(i: i64) -> BigRational {
@@ -493,23 +473,11 @@ impl ExactEvaluator {
 }
 
 /// Exact positions of the vertices of the refined meshes, recomputed from the original f64
-/// positions with the rules of [`crate::scheme::catmull_clark::refine`] (in rationals), memoized.
+/// positions with the rules of [`crate::scheme::catmull_clark::refine`] in rationals
+/// ([`refined_vertex`]), memoized.
 struct ExactPositions<'e> {
     evaluator: &'e ExactEvaluator,
     vertices: HashMap<(usize, usize), Point>,
-    faces: HashMap<(usize, usize), Point>,
-}
-
-fn add(a: &Point, b: &Point) -> Point {
-    std::array::from_fn(|c| &a[c] + &b[c])
-}
-
-fn scale(a: &Point, s: &BigRational) -> Point {
-    std::array::from_fn(|c| &a[c] * s)
-}
-
-fn ratio(p: i64, q: i64) -> BigRational {
-    BigRational::new(BigInt::from(p), BigInt::from(q))
 }
 
 impl<'e> ExactPositions<'e> {
@@ -517,7 +485,6 @@ impl<'e> ExactPositions<'e> {
         ExactPositions {
             evaluator,
             vertices: HashMap::new(),
-            faces: HashMap::new(),
         }
     }
 
@@ -532,79 +499,19 @@ impl<'e> ExactPositions<'e> {
             std::array::from_fn(|c| BigRational::from_float(p[c]).unwrap_or_else(BigRational::zero))
         } else {
             let coarse = &self.evaluator.levels[level - 1];
-            let (nv, ne) = (
-                coarse.positions.len(),
-                self.evaluator.edges[level - 1].halfedge.len(),
-            );
-            if v < nv {
-                self.vertex_point(level - 1, v)
-            } else if v < nv + ne {
-                self.edge_point(level - 1, self.evaluator.edges[level - 1].halfedge[v - nv])
-            } else {
-                self.face_point(level - 1, v - nv - ne)
+            let terms: Vec<(u32, BigRational)> =
+                refined_vertex(coarse, &self.evaluator.edges[level - 1], v);
+            let mut sum: Point = std::array::from_fn(|_| BigRational::zero());
+            for (j, w) in terms {
+                let q = self.vertex(level - 1, j as usize);
+                for c in 0..3 {
+                    sum[c] += &q[c] * &w;
+                }
             }
+            sum
         };
         self.vertices.insert((level, v), point.clone());
         point
-    }
-
-    /// The centroid of face `f` of level `level`.
-    fn face_point(&mut self, level: usize, f: usize) -> Point {
-        if let Some(p) = self.faces.get(&(level, f)) {
-            return p.clone();
-        }
-        let corners: Vec<u32> = self.evaluator.levels[level].face(f).to_vec();
-        let mut sum: Point = std::array::from_fn(|_| BigRational::zero());
-        for &c in &corners {
-            sum = add(&sum, &self.vertex(level, c as usize));
-        }
-        let point = scale(&sum, &ratio(1, corners.len() as i64));
-        self.faces.insert((level, f), point.clone());
-        point
-    }
-
-    /// The edge point of the edge of half-edge `h` of level `level`.
-    fn edge_point(&mut self, level: usize, h: usize) -> Point {
-        let mesh = &self.evaluator.levels[level];
-        let (a, b) = (mesh.face_vertices[h] as usize, mesh.head(h) as usize);
-        let twin = mesh.twin[h];
-        let (fl, fr) = (mesh.face_of[h] as usize, twin);
-        let ends = add(&self.vertex(level, a), &self.vertex(level, b));
-        if twin == NONE {
-            return scale(&ends, &ratio(1, 2));
-        }
-        let fr = mesh.face_of[fr as usize] as usize;
-        let faces = add(&self.face_point(level, fl), &self.face_point(level, fr));
-        scale(&add(&ends, &faces), &ratio(1, 4))
-    }
-
-    /// The vertex point of vertex `v` of level `level`.
-    fn vertex_point(&mut self, level: usize, v: usize) -> Point {
-        let mesh = &self.evaluator.levels[level];
-        let fan = mesh.fan(v);
-        let centre = self.vertex(level, v);
-        if fan.is_empty() {
-            return centre;
-        }
-        if mesh.is_boundary_vertex(v) {
-            if fan.len() == 1 && mesh.boundary == BoundaryMode::EdgeAndCorner {
-                return centre;
-            }
-            let first = mesh.head(fan[0]) as usize;
-            let last = mesh.face_vertices[mesh.prev(fan[fan.len() - 1])] as usize;
-            let ends = add(&self.vertex(level, first), &self.vertex(level, last));
-            return scale(&add(&ends, &scale(&centre, &int(6))), &ratio(1, 8));
-        }
-        // (Q + 2R + (n - 3) V) / n = (sum F / n + sum (V + E) / n + (n - 3) V) / n.
-        let n = fan.len() as i64;
-        let mut sum: Point = scale(&centre, &int(n - 3));
-        for &h in &fan {
-            let (f, e) = (mesh.face_of[h] as usize, mesh.head(h) as usize);
-            let face = scale(&self.face_point(level, f), &ratio(1, n));
-            let edge = scale(&add(&centre, &self.vertex(level, e)), &ratio(1, n));
-            sum = add(&add(&sum, &face), &edge);
-        }
-        scale(&sum, &ratio(1, n))
     }
 }
 

@@ -8,8 +8,10 @@
 //!
 //! 1. **Isolation** as the tessellator does it ([`isolate_loop`]): at most one Loop step. The
 //!    refined control points are recomputed exactly (rationals) from the input's f64 positions,
-//!    which are exact binary rationals, with the same rules; `(u, v)` descends into the child
-//!    that holds it (the inverse of [`crate::scheme::triangle::split::child_to_parent`]).
+//!    which are exact binary rationals, with the same rules (the one rule function
+//!    [`crate::scheme::loop_scheme::refine::loop_stencil`], over `BigRational`); `(u, v)`
+//!    descends into the child that holds it (the inverse of
+//!    [`crate::scheme::triangle::split::child_to_parent`]).
 //! 2. **Patch** of that triangle ([`crate::scheme::triangle::patch`]): control points in the table's
 //!    layout (phantoms `a + b - c` included, exactly), the patch parameters
 //!    `(u', v') = (w_{r+1}, w_{r+2})` of the child's barycentric weights for a patch at corner
@@ -41,10 +43,11 @@ use schemes::triangle_local::{TriangleLocalMatrices, SUB_TRIANGLES};
 use schemes::TriangleScheme;
 
 use crate::eval::exact_eval::{null_vectors, LimitPoint};
-use crate::mesh::topology::{Mesh, NONE};
-use crate::mesh::triangle_topology::neighbours;
+use crate::mesh::topology::Mesh;
 use crate::scheme::loop_scheme::isolate::isolate_loop;
+use crate::scheme::loop_scheme::refine::{loop_beta, loop_stencil};
 use crate::scheme::patch::PatchKind;
+use crate::scheme::stencil::Stencil;
 use crate::scheme::triangle::isolation::TriangleIsolation;
 use crate::RuntimeError;
 
@@ -98,7 +101,8 @@ impl LoopExactEvaluator {
             .map(|&p| exact(p))
             .collect::<Result<Vec<_>, _>>()?;
         if iso.steps == 1 {
-            control = refine_exactly(mesh, &control);
+            // The rules loop_refine positioned the isolated mesh with, in rationals.
+            control = apply_exactly(&loop_stencil::<BigRational>(mesh)?, &control);
         }
         for &[a, b, c] in &iso.phantoms.definitions {
             let (a, b, c) = (
@@ -320,61 +324,14 @@ fn child_of(u: &BigRational, v: &BigRational) -> (u8, BigRational, BigRational, 
     }
 }
 
-/// One Loop step of the control points, exactly, numbered as [`crate::scheme::loop_scheme::refine`] numbers
-/// them (vertex points, then one edge point per edge in order of first appearance).
-fn refine_exactly(mesh: &Mesh, p: &[Point]) -> Vec<Point> {
-    let mut out = Vec::with_capacity(p.len() + mesh.face_vertices.len());
-    for v in 0..p.len() {
-        let ring = neighbours(mesh, v);
-        let point = if mesh.vertex_halfedge[v] == NONE {
-            p[v].clone()
-        } else if mesh.is_boundary_vertex(v) {
-            let (a, b) = (ring[0] as usize, ring[ring.len() - 1] as usize);
-            combine(&[
-                (&p[a], ratio(1, 8)),
-                (&p[v], ratio(3, 4)),
-                (&p[b], ratio(1, 8)),
-            ])
-        } else {
-            let n = ring.len() as i64;
-            let beta = if n == 3 {
-                ratio(3, 16)
-            } else {
-                ratio(3, 8 * n)
-            };
-            let mut terms = vec![(
-                &p[v],
-                BigRational::one() - &beta * BigRational::from_integer(n.into()),
-            )];
-            terms.extend(ring.iter().map(|&e| (&p[e as usize], beta.clone())));
-            combine(&terms)
-        };
-        out.push(point);
-    }
-    let mut seen = vec![false; mesh.face_vertices.len()];
-    for h in 0..mesh.face_vertices.len() {
-        if seen[h] {
-            continue;
-        }
-        seen[h] = true;
-        let (a, b) = (mesh.face_vertices[h] as usize, mesh.head(h) as usize);
-        let t = mesh.twin[h];
-        let point = if t == NONE {
-            combine(&[(&p[a], ratio(1, 2)), (&p[b], ratio(1, 2))])
-        } else {
-            seen[t as usize] = true;
-            let c = mesh.head(mesh.next(h)) as usize;
-            let d = mesh.head(mesh.next(t as usize)) as usize;
-            combine(&[
-                (&p[a], ratio(3, 8)),
-                (&p[b], ratio(3, 8)),
-                (&p[c], ratio(1, 8)),
-                (&p[d], ratio(1, 8)),
-            ])
-        };
-        out.push(point);
-    }
-    out
+/// `stencil` applied to exact points: row `i` gives `sum w p_j` over its entries.
+fn apply_exactly(stencil: &Stencil<BigRational>, p: &[Point]) -> Vec<Point> {
+    (0..stencil.rows())
+        .map(|i| {
+            let (js, ws) = stencil.row(i);
+            std::array::from_fn(|c| js.iter().zip(ws).map(|(&j, w)| w * &p[j as usize][c]).sum())
+        })
+        .collect()
 }
 
 /// Limit position (exact) and tangent masks (f64) at the patch vertex (module docs, step 4).
@@ -387,11 +344,7 @@ fn at_vertex(
     let (position, du, dv) = match matrices.neighbourhood {
         TriangleNeighbourhood::Interior { valence } => {
             let v = i64::from(valence);
-            let beta = if v == 3 {
-                ratio(3, 16)
-            } else {
-                ratio(3, 8 * v)
-            };
+            let beta: BigRational = loop_beta(valence as usize);
             let chi =
                 BigRational::one() / (ratio(3, 8) / &beta + BigRational::from_integer(v.into()));
             let mut terms = vec![(

@@ -102,6 +102,12 @@ impl Mesh {
         Ok(mesh)
     }
 
+    /// The vertex positions as the f32 control points a frame takes
+    /// ([`crate::Tessellator::evaluate`]).
+    pub fn positions_f32(&self) -> Vec<[f32; 3]> {
+        self.positions.iter().map(|p| p.map(|c| c as f32)).collect()
+    }
+
     /// Number of faces.
     pub fn faces(&self) -> usize {
         self.face_offsets.len() - 1

@@ -10,3 +10,127 @@ pub mod patch;
 pub mod sqrt3;
 pub mod stencil;
 pub mod triangle;
+
+use std::str::FromStr;
+
+use table_format::SchemeId;
+
+use crate::stencil_table::StencilTable;
+use crate::RuntimeError;
+
+/// The subdivision schemes a [`crate::Surface`] can be built with (each has embedded tables).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, clap::ValueEnum)]
+pub enum Scheme {
+    /// Catmull–Clark: any polygons, closed or with boundary.
+    CatmullClark,
+    /// Loop (Warren's weights): triangles, closed or with boundary.
+    Loop,
+    /// The modified butterfly (interpolating): closed triangle meshes.
+    Butterfly,
+    /// Kobbelt's √3 (two steps as one ternary step): closed triangle meshes.
+    Sqrt3,
+}
+
+impl Scheme {
+    /// Every scheme, in the order the CLI lists them.
+    pub const ALL: [Scheme; 4] = [
+        Scheme::CatmullClark,
+        Scheme::Loop,
+        Scheme::Butterfly,
+        Scheme::Sqrt3,
+    ];
+
+    /// The catalogue name (`catmull-clark`, `loop`, `butterfly`, `sqrt3`), as the CLI and the
+    /// tables spell it.
+    pub fn name(self) -> &'static str {
+        self.table_scheme().name()
+    }
+
+    /// Whether the scheme subdivides triangles (the triangle dual grid tessellates it).
+    pub fn is_triangle(self) -> bool {
+        self != Scheme::CatmullClark
+    }
+
+    /// The scheme id its tables carry.
+    pub fn table_scheme(self) -> SchemeId {
+        match self {
+            Scheme::CatmullClark => SchemeId::CatmullClark,
+            Scheme::Loop => SchemeId::Loop,
+            Scheme::Butterfly => SchemeId::Butterfly,
+            Scheme::Sqrt3 => SchemeId::Sqrt3,
+        }
+    }
+
+    /// The embedded default table for a mesh with boundary rule `boundary` (Catmull–Clark has
+    /// a pinned-corner companion for "edge and corner").
+    pub fn default_table(
+        self,
+        boundary: schemes::BoundaryMode,
+    ) -> Result<StencilTable, RuntimeError> {
+        match self {
+            Scheme::CatmullClark => StencilTable::default_for(boundary),
+            Scheme::Loop => StencilTable::default_loop(),
+            Scheme::Butterfly => StencilTable::default_butterfly(),
+            Scheme::Sqrt3 => StencilTable::default_sqrt3(),
+        }
+    }
+
+    /// One whole-mesh subdivision step by this scheme's rules (two steps for √3, its ternary
+    /// step): for reaching a face count in benchmarks and for whole-mesh references.
+    pub fn refine(self, mesh: &crate::mesh::Mesh) -> Result<crate::mesh::Mesh, RuntimeError> {
+        use crate::scheme::triangle::region_patch::RegionScheme;
+        match self {
+            Scheme::CatmullClark => Ok(catmull_clark::refine::refine(mesh).mesh),
+            Scheme::Loop => Ok(loop_scheme::refine::loop_refine(mesh)?.mesh),
+            Scheme::Butterfly => RegionScheme::Butterfly.refine(mesh),
+            Scheme::Sqrt3 => RegionScheme::Sqrt3.refine(mesh),
+        }
+    }
+
+    /// Refuse a table made for another scheme: its stencils have another layout or another
+    /// limit surface, and would be read silently wrong.
+    pub fn check_table(self, table: &StencilTable) -> Result<(), RuntimeError> {
+        let found = table.index().meta.scheme;
+        if found == self.table_scheme() {
+            Ok(())
+        } else {
+            Err(RuntimeError::InvalidParameter {
+                name: "table".to_owned(),
+                reason: format!(
+                    "it holds {} stencils, but the surface is {}",
+                    found.name(),
+                    self.name()
+                ),
+            })
+        }
+    }
+}
+
+impl std::fmt::Display for Scheme {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Scheme {
+    type Err = RuntimeError;
+
+    /// A scheme by its catalogue name; a catalogued scheme without a runtime table is named
+    /// as such.
+    fn from_str(name: &str) -> Result<Self, Self::Err> {
+        if let Some(scheme) = Scheme::ALL.into_iter().find(|s| s.name() == name) {
+            return Ok(scheme);
+        }
+        if schemes::triangle::TRIANGLE_SCHEME_NAMES.contains(&name)
+            || schemes::quad::QUAD_SCHEME_NAMES.contains(&name)
+        {
+            return Err(RuntimeError::Unsupported(format!(
+                "scheme `{name}`: no table for this scheme yet (the runtime has tables for catmull-clark, loop, butterfly and sqrt3)"
+            )));
+        }
+        Err(RuntimeError::InvalidParameter {
+            name: format!("scheme `{name}`"),
+            reason: "not a scheme; catmull-clark, loop, butterfly or sqrt3".to_owned(),
+        })
+    }
+}

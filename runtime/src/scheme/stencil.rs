@@ -120,15 +120,47 @@ impl<W: Weight> Stencil<W> {
     /// rows).
     pub fn then(&self, outer: &Stencil<W>) -> Stencil<W> {
         debug_assert_eq!(outer.columns, self.rows());
+        // Each outer row gathers into a dense accumulator over the columns (one per worker),
+        // remembering which columns it touched: no sorting of the expanded terms.
+        let rows: Vec<Vec<(u32, W)>> = (0..outer.rows())
+            .into_par_iter()
+            .map_init(
+                || {
+                    (
+                        vec![W::zero(); self.columns],
+                        vec![false; self.columns],
+                        Vec::new(),
+                    )
+                },
+                |(acc, seen, touched), i| {
+                    let (js, ws) = outer.row(i);
+                    for (&j, w) in js.iter().zip(ws) {
+                        let (ks, vs) = self.row(j as usize);
+                        for (&k, v) in ks.iter().zip(vs) {
+                            let k = k as usize;
+                            if !seen[k] {
+                                seen[k] = true;
+                                touched.push(k as u32);
+                            }
+                            acc[k] = acc[k].clone() + w.clone() * v.clone();
+                        }
+                    }
+                    touched.sort_unstable();
+                    let row = touched
+                        .drain(..)
+                        .map(|k| {
+                            let k_ = k as usize;
+                            seen[k_] = false;
+                            (k, std::mem::replace(&mut acc[k_], W::zero()))
+                        })
+                        .collect();
+                    row
+                },
+            )
+            .collect();
         let mut out = Stencil::new(self.columns);
-        for i in 0..outer.rows() {
-            let (js, ws) = outer.row(i);
-            let mut terms = Vec::new();
-            for (&j, w) in js.iter().zip(ws) {
-                let (ks, vs) = self.row(j as usize);
-                terms.extend(ks.iter().zip(vs).map(|(&k, v)| (k, w.clone() * v.clone())));
-            }
-            out.push_row(terms);
+        for row in rows {
+            out.push_row(row);
         }
         out
     }

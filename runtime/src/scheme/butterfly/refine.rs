@@ -18,10 +18,10 @@
 
 use schemes::TriangleScheme;
 
-use crate::mesh::geometry::{add, scale};
 use crate::mesh::topology::Mesh;
 use crate::mesh::triangle_topology::{require_closed_triangles, ring_from};
 use crate::scheme::loop_scheme::refine::LoopRefinement;
+use crate::scheme::stencil::Stencil;
 use crate::scheme::triangle::split::TriangleSplit;
 use crate::RuntimeError;
 
@@ -53,63 +53,89 @@ impl ButterflyWeights {
 }
 
 /// The far vertex of the triangle across the edge of half-edge `h` (a closed mesh).
-fn across(mesh: &Mesh, h: usize) -> usize {
-    mesh.head(mesh.next(mesh.twin[h] as usize)) as usize
+fn across(mesh: &Mesh, h: usize) -> u32 {
+    mesh.head(mesh.next(mesh.twin[h] as usize))
 }
 
-/// Refine the closed triangle mesh `mesh` once.
-pub fn butterfly_refine(mesh: &Mesh) -> Result<LoopRefinement, RuntimeError> {
+/// One butterfly step of the closed triangle mesh `mesh` as rows over its vertices (f64: the
+/// extraordinary weights have cosines): refined vertex `i`, numbered as
+/// [`crate::scheme::triangle::split`] says, is `sum w p_j` over row `i`. Why a map: the same
+/// rules then position the refined mesh ([`butterfly_refine`]) and compose into the per-frame
+/// stencil of an isolation. Refuses a boundary, or a vertex of valence below 3.
+pub fn butterfly_stencil(mesh: &Mesh) -> Result<Stencil<f64>, RuntimeError> {
     require_closed_triangles(mesh, "butterfly")?;
-    let p = &mesh.positions;
-    let nv = p.len();
-    let valence: Vec<usize> = (0..nv).map(|v| mesh.fan(v).len()).collect();
+    rows(mesh, &TriangleSplit::new(mesh))
+}
+
+/// The rules of the module docs over `split`'s numbering (`mesh` closed, all triangles).
+fn rows(mesh: &Mesh, split: &TriangleSplit) -> Result<Stencil<f64>, RuntimeError> {
+    let nv = mesh.positions.len();
+    let valence: Vec<usize> = mesh.valences();
     let max_valence = valence.iter().copied().max().unwrap_or(0);
     let weights = ButterflyWeights::new(max_valence)?;
-    let split = TriangleSplit::new(mesh);
-    // The extraordinary rule of the tail `a` of half-edge `h`.
-    let extraordinary = |h: usize| -> Result<[f64; 3], RuntimeError> {
-        let a = mesh.face_vertices[h] as usize;
-        let (q, s) = weights.of(valence[a]).ok_or_else(|| {
+    // The extraordinary rule of the tail `a` of half-edge `h`, every weight times `factor`.
+    let extraordinary = |h: usize, factor: f64| -> Result<Vec<(u32, f64)>, RuntimeError> {
+        let a = mesh.face_vertices[h];
+        let (q, s) = weights.of(valence[a as usize]).ok_or_else(|| {
             RuntimeError::Unsupported(format!(
                 "vertex {a} has valence {}: the butterfly needs at least 3",
-                valence[a]
+                valence[a as usize]
             ))
         })?;
-        Ok(ring_from(mesh, h)
-            .iter()
-            .zip(s)
-            .fold(scale(*q, p[a]), |acc, (&e, &w)| {
-                add(acc, scale(w, p[e as usize]))
-            }))
+        let mut row = vec![(a, factor * q)];
+        row.extend(
+            ring_from(mesh, h)
+                .iter()
+                .zip(s)
+                .map(|(&e, &w)| (e, factor * w)),
+        );
+        Ok(row)
     };
-    let mut positions = p.clone();
+    // The scheme interpolates: old vertices stay.
+    let mut stencil = Stencil::identity(nv);
     for &h in &split.first_halfedge {
         let h = h as usize;
         let t = mesh.twin[h] as usize;
-        let (a, b) = (mesh.face_vertices[h] as usize, mesh.head(h) as usize);
-        let point = match (valence[a] == 6, valence[b] == 6) {
+        let (a, b) = (mesh.face_vertices[h], mesh.head(h));
+        let row = match (valence[a as usize] == 6, valence[b as usize] == 6) {
             (true, true) => {
-                let c = mesh.head(mesh.next(h)) as usize;
-                let d = mesh.head(mesh.next(t)) as usize;
-                let wings = [mesh.next(h), mesh.prev(h), mesh.next(t), mesh.prev(t)]
-                    .iter()
-                    .fold([0.0; 3], |acc, &g| add(acc, p[across(mesh, g)]));
-                add(
-                    add(scale(0.5, add(p[a], p[b])), scale(0.125, add(p[c], p[d]))),
-                    scale(-1.0 / 16.0, wings),
-                )
+                let c = mesh.head(mesh.next(h));
+                let d = mesh.head(mesh.next(t));
+                let mut row = vec![(a, 0.5), (b, 0.5), (c, 0.125), (d, 0.125)];
+                row.extend(
+                    [mesh.next(h), mesh.prev(h), mesh.next(t), mesh.prev(t)]
+                        .iter()
+                        .map(|&g| (across(mesh, g), -1.0 / 16.0)),
+                );
+                row
             }
-            (false, true) => extraordinary(h)?,
-            (true, false) => extraordinary(t)?,
-            (false, false) => scale(0.5, add(extraordinary(h)?, extraordinary(t)?)),
+            (false, true) => extraordinary(h, 1.0)?,
+            (true, false) => extraordinary(t, 1.0)?,
+            (false, false) => {
+                let mut row = extraordinary(h, 0.5)?;
+                row.extend(extraordinary(t, 0.5)?);
+                row
+            }
         };
-        positions.push(point);
+        stencil.push_row(row);
     }
+    Ok(stencil)
+}
+
+/// Refine the closed triangle mesh `mesh` once: the positions are [`butterfly_stencil`]'s rows
+/// applied to the coarse positions, and the rows come back with the mesh.
+pub fn butterfly_refine(mesh: &Mesh) -> Result<LoopRefinement, RuntimeError> {
+    require_closed_triangles(mesh, "butterfly")?;
+    let nv = mesh.positions.len();
+    let split = TriangleSplit::new(mesh);
+    let stencil = rows(mesh, &split)?;
+    let positions = stencil.apply(&mesh.positions);
     let faces = split.child_faces(mesh, nv);
     let refined = Mesh::new(positions, &faces, &[], mesh.boundary)?;
     Ok(LoopRefinement {
         mesh: refined,
         edges: split.edges,
+        stencil,
     })
 }
 

@@ -10,6 +10,7 @@ use crate::mesh::VertexSource;
 use crate::scheme::catmull_clark::refine::refine;
 use crate::scheme::patch::gather_patches;
 use crate::scheme::patch::FacePatch;
+use crate::scheme::stencil::Stencil;
 use crate::MeshError;
 
 /// At most this many steps are tried (two always suffice for a valid mesh).
@@ -31,6 +32,10 @@ pub struct Isolation {
     pub corners: Vec<[u8; MAX_STEPS]>,
     /// Number of sides of every input face.
     pub input_sides: Vec<u32>,
+    /// Every vertex of `mesh` as a combination of the input mesh's vertices: the refinement
+    /// steps composed, so a moved input maps to the isolated control points without refining
+    /// again (the identity when no step was taken).
+    pub refinement: Stencil<f64>,
 }
 
 impl Isolation {
@@ -76,6 +81,7 @@ pub fn isolate_with_origins(mesh: &Mesh) -> Result<Isolation, MeshError> {
     let mut current = mesh.clone();
     let mut origin: Vec<u32> = (0..mesh.faces() as u32).collect();
     let mut corners = vec![[0u8; MAX_STEPS]; mesh.faces()];
+    let mut refinement = Stencil::identity(mesh.positions.len());
     let input_sides = (0..mesh.faces())
         .map(|f| mesh.face(f).len() as u32)
         .collect();
@@ -89,6 +95,7 @@ pub fn isolate_with_origins(mesh: &Mesh) -> Result<Isolation, MeshError> {
                     origin,
                     corners,
                     input_sides,
+                    refinement,
                 })
             }
             Err(e) if steps == MAX_STEPS => return Err(e),
@@ -107,7 +114,9 @@ pub fn isolate_with_origins(mesh: &Mesh) -> Result<Isolation, MeshError> {
                     .iter()
                     .map(|&f| origin[f as usize])
                     .collect();
-                current = refine(&current).mesh;
+                let step = refine(&current);
+                refinement = refinement.then(&step.stencil);
+                current = step.mesh;
             }
         }
     }

@@ -17,6 +17,7 @@
 use schemes::BoundaryMode;
 
 use crate::mesh::topology::{Mesh, NONE};
+use crate::scheme::stencil::{Stencil, Weight};
 
 /// The refined mesh, and for each refined vertex what it was made from.
 #[derive(Clone, Debug)]
@@ -27,90 +28,129 @@ pub struct Refinement {
     pub vertex_points: usize,
     /// Number of edge points.
     pub edge_points: usize,
+    /// Every refined vertex as a combination of the coarse ones (the rules above).
+    pub stencil: Stencil<f64>,
 }
 
-fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+/// The edge numbering of one step: edge points in order of the first half-edge of each edge.
+#[derive(Clone, Debug)]
+pub struct EdgeIds {
+    /// The first half-edge of every edge.
+    pub halfedge: Vec<usize>,
+    /// The edge of every half-edge.
+    pub of_halfedge: Vec<u32>,
 }
 
-fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
-    [a[0] * s, a[1] * s, a[2] * s]
+impl EdgeIds {
+    /// Number the edges of `mesh`.
+    pub fn new(mesh: &Mesh) -> Self {
+        let mut of_halfedge = vec![NONE; mesh.face_vertices.len()];
+        let mut halfedge = Vec::new();
+        for h in 0..of_halfedge.len() {
+            if of_halfedge[h] != NONE {
+                continue;
+            }
+            of_halfedge[h] = halfedge.len() as u32;
+            if mesh.twin[h] != NONE {
+                of_halfedge[mesh.twin[h] as usize] = halfedge.len() as u32;
+            }
+            halfedge.push(h);
+        }
+        EdgeIds {
+            halfedge,
+            of_halfedge,
+        }
+    }
+}
+
+/// `(index, weight)` terms of the centroid of face `f`, scaled by `s`.
+fn face_terms<W: Weight>(mesh: &Mesh, f: usize, s: W, out: &mut Vec<(u32, W)>) {
+    let face = mesh.face(f);
+    let w = s * W::ratio(1, face.len() as i64);
+    out.extend(face.iter().map(|&v| (v, w.clone())));
+}
+
+/// Refined vertex `child` of `mesh` (numbered as [`refine`] numbers them) as `(coarse vertex,
+/// weight)` terms: the one statement of the Catmull–Clark rules, in any [`Weight`] (f64 for
+/// positions and per-frame stencils, rationals for exact evaluation).
+pub fn refined_vertex<W: Weight>(mesh: &Mesh, edges: &EdgeIds, child: usize) -> Vec<(u32, W)> {
+    let nv = mesh.positions.len();
+    let ne = edges.halfedge.len();
+    let mut terms = Vec::new();
+    if child >= nv + ne {
+        face_terms(mesh, child - nv - ne, W::ratio(1, 1), &mut terms);
+    } else if child >= nv {
+        let h = edges.halfedge[child - nv];
+        let (a, b) = (mesh.face_vertices[h], mesh.head(h));
+        match mesh.twin[h] {
+            NONE => terms.extend([(a, W::ratio(1, 2)), (b, W::ratio(1, 2))]),
+            t => {
+                terms.extend([(a, W::ratio(1, 4)), (b, W::ratio(1, 4))]);
+                face_terms(mesh, mesh.face_of[h] as usize, W::ratio(1, 4), &mut terms);
+                face_terms(
+                    mesh,
+                    mesh.face_of[t as usize] as usize,
+                    W::ratio(1, 4),
+                    &mut terms,
+                );
+            }
+        }
+    } else {
+        let v = child;
+        let fan = mesh.fan(v);
+        let corner = fan.len() == 1 && mesh.boundary == BoundaryMode::EdgeAndCorner;
+        if fan.is_empty() || (corner && mesh.is_boundary_vertex(v)) {
+            terms.push((v as u32, W::ratio(1, 1)));
+        } else if mesh.is_boundary_vertex(v) {
+            // Boundary neighbours: the head of the first outgoing edge (no twin) and the tail
+            // of the last face's incoming edge.
+            let first = mesh.head(fan[0]);
+            let last = mesh.face_vertices[mesh.prev(fan[fan.len() - 1])];
+            terms.extend([
+                (first, W::ratio(1, 8)),
+                (last, W::ratio(1, 8)),
+                (v as u32, W::ratio(3, 4)),
+            ]);
+        } else {
+            // (Q + 2R + (n - 3) V) / n = (sum F / n + sum (V + E) / n + (n - 3) V) / n.
+            let n = fan.len() as i64;
+            let nn = n * n;
+            terms.push((
+                v as u32,
+                W::ratio(n - 3, n) + W::ratio(fan.len() as i64, nn),
+            ));
+            for &h in &fan {
+                terms.push((mesh.head(h), W::ratio(1, nn)));
+                face_terms(mesh, mesh.face_of[h] as usize, W::ratio(1, nn), &mut terms);
+            }
+        }
+    }
+    terms
+}
+
+/// Every refined vertex of one step of `mesh` as a combination of its vertices.
+pub fn refinement_stencil<W: Weight>(mesh: &Mesh, edges: &EdgeIds) -> Stencil<W> {
+    let rows = mesh.positions.len() + edges.halfedge.len() + mesh.faces();
+    let mut stencil = Stencil::new(mesh.positions.len());
+    for child in 0..rows {
+        stencil.push_row(refined_vertex(mesh, edges, child));
+    }
+    stencil
 }
 
 /// Refine `mesh` once.
 pub fn refine(mesh: &Mesh) -> Refinement {
-    let p = &mesh.positions;
-    let nv = p.len();
-    let nf = mesh.faces();
-    let halfedges = mesh.face_vertices.len();
-    let face_points: Vec<[f64; 3]> = (0..nf)
-        .map(|f| {
-            let face = mesh.face(f);
-            let sum = face
-                .iter()
-                .fold([0.0; 3], |acc, &v| add(acc, p[v as usize]));
-            scale(sum, 1.0 / face.len() as f64)
-        })
-        .collect();
-    // Edge ids: one per half-edge pair.
-    let mut edge_of = vec![NONE; halfedges];
-    let mut edge_points = Vec::new();
-    for h in 0..halfedges {
-        if edge_of[h] != NONE {
-            continue;
-        }
-        let id = edge_points.len() as u32;
-        edge_of[h] = id;
-        let (a, b) = (p[mesh.face_vertices[h] as usize], p[mesh.head(h) as usize]);
-        let t = mesh.twin[h];
-        let point = if t == NONE {
-            scale(add(a, b), 0.5)
-        } else {
-            edge_of[t as usize] = id;
-            let fl = face_points[mesh.face_of[h] as usize];
-            let fr = face_points[mesh.face_of[t as usize] as usize];
-            scale(add(add(a, b), add(fl, fr)), 0.25)
-        };
-        edge_points.push(point);
-    }
-    let vertex_points: Vec<[f64; 3]> = (0..nv)
-        .map(|v| {
-            let fan = mesh.fan(v);
-            if fan.is_empty() {
-                return p[v];
-            }
-            if mesh.is_boundary_vertex(v) {
-                if fan.len() == 1 && mesh.boundary == BoundaryMode::EdgeAndCorner {
-                    return p[v];
-                }
-                // Boundary neighbours: the head of the first outgoing edge (no twin) and the tail
-                // of the last face's incoming edge.
-                let first = mesh.head(fan[0]);
-                let last = mesh.face_vertices[mesh.prev(fan[fan.len() - 1])];
-                let ends = add(p[first as usize], p[last as usize]);
-                return scale(add(ends, scale(p[v], 6.0)), 1.0 / 8.0);
-            }
-            let n = fan.len() as f64;
-            let q = fan.iter().fold([0.0; 3], |acc, &h| {
-                add(acc, face_points[mesh.face_of[h] as usize])
-            });
-            let r = fan.iter().fold([0.0; 3], |acc, &h| {
-                add(acc, scale(add(p[v], p[mesh.head(h) as usize]), 0.5))
-            });
-            let (q, r) = (scale(q, 1.0 / n), scale(r, 1.0 / n));
-            scale(add(add(q, scale(r, 2.0)), scale(p[v], n - 3.0)), 1.0 / n)
-        })
-        .collect();
-    let ne = edge_points.len();
-    let mut positions = vertex_points;
-    positions.extend(edge_points);
-    positions.extend(face_points);
-    let mut faces = Vec::with_capacity(halfedges);
-    for f in 0..nf {
+    let nv = mesh.positions.len();
+    let edges = EdgeIds::new(mesh);
+    let ne = edges.halfedge.len();
+    let stencil = refinement_stencil::<f64>(mesh, &edges);
+    let positions = stencil.apply(&mesh.positions);
+    let mut faces = Vec::with_capacity(mesh.face_vertices.len());
+    for f in 0..mesh.faces() {
         for h in mesh.face_halfedges(f) {
             let v = i64::from(mesh.face_vertices[h]);
-            let e_next = (nv + edge_of[h] as usize) as i64;
-            let e_prev = (nv + edge_of[mesh.prev(h)] as usize) as i64;
+            let e_next = (nv + edges.of_halfedge[h] as usize) as i64;
+            let e_prev = (nv + edges.of_halfedge[mesh.prev(h)] as usize) as i64;
             let fp = (nv + ne + f) as i64;
             faces.push(vec![v, e_next, fp, e_prev]);
         }
@@ -121,6 +161,7 @@ pub fn refine(mesh: &Mesh) -> Refinement {
         mesh,
         vertex_points: nv,
         edge_points: ne,
+        stencil,
     }
 }
 

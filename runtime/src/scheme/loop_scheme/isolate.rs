@@ -32,7 +32,10 @@ pub fn isolate_loop(mesh: &Mesh) -> Result<TriangleIsolation, RuntimeError> {
         mesh,
         Split::Dyadic,
         MAX_LOOP_STEPS,
-        |m| Ok(loop_refine(m)?.mesh),
+        |m| {
+            let step = loop_refine(m)?;
+            Ok((step.mesh, step.stencil))
+        },
         |m| {
             let phantoms = Phantoms::new(m);
             if let Some((face, reason)) = isolation_defect(m) {
@@ -42,4 +45,37 @@ pub fn isolate_loop(mesh: &Mesh) -> Result<TriangleIsolation, RuntimeError> {
             Ok((patches, phantoms))
         },
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::test_meshes::{lattice_torus, octahedron, tetrahedron};
+    use crate::scheme::triangle::isolation::testing::check_refinement;
+    use schemes::BoundaryMode;
+
+    /// The octahedron without its face `(0, 2, 4)`: a boundary triangle loop, interior
+    /// vertices of valence 4 and boundary corners with two and three triangles.
+    fn open_octahedron() -> Mesh {
+        let o = octahedron();
+        let faces: Vec<Vec<i64>> = (1..o.faces())
+            .map(|f| o.face(f).iter().map(|&v| i64::from(v)).collect())
+            .collect();
+        Mesh::new(o.positions.clone(), &faces, &[], BoundaryMode::EdgeOnly).expect("valid")
+    }
+
+    /// The composed stencil reproduces the isolated positions, and moved input positions give
+    /// what isolating the moved mesh gives; a regular torus takes no step (the identity).
+    #[test]
+    fn the_refinement_stencil_is_the_isolation() {
+        for (name, mesh) in [
+            ("octahedron", octahedron()),
+            ("tetrahedron", tetrahedron()),
+            ("open octahedron", open_octahedron()),
+        ] {
+            assert_eq!(check_refinement(name, &mesh, isolate_loop), 1, "{name}");
+        }
+        let torus = lattice_torus(6, |a, b| [a as f64, b as f64, (a * b) as f64 * 0.1]);
+        assert_eq!(check_refinement("torus", &torus, isolate_loop), 0);
+    }
 }

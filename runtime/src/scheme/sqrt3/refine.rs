@@ -27,6 +27,7 @@ use schemes::triangle::TriangleVertexRule;
 use crate::mesh::geometry::{add, scale};
 use crate::mesh::topology::Mesh;
 use crate::mesh::triangle_topology::{neighbours, require_closed_triangles};
+use crate::scheme::stencil::Stencil;
 use crate::scheme::triangle::split::TriangleSplit;
 use crate::RuntimeError;
 
@@ -47,60 +48,96 @@ pub fn sqrt3_limit_position(p: [f64; 3], ring_average: [f64; 3], valence: usize)
     scale(1.0 / (1.0 + w), add(p, scale(w, ring_average)))
 }
 
-/// Refine the closed triangle mesh `mesh` by two √3 steps, one ternary step (module docs).
-pub fn sqrt3_refine(mesh: &Mesh) -> Result<Mesh, RuntimeError> {
+/// Two √3 steps of a closed triangle mesh as one ternary step, and the rules that made it.
+#[derive(Clone, Debug)]
+pub struct Sqrt3Refinement {
+    /// The refined mesh (nine triangles per triangle, `9f + c` from triangle `f`, numbered as
+    /// the ternary split of [`crate::scheme::triangle::split`] says).
+    pub mesh: Mesh,
+    /// The composed step's rules: row `i` is refined vertex `i` over the coarse vertices, so
+    /// `stencil.apply(&coarse.positions) == mesh.positions` (how the positions were made).
+    pub stencil: Stencil<f64>,
+}
+
+/// Two √3 steps of the closed triangle mesh `mesh`, composed, as rows over its vertices (f64:
+/// `alpha_k` has a cosine): refined vertex `i`, numbered as the ternary split of
+/// [`crate::scheme::triangle::split`] says, is `sum w p_j` over row `i`. Why a map: the same
+/// rules then position the refined mesh ([`sqrt3_refine`]) and compose into the per-frame
+/// stencil of an isolation. Refuses a boundary.
+pub fn sqrt3_stencil(mesh: &Mesh) -> Result<Stencil<f64>, RuntimeError> {
     require_closed_triangles(mesh, "sqrt3")?;
-    let p = &mesh.positions;
-    let nv = p.len();
-    let centroid: Vec<[f64; 3]> = (0..mesh.faces())
-        .map(|f| {
-            let sum = mesh
-                .face(f)
-                .iter()
-                .fold([0.0; 3], |acc, &v| add(acc, p[v as usize]));
-            scale(1.0 / 3.0, sum)
-        })
-        .collect();
-    // The old vertices after the first step, and after the second.
-    let mut half = Vec::with_capacity(nv);
-    let mut positions = Vec::with_capacity(nv + 3 * mesh.faces());
+    Ok(rows(mesh, &TriangleSplit::new(mesh)))
+}
+
+/// The module docs' two steps over `split`'s ternary numbering (`mesh` closed, all
+/// triangles), composed: the first step's points are the old vertices moved (`h_v`, numbered
+/// as the vertices) and then every triangle's centroid `c_f` (number `nv + f`); the second
+/// step's rows are over those.
+fn rows(mesh: &Mesh, split: &TriangleSplit) -> Stencil<f64> {
+    let nv = mesh.positions.len();
+    let centroid = |f: usize| (nv + f) as u32;
+    let mut first = Stencil::new(nv);
+    let mut second = Stencil::new(nv + mesh.faces());
     for v in 0..nv {
         let fan = mesh.fan(v);
         let k = fan.len();
+        if k == 0 {
+            // An unused vertex stays where it is.
+            first.push_row(vec![(v as u32, 1.0)]);
+            second.push_row(vec![(v as u32, 1.0)]);
+            continue;
+        }
         let alpha = sqrt3_alpha(k);
-        let ring = neighbours(mesh, v)
-            .iter()
-            .fold([0.0; 3], |acc, &e| add(acc, p[e as usize]));
-        let h = add(scale(1.0 - alpha, p[v]), scale(alpha / k as f64, ring));
-        let centroids = fan.iter().fold([0.0; 3], |acc, &g| {
-            add(acc, centroid[mesh.face_of[g] as usize])
-        });
-        positions.push(add(
-            scale(1.0 - alpha, h),
-            scale(alpha / k as f64, centroids),
-        ));
-        half.push(h);
+        let ring = alpha / k as f64;
+        let mut h = vec![(v as u32, 1.0 - alpha)];
+        h.extend(neighbours(mesh, v).iter().map(|&e| (e, ring)));
+        first.push_row(h);
+        let mut moved = vec![(v as u32, 1.0 - alpha)];
+        moved.extend(
+            fan.iter()
+                .map(|&g| (centroid(mesh.face_of[g] as usize), ring)),
+        );
+        second.push_row(moved);
     }
-    let split = TriangleSplit::new(mesh);
+    for f in 0..mesh.faces() {
+        first.push_row(mesh.face(f).iter().map(|&v| (v, 1.0 / 3.0)).collect());
+    }
     for (&[a, b], &h) in split.edges.iter().zip(&split.first_halfedge) {
         let h = h as usize;
-        let across = add(
-            centroid[mesh.face_of[h] as usize],
-            centroid[mesh.face_of[mesh.twin[h] as usize] as usize],
-        );
+        let across = [
+            centroid(mesh.face_of[h] as usize),
+            centroid(mesh.face_of[mesh.twin[h] as usize] as usize),
+        ];
         for end in [a, b] {
-            positions.push(scale(1.0 / 3.0, add(half[end as usize], across)));
+            let mut third = vec![(end, 1.0 / 3.0)];
+            third.extend(across.iter().map(|&c| (c, 1.0 / 3.0)));
+            second.push_row(third);
         }
     }
     for f in 0..mesh.faces() {
-        let ring = mesh.face_halfedges(f).fold([0.0; 3], |acc, h| {
+        let mut centre = vec![(centroid(f), 2.0 / 3.0)];
+        for h in mesh.face_halfedges(f) {
             let g = mesh.face_of[mesh.twin[h] as usize] as usize;
-            add(acc, add(half[mesh.face_vertices[h] as usize], centroid[g]))
-        });
-        positions.push(add(scale(2.0 / 3.0, centroid[f]), scale(1.0 / 18.0, ring)));
+            centre.push((mesh.face_vertices[h], 1.0 / 18.0));
+            centre.push((centroid(g), 1.0 / 18.0));
+        }
+        second.push_row(centre);
     }
+    first.then(&second)
+}
+
+/// Refine the closed triangle mesh `mesh` by two √3 steps, one ternary step (module docs): the
+/// positions are [`sqrt3_stencil`]'s rows applied to the coarse positions, and the rows come
+/// back with the mesh.
+pub fn sqrt3_refine(mesh: &Mesh) -> Result<Sqrt3Refinement, RuntimeError> {
+    require_closed_triangles(mesh, "sqrt3")?;
+    let nv = mesh.positions.len();
+    let split = TriangleSplit::new(mesh);
+    let stencil = rows(mesh, &split);
+    let positions = stencil.apply(&mesh.positions);
     let faces = split.ternary_child_faces(mesh, nv);
-    Ok(Mesh::new(positions, &faces, &[], mesh.boundary)?)
+    let mesh = Mesh::new(positions, &faces, &[], mesh.boundary)?;
+    Ok(Sqrt3Refinement { mesh, stencil })
 }
 
 #[cfg(test)]
@@ -123,7 +160,7 @@ mod tests {
     fn a_flat_lattice_refines_onto_the_ternary_lattice() {
         let m = 9i64;
         let torus = lattice_torus(m, |a, b| [a as f64, b as f64, 2.0 * a as f64 - b as f64]);
-        let r = sqrt3_refine(&torus).expect("refines");
+        let r = sqrt3_refine(&torus).expect("refines").mesh;
         assert_eq!(r.faces(), 9 * torus.faces());
         assert_eq!(r.euler_characteristic(), 0);
         let mut checked = 0;
@@ -167,8 +204,8 @@ mod tests {
     #[test]
     fn the_limit_position_is_invariant_under_the_step() {
         let coarse = octahedron();
-        let fine = sqrt3_refine(&coarse).expect("refines");
-        let finer = sqrt3_refine(&fine).expect("refines");
+        let fine = sqrt3_refine(&coarse).expect("refines").mesh;
+        let finer = sqrt3_refine(&fine).expect("refines").mesh;
         let limit = |m: &Mesh, v: usize| {
             let ring = neighbours(m, v);
             let sum = ring

@@ -14,6 +14,7 @@ use crate::mesh::topology::Mesh;
 use crate::mesh::triangle_topology::require_closed_triangles;
 use crate::scheme::butterfly::refine::butterfly_refine;
 use crate::scheme::sqrt3::refine::sqrt3_refine;
+use crate::scheme::stencil::Stencil;
 use crate::scheme::triangle::isolation::{
     isolate_by_refinement, TriangleIsolation, MAX_ISOLATION_STEPS,
 };
@@ -44,9 +45,22 @@ impl RegionScheme {
 
     /// One whole-mesh step: a butterfly step, or two √3 steps.
     pub fn refine(self, mesh: &Mesh) -> Result<Mesh, RuntimeError> {
+        Ok(self.refine_with_stencil(mesh)?.0)
+    }
+
+    /// One whole-mesh step ([`RegionScheme::refine`]) and its rules, rows over `mesh`'s
+    /// vertices ([`butterfly_refine`], [`sqrt3_refine`]): what an isolation composes into its
+    /// per-frame stencil.
+    pub fn refine_with_stencil(self, mesh: &Mesh) -> Result<(Mesh, Stencil<f64>), RuntimeError> {
         match self {
-            RegionScheme::Butterfly => Ok(butterfly_refine(mesh)?.mesh),
-            RegionScheme::Sqrt3 => sqrt3_refine(mesh),
+            RegionScheme::Butterfly => {
+                let step = butterfly_refine(mesh)?;
+                Ok((step.mesh, step.stencil))
+            }
+            RegionScheme::Sqrt3 => {
+                let step = sqrt3_refine(mesh)?;
+                Ok((step.mesh, step.stencil))
+            }
         }
     }
 }
@@ -69,7 +83,31 @@ pub fn isolate_regions(
         mesh,
         scheme.split(),
         scheme.max_steps(),
-        |m| scheme.refine(m),
+        |m| scheme.refine_with_stencil(m),
         |m| Ok((gather_region_patches(m, &catalogue)?, Phantoms::new(m))),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::test_meshes::{lattice_torus, octahedron, tetrahedron};
+    use crate::scheme::triangle::isolation::testing::check_refinement;
+
+    /// For the butterfly and √3: the composed stencil reproduces the isolated positions over
+    /// every step, and moved input positions give what isolating the moved mesh gives; a
+    /// regular torus takes no step.
+    #[test]
+    fn the_refinement_stencil_is_the_isolation() {
+        for scheme in [RegionScheme::Butterfly, RegionScheme::Sqrt3] {
+            let isolate = |m: &Mesh| isolate_regions(m, scheme);
+            for (name, mesh) in [("octahedron", octahedron()), ("tetrahedron", tetrahedron())] {
+                let name = format!("{name} ({})", scheme.name());
+                let steps = check_refinement(&name, &mesh, isolate);
+                assert!(steps >= 2, "{name}: {steps} steps");
+            }
+            let torus = lattice_torus(8, |a, b| [a as f64, b as f64, 0.0]);
+            assert_eq!(check_refinement("torus", &torus, isolate), 0);
+        }
+    }
 }

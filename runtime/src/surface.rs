@@ -1,0 +1,468 @@
+//! The facade: a [`Surface`] is a mesh's topology prepared once for one scheme (validated,
+//! isolated, its patches gathered, its tables loaded); [`Surface::tessellator`] plans a
+//! tessellation at some [`Rates`]; [`Tessellator::evaluate`] turns the *input* control points
+//! of one frame into a [`Frame`].
+//!
+//! The per-frame path never refines. Isolation's refinement steps are linear in the control
+//! points, so they are composed once into one sparse map from the input vertices to the isolated
+//! mesh's vertices ([`crate::scheme::stencil::Stencil`]); a frame applies that map (a few dozen
+//! multiply-adds per isolated vertex) and then the table stencils of the plan.
+
+use std::time::Instant;
+
+use crate::mesh::{Mesh, VertexSource};
+use crate::scheme::catmull_clark::isolate::{isolate_with_origins, Isolation};
+use crate::scheme::loop_scheme::isolate::isolate_loop;
+use crate::scheme::stencil::Stencil;
+use crate::scheme::triangle::isolation::TriangleIsolation;
+use crate::scheme::triangle::region_isolate::isolate_regions;
+use crate::scheme::triangle::region_patch::RegionScheme;
+use crate::scheme::Scheme;
+use crate::stencil_table::StencilTable;
+use crate::tessellate::dual_grid::{DualGrid, MAX_RATE};
+use crate::tessellate::lai_cheng::{
+    tessellate_adaptive, AdaptiveMesh, AdaptiveOptions, AdaptiveStats,
+};
+use crate::tessellate::rates::{tolerance_rates, view_rates, ViewCamera};
+use crate::tessellate::triangle_dual_grid::TriangleDualGrid;
+use crate::tessellate::triangle_mesh::TriangleMesh;
+use crate::tessellate::triangle_rates::triangle_tolerance_rates;
+use crate::RuntimeError;
+
+/// How finely to tessellate: points per face side, on every face or chosen per face.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Rates {
+    /// Rate `n` (1..=24) on every face.
+    Uniform(u32),
+    /// One rate per **input** face, in OBJ face order; faces made by isolation inherit their
+    /// input face's rate.
+    PerFace(Vec<u32>),
+    /// Per face the smallest rate whose tessellation deviates from the limit surface by at most
+    /// this distance (in the mesh's units), measured on the mesh given to [`Surface::new`]
+    /// (docs/results.md, docs/cli.md).
+    Tolerance(f64),
+    /// Per face the projected size over a target edge length in pixels (docs/cli.md).
+    View(ViewCamera),
+}
+
+/// The isolated mesh of either family of schemes.
+#[derive(Debug)]
+enum Isolated {
+    Quad(Isolation),
+    Triangle(TriangleIsolation),
+}
+
+/// A subdivision surface: one mesh's topology prepared for one scheme. Build it once per
+/// topology; positions may change every frame ([`Tessellator::evaluate`]).
+///
+/// ```
+/// let mesh = subtess::Mesh::read_obj(concat!(env!("CARGO_MANIFEST_DIR"), "/data/cube.obj"))?;
+/// let surface = subtess::Surface::new(&mesh, subtess::Scheme::CatmullClark)?;
+/// let mut tessellator = surface.tessellator(&subtess::Rates::Uniform(4))?;
+/// let frame = tessellator.evaluate(&mesh.positions_f32())?;
+/// assert_eq!(frame.positions().len(), frame.normals().len());
+/// assert!(frame.triangles().iter().flatten().all(|&i| (i as usize) < frame.positions().len()));
+/// # Ok::<(), subtess::RuntimeError>(())
+/// ```
+#[derive(Debug)]
+pub struct Surface {
+    scheme: Scheme,
+    table: StencilTable,
+    isolated: Isolated,
+    input_vertices: usize,
+    input_faces: usize,
+    boundary_loops: usize,
+    /// Input vertices to isolated vertices; `None` when isolation took no step.
+    refinement: Option<Stencil<f32>>,
+    isolation_seconds: f64,
+}
+
+impl Surface {
+    /// Validate `mesh` for `scheme`, isolate its irregular vertices and gather its patches,
+    /// with the scheme's embedded default table.
+    pub fn new(mesh: &Mesh, scheme: Scheme) -> Result<Surface, RuntimeError> {
+        Self::with_table(mesh, scheme, scheme.default_table(mesh.boundary)?)
+    }
+
+    /// [`Surface::new`] with another table (one written by `stencilgen tables` for `scheme`).
+    pub fn with_table(
+        mesh: &Mesh,
+        scheme: Scheme,
+        table: StencilTable,
+    ) -> Result<Surface, RuntimeError> {
+        scheme.check_table(&table)?;
+        let started = Instant::now();
+        let isolated = match scheme {
+            Scheme::CatmullClark => Isolated::Quad(isolate_with_origins(mesh)?),
+            Scheme::Loop => Isolated::Triangle(isolate_loop(mesh)?),
+            Scheme::Butterfly => {
+                Isolated::Triangle(isolate_regions(mesh, RegionScheme::Butterfly)?)
+            }
+            Scheme::Sqrt3 => Isolated::Triangle(isolate_regions(mesh, RegionScheme::Sqrt3)?),
+        };
+        let (steps, refinement) = match &isolated {
+            Isolated::Quad(iso) => (iso.steps, &iso.refinement),
+            Isolated::Triangle(iso) => (iso.steps, &iso.refinement),
+        };
+        let refinement = (steps > 0).then(|| refinement.to_f32());
+        Ok(Surface {
+            scheme,
+            table,
+            input_vertices: mesh.positions.len(),
+            input_faces: mesh.faces(),
+            boundary_loops: mesh.boundary_loops(),
+            refinement,
+            isolation_seconds: started.elapsed().as_secs_f64(),
+            isolated,
+        })
+    }
+
+    /// The scheme.
+    pub fn scheme(&self) -> Scheme {
+        self.scheme
+    }
+
+    /// The stencil table the surface reads.
+    pub fn table(&self) -> &StencilTable {
+        &self.table
+    }
+
+    /// Number of input vertices: the length [`Tessellator::evaluate`] wants.
+    pub fn input_vertices(&self) -> usize {
+        self.input_vertices
+    }
+
+    /// Number of input faces.
+    pub fn input_faces(&self) -> usize {
+        self.input_faces
+    }
+
+    /// Number of faces after isolation (the patches a tessellation evaluates).
+    pub fn faces(&self) -> usize {
+        self.mesh().faces()
+    }
+
+    /// Refinement steps isolation took (0 when every input face is a table patch).
+    pub fn isolation_steps(&self) -> usize {
+        match &self.isolated {
+            Isolated::Quad(iso) => iso.steps,
+            Isolated::Triangle(iso) => iso.steps,
+        }
+    }
+
+    /// Wall time of isolation (refinement, patch gathering, composing the refinement map).
+    pub fn isolation_seconds(&self) -> f64 {
+        self.isolation_seconds
+    }
+
+    /// Number of boundary loops of the input (0: closed, and a watertight output is expected).
+    pub fn boundary_loops(&self) -> usize {
+        self.boundary_loops
+    }
+
+    /// Weights of the map from input to isolated control points (0 when none is needed): the
+    /// per-frame cost isolation adds.
+    pub fn refinement_weights(&self) -> usize {
+        self.refinement.as_ref().map_or(0, Stencil::entries)
+    }
+
+    /// The isolated mesh (at the positions given to [`Surface::new`]).
+    fn mesh(&self) -> &Mesh {
+        match &self.isolated {
+            Isolated::Quad(iso) => &iso.mesh,
+            Isolated::Triangle(iso) => &iso.mesh,
+        }
+    }
+
+    /// The input face every isolated face lies in.
+    fn origin(&self) -> &[u32] {
+        match &self.isolated {
+            Isolated::Quad(iso) => &iso.origin,
+            Isolated::Triangle(iso) => &iso.origin,
+        }
+    }
+
+    /// A point on an isolated face in the input face's own parameters.
+    fn input_source(&self, source: VertexSource) -> VertexSource {
+        match &self.isolated {
+            Isolated::Quad(iso) => iso.input_source(source),
+            Isolated::Triangle(iso) => iso.input_source(source),
+        }
+    }
+
+    /// The isolated mesh's control points for input positions `positions` (one per input
+    /// vertex), into `out`; `None` when isolation took no step (the input is the control).
+    fn control_points(&self, positions: &[[f32; 3]], out: &mut Vec<[f32; 3]>) -> bool {
+        match &self.refinement {
+            Some(map) => {
+                out.resize(map.rows(), [0.0; 3]);
+                map.apply_into(positions, out);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Per isolated face rates, and how many faces miss a tolerance.
+    fn face_rates(&self, rates: &Rates) -> Result<(Vec<u32>, Option<usize>), RuntimeError> {
+        let faces = self.faces();
+        let check = |n: u32, what: &str| {
+            if (1..=MAX_RATE).contains(&n) {
+                Ok(n)
+            } else {
+                Err(RuntimeError::InvalidParameter {
+                    name: what.to_owned(),
+                    reason: format!("{n} is not a rate in 1..={MAX_RATE}"),
+                })
+            }
+        };
+        Ok(match rates {
+            Rates::Uniform(n) => (vec![check(*n, "rate")?; faces], None),
+            Rates::PerFace(per_input) => {
+                if per_input.len() != self.input_faces {
+                    return Err(RuntimeError::InvalidParameter {
+                        name: "rates".to_owned(),
+                        reason: format!(
+                            "{} rates for a mesh of {} faces",
+                            per_input.len(),
+                            self.input_faces
+                        ),
+                    });
+                }
+                for (f, &n) in per_input.iter().enumerate() {
+                    check(n, &format!("rate of face {f}"))?;
+                }
+                let rates = self
+                    .origin()
+                    .iter()
+                    .map(|&f| per_input[f as usize])
+                    .collect();
+                (rates, None)
+            }
+            Rates::Tolerance(t) => {
+                let chosen = match &self.isolated {
+                    Isolated::Quad(iso) => {
+                        tolerance_rates(&self.table, &iso.mesh, &iso.patches, *t)?
+                    }
+                    Isolated::Triangle(iso) => triangle_tolerance_rates(&self.table, iso, *t)?,
+                };
+                let unmet = chosen.unmet.len();
+                (chosen.rates, Some(unmet))
+            }
+            Rates::View(camera) => (view_rates(self.mesh(), camera)?, None),
+        })
+    }
+
+    /// Plan a dual-grid tessellation at `rates`: table lookups, connectivity and the triangles
+    /// (the topology does not change between frames), built once.
+    pub fn tessellator(&self, rates: &Rates) -> Result<Tessellator<'_>, RuntimeError> {
+        let started = Instant::now();
+        let (rates, faces_over_tolerance) = self.face_rates(rates)?;
+        let grid = match &self.isolated {
+            Isolated::Quad(iso) => {
+                Grid::Quad(DualGrid::new(&self.table, &iso.mesh, &iso.patches, &rates)?)
+            }
+            Isolated::Triangle(iso) => Grid::Triangle(TriangleDualGrid::new(
+                &self.table,
+                &iso.mesh,
+                &iso.patches,
+                &rates,
+            )?),
+        };
+        let (vertices, triangle_count) = match &grid {
+            Grid::Quad(g) => (g.vertex_count(), g.triangle_count()),
+            Grid::Triangle(g) => (g.vertex_count(), g.triangle_count()),
+        };
+        let mut triangles = vec![[0u32; 3]; triangle_count];
+        let sources = match &grid {
+            Grid::Quad(g) => {
+                g.connect(&mut triangles);
+                g.sources()
+            }
+            Grid::Triangle(g) => {
+                g.connect(&mut triangles);
+                g.sources()
+            }
+        };
+        let sources = sources.into_iter().map(|s| self.input_source(s)).collect();
+        Ok(Tessellator {
+            surface: self,
+            grid,
+            rates,
+            faces_over_tolerance,
+            control: Vec::new(),
+            positions: vec![[0.0; 3]; vertices],
+            normals: vec![[0.0; 3]; vertices],
+            triangles,
+            sources,
+            plan_seconds: started.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// Lai and Cheng's error-bounded adaptive tessellation (Catmull–Clark only), its sources in
+    /// the input faces' own parameters.
+    pub fn tessellate_adaptive(
+        &self,
+        options: &AdaptiveOptions,
+    ) -> Result<(AdaptiveMesh, AdaptiveStats), RuntimeError> {
+        let Isolated::Quad(iso) = &self.isolated else {
+            return Err(RuntimeError::Unsupported(format!(
+                "--scheme {} tessellates with the dual grid (Lai–Cheng's adaptive method is for catmull-clark)",
+                self.scheme
+            )));
+        };
+        let (mut adaptive, stats) =
+            tessellate_adaptive(&self.table, &iso.mesh, &iso.patches, options)?;
+        for source in &mut adaptive.sources {
+            *source = iso.input_source(*source);
+        }
+        Ok((adaptive, stats))
+    }
+}
+
+/// The dual grid of either family.
+#[derive(Debug)]
+enum Grid<'s> {
+    Quad(DualGrid<'s>),
+    Triangle(TriangleDualGrid<'s>),
+}
+
+/// A planned tessellation of a [`Surface`]: evaluate it once per frame.
+#[derive(Debug)]
+pub struct Tessellator<'s> {
+    surface: &'s Surface,
+    grid: Grid<'s>,
+    rates: Vec<u32>,
+    faces_over_tolerance: Option<usize>,
+    /// The isolated control points of the current frame (when isolation took steps).
+    control: Vec<[f32; 3]>,
+    positions: Vec<[f32; 3]>,
+    normals: Vec<[f32; 3]>,
+    triangles: Vec<[u32; 3]>,
+    sources: Vec<VertexSource>,
+    plan_seconds: f64,
+}
+
+impl<'s> Tessellator<'s> {
+    /// Evaluate one frame from `positions`, one point per **input** vertex in OBJ order: the
+    /// limit positions and unit normals of every output vertex. The same positions give the
+    /// same frame; deformed positions give what a fresh [`Surface`] of the deformed mesh gives.
+    pub fn evaluate(&mut self, positions: &[[f32; 3]]) -> Result<Frame<'_>, RuntimeError> {
+        if positions.len() != self.surface.input_vertices {
+            return Err(RuntimeError::InvalidParameter {
+                name: "positions".to_owned(),
+                reason: format!(
+                    "{} points for a mesh of {} vertices",
+                    positions.len(),
+                    self.surface.input_vertices
+                ),
+            });
+        }
+        if let Some(v) = positions
+            .iter()
+            .position(|p| p.iter().any(|c| !c.is_finite()))
+        {
+            return Err(RuntimeError::InvalidParameter {
+                name: format!("position of vertex {v}"),
+                reason: format!("{:?} is not finite", positions[v]),
+            });
+        }
+        let control = if self.surface.control_points(positions, &mut self.control) {
+            self.control.as_slice()
+        } else {
+            positions
+        };
+        match &self.grid {
+            Grid::Quad(g) => g.evaluate(control, &mut self.positions, &mut self.normals),
+            Grid::Triangle(g) => g.evaluate(control, &mut self.positions, &mut self.normals),
+        }
+        Ok(Frame {
+            positions: &self.positions,
+            normals: &self.normals,
+            triangles: &self.triangles,
+            sources: &self.sources,
+        })
+    }
+
+    /// The surface this plan belongs to.
+    pub fn surface(&self) -> &'s Surface {
+        self.surface
+    }
+
+    /// Output vertices per frame.
+    pub fn vertex_count(&self) -> usize {
+        self.positions.len()
+    }
+
+    /// Output triangles per frame.
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// The rate of every isolated face.
+    pub fn rates(&self) -> &[u32] {
+        &self.rates
+    }
+
+    /// With [`Rates::Tolerance`]: how many faces do not meet it even at the largest rate (they
+    /// get the largest).
+    pub fn faces_over_tolerance(&self) -> Option<usize> {
+        self.faces_over_tolerance
+    }
+
+    /// How many quad faces take the separable (tensor-product) path (0 for triangle schemes).
+    pub fn separable_faces(&self) -> usize {
+        match &self.grid {
+            Grid::Quad(g) => g.separable_faces(),
+            Grid::Triangle(_) => 0,
+        }
+    }
+
+    /// Seconds spent planning (rates, table lookups, connectivity, triangles, sources).
+    pub fn plan_seconds(&self) -> f64 {
+        self.plan_seconds
+    }
+}
+
+/// One evaluated frame: borrowed from its [`Tessellator`] until the next
+/// [`Tessellator::evaluate`].
+#[derive(Clone, Copy, Debug)]
+pub struct Frame<'a> {
+    positions: &'a [[f32; 3]],
+    normals: &'a [[f32; 3]],
+    triangles: &'a [[u32; 3]],
+    sources: &'a [VertexSource],
+}
+
+impl<'a> Frame<'a> {
+    /// Limit positions, one per output vertex.
+    pub fn positions(&self) -> &'a [[f32; 3]] {
+        self.positions
+    }
+
+    /// Unit normals, one per output vertex (zero where the tangents are degenerate).
+    pub fn normals(&self) -> &'a [[f32; 3]] {
+        self.normals
+    }
+
+    /// Triangles (indices into the vertices), counter-clockwise seen from outside for
+    /// counter-clockwise input faces.
+    pub fn triangles(&self) -> &'a [[u32; 3]] {
+        self.triangles
+    }
+
+    /// Where every output vertex lies: input face, sub-face (of an n-gon), exact `(u, v)`.
+    pub fn sources(&self) -> &'a [VertexSource] {
+        self.sources
+    }
+
+    /// A copy as the tessellators' [`TriangleMesh`] (for the writers in [`crate::io`]).
+    pub fn to_triangle_mesh(&self) -> TriangleMesh {
+        TriangleMesh {
+            positions: self.positions.to_vec(),
+            normals: self.normals.to_vec(),
+            sources: self.sources.to_vec(),
+            triangles: self.triangles.to_vec(),
+        }
+    }
+}
