@@ -40,6 +40,7 @@ use subtess::mesh::topology::Mesh;
 use subtess::scheme::catmull_clark::isolate::isolate;
 use subtess::stencil_table::StencilTable;
 use subtess::tessellate::dual_grid::DualGrid;
+use subtess::tessellate::GridPlan;
 
 /// Quads around the torus's axis and around its tube.
 const AROUND: usize = 200;

@@ -14,7 +14,7 @@ use subtess::tessellate::bezier::{
     tessellate_bezier_full, BezierOptions, BezierPatches, EdgeTest, SharedCurves,
 };
 
-fn boundary_loops(mesh: &subtess::tessellate::triangle_mesh::TriangleMesh) -> Option<usize> {
+fn boundary_loops(mesh: &subtess::mesh::triangle_mesh::TriangleMesh) -> Option<usize> {
     let edges = mesh.boundary_edges()?;
     let mut next = std::collections::HashMap::new();
     for &(a, b) in &edges {

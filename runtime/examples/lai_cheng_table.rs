@@ -254,7 +254,7 @@ fn main() -> Result<(), subtess::RuntimeError> {
 
 /// Every undirected edge of the triangle mesh is used by exactly two triangles, once in each
 /// direction.
-fn triangle_edges_paired(mesh: &subtess::tessellate::triangle_mesh::TriangleMesh) -> bool {
+fn triangle_edges_paired(mesh: &subtess::mesh::triangle_mesh::TriangleMesh) -> bool {
     let mut edges = std::collections::HashMap::new();
     for t in &mesh.triangles {
         for k in 0..3 {

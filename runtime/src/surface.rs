@@ -10,12 +10,13 @@
 
 use std::time::Instant;
 
+use crate::mesh::triangle_mesh::TriangleMesh;
 use crate::mesh::{Mesh, VertexSource};
 use crate::scheme::catmull_clark::isolate::{isolate_with_origins, Isolation};
 use crate::scheme::loop_scheme::isolate::isolate_loop;
+use crate::scheme::region_isolate::isolate_regions;
 use crate::scheme::stencil::Stencil;
 use crate::scheme::triangle::isolation::TriangleIsolation;
-use crate::scheme::triangle::region_isolate::isolate_regions;
 use crate::scheme::triangle::region_patch::RegionScheme;
 use crate::scheme::Scheme;
 use crate::stencil_table::StencilTable;
@@ -25,14 +26,15 @@ use crate::tessellate::lai_cheng::{
 };
 use crate::tessellate::rates::{tolerance_rates, view_rates, ViewCamera};
 use crate::tessellate::triangle_dual_grid::TriangleDualGrid;
-use crate::tessellate::triangle_mesh::TriangleMesh;
 use crate::tessellate::triangle_rates::triangle_tolerance_rates;
+use crate::tessellate::GridPlan;
 use crate::RuntimeError;
 
 /// How finely to tessellate: points per face side, on every face or chosen per face.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Rates {
-    /// Rate `n` (1..=24) on every face.
+    /// Rate `n` on every face: 1..=24 with the default Catmull–Clark and Loop tables, 1..=8
+    /// with the butterfly's and √3's (a rate the table lacks is refused by name).
     Uniform(u32),
     /// One rate per **input** face, in OBJ face order; faces made by isolation inherit their
     /// input face's rate.
@@ -150,7 +152,8 @@ impl Surface {
         }
     }
 
-    /// Wall time of isolation (refinement, patch gathering, composing the refinement map).
+    /// Wall time of isolation: the refinement steps, the patch gathering of each attempt, and
+    /// composing the refinement map.
     pub fn isolation_seconds(&self) -> f64 {
         self.isolation_seconds
     }
@@ -258,32 +261,21 @@ impl Surface {
     pub fn tessellator(&self, rates: &Rates) -> Result<Tessellator<'_>, RuntimeError> {
         let started = Instant::now();
         let (rates, faces_over_tolerance) = self.face_rates(rates)?;
-        let grid = match &self.isolated {
+        let grid: Box<dyn GridPlan + '_> = match &self.isolated {
             Isolated::Quad(iso) => {
-                Grid::Quad(DualGrid::new(&self.table, &iso.mesh, &iso.patches, &rates)?)
+                Box::new(DualGrid::new(&self.table, &iso.mesh, &iso.patches, &rates)?)
             }
-            Isolated::Triangle(iso) => Grid::Triangle(TriangleDualGrid::new(
+            Isolated::Triangle(iso) => Box::new(TriangleDualGrid::new(
                 &self.table,
                 &iso.mesh,
                 &iso.patches,
                 &rates,
             )?),
         };
-        let (vertices, triangle_count) = match &grid {
-            Grid::Quad(g) => (g.vertex_count(), g.triangle_count()),
-            Grid::Triangle(g) => (g.vertex_count(), g.triangle_count()),
-        };
-        let mut triangles = vec![[0u32; 3]; triangle_count];
-        let sources = match &grid {
-            Grid::Quad(g) => {
-                g.connect(&mut triangles);
-                g.sources()
-            }
-            Grid::Triangle(g) => {
-                g.connect(&mut triangles);
-                g.sources()
-            }
-        };
+        let vertices = grid.vertex_count();
+        let mut triangles = vec![[0u32; 3]; grid.triangle_count()];
+        grid.connect(&mut triangles);
+        let sources = grid.sources();
         let sources = sources.into_iter().map(|s| self.input_source(s)).collect();
         Ok(Tessellator {
             surface: self,
@@ -320,18 +312,11 @@ impl Surface {
     }
 }
 
-/// The dual grid of either family.
-#[derive(Debug)]
-enum Grid<'s> {
-    Quad(DualGrid<'s>),
-    Triangle(TriangleDualGrid<'s>),
-}
-
 /// A planned tessellation of a [`Surface`]: evaluate it once per frame.
 #[derive(Debug)]
 pub struct Tessellator<'s> {
     surface: &'s Surface,
-    grid: Grid<'s>,
+    grid: Box<dyn GridPlan + 's>,
     rates: Vec<u32>,
     faces_over_tolerance: Option<usize>,
     /// The isolated control points of the current frame (when isolation took steps).
@@ -372,10 +357,8 @@ impl<'s> Tessellator<'s> {
         } else {
             positions
         };
-        match &self.grid {
-            Grid::Quad(g) => g.evaluate(control, &mut self.positions, &mut self.normals),
-            Grid::Triangle(g) => g.evaluate(control, &mut self.positions, &mut self.normals),
-        }
+        self.grid
+            .evaluate(control, &mut self.positions, &mut self.normals);
         Ok(Frame {
             positions: &self.positions,
             normals: &self.normals,
@@ -412,10 +395,7 @@ impl<'s> Tessellator<'s> {
 
     /// How many quad faces take the separable (tensor-product) path (0 for triangle schemes).
     pub fn separable_faces(&self) -> usize {
-        match &self.grid {
-            Grid::Quad(g) => g.separable_faces(),
-            Grid::Triangle(_) => 0,
-        }
+        self.grid.separable_faces()
     }
 
     /// Seconds spent planning (rates, table lookups, connectivity, triangles, sources).

@@ -12,6 +12,7 @@ use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
 use proptest::prelude::*;
+use subtess::mesh::triangle_mesh::TriangleMesh;
 use subtess::tessellate::bezier::bicubic::bernstein;
 use subtess::tessellate::bezier::displacement_map::{signed_distance, DistanceCase};
 use subtess::tessellate::bezier::edge_tests::{map4p_points, map8p_points, map_test};
@@ -20,7 +21,6 @@ use subtess::tessellate::bezier::{
     tessellate_bezier, tessellate_bezier_full, BezierOptions, BezierPatches, BicubicPatch,
     DisplacementMap, EdgeTest,
 };
-use subtess::tessellate::triangle_mesh::TriangleMesh;
 use subtess::RuntimeError;
 
 type P3 = [f64; 3];

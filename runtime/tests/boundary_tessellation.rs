@@ -5,10 +5,10 @@
 
 use proptest::prelude::*;
 use subtess::mesh::topology::Mesh;
+use subtess::mesh::triangle_mesh::TriangleMesh;
 use subtess::scheme::catmull_clark::isolate::isolate;
 use subtess::stencil_table::StencilTable;
 use subtess::tessellate::dual_grid::tessellate;
-use subtess::tessellate::triangle_mesh::TriangleMesh;
 
 /// A 3 x 3 grid of quads over `[0,3]^2` with bumpy heights; face `(i, j)` is `3j + i` and runs
 /// `u` along `x`, `v` along `y`.

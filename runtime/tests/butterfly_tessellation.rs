@@ -12,12 +12,13 @@ mod common;
 use proptest::prelude::*;
 use subtess::mesh::topology::Mesh;
 use subtess::scheme::butterfly::refine::butterfly_refine;
+use subtess::scheme::region_isolate::isolate_regions;
 use subtess::scheme::triangle::isolation::TriangleIsolation;
-use subtess::scheme::triangle::region_isolate::isolate_regions;
 use subtess::scheme::triangle::region_patch::RegionScheme;
 use subtess::scheme::triangle::split::child_to_parent;
 use subtess::stencil_table::StencilTable;
 use subtess::tessellate::triangle_dual_grid::TriangleDualGrid;
+use subtess::tessellate::GridPlan;
 
 use common::{
     check_rates_give_a_manifold, check_region_layouts, check_spot_at_mixed_rates, check_topology,
@@ -25,7 +26,7 @@ use common::{
 };
 
 /// Three steps separate neighbouring extraordinary vertices (six edges apart, module docs of
-/// `subtess::scheme::triangle::region_isolate`); a regular torus needs none. Every region of the valence shows
+/// `subtess::scheme::region_isolate`); a regular torus needs none. Every region of the valence shows
 /// up, and nothing else.
 #[test]
 fn isolation_separates_the_extraordinary_vertices() {

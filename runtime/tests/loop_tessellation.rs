@@ -22,11 +22,12 @@ use std::collections::HashMap;
 use proptest::prelude::*;
 use schemes::BoundaryMode;
 use subtess::mesh::topology::Mesh;
+use subtess::mesh::triangle_mesh::TriangleMesh;
 use subtess::scheme::loop_scheme::isolate::isolate_loop;
 use subtess::scheme::loop_scheme::refine::loop_refine;
 use subtess::scheme::triangle::isolation::TriangleIsolation;
 use subtess::tessellate::triangle_dual_grid::{TriangleDualGrid, TriangleStencils};
-use subtess::tessellate::triangle_mesh::TriangleMesh;
+use subtess::tessellate::GridPlan;
 use subtess::{MeshError, RuntimeError};
 use table_format::{PointSet, SectionKey, StencilKind};
 

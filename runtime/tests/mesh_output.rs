@@ -15,10 +15,10 @@ use serde_json::Value;
 use subtess::io::mesh_output::{write_glb, write_gltf, write_mesh, write_obj, write_ply};
 use subtess::io::obj::read_obj;
 use subtess::mesh::topology::Mesh;
+use subtess::mesh::triangle_mesh::{TriangleMesh, VertexSource};
 use subtess::scheme::catmull_clark::isolate::isolate;
 use subtess::stencil_table::StencilTable;
 use subtess::tessellate::dual_grid::tessellate_uniform;
-use subtess::tessellate::triangle_mesh::{TriangleMesh, VertexSource};
 use subtess::RuntimeError;
 
 // ---------------------------------------------------------------------------------------------

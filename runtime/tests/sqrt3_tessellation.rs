@@ -14,13 +14,14 @@ mod common;
 use proptest::prelude::*;
 use subtess::mesh::topology::Mesh;
 use subtess::mesh::triangle_topology::neighbours;
+use subtess::scheme::region_isolate::isolate_regions;
 use subtess::scheme::sqrt3::refine::{sqrt3_limit_position, sqrt3_refine};
 use subtess::scheme::triangle::isolation::TriangleIsolation;
-use subtess::scheme::triangle::region_isolate::isolate_regions;
 use subtess::scheme::triangle::region_patch::RegionScheme;
 use subtess::scheme::triangle::split::ternary_child_to_parent;
 use subtess::stencil_table::StencilTable;
 use subtess::tessellate::triangle_dual_grid::TriangleDualGrid;
+use subtess::tessellate::GridPlan;
 
 use common::{
     check_rates_give_a_manifold, check_region_layouts, check_spot_at_mixed_rates, check_topology,

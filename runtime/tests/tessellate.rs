@@ -10,6 +10,7 @@ use subtess::scheme::catmull_clark::isolate::isolate;
 use subtess::scheme::patch::dual_positions;
 use subtess::stencil_table::StencilTable;
 use subtess::tessellate::dual_grid::{tessellate, tessellate_uniform};
+use subtess::tessellate::GridPlan;
 
 fn load(path: &Path) -> Mesh {
     let obj = read_obj(path).unwrap_or_else(|e| panic!("{e}"));

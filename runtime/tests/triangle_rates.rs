@@ -10,13 +10,13 @@ use std::sync::OnceLock;
 use num_rational::BigRational;
 use subtess::eval::loop_exact_eval::LoopExactEvaluator;
 use subtess::mesh::topology::Mesh;
+use subtess::mesh::triangle_mesh::TriangleMesh;
 use subtess::scheme::loop_scheme::isolate::isolate_loop;
+use subtess::scheme::region_isolate::isolate_regions;
 use subtess::scheme::triangle::isolation::TriangleIsolation;
-use subtess::scheme::triangle::region_isolate::isolate_regions;
 use subtess::scheme::triangle::region_patch::RegionScheme;
 use subtess::stencil_table::StencilTable;
 use subtess::tessellate::triangle_dual_grid::tessellate_triangles;
-use subtess::tessellate::triangle_mesh::TriangleMesh;
 use subtess::tessellate::triangle_rates::{
     measure_triangle_deviation, triangle_face_deviation, triangle_table_rates,
     triangle_tolerance_rates, triangle_tolerance_rates_among,

@@ -24,7 +24,7 @@ use std::path::Path;
 
 use serde_json::{json, Value};
 
-use crate::tessellate::triangle_mesh::{TriangleMesh, VertexSource};
+use crate::mesh::triangle_mesh::{TriangleMesh, VertexSource};
 use crate::RuntimeError;
 
 /// The `generator` written into every file's header or `asset`.
@@ -198,7 +198,7 @@ pub const PLY_VERTEX_BYTES: usize = 37;
 ///
 /// Each vertex is a [`PLY_VERTEX_BYTES`]-byte record `float x y z nx ny nz`, `uint face`,
 /// `float u v`, `uchar subface`: position, normal, and the face and parameters it was evaluated
-/// at ([`crate::tessellate::triangle_mesh::VertexSource`]: the CLI writes the input mesh's faces; `subface`
+/// at ([`crate::mesh::triangle_mesh::VertexSource`]: the CLI writes the input mesh's faces; `subface`
 /// is the sub-face of a non-quad face, 0 for quads). Each triangle is
 /// `property list uchar uint vertex_indices` (the byte 3, then three `u32`), 13 bytes.
 pub fn write_ply(mesh: &TriangleMesh, path: &Path) -> Result<(), RuntimeError> {

@@ -7,7 +7,9 @@ pub mod source;
 #[cfg(test)]
 pub(crate) mod test_meshes;
 pub mod topology;
+pub mod triangle_mesh;
 pub mod triangle_topology;
 
 pub use source::VertexSource;
 pub use topology::{Mesh, NONE};
+pub use triangle_mesh::TriangleMesh;

@@ -7,6 +7,7 @@ pub mod butterfly;
 pub mod catmull_clark;
 pub mod loop_scheme;
 pub mod patch;
+pub mod region_isolate;
 pub mod sqrt3;
 pub mod stencil;
 pub mod triangle;

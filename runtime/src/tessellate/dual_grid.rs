@@ -23,43 +23,26 @@
 //! ([`DualGrid::connect`]), both in parallel with rayon. Regular interior faces, most of any
 //! isolated mesh, are evaluated as tensor products: their table stencils factor into the cubic
 //! B-spline weights of the two directions (checked when the plan is built), so a point costs 12
-//! multiply-adds per quantity instead of 48.
+//! multiply-adds per coordinate for position, d/du and d/dv together instead of 48.
 
 use std::ops::Range;
 use std::time::Instant;
 
-use rayon::prelude::*;
 use table_format::{PointSet, SectionKey, StencilKind};
 
 use crate::mesh::topology::{Mesh, NONE};
+use crate::mesh::triangle_mesh::{TriangleMesh, VertexSource};
 use crate::scheme::patch::{dual_index_in_patch, FacePatch};
 use crate::stencil_table::StencilTable;
-use crate::tessellate::triangle_mesh::{TriangleMesh, VertexSource};
+pub use crate::tessellate::kernel::TessellationTime;
+use crate::tessellate::kernel::{
+    cross, evaluate_points, for_each_range, merge_rows, unit, weighted_point, Connectivity,
+    GridPlan, PointPlan, Stencils, MAX_PATCH,
+};
 use crate::RuntimeError;
-
-/// The largest patch (control points) the evaluator takes: an interior vertex of valence `v`
-/// has `2v + 8`, a boundary vertex with `k` faces `2k + 8`.
-pub(crate) const MAX_PATCH: usize = 40;
 
 /// The largest rate of the tables the evaluator takes.
 pub const MAX_RATE: u32 = 64;
-
-/// Timings of one tessellation.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct TessellationTime {
-    /// Seconds spent building the plan (table lookups, patches' connectivity records).
-    pub plan_seconds: f64,
-    /// Seconds spent evaluating and connecting (the per-frame work).
-    pub seconds: f64,
-}
-
-/// The three stencils of one point set of one patch: `points x K` weights each, point-major.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Stencils<'t> {
-    pub(crate) position: &'t [f32],
-    pub(crate) du: &'t [f32],
-    pub(crate) dv: &'t [f32],
-}
 
 /// The cubic B-spline factors of the regular patch at rate `n`, recovered from the table:
 /// `x[a][i]` is the weight of control column `a` (`u = -1, 0, 1, 2`) at the dual point
@@ -169,14 +152,6 @@ enum FaceEval<'t> {
     },
 }
 
-/// A point evaluated on its own (the boundary curve): one row of each stencil.
-#[derive(Clone, Debug)]
-pub(crate) struct PointPlan<'t> {
-    pub(crate) stencils: Stencils<'t>,
-    pub(crate) control: Range<u32>,
-    pub(crate) source: VertexSource,
-}
-
 /// A row of output vertices `start + t * step`, `t = 0..len`, at parameters
 /// `(offset + 2t) / denominator` along an edge.
 #[derive(Clone, Copy, Debug)]
@@ -223,13 +198,8 @@ pub struct DualGrid<'t> {
     /// Boundary-curve points (vertex limit points first, then edges' interior points).
     boundary_points: Vec<PointPlan<'t>>,
     strips: Vec<Strip>,
-    /// Vertex polygons, concatenated; `polygon_offsets[v]..polygon_offsets[v+1]`.
-    polygons: Vec<u32>,
-    polygon_offsets: Vec<u32>,
-    /// Triangle offsets: faces, then strips, then polygons (prefix sums, one past each item).
-    face_triangles: Vec<usize>,
-    strip_triangles: Vec<usize>,
-    polygon_triangles: Vec<usize>,
+    /// Vertex polygons and the triangle offsets of every face, strip and polygon.
+    connectivity: Connectivity,
     vertex_count: usize,
     boundary: bool,
 }
@@ -321,11 +291,7 @@ impl<'t> DualGrid<'t> {
             control: Vec::new(),
             boundary_points: Vec::new(),
             strips: Vec::new(),
-            polygons: Vec::new(),
-            polygon_offsets: vec![0],
-            face_triangles: Vec::new(),
-            strip_triangles: Vec::new(),
-            polygon_triangles: Vec::new(),
+            connectivity: Connectivity::default(),
             vertex_count: 0,
             boundary: false,
         };
@@ -491,114 +457,32 @@ impl<'t> DualGrid<'t> {
         // Vertex polygons: corner points in fan order, after the limit point on the boundary.
         for (v, &limit) in limit_point.iter().enumerate() {
             if limit != NONE {
-                self.polygons.push(limit);
+                self.connectivity.polygons.push(limit);
             }
             for h in mesh.fan(v) {
                 let f = mesh.face_of[h] as usize;
                 let corner = self.corner_point(f, h - mesh.face_halfedges(f).start);
-                self.polygons.push(corner);
+                self.connectivity.polygons.push(corner);
             }
-            self.polygon_offsets.push(self.polygons.len() as u32);
+            self.connectivity
+                .polygon_offsets
+                .push(self.connectivity.polygons.len() as u32);
         }
         self.vertex_count = (dual_total as usize) + self.boundary_points.len();
-        let prefix = |counts: &mut dyn Iterator<Item = usize>| -> Vec<usize> {
-            let mut total = 0;
-            counts
-                .map(|c| {
-                    total += c;
-                    total
-                })
-                .collect()
-        };
-        self.face_triangles = prefix(&mut self.rates.iter().map(|&n| 2 * (n as usize - 1).pow(2)));
         let strip_count = |s: &Strip| match *s {
             Strip::Interior { left, right } => strip_triangle_count(left.len, right.len),
             Strip::Boundary { row, .. } => strip_triangle_count(row.len, row.len + 1),
         };
-        self.strip_triangles = prefix(&mut self.strips.iter().map(strip_count));
-        self.polygon_triangles = prefix(
-            &mut self
-                .polygon_offsets
-                .windows(2)
-                .map(|w| (w[1] - w[0]).saturating_sub(2) as usize),
+        self.connectivity.count(
+            self.rates.iter().map(|&n| 2 * (n as usize - 1).pow(2)),
+            self.strips.iter().map(strip_count),
         );
         Ok(())
-    }
-
-    /// Output vertices per frame.
-    pub fn vertex_count(&self) -> usize {
-        self.vertex_count
-    }
-
-    /// Output triangles per frame.
-    pub fn triangle_count(&self) -> usize {
-        [
-            &self.face_triangles,
-            &self.strip_triangles,
-            &self.polygon_triangles,
-        ]
-        .iter()
-        .map(|v| v.last().copied().unwrap_or(0))
-        .sum()
     }
 
     /// Whether the mesh has a boundary (its output then has boundary loops).
     pub fn has_boundary(&self) -> bool {
         self.boundary
-    }
-
-    /// How many faces take the separable (tensor-product) path.
-    pub fn separable_faces(&self) -> usize {
-        self.faces
-            .iter()
-            .filter(|f| matches!(f, FaceEval::Separable { .. }))
-            .count()
-    }
-
-    /// Where every output vertex is evaluated, in output order.
-    pub fn sources(&self) -> Vec<VertexSource> {
-        let mut out = Vec::with_capacity(self.vertex_count);
-        for (f, &n) in self.rates.iter().enumerate() {
-            for j in 0..n {
-                for i in 0..n {
-                    out.push(VertexSource {
-                        face: f as u32,
-                        u: 2 * i + 1,
-                        v: 2 * j + 1,
-                        denominator: 2 * n,
-                        subface: 0,
-                    });
-                }
-            }
-        }
-        out.extend(self.boundary_points.iter().map(|p| p.source));
-        out
-    }
-
-    /// Evaluate every output vertex from the control points `control` (the mesh's vertex
-    /// positions): limit positions and unit normals, `vertex_count()` each.
-    pub fn evaluate(
-        &self,
-        control: &[[f32; 3]],
-        positions: &mut [[f32; 3]],
-        normals: &mut [[f32; 3]],
-    ) {
-        let dual = self.first[self.rates.len()] as usize;
-        let (face_positions, curve_positions) = positions.split_at_mut(dual);
-        let (face_normals, curve_normals) = normals.split_at_mut(dual);
-        let vertex_offsets: Vec<usize> = self.first[1..].iter().map(|&x| x as usize).collect();
-        for_each_range(
-            &vertex_offsets,
-            (face_positions, face_normals),
-            |f, (p, q)| self.evaluate_face(f, control, p, q),
-        );
-        evaluate_points(
-            &self.boundary_points,
-            &self.control,
-            control,
-            curve_positions,
-            curve_normals,
-        );
     }
 
     fn evaluate_face(
@@ -638,39 +522,6 @@ impl<'t> DualGrid<'t> {
         }
     }
 
-    /// Write every triangle (`triangle_count()` of them).
-    pub fn connect(&self, triangles: &mut [[u32; 3]]) {
-        let faces_end = self.face_triangles.last().copied().unwrap_or(0);
-        let strips_end = faces_end + self.strip_triangles.last().copied().unwrap_or(0);
-        let (faces, rest) = triangles.split_at_mut(faces_end);
-        let (strips, polygons) = rest.split_at_mut(strips_end - faces_end);
-        rayon::join(
-            || {
-                for_each_range(&self.face_triangles, faces, |f, out| {
-                    self.connect_face(f, out)
-                })
-            },
-            || {
-                rayon::join(
-                    || {
-                        for_each_range(&self.strip_triangles, strips, |s, out| {
-                            connect_strip(&self.strips[s], out)
-                        })
-                    },
-                    || {
-                        for_each_range(&self.polygon_triangles, polygons, |v, out| {
-                            let ring = &self.polygons[self.polygon_offsets[v] as usize
-                                ..self.polygon_offsets[v + 1] as usize];
-                            for (i, t) in out.iter_mut().enumerate() {
-                                *t = [ring[0], ring[i + 1], ring[i + 2]];
-                            }
-                        })
-                    },
-                )
-            },
-        );
-    }
-
     fn connect_face(&self, f: usize, out: &mut [[u32; 3]]) {
         let n = self.rates[f];
         let mut k = 0;
@@ -684,103 +535,70 @@ impl<'t> DualGrid<'t> {
             }
         }
     }
+}
 
-    /// Plan and evaluate in one go into a fresh [`TriangleMesh`] (with sources).
-    pub fn tessellate(&self, mesh: &Mesh) -> TriangleMesh {
-        let control: Vec<[f32; 3]> = mesh.positions.iter().map(|p| p.map(|c| c as f32)).collect();
-        let mut out = TriangleMesh {
-            positions: vec![[0.0; 3]; self.vertex_count],
-            normals: vec![[0.0; 3]; self.vertex_count],
-            sources: self.sources(),
-            triangles: vec![[0; 3]; self.triangle_count()],
-        };
-        self.evaluate(&control, &mut out.positions, &mut out.normals);
-        self.connect(&mut out.triangles);
+impl GridPlan for DualGrid<'_> {
+    /// Output vertices per frame.
+    fn vertex_count(&self) -> usize {
+        self.vertex_count
+    }
+    /// Output triangles per frame.
+    fn triangle_count(&self) -> usize {
+        self.connectivity.triangle_count()
+    }
+    /// Where every output vertex is evaluated, in output order.
+    fn sources(&self) -> Vec<VertexSource> {
+        let mut out = Vec::with_capacity(self.vertex_count);
+        for (f, &n) in self.rates.iter().enumerate() {
+            for j in 0..n {
+                for i in 0..n {
+                    out.push(VertexSource {
+                        face: f as u32,
+                        u: 2 * i + 1,
+                        v: 2 * j + 1,
+                        denominator: 2 * n,
+                        subface: 0,
+                    });
+                }
+            }
+        }
+        out.extend(self.boundary_points.iter().map(|p| p.source));
         out
     }
-}
-
-/// Run `work(item, slice)` for every item in parallel, where item `i` owns
-/// `out[ends[i-1]..ends[i]]` (`ends` are prefix sums). Items are grouped into contiguous chunks of
-/// about equal output so that the split costs little next to the work.
-pub(crate) fn for_each_range<T: SplitSlices + Send>(
-    ends: &[usize],
-    out: T,
-    work: impl Fn(usize, T) + Sync + Send,
-) {
-    let total = ends.last().copied().unwrap_or(0);
-    let chunks = (rayon::current_num_threads() * 16).max(1);
-    let target = total.div_ceil(chunks).max(1);
-    // Chunk boundaries in items: [item_start, item_end), with their output ranges.
-    let mut pieces = Vec::with_capacity(chunks + 1);
-    let mut rest = out;
-    let (mut item, mut consumed) = (0usize, 0usize);
-    while item < ends.len() {
-        let start_item = item;
-        let start = consumed;
-        while item < ends.len() && (ends[item] - start < target || item == start_item) {
-            item += 1;
-        }
-        let end = ends[item - 1];
-        let (piece, tail) = rest.split_at(end - start);
-        rest = tail;
-        consumed = end;
-        pieces.push((start_item..item, start, piece));
+    /// Evaluate every output vertex from the control points `control` (the mesh's vertex
+    /// positions): limit positions and unit normals, `vertex_count()` each.
+    fn evaluate(&self, control: &[[f32; 3]], positions: &mut [[f32; 3]], normals: &mut [[f32; 3]]) {
+        let dual = self.first[self.rates.len()] as usize;
+        let (face_positions, curve_positions) = positions.split_at_mut(dual);
+        let (face_normals, curve_normals) = normals.split_at_mut(dual);
+        let vertex_offsets: Vec<usize> = self.first[1..].iter().map(|&x| x as usize).collect();
+        for_each_range(
+            &vertex_offsets,
+            (face_positions, face_normals),
+            |f, (p, q)| self.evaluate_face(f, control, p, q),
+        );
+        evaluate_points(
+            &self.boundary_points,
+            &self.control,
+            control,
+            curve_positions,
+            curve_normals,
+        );
     }
-    pieces
-        .into_par_iter()
-        .for_each(|(items, start, mut piece)| {
-            let mut at = start;
-            for i in items {
-                let (mine, tail) = piece.split_at(ends[i] - at);
-                piece = tail;
-                at = ends[i];
-                work(i, mine);
-            }
-        });
-}
-
-/// Mutable slices (or tuples of them, split in step) that [`for_each_range`] hands out.
-pub(crate) trait SplitSlices: Sized {
-    fn split_at(self, mid: usize) -> (Self, Self);
-}
-
-impl<T> SplitSlices for &mut [T] {
-    fn split_at(self, mid: usize) -> (Self, Self) {
-        self.split_at_mut(mid)
+    /// Write every triangle (`triangle_count()` of them).
+    fn connect(&self, triangles: &mut [[u32; 3]]) {
+        self.connectivity.connect(
+            triangles,
+            |f, out| self.connect_face(f, out),
+            |s, out| connect_strip(&self.strips[s], out),
+        );
     }
-}
-
-impl<A, B> SplitSlices for (&mut [A], &mut [B]) {
-    fn split_at(self, mid: usize) -> (Self, Self) {
-        let (a0, a1) = self.0.split_at_mut(mid);
-        let (b0, b1) = self.1.split_at_mut(mid);
-        ((a0, b0), (a1, b1))
-    }
-}
-
-/// Merge two rows running along an edge into triangles, in order of their parameters
-/// `param_a(i) / den_a` and `param_b(j) / den_b`; `b` lies to the right of the edge.
-pub(crate) fn merge_rows(
-    a: impl Fn(u32) -> u32,
-    na: u32,
-    param_a: impl Fn(u32) -> u64,
-    b: impl Fn(u32) -> u32,
-    nb: u32,
-    param_b: impl Fn(u32) -> u64,
-    out: &mut [[u32; 3]],
-) {
-    let (mut i, mut j, mut k) = (0, 0, 0);
-    while i + 1 < na || j + 1 < nb {
-        let advance_a = j + 1 == nb || (i + 1 < na && param_a(i + 1) <= param_b(j + 1));
-        if advance_a {
-            out[k] = [b(j), a(i + 1), a(i)];
-            i += 1;
-        } else {
-            out[k] = [b(j), b(j + 1), a(i)];
-            j += 1;
-        }
-        k += 1;
+    /// How many faces take the separable (tensor-product) path.
+    fn separable_faces(&self) -> usize {
+        self.faces
+            .iter()
+            .filter(|f| matches!(f, FaceEval::Separable { .. }))
+            .count()
     }
 }
 
@@ -822,68 +640,6 @@ fn connect_strip(strip: &Strip, out: &mut [[u32; 3]]) {
             );
         }
     }
-}
-
-pub(crate) fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-pub(crate) fn unit(v: [f32; 3]) -> [f32; 3] {
-    let length = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    if length > 0.0 {
-        v.map(|x| x / length)
-    } else {
-        [0.0; 3]
-    }
-}
-
-/// Evaluate points planned one by one (`plans[i]` into `positions[i]`, `normals[i]`), in
-/// parallel: each plan's control points are `indices[plan.control]`, vertices of `control`.
-pub(crate) fn evaluate_points(
-    plans: &[PointPlan],
-    indices: &[u32],
-    control: &[[f32; 3]],
-    positions: &mut [[f32; 3]],
-    normals: &mut [[f32; 3]],
-) {
-    positions
-        .par_iter_mut()
-        .zip(normals.par_iter_mut())
-        .zip(plans.par_iter())
-        .for_each(|((p, q), plan)| {
-            let points = &indices[plan.control.start as usize..plan.control.end as usize];
-            let mut local = [[0.0f32; 3]; MAX_PATCH];
-            for (l, &v) in local.iter_mut().zip(points) {
-                *l = control[v as usize];
-            }
-            (*p, *q) = weighted_point(&plan.stencils, &local[..points.len()], 0);
-        });
-}
-
-/// Position and unit normal of table point `point` (row of the stencils) from the patch's
-/// control points.
-pub(crate) fn weighted_point(
-    s: &Stencils,
-    control: &[[f32; 3]],
-    point: usize,
-) -> ([f32; 3], [f32; 3]) {
-    let k = control.len();
-    let rows = point * k..(point + 1) * k;
-    let (wp, wu, wv) = (&s.position[rows.clone()], &s.du[rows.clone()], &s.dv[rows]);
-    let mut p = [[0.0f32; 3]; 3];
-    for l in 0..k {
-        let q = control[l];
-        for x in 0..3 {
-            p[0][x] += wp[l] * q[x];
-            p[1][x] += wu[l] * q[x];
-            p[2][x] += wv[l] * q[x];
-        }
-    }
-    (p[0], unit(cross(p[1], p[2])))
 }
 
 /// The tensor-product evaluation of a regular face: per row `j`, contract the 4 x 4 grid with the

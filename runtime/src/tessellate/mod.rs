@@ -1,12 +1,14 @@
 //! The tessellators: the dual grid for quads and for triangles (Schaefer and Warren), their
 //! rate selection (per face, tolerance, view), Lai and Cheng's error-bounded adaptive method,
 //! and Espino et al.'s displacement-map tessellation of Bézier patches; all write a
-//! [`triangle_mesh::TriangleMesh`].
+//! [`crate::mesh::TriangleMesh`].
 
 pub mod bezier;
 pub mod dual_grid;
+mod kernel;
 pub mod lai_cheng;
 pub mod rates;
 pub mod triangle_dual_grid;
-pub mod triangle_mesh;
 pub mod triangle_rates;
+
+pub use kernel::GridPlan;

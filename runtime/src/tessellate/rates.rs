@@ -70,9 +70,9 @@ use rayon::prelude::*;
 use table_format::{PointSet, SectionKey, StencilKind};
 
 use crate::mesh::topology::{Mesh, NONE};
+use crate::mesh::triangle_mesh::TriangleMesh;
 use crate::scheme::patch::{dual_index_in_patch, FacePatch};
 use crate::stencil_table::StencilTable;
-use crate::tessellate::triangle_mesh::TriangleMesh;
 use crate::RuntimeError;
 
 /// The largest rate selected: the largest of the default table (`n = 1..=24`).

@@ -39,15 +39,15 @@ use std::time::Instant;
 use table_format::{PointSet, SectionKey, StencilKind};
 
 use crate::mesh::topology::{Mesh, NONE};
+use crate::mesh::triangle_mesh::{TriangleMesh, VertexSource};
 use crate::scheme::triangle::patch::{
     dual_in_patch, dual_index, primal_in_patch, primal_index, Phantoms, TrianglePatch,
 };
 pub use crate::stencil_table::TriangleStencils;
-use crate::tessellate::dual_grid::{
-    cross, evaluate_points, for_each_range, merge_rows, unit, weighted_point, PointPlan, Stencils,
-    TessellationTime,
+use crate::tessellate::kernel::{
+    cross, evaluate_points, for_each_range, merge_rows, unit, weighted_point, Connectivity,
+    GridPlan, PointPlan, Stencils, TessellationTime,
 };
-use crate::tessellate::triangle_mesh::{TriangleMesh, VertexSource};
 use crate::RuntimeError;
 
 /// The largest patch (control points) the evaluator takes: an interior vertex of valence `v`
@@ -202,13 +202,8 @@ pub struct TriangleDualGrid<'t> {
     strips: Vec<TriangleStrip>,
     /// The output vertex of every mesh vertex's limit point ([`NONE`] for unused vertices).
     limit_points: Vec<u32>,
-    /// Vertex polygons, concatenated, each fanned from its first entry (the limit point).
-    polygons: Vec<u32>,
-    polygon_offsets: Vec<u32>,
-    /// Triangle offsets: faces, then strips, then polygons (prefix sums, one past each item).
-    face_triangles: Vec<usize>,
-    strip_triangles: Vec<usize>,
-    polygon_triangles: Vec<usize>,
+    /// Vertex polygons and the triangle offsets of every face, strip and polygon.
+    connectivity: Connectivity,
     vertex_count: usize,
     boundary: bool,
     /// The mesh's phantom points, appended to the control points when a patch reads one.
@@ -311,11 +306,7 @@ impl<'t> TriangleDualGrid<'t> {
             points: Vec::new(),
             strips: Vec::new(),
             limit_points: Vec::new(),
-            polygons: Vec::new(),
-            polygon_offsets: vec![0],
-            face_triangles: Vec::new(),
-            strip_triangles: Vec::new(),
-            polygon_triangles: Vec::new(),
+            connectivity: Connectivity::default(),
             vertex_count: 0,
             boundary: false,
             phantoms: None,
@@ -469,60 +460,35 @@ impl<'t> TriangleDualGrid<'t> {
         for (v, &limit) in limit_point.iter().enumerate() {
             let fan = mesh.fan(v);
             if fan.is_empty() {
-                self.polygon_offsets.push(self.polygons.len() as u32);
+                self.connectivity
+                    .polygon_offsets
+                    .push(self.connectivity.polygons.len() as u32);
                 continue;
             }
-            self.polygons.push(limit);
-            let start = self.polygons.len();
+            self.connectivity.polygons.push(limit);
+            let start = self.connectivity.polygons.len();
             for &h in &fan {
                 let f = mesh.face_of[h] as usize;
                 let corner = h - mesh.face_halfedges(f).start;
                 let point = self.zigzag(f, corner, false).at(0);
-                self.polygons.push(point);
+                self.connectivity.polygons.push(point);
             }
             if !mesh.is_boundary_vertex(v) {
-                self.polygons.push(self.polygons[start]);
+                self.connectivity
+                    .polygons
+                    .push(self.connectivity.polygons[start]);
             }
-            self.polygon_offsets.push(self.polygons.len() as u32);
+            self.connectivity
+                .polygon_offsets
+                .push(self.connectivity.polygons.len() as u32);
         }
         self.vertex_count = self.first[self.rates.len()] as usize + self.points.len();
         self.limit_points = limit_point;
-        let prefix = |counts: &mut dyn Iterator<Item = usize>| -> Vec<usize> {
-            let mut total = 0;
-            counts
-                .map(|c| {
-                    total += c;
-                    total
-                })
-                .collect()
-        };
-        self.face_triangles =
-            prefix(&mut self.rates.iter().map(|&n| 6 * interior_points(n) as usize));
-        self.strip_triangles = prefix(&mut self.strips.iter().map(TriangleStrip::triangles));
-        self.polygon_triangles = prefix(
-            &mut self
-                .polygon_offsets
-                .windows(2)
-                .map(|w| (w[1] - w[0]).saturating_sub(2) as usize),
+        self.connectivity.count(
+            self.rates.iter().map(|&n| 6 * interior_points(n) as usize),
+            self.strips.iter().map(TriangleStrip::triangles),
         );
         Ok(())
-    }
-
-    /// Output vertices per frame.
-    pub fn vertex_count(&self) -> usize {
-        self.vertex_count
-    }
-
-    /// Output triangles per frame.
-    pub fn triangle_count(&self) -> usize {
-        [
-            &self.face_triangles,
-            &self.strip_triangles,
-            &self.polygon_triangles,
-        ]
-        .iter()
-        .map(|v| v.last().copied().unwrap_or(0))
-        .sum()
     }
 
     /// The output vertex holding mesh vertex `vertex`'s limit point (`None` for a vertex no
@@ -537,74 +503,6 @@ impl<'t> TriangleDualGrid<'t> {
     /// Whether the mesh has a boundary (its output then has boundary loops).
     pub fn has_boundary(&self) -> bool {
         self.boundary
-    }
-
-    /// Where every output vertex is evaluated, in output order, in the tessellated mesh's
-    /// triangles: dual points over `3n`, primal points over `n`.
-    pub fn sources(&self) -> Vec<VertexSource> {
-        let mut out = Vec::with_capacity(self.vertex_count);
-        for (f, &n) in self.rates.iter().enumerate() {
-            let source = |u, v, denominator| VertexSource {
-                face: f as u32,
-                u,
-                v,
-                denominator,
-                subface: 0,
-            };
-            for j in 0..n {
-                for i in 0..n - j {
-                    out.push(source(3 * i + 1, 3 * j + 1, 3 * n));
-                    if i + j + 1 < n {
-                        out.push(source(3 * i + 2, 3 * j + 2, 3 * n));
-                    }
-                }
-            }
-            for j in 1..n {
-                for i in 1..n - j {
-                    out.push(source(i, j, n));
-                }
-            }
-        }
-        out.extend(self.points.iter().map(|p| p.source));
-        out
-    }
-
-    /// Evaluate every output vertex from the control points `control` (the mesh's vertex
-    /// positions): limit positions and unit normals, `vertex_count()` each.
-    pub fn evaluate(
-        &self,
-        control: &[[f32; 3]],
-        positions: &mut [[f32; 3]],
-        normals: &mut [[f32; 3]],
-    ) {
-        let extended;
-        let control = match &self.phantoms {
-            Some(phantoms) => {
-                extended = phantoms.extend(control);
-                extended.as_slice()
-            }
-            None => control,
-        };
-        let owned = self.first[self.rates.len()] as usize;
-        let (face_positions, point_positions) = positions.split_at_mut(owned);
-        let (face_normals, point_normals) = normals.split_at_mut(owned);
-        let ends: Vec<usize> = self.first[1..].iter().map(|&x| x as usize).collect();
-        rayon::join(
-            || {
-                for_each_range(&ends, (face_positions, face_normals), |f, (p, q)| {
-                    self.evaluate_face(f, control, p, q)
-                })
-            },
-            || {
-                evaluate_points(
-                    &self.points,
-                    &self.control,
-                    control,
-                    point_positions,
-                    point_normals,
-                )
-            },
-        );
     }
 
     fn evaluate_face(
@@ -644,39 +542,6 @@ impl<'t> TriangleDualGrid<'t> {
         }
     }
 
-    /// Write every triangle (`triangle_count()` of them).
-    pub fn connect(&self, triangles: &mut [[u32; 3]]) {
-        let faces_end = self.face_triangles.last().copied().unwrap_or(0);
-        let strips_end = faces_end + self.strip_triangles.last().copied().unwrap_or(0);
-        let (faces, rest) = triangles.split_at_mut(faces_end);
-        let (strips, polygons) = rest.split_at_mut(strips_end - faces_end);
-        rayon::join(
-            || {
-                for_each_range(&self.face_triangles, faces, |f, out| {
-                    self.connect_face(f, out)
-                })
-            },
-            || {
-                rayon::join(
-                    || {
-                        for_each_range(&self.strip_triangles, strips, |s, out| {
-                            self.strips[s].connect(out)
-                        })
-                    },
-                    || {
-                        for_each_range(&self.polygon_triangles, polygons, |v, out| {
-                            let ring = &self.polygons[self.polygon_offsets[v] as usize
-                                ..self.polygon_offsets[v + 1] as usize];
-                            for (i, t) in out.iter_mut().enumerate() {
-                                *t = [ring[0], ring[i + 1], ring[i + 2]];
-                            }
-                        })
-                    },
-                )
-            },
-        );
-    }
-
     /// The hexagon around every interior primal point, fanned at it.
     fn connect_face(&self, f: usize, out: &mut [[u32; 3]]) {
         let n = self.rates[f];
@@ -703,20 +568,85 @@ impl<'t> TriangleDualGrid<'t> {
             }
         }
     }
+}
 
-    /// Plan and evaluate in one go into a fresh [`TriangleMesh`] (with sources in the
-    /// tessellated mesh's triangles).
-    pub fn tessellate(&self, mesh: &Mesh) -> TriangleMesh {
-        let control: Vec<[f32; 3]> = mesh.positions.iter().map(|p| p.map(|c| c as f32)).collect();
-        let mut out = TriangleMesh {
-            positions: vec![[0.0; 3]; self.vertex_count],
-            normals: vec![[0.0; 3]; self.vertex_count],
-            sources: self.sources(),
-            triangles: vec![[0; 3]; self.triangle_count()],
-        };
-        self.evaluate(&control, &mut out.positions, &mut out.normals);
-        self.connect(&mut out.triangles);
+impl GridPlan for TriangleDualGrid<'_> {
+    /// Output vertices per frame.
+    fn vertex_count(&self) -> usize {
+        self.vertex_count
+    }
+    /// Output triangles per frame.
+    fn triangle_count(&self) -> usize {
+        self.connectivity.triangle_count()
+    }
+    /// Where every output vertex is evaluated, in output order, in the tessellated mesh's
+    /// triangles: dual points over `3n`, primal points over `n`.
+    fn sources(&self) -> Vec<VertexSource> {
+        let mut out = Vec::with_capacity(self.vertex_count);
+        for (f, &n) in self.rates.iter().enumerate() {
+            let source = |u, v, denominator| VertexSource {
+                face: f as u32,
+                u,
+                v,
+                denominator,
+                subface: 0,
+            };
+            for j in 0..n {
+                for i in 0..n - j {
+                    out.push(source(3 * i + 1, 3 * j + 1, 3 * n));
+                    if i + j + 1 < n {
+                        out.push(source(3 * i + 2, 3 * j + 2, 3 * n));
+                    }
+                }
+            }
+            for j in 1..n {
+                for i in 1..n - j {
+                    out.push(source(i, j, n));
+                }
+            }
+        }
+        out.extend(self.points.iter().map(|p| p.source));
         out
+    }
+    /// Evaluate every output vertex from the control points `control` (the mesh's vertex
+    /// positions): limit positions and unit normals, `vertex_count()` each.
+    fn evaluate(&self, control: &[[f32; 3]], positions: &mut [[f32; 3]], normals: &mut [[f32; 3]]) {
+        let extended;
+        let control = match &self.phantoms {
+            Some(phantoms) => {
+                extended = phantoms.extend(control);
+                extended.as_slice()
+            }
+            None => control,
+        };
+        let owned = self.first[self.rates.len()] as usize;
+        let (face_positions, point_positions) = positions.split_at_mut(owned);
+        let (face_normals, point_normals) = normals.split_at_mut(owned);
+        let ends: Vec<usize> = self.first[1..].iter().map(|&x| x as usize).collect();
+        rayon::join(
+            || {
+                for_each_range(&ends, (face_positions, face_normals), |f, (p, q)| {
+                    self.evaluate_face(f, control, p, q)
+                })
+            },
+            || {
+                evaluate_points(
+                    &self.points,
+                    &self.control,
+                    control,
+                    point_positions,
+                    point_normals,
+                )
+            },
+        );
+    }
+    /// Write every triangle (`triangle_count()` of them).
+    fn connect(&self, triangles: &mut [[u32; 3]]) {
+        self.connectivity.connect(
+            triangles,
+            |f, out| self.connect_face(f, out),
+            |s, out| self.strips[s].connect(out),
+        );
     }
 }
 

@@ -75,15 +75,15 @@ use rayon::prelude::*;
 use table_format::{PointSet, SectionKey, StencilKind};
 
 use crate::mesh::topology::NONE;
+use crate::mesh::triangle_mesh::TriangleMesh;
 use crate::scheme::triangle::isolation::TriangleIsolation;
 use crate::scheme::triangle::patch::{dual_in_patch, dual_index, primal_in_patch, primal_index};
 use crate::stencil_table::StencilTable;
-use crate::tessellate::dual_grid::merge_rows;
+use crate::tessellate::kernel::merge_rows;
 use crate::tessellate::rates::{
     check_tolerance, select_rates, sorted_candidates, ToleranceRates, TriangleCells,
 };
 use crate::tessellate::triangle_dual_grid::{zigzag_cell, TriangleStencils, MAX_TRIANGLE_RATE};
-use crate::tessellate::triangle_mesh::TriangleMesh;
 use crate::RuntimeError;
 
 /// The rates a table has triangle grids for (position sections on both the primal and the dual
@@ -724,7 +724,7 @@ mod tests {
     use crate::mesh::test_meshes::{lattice_torus, octahedron};
     use crate::mesh::topology::Mesh;
     use crate::scheme::loop_scheme::isolate::isolate_loop;
-    use crate::scheme::triangle::region_isolate::isolate_regions;
+    use crate::scheme::region_isolate::isolate_regions;
     use crate::scheme::triangle::region_patch::RegionScheme;
     use crate::tessellate::triangle_dual_grid::tessellate_triangles;
 

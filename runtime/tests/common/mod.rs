@@ -10,13 +10,14 @@ use schemes::triangle_local::{canonical_triangle_point, TrianglePoint};
 use schemes::{BoundaryMode, TriangleScheme};
 use subtess::io::obj::read_obj;
 use subtess::mesh::topology::Mesh;
+use subtess::mesh::triangle_mesh::{TriangleMesh, VertexSource};
 use subtess::scheme::triangle::cone_chart::ConeChart;
 use subtess::scheme::triangle::isolation::TriangleIsolation;
 use subtess::scheme::triangle::region_patch::RegionScheme;
 use subtess::scheme::triangle::split::{Split, TriangleSplit};
 use subtess::stencil_table::StencilTable;
 use subtess::tessellate::triangle_dual_grid::TriangleDualGrid;
-use subtess::tessellate::triangle_mesh::{TriangleMesh, VertexSource};
+use subtess::tessellate::GridPlan;
 
 pub fn mesh(positions: Vec<[f64; 3]>, faces: &[[i64; 3]]) -> Mesh {
     let faces: Vec<Vec<i64>> = faces.iter().map(|f| f.to_vec()).collect();
@@ -474,7 +475,7 @@ pub fn worst_normal_angle(
 pub fn check_spot_at_mixed_rates(scheme: RegionScheme, table: &StencilTable, steps: usize) {
     let Some(dir) = models() else { return };
     let m = load(&dir.join("crane/spot_triangulated.obj"));
-    let iso = subtess::scheme::triangle::region_isolate::isolate_regions(&m, scheme)
+    let iso = subtess::scheme::region_isolate::isolate_regions(&m, scheme)
         .unwrap_or_else(|e| panic!("spot: {e}"));
     assert_eq!(iso.steps, steps);
     let rates: Vec<u32> = (0..iso.mesh.faces())

@@ -1,5 +1,5 @@
 //! The modified butterfly (Zorin, Schröder and Sweldens 1996): one refinement step on closed
 //! triangle meshes. Its isolation and region patches are shared with √3
-//! ([`crate::scheme::triangle::region_isolate`]).
+//! ([`crate::scheme::region_isolate`]).
 
 pub mod refine;

@@ -1,5 +1,5 @@
 //! Kobbelt's √3: two steps composed into one ternary refinement of closed triangle meshes. Its
 //! isolation and region patches are shared with the butterfly
-//! ([`crate::scheme::triangle::region_isolate`]).
+//! ([`crate::scheme::region_isolate`]).
 
 pub mod refine;

@@ -17,7 +17,7 @@
 //! * its layout holds no other extraordinary vertex (the rules the table was made with are the
 //!   regular ones everywhere but at `V`).
 //!
-//! [`crate::scheme::triangle::region_isolate`] refines until that holds. A region's frame puts its first corner
+//! [`crate::scheme::region_isolate`] refines until that holds. A region's frame puts its first corner
 //! at patch `(0,0)`: the patch's `corner` is the face corner that is the region's first.
 
 use std::collections::{BTreeMap, BTreeSet};

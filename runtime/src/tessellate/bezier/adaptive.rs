@@ -21,7 +21,7 @@ use super::bicubic::{BicubicPatch, SurfacePoint};
 use super::displacement_map::{coarse_triangles, DisplacementMap, COARSE_SEGMENTS};
 use super::edge_tests::{flat_test, map_test, EdgeTest};
 use super::patch_input::BezierPatches;
-use crate::tessellate::triangle_mesh::{TriangleMesh, VertexSource};
+use crate::mesh::triangle_mesh::{TriangleMesh, VertexSource};
 
 /// A point of the parameter grid: `(u, v) = (g[0] / D, g[1] / D)`.
 pub type GridPoint = [u32; 2];

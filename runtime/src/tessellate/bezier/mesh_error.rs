@@ -12,7 +12,7 @@ use super::patch_input::BezierPatches;
 pub use crate::mesh::geometry::{
     closest_point_on_segment, closest_point_on_triangle, point_triangle_distance,
 };
-use crate::tessellate::triangle_mesh::TriangleMesh;
+use crate::mesh::triangle_mesh::TriangleMesh;
 
 /// A uniform grid over a triangle soup answering exact nearest-distance queries.
 #[derive(Clone, Debug)]

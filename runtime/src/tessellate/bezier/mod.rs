@@ -37,7 +37,7 @@ pub use displacement_map::DisplacementMap;
 pub use edge_tests::EdgeTest;
 pub use patch_input::{BezierPatches, PatchFormat};
 
-use crate::tessellate::triangle_mesh::TriangleMesh;
+use crate::mesh::triangle_mesh::TriangleMesh;
 use crate::RuntimeError;
 use adaptive::{Prepared, Refinement};
 

@@ -56,9 +56,9 @@ use serde_json::{json, Value};
 use table_format::{PointSet, SectionKey, StencilKind};
 
 use crate::mesh::topology::{Mesh, NONE};
+use crate::mesh::triangle_mesh::{TriangleMesh, VertexSource};
 use crate::scheme::patch::{FacePatch, PatchKind};
 use crate::stencil_table::StencilTable;
-use crate::tessellate::triangle_mesh::{TriangleMesh, VertexSource};
 use crate::RuntimeError;
 use bezier_net::{
     corner_normals, corners, cross, flatness_bound, longer_diagonal, unit, Net, Point,

@@ -1,0 +1,326 @@
+//! The dual-grid kernel the quad grid ([`crate::tessellate::dual_grid`]) and the triangle grid
+//! ([`crate::tessellate::triangle_dual_grid`]) share: table stencil rows and their evaluation,
+//! the points evaluated one by one (limit points, boundary curves), and the connectivity of a
+//! plan (face interiors, strips along edges, polygons around vertices) written in parallel at
+//! precomputed offsets.
+
+use std::ops::Range;
+
+use rayon::prelude::*;
+
+use crate::mesh::triangle_mesh::{TriangleMesh, VertexSource};
+use crate::mesh::Mesh;
+
+/// The largest patch (control points) the evaluator takes: an interior quad vertex of valence
+/// `v` has `2v + 8`, a boundary vertex with `k` faces `2k + 8`; a triangle patch at most 40.
+pub(crate) const MAX_PATCH: usize = 40;
+
+/// Timings of one tessellation.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TessellationTime {
+    /// Seconds spent building the plan (table lookups, patches' connectivity records).
+    pub plan_seconds: f64,
+    /// Seconds spent evaluating and connecting (the per-frame work).
+    pub seconds: f64,
+}
+
+/// The three stencils of one point set of one patch: `points x K` weights each, point-major.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Stencils<'t> {
+    pub(crate) position: &'t [f32],
+    pub(crate) du: &'t [f32],
+    pub(crate) dv: &'t [f32],
+}
+
+/// A point evaluated on its own (the boundary curve): one row of each stencil.
+#[derive(Clone, Debug)]
+pub(crate) struct PointPlan<'t> {
+    pub(crate) stencils: Stencils<'t>,
+    pub(crate) control: Range<u32>,
+    pub(crate) source: VertexSource,
+}
+
+/// Run `work(item, slice)` for every item in parallel, where item `i` owns
+/// `out[ends[i-1]..ends[i]]` (`ends` are prefix sums). Items are grouped into contiguous chunks of
+/// about equal output so that the split costs little next to the work.
+pub(crate) fn for_each_range<T: SplitSlices + Send>(
+    ends: &[usize],
+    out: T,
+    work: impl Fn(usize, T) + Sync + Send,
+) {
+    let total = ends.last().copied().unwrap_or(0);
+    let chunks = (rayon::current_num_threads() * 16).max(1);
+    let target = total.div_ceil(chunks).max(1);
+    // Chunk boundaries in items: [item_start, item_end), with their output ranges.
+    let mut pieces = Vec::with_capacity(chunks + 1);
+    let mut rest = out;
+    let (mut item, mut consumed) = (0usize, 0usize);
+    while item < ends.len() {
+        let start_item = item;
+        let start = consumed;
+        while item < ends.len() && (ends[item] - start < target || item == start_item) {
+            item += 1;
+        }
+        let end = ends[item - 1];
+        let (piece, tail) = rest.split_at(end - start);
+        rest = tail;
+        consumed = end;
+        pieces.push((start_item..item, start, piece));
+    }
+    pieces
+        .into_par_iter()
+        .for_each(|(items, start, mut piece)| {
+            let mut at = start;
+            for i in items {
+                let (mine, tail) = piece.split_at(ends[i] - at);
+                piece = tail;
+                at = ends[i];
+                work(i, mine);
+            }
+        });
+}
+
+/// Mutable slices (or tuples of them, split in step) that [`for_each_range`] hands out.
+pub(crate) trait SplitSlices: Sized {
+    fn split_at(self, mid: usize) -> (Self, Self);
+}
+
+impl<T> SplitSlices for &mut [T] {
+    fn split_at(self, mid: usize) -> (Self, Self) {
+        self.split_at_mut(mid)
+    }
+}
+
+impl<A, B> SplitSlices for (&mut [A], &mut [B]) {
+    fn split_at(self, mid: usize) -> (Self, Self) {
+        let (a0, a1) = self.0.split_at_mut(mid);
+        let (b0, b1) = self.1.split_at_mut(mid);
+        ((a0, b0), (a1, b1))
+    }
+}
+
+/// Merge two rows running along an edge into triangles, in order of their parameters
+/// `param_a(i) / den_a` and `param_b(j) / den_b`; `b` lies to the right of the edge.
+pub(crate) fn merge_rows(
+    a: impl Fn(u32) -> u32,
+    na: u32,
+    param_a: impl Fn(u32) -> u64,
+    b: impl Fn(u32) -> u32,
+    nb: u32,
+    param_b: impl Fn(u32) -> u64,
+    out: &mut [[u32; 3]],
+) {
+    let (mut i, mut j, mut k) = (0, 0, 0);
+    while i + 1 < na || j + 1 < nb {
+        let advance_a = j + 1 == nb || (i + 1 < na && param_a(i + 1) <= param_b(j + 1));
+        if advance_a {
+            out[k] = [b(j), a(i + 1), a(i)];
+            i += 1;
+        } else {
+            out[k] = [b(j), b(j + 1), a(i)];
+            j += 1;
+        }
+        k += 1;
+    }
+}
+
+pub(crate) fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+pub(crate) fn unit(v: [f32; 3]) -> [f32; 3] {
+    let length = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    if length > 0.0 {
+        v.map(|x| x / length)
+    } else {
+        [0.0; 3]
+    }
+}
+
+/// Evaluate points planned one by one (`plans[i]` into `positions[i]`, `normals[i]`), in
+/// parallel: each plan's control points are `indices[plan.control]`, vertices of `control`.
+pub(crate) fn evaluate_points(
+    plans: &[PointPlan],
+    indices: &[u32],
+    control: &[[f32; 3]],
+    positions: &mut [[f32; 3]],
+    normals: &mut [[f32; 3]],
+) {
+    positions
+        .par_iter_mut()
+        .zip(normals.par_iter_mut())
+        .zip(plans.par_iter())
+        .for_each(|((p, q), plan)| {
+            let points = &indices[plan.control.start as usize..plan.control.end as usize];
+            let mut local = [[0.0f32; 3]; MAX_PATCH];
+            for (l, &v) in local.iter_mut().zip(points) {
+                *l = control[v as usize];
+            }
+            (*p, *q) = weighted_point(&plan.stencils, &local[..points.len()], 0);
+        });
+}
+
+/// Position and unit normal of table point `point` (row of the stencils) from the patch's
+/// control points.
+pub(crate) fn weighted_point(
+    s: &Stencils,
+    control: &[[f32; 3]],
+    point: usize,
+) -> ([f32; 3], [f32; 3]) {
+    let k = control.len();
+    let rows = point * k..(point + 1) * k;
+    let (wp, wu, wv) = (&s.position[rows.clone()], &s.du[rows.clone()], &s.dv[rows]);
+    let mut p = [[0.0f32; 3]; 3];
+    for l in 0..k {
+        let q = control[l];
+        for x in 0..3 {
+            p[0][x] += wp[l] * q[x];
+            p[1][x] += wu[l] * q[x];
+            p[2][x] += wv[l] * q[x];
+        }
+    }
+    (p[0], unit(cross(p[1], p[2])))
+}
+
+/// Running totals of `counts`: item `i` owns `[ends[i-1], ends[i])`.
+pub(crate) fn prefix_sums(counts: impl Iterator<Item = usize>) -> Vec<usize> {
+    let mut total = 0;
+    counts
+        .map(|c| {
+            total += c;
+            total
+        })
+        .collect()
+}
+
+/// The triangles of a plan in three groups, each item writing a disjoint slice: face interiors,
+/// strips along edges, and the polygons around vertices (fanned from their first entry).
+#[derive(Clone, Debug)]
+pub(crate) struct Connectivity {
+    /// Vertex polygons, concatenated; `polygon_offsets[v]..polygon_offsets[v+1]`.
+    pub(crate) polygons: Vec<u32>,
+    pub(crate) polygon_offsets: Vec<u32>,
+    /// Triangle offsets: faces, then strips, then polygons (prefix sums, one past each item).
+    face_triangles: Vec<usize>,
+    strip_triangles: Vec<usize>,
+    polygon_triangles: Vec<usize>,
+}
+
+impl Default for Connectivity {
+    fn default() -> Self {
+        Connectivity {
+            polygons: Vec::new(),
+            polygon_offsets: vec![0],
+            face_triangles: Vec::new(),
+            strip_triangles: Vec::new(),
+            polygon_triangles: Vec::new(),
+        }
+    }
+}
+
+impl Connectivity {
+    /// Close the plan: the triangles of every face and every strip (the polygons' follow from
+    /// their lengths, a `k`-gon giving `k - 2`).
+    pub(crate) fn count(
+        &mut self,
+        face_triangles: impl Iterator<Item = usize>,
+        strip_triangles: impl Iterator<Item = usize>,
+    ) {
+        self.face_triangles = prefix_sums(face_triangles);
+        self.strip_triangles = prefix_sums(strip_triangles);
+        self.polygon_triangles = prefix_sums(
+            self.polygon_offsets
+                .windows(2)
+                .map(|w| (w[1] - w[0]).saturating_sub(2) as usize),
+        );
+    }
+
+    /// Number of triangles.
+    pub(crate) fn triangle_count(&self) -> usize {
+        [
+            &self.face_triangles,
+            &self.strip_triangles,
+            &self.polygon_triangles,
+        ]
+        .iter()
+        .map(|v| v.last().copied().unwrap_or(0))
+        .sum()
+    }
+
+    /// Write every triangle: `face(f, out)` and `strip(s, out)` fill their items' slices, the
+    /// polygons are fanned here; all three groups in parallel.
+    pub(crate) fn connect(
+        &self,
+        triangles: &mut [[u32; 3]],
+        face: impl Fn(usize, &mut [[u32; 3]]) + Sync + Send,
+        strip: impl Fn(usize, &mut [[u32; 3]]) + Sync + Send,
+    ) {
+        let faces_end = self.face_triangles.last().copied().unwrap_or(0);
+        let strips_end = faces_end + self.strip_triangles.last().copied().unwrap_or(0);
+        let (faces, rest) = triangles.split_at_mut(faces_end);
+        let (strips, polygons) = rest.split_at_mut(strips_end - faces_end);
+        rayon::join(
+            || for_each_range(&self.face_triangles, faces, &face),
+            || {
+                rayon::join(
+                    || for_each_range(&self.strip_triangles, strips, &strip),
+                    || {
+                        for_each_range(&self.polygon_triangles, polygons, |v, out| {
+                            let ring = &self.polygons[self.polygon_offsets[v] as usize
+                                ..self.polygon_offsets[v + 1] as usize];
+                            for (i, t) in out.iter_mut().enumerate() {
+                                *t = [ring[0], ring[i + 1], ring[i + 2]];
+                            }
+                        })
+                    },
+                )
+            },
+        );
+    }
+}
+
+/// What a dual-grid plan does per frame, for quads ([`crate::tessellate::dual_grid::DualGrid`])
+/// and triangles ([`crate::tessellate::triangle_dual_grid::TriangleDualGrid`]) alike: the plan
+/// is built once per mesh and rates; a frame evaluates every output vertex from the control
+/// points and, where the topology changed, writes the triangles.
+pub trait GridPlan: Sync + Send + std::fmt::Debug {
+    /// Output vertices per frame.
+    fn vertex_count(&self) -> usize;
+
+    /// Output triangles per frame.
+    fn triangle_count(&self) -> usize;
+
+    /// Where every output vertex is evaluated, in output order, in the tessellated mesh's faces.
+    fn sources(&self) -> Vec<VertexSource>;
+
+    /// Evaluate every output vertex from the control points `control` (the tessellated mesh's
+    /// vertex positions): limit positions and unit normals, `vertex_count()` each.
+    fn evaluate(&self, control: &[[f32; 3]], positions: &mut [[f32; 3]], normals: &mut [[f32; 3]]);
+
+    /// Write every triangle (`triangle_count()` of them).
+    fn connect(&self, triangles: &mut [[u32; 3]]);
+
+    /// How many faces take a separable (tensor-product) fast path.
+    fn separable_faces(&self) -> usize {
+        0
+    }
+
+    /// Evaluate and connect in one go into a fresh [`TriangleMesh`] (with sources in the
+    /// tessellated mesh's faces), from `mesh`'s own positions.
+    fn tessellate(&self, mesh: &Mesh) -> TriangleMesh {
+        let vertices = self.vertex_count();
+        let mut out = TriangleMesh {
+            positions: vec![[0.0; 3]; vertices],
+            normals: vec![[0.0; 3]; vertices],
+            sources: self.sources(),
+            triangles: vec![[0; 3]; self.triangle_count()],
+        };
+        self.evaluate(&mesh.positions_f32(), &mut out.positions, &mut out.normals);
+        self.connect(&mut out.triangles);
+        out
+    }
+}
