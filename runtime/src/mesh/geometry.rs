@@ -1,36 +1,50 @@
-//! Small 3D vector helpers and exact point–triangle distances, shared by the error measures of
+//! The one set of 3D vector helpers (generic over f32 and f64: the evaluators work in f32, the
+//! error measures in f64) and exact point–triangle distances, shared by the error measures of
 //! the tessellators (`rates`, `bezier`).
+
+use num_traits::Float;
 
 /// A point or vector in 3D.
 pub type Point3 = [f64; 3];
 
 /// Difference `a - b`.
-pub fn sub(a: Point3, b: Point3) -> Point3 {
+pub fn sub<T: Float>(a: [T; 3], b: [T; 3]) -> [T; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
 /// Sum `a + b`.
-pub fn add(a: Point3, b: Point3) -> Point3 {
+pub fn add<T: Float>(a: [T; 3], b: [T; 3]) -> [T; 3] {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
 
 /// `s * a`.
-pub fn scale(s: f64, a: Point3) -> Point3 {
+pub fn scale<T: Float>(s: T, a: [T; 3]) -> [T; 3] {
     [s * a[0], s * a[1], s * a[2]]
 }
 
 /// Dot product.
-pub fn dot(a: Point3, b: Point3) -> f64 {
+pub fn dot<T: Float>(a: [T; 3], b: [T; 3]) -> T {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 /// Cross product.
-pub fn cross(a: Point3, b: Point3) -> Point3 {
+pub fn cross<T: Float>(a: [T; 3], b: [T; 3]) -> [T; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],
         a[0] * b[1] - a[1] * b[0],
     ]
+}
+
+/// `v` scaled to unit length, or zero where it has none (a degenerate tangent pair gives a
+/// zero normal rather than NaN).
+pub fn normalize<T: Float>(v: [T; 3]) -> [T; 3] {
+    let length = norm(v);
+    if length > T::zero() {
+        v.map(|x| x / length)
+    } else {
+        [T::zero(); 3]
+    }
 }
 
 /// Euclidean distance between two points.
@@ -39,7 +53,7 @@ pub fn distance(a: Point3, b: Point3) -> f64 {
 }
 
 /// Euclidean length.
-pub fn norm(a: Point3) -> f64 {
+pub fn norm<T: Float>(a: [T; 3]) -> T {
     dot(a, a).sqrt()
 }
 

@@ -8,6 +8,7 @@ use std::ops::Range;
 
 use rayon::prelude::*;
 
+pub(crate) use crate::mesh::geometry::{cross, normalize as unit};
 use crate::mesh::triangle_mesh::{TriangleMesh, VertexSource};
 use crate::mesh::Mesh;
 
@@ -121,23 +122,6 @@ pub(crate) fn merge_rows(
             j += 1;
         }
         k += 1;
-    }
-}
-
-pub(crate) fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-pub(crate) fn unit(v: [f32; 3]) -> [f32; 3] {
-    let length = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    if length > 0.0 {
-        v.map(|x| x / length)
-    } else {
-        [0.0; 3]
     }
 }
 

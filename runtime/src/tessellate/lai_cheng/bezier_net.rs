@@ -8,24 +8,10 @@
 /// A point in space.
 pub type Point = [f64; 3];
 
+pub(crate) use crate::mesh::geometry::{cross, norm, sub};
+
 /// A bicubic net, `b[4 j + i]`.
 pub type Net = [Point; 16];
-
-pub(crate) fn sub(a: Point, b: Point) -> Point {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-pub(crate) fn norm(a: Point) -> f64 {
-    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
-}
-
-pub(crate) fn cross(a: Point, b: Point) -> Point {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
 
 /// `a` scaled to unit length, or zero when it has none.
 pub(crate) fn unit(a: Point) -> Point {
