@@ -248,8 +248,7 @@ fn child(parent: &str, name: &str) -> String {
 /// (`a::{b::C, d}` is `a::b::C` and `a::d`), as segment lists.
 fn path_tree(t: &[String], mut i: usize, prefix: Vec<String>, out: &mut Vec<Vec<String>>) {
     let mut path = prefix;
-    loop {
-        let Some(seg) = t.get(i) else { break };
+    while let Some(seg) = t.get(i) {
         if !seg.starts_with(|c: char| c.is_alphanumeric() || c == '_') {
             break;
         }
