@@ -5,7 +5,8 @@
 //! `stencilgen::cone_patch` solves with them.
 //!
 //! **Sectors and the patch** are those of [`crate::triangle_local`]: sector `s` holds the points
-//! `(a, b)`, `a >= 1`, `b >= 0`, of its own skew chart, named by [`canonical_triangle_point`];
+//! `(a, b)`, `a >= 1`, `b >= 0`, of its own skew chart, named by
+//! [`crate::triangle_local::canonical_triangle_point`];
 //! the patch is the triangle `V, E_0, E_1` of sector 0, `(u, v)` barycentric, `V` at `(0, 0)`.
 //!
 //! **Rules.** The butterfly is interpolatory: a vertex keeps its value, `V' = V`. A new point on
@@ -17,8 +18,10 @@
 //! read in the chart of the new point's own sector. A stencil of such an edge reaches at most
 //! the chart sectors `-1..=2` around the point (checked: [`stencil_sector_span`]); its six
 //! triangles then develop into the chart without crossing its cut at 180 degrees, so
-//! [`canonical_triangle_point`] names the true vertices even at `K = 3`, where both wings of the
-//! edge `E_0 E_1` are `E_2`.
+//! `canonical_triangle_point` names the true vertices even at `K = 3`, where both wings of the
+//! edge `E_0 E_1` are `E_2`. The rules are written in the crate-private `cone_rules`, next to
+//! √3's: the shared row machinery of [`crate::cone_local`] applies them, and a shared module
+//! must not import the scheme modules built on it.
 //!
 //! **The layout** is the graph-distance ball of radius [`LAYOUT_RADIUS`] around `{V, E_0, E_1}`
 //! on the `K`-valent cone, in this order ([`butterfly_layout`]):
@@ -54,14 +57,14 @@
 //! **Numbers.** Every matrix is kept in f64 (the weights' f64 values) and, when all weights are
 //! rational (`K = 3, 4, 6`), also exactly as `BigRational`.
 
+use crate::cone::layout_ball;
 pub use crate::cone::{chart_sector, layout_key, point_name, LAYOUT_RADIUS};
-use crate::cone::{layout_ball, Weight};
 pub use crate::cone_local::{ConeLocalMatrices, RegularTile};
 
-use crate::cone_local::Combination;
+use crate::cone_rules::edge_of;
 use crate::triangle::{apply_map, lattice_symmetries, TriangleRefinement};
-use crate::triangle_local::{canonical_triangle_point, TrianglePoint};
-use crate::{TriangleScheme, TriangleWeight};
+use crate::triangle_local::TrianglePoint;
+use crate::TriangleScheme;
 
 /// The chart sectors (smallest, largest) that the regular edge stencil of the level-1 point
 /// `(a, b)` (`a >= 1, b >= 0`, not both even, not `(1, 0)`) reaches in its own sector's chart,
@@ -87,113 +90,10 @@ pub fn stencil_sector_span(scheme: &TriangleScheme, a: i64, b: i64) -> Option<(i
         })
 }
 
-/// The level-0 edge `(p, p + R^k (1, 0))` whose new point is the odd level-1 point `(a, b)`.
-fn edge_of(a: i64, b: i64) -> Option<((i64, i64), usize)> {
-    match (a.rem_euclid(2), b.rem_euclid(2)) {
-        (0, 0) => None,
-        (1, 0) => Some((((a - 1) / 2, b / 2), 0)),
-        (0, 1) => Some(((a / 2, (b - 1) / 2), 1)),
-        _ => Some((((a - 1) / 2, (b + 1) / 2), 5)),
-    }
-}
-
 /// The layout of valence `valence` in table order (see the module docs): the ball of graph
 /// radius [`LAYOUT_RADIUS`] around the patch.
 pub fn butterfly_layout(valence: u32) -> Vec<TrianglePoint> {
     layout_ball(valence, LAYOUT_RADIUS)
-}
-
-/// The modified butterfly's rules at one valence, in one number field.
-#[derive(Clone, Debug)]
-pub(crate) struct ButterflyRules<T> {
-    pub(crate) valence: u32,
-    /// `(3/4, [s_0, .., s_{K-1}])` at an edge of `V`; `None` at `K = 6` (regular rule).
-    extraordinary: Option<(T, Vec<T>)>,
-    /// The regular edge rule of the edge `(0,0)-(1,0)`.
-    edge: Vec<((i64, i64), T)>,
-}
-
-impl<T: Weight> ButterflyRules<T> {
-    /// `None` when a weight is irrational in an exact field.
-    pub(crate) fn new(scheme: &TriangleScheme, valence: u32) -> Option<Self> {
-        let TriangleRefinement::Dyadic {
-            edge,
-            edge_denominator,
-        } = scheme.refinement
-        else {
-            return None;
-        };
-        let extraordinary = if valence == 6 {
-            None
-        } else {
-            let (q, s) = scheme.butterfly_extraordinary(valence)?;
-            let s: Option<Vec<T>> = s.into_iter().map(T::from_weight).collect();
-            Some((T::from_weight(q)?, s?))
-        };
-        let edge = edge
-            .iter()
-            .map(|&(o, w)| {
-                Some((
-                    o,
-                    T::from_weight(TriangleWeight::ratio(w, edge_denominator))?,
-                ))
-            })
-            .collect::<Option<Vec<_>>>()?;
-        Some(ButterflyRules {
-            valence,
-            extraordinary,
-            edge,
-        })
-    }
-
-    /// The level-`(k-1)` combination of the level-`k` point `point`, or the reason the chart
-    /// cannot name the stencil.
-    pub(crate) fn refine(&self, point: TrianglePoint) -> Result<Combination<T>, String> {
-        let TrianglePoint::Sector { s, a, b } = point else {
-            return Ok(vec![(TrianglePoint::Centre, T::one_weight())]);
-        };
-        let si = i64::from(s);
-        let Some((p, k)) = edge_of(a, b) else {
-            return Ok(vec![(
-                canonical_triangle_point(self.valence, si, a / 2, b / 2),
-                T::one_weight(),
-            )]);
-        };
-        if let (Some((q, weights)), true) = (&self.extraordinary, p == (0, 0) && k == 0) {
-            let mut out = vec![(TrianglePoint::Centre, q.clone())];
-            out.extend(weights.iter().enumerate().map(|(j, w)| {
-                (
-                    TrianglePoint::Sector {
-                        s: (s + j as u32) % self.valence,
-                        a: 1,
-                        b: 0,
-                    },
-                    w.clone(),
-                )
-            }));
-            return Ok(out);
-        }
-        let map = lattice_symmetries()[k];
-        self.edge
-            .iter()
-            .map(|(o, w)| {
-                let o = apply_map(map, *o);
-                let q = (p.0 + o.0, p.1 + o.1);
-                let sector = chart_sector(q.0, q.1);
-                // At K = 6 the cone is the plane and every chart position is right.
-                if self.valence != 6 && q != (0, 0) && !(-1..=2).contains(&sector) {
-                    return Err(format!(
-                        "the stencil of {} reaches chart sector {sector}, past the cut",
-                        point_name(point)
-                    ));
-                }
-                Ok((
-                    canonical_triangle_point(self.valence, si, q.0, q.1),
-                    w.clone(),
-                ))
-            })
-            .collect()
-    }
 }
 
 /// One regular tile of the patch's outer half at level [`ConeLocalMatrices::tile_level`]

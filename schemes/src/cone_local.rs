@@ -22,7 +22,8 @@
 //!   rules.
 //!
 //! The rows are built by one memoized implementation ([`RowMemo`]) over the scheme's rules
-//! ([`ConeRules`]); reading a level-0 point outside the layout is an error, which is how every
+//! ([`ConeRules`], kept with the family enum [`ConeFamily`]); reading a level-0 point outside
+//! the layout is an error, which is how every
 //! layout is checked. Every matrix is kept in f64 and, when every weight is rational
 //! (`K = 3, 4, 6` for both schemes), also exactly as [`BigRational`].
 
@@ -30,95 +31,13 @@ use std::collections::{BTreeMap, BTreeSet, HashMap};
 
 use num_rational::BigRational;
 
-use crate::butterfly_local::{ButterflyRules, LAYOUT_RADIUS};
-use crate::cone::{interiors_meet, layout_ball, point_name, Weight};
+use crate::cone::{interiors_meet, layout_ball, point_name, Weight, LAYOUT_RADIUS};
+use crate::cone_rules::ConeRules;
+// The family enum lives with the rules it tells apart (`cone_rules`); this is its public path.
+pub use crate::cone_rules::ConeFamily;
 use crate::local_matrices::UnsupportedNeighbourhood;
-use crate::sqrt3_local::Sqrt3Rules;
-use crate::triangle::TriangleRefinement;
 use crate::triangle_local::{canonical_triangle_point, TrianglePoint};
-use crate::{TriangleScheme, TriangleVertexRule};
-
-/// The schemes whose extraordinary neighbourhoods are built here, told apart by their rules.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum ConeFamily {
-    /// The modified butterfly (Zorin, Schröder and Sweldens 1996): interpolatory, dyadic.
-    Butterfly,
-    /// √3 subdivision (Kobbelt 2000), two √3 steps as one ternary step.
-    Sqrt3,
-}
-
-impl ConeFamily {
-    /// The family whose rules `scheme` has, or why it has none.
-    pub fn of(scheme: &TriangleScheme) -> Result<Self, String> {
-        if scheme.vertex == TriangleVertexRule::Interpolatory {
-            Ok(ConeFamily::Butterfly)
-        } else if scheme.vertex == TriangleVertexRule::Sqrt3
-            && scheme.refinement == TriangleRefinement::Sqrt3
-        {
-            Ok(ConeFamily::Sqrt3)
-        } else {
-            Err(
-                "these local matrices are the modified butterfly's (interpolatory rules) or \
-                 √3's (Kobbelt 2000: centroids, edge flips)"
-                    .to_owned(),
-            )
-        }
-    }
-
-    /// The dilation `λ` of one step: `x -> λx` maps the patch's inner part onto the patch
-    /// (2 for the butterfly, 3 for two √3 steps).
-    pub fn dilation(self) -> u32 {
-        match self {
-            ConeFamily::Butterfly => 2,
-            ConeFamily::Sqrt3 => 3,
-        }
-    }
-
-    /// `λ^level`: level-`level` coordinates per level-0 unit.
-    pub fn scale(self, level: u32) -> i64 {
-        i64::from(self.dilation()).pow(level)
-    }
-}
-
-/// A linear combination of coarser points making a finer point.
-pub(crate) type Combination<T> = Vec<(TrianglePoint, T)>;
-
-/// One step of a family's true rules around `V`, in one number field.
-#[derive(Clone, Debug)]
-pub(crate) enum ConeRules<T> {
-    /// The butterfly's rules ([`crate::butterfly_local`]).
-    Butterfly(ButterflyRules<T>),
-    /// Two √3 steps ([`crate::sqrt3_local`]).
-    Sqrt3(Sqrt3Rules<T>),
-}
-
-impl<T: Weight> ConeRules<T> {
-    /// The rules of `family` for `scheme` at `valence`; `None` when a weight is irrational in
-    /// an exact field, or the scheme lacks the family's refinement.
-    pub(crate) fn new(family: ConeFamily, scheme: &TriangleScheme, valence: u32) -> Option<Self> {
-        match family {
-            ConeFamily::Butterfly => ButterflyRules::new(scheme, valence).map(ConeRules::Butterfly),
-            ConeFamily::Sqrt3 => Sqrt3Rules::new(valence).map(ConeRules::Sqrt3),
-        }
-    }
-
-    /// The valence `K` of `V`.
-    pub(crate) fn valence(&self) -> u32 {
-        match self {
-            ConeRules::Butterfly(r) => r.valence,
-            ConeRules::Sqrt3(r) => r.valence,
-        }
-    }
-
-    /// The level-`(k-1)` combination of the level-`k` point `point`, or the reason the chart
-    /// cannot name the stencil.
-    pub(crate) fn refine(&self, point: TrianglePoint) -> Result<Combination<T>, String> {
-        match self {
-            ConeRules::Butterfly(r) => r.refine(point),
-            ConeRules::Sqrt3(r) => r.refine(point),
-        }
-    }
-}
+use crate::TriangleScheme;
 
 /// One regular tile of a region at level `L` (the corner's: [`ConeLocalMatrices::tile_level`]).
 #[derive(Clone, Debug, PartialEq, Eq)]

@@ -41,9 +41,10 @@ use num_rational::BigRational;
 
 use crate::cone::{chart_sector, interiors_meet, layout_key, Weight};
 use crate::cone_local::{
-    level0_reads, support_scaled, tile_set, ConeFamily, ConeLocalMatrices, ConeRules, RegularTile,
-    RowMemo, TileSet,
+    level0_reads, support_scaled, tile_set, ConeFamily, ConeLocalMatrices, RegularTile, RowMemo,
+    TileSet,
 };
+use crate::cone_rules::ConeRules;
 use crate::local_matrices::UnsupportedNeighbourhood;
 use crate::triangle_local::TrianglePoint;
 use crate::TriangleScheme;

@@ -18,7 +18,10 @@ pub mod butterfly_local;
 pub mod butterfly_regions;
 pub mod cone;
 pub mod cone_local;
+// Crate-private: the families' rules, which the shared cone modules apply (no public items
+// of its own; `ConeFamily` and `HALF_LEVEL_STEPS` are re-exported where they were).
 pub mod cone_regions;
+mod cone_rules;
 pub mod curve;
 pub mod local_matrices;
 pub mod loop_regular;

@@ -5,7 +5,8 @@
 //! original lattice). Data only: `stencilgen::sqrt3_patch` solves with them.
 //!
 //! **Sectors and the patch** are those of [`crate::triangle_local`]: sector `s` holds the points
-//! `(a, b)`, `a >= 1`, `b >= 0`, of its own skew chart, named by [`canonical_triangle_point`];
+//! `(a, b)`, `a >= 1`, `b >= 0`, of its own skew chart, named by
+//! [`crate::triangle_local::canonical_triangle_point`];
 //! the patch is the triangle `V, E_0, E_1` of sector 0, `(u, v)` barycentric, `V` at `(0, 0)`.
 //!
 //! **Levels.** "Level `k`" is the ternary level: `2k` √3 steps. In level-`(k+1)` integer skew
@@ -30,12 +31,15 @@
 //!
 //! **Rules** (Kobbelt 2000). One √3 step: every triangle gets its centroid, and every old
 //! vertex of valence `v` moves to `(1 - alpha_v) p + (alpha_v / v) sum` of its `v` neighbours,
-//! `alpha_v = (4 - 2 cos(2π/v))/9` ([`TriangleVertexRule::Sqrt3`]); the old edges are flipped.
+//! `alpha_v = (4 - 2 cos(2π/v))/9` ([`crate::TriangleVertexRule::Sqrt3`]); the old edges are flipped.
 //! Old vertices keep their valence, centroids have valence 6, so only `V` is extraordinary. At
 //! the half level `V`'s neighbours are the `K` centroids `(1,1)_s` (level-`(k+1)` coordinates),
 //! at level `k + 1` the `K` centroids `(1,0)_s` on the original edges' directions. Every rule
 //! reads a one-ring, which develops into the point's sector chart turned at most one sector
-//! either way, so [`canonical_triangle_point`] names the true vertices at every `K >= 3`.
+//! either way, so `canonical_triangle_point` names the true vertices at every `K >= 3`. The
+//! rules are written in the crate-private `cone_rules`, next to the butterfly's: the shared
+//! row machinery of [`crate::cone_local`] applies them, and a shared module must not import the
+//! scheme modules built on it.
 //!
 //! **The layout** is the graph-distance ball of radius [`LAYOUT_RADIUS`] around `{V, E_0, E_1}`
 //! on the `K`-valent cone, in this order ([`sqrt3_layout`]):
@@ -77,136 +81,17 @@
 //! The cone ball, its order, point names and the separating-axis test are
 //! [`crate::cone`]'s, shared with the butterfly.
 
-use std::collections::BTreeMap;
-
-use crate::cone::{layout_ball, Weight};
+use crate::cone::layout_ball;
 pub use crate::cone::{layout_key, point_name, LAYOUT_RADIUS};
 pub use crate::cone_local::{ConeLocalMatrices, RegularTile};
+pub use crate::cone_rules::HALF_LEVEL_STEPS;
 
-use crate::cone_local::Combination;
-use crate::triangle::NEIGHBOURS;
-use crate::triangle_local::{canonical_triangle_point, TrianglePoint};
-use crate::{TriangleVertexRule, TriangleWeight};
-
-/// The six neighbours of a half-level point among the half-level points (level-`(k+1)`
-/// coordinates), counter-clockwise: the steps of the lattice `a = b (mod 3)` turned by 30
-/// degrees.
-pub const HALF_LEVEL_STEPS: [(i64, i64); 6] =
-    [(1, 1), (-1, 2), (-2, 1), (-1, -1), (1, -2), (2, -1)];
+use crate::triangle_local::TrianglePoint;
 
 /// The layout of valence `valence` in table order (see the module docs): the ball of graph
 /// radius [`LAYOUT_RADIUS`] around the patch.
 pub fn sqrt3_layout(valence: u32) -> Vec<TrianglePoint> {
     layout_ball(valence, LAYOUT_RADIUS)
-}
-
-/// √3's rules at one valence, in one number field.
-#[derive(Clone, Debug)]
-pub(crate) struct Sqrt3Rules<T> {
-    pub(crate) valence: u32,
-    /// `(1 - alpha_K, alpha_K / K)` at `V`.
-    extraordinary: (T, T),
-    /// `(1 - alpha_6, alpha_6 / 6) = (2/3, 1/18)` at every other vertex.
-    regular: (T, T),
-    /// `1/3`, a centroid's weight per corner.
-    third: T,
-}
-
-impl<T: Weight> Sqrt3Rules<T> {
-    /// `None` when `alpha_K` is irrational in an exact field.
-    pub(crate) fn new(valence: u32) -> Option<Self> {
-        let pair = |v: u32| {
-            let (c, b) = TriangleVertexRule::Sqrt3.weights(v);
-            Some((T::from_weight(c)?, T::from_weight(b)?))
-        };
-        Some(Sqrt3Rules {
-            valence,
-            extraordinary: pair(valence)?,
-            regular: pair(6)?,
-            third: T::from_weight(TriangleWeight::ratio(1, 3))?,
-        })
-    }
-
-    /// A vertex rule: `centre` on `p`, `beta` on each of `ring`.
-    fn vertex(
-        p: TrianglePoint,
-        (centre, beta): &(T, T),
-        ring: Vec<TrianglePoint>,
-    ) -> Combination<T> {
-        let mut out = vec![(p, centre.clone())];
-        out.extend(ring.into_iter().map(|q| (q, beta.clone())));
-        out
-    }
-
-    /// The first √3 step: the half-level point `point` (level-`(k+1)` coordinates,
-    /// `a = b (mod 3)`) in level-`k` points (level-`k` coordinates).
-    fn first(&self, point: TrianglePoint) -> Result<Combination<T>, String> {
-        let TrianglePoint::Sector { s, a, b } = point else {
-            let ring = (0..self.valence)
-                .map(|s| TrianglePoint::Sector { s, a: 1, b: 0 })
-                .collect();
-            return Ok(Self::vertex(point, &self.extraordinary, ring));
-        };
-        let s = i64::from(s);
-        let at = |x: i64, y: i64| canonical_triangle_point(self.valence, s, x, y);
-        if a % 3 == 0 && b % 3 == 0 {
-            let (x, y) = (a / 3, b / 3);
-            let ring = NEIGHBOURS
-                .iter()
-                .map(|&(dx, dy)| at(x + dx, y + dy))
-                .collect();
-            return Ok(Self::vertex(at(x, y), &self.regular, ring));
-        }
-        if (a - b).rem_euclid(3) != 0 {
-            return Err(format!("{} is not a half-level point", point_name(point)));
-        }
-        // A centroid: the three of its half-level neighbours that are old vertices.
-        Ok(HALF_LEVEL_STEPS
-            .iter()
-            .map(|&(da, db)| (a + da, b + db))
-            .filter(|&(x, y)| x.rem_euclid(3) == 0 && y.rem_euclid(3) == 0)
-            .map(|(x, y)| (at(x / 3, y / 3), self.third.clone()))
-            .collect())
-    }
-
-    /// The second √3 step: the level-`(k+1)` point `point` in half-level points (both in
-    /// level-`(k+1)` coordinates).
-    fn second(&self, point: TrianglePoint) -> Combination<T> {
-        let TrianglePoint::Sector { s, a, b } = point else {
-            let ring = (0..self.valence)
-                .map(|s| TrianglePoint::Sector { s, a: 1, b: 1 })
-                .collect();
-            return Self::vertex(point, &self.extraordinary, ring);
-        };
-        let s = i64::from(s);
-        let at = |x: i64, y: i64| canonical_triangle_point(self.valence, s, x, y);
-        if (a - b).rem_euclid(3) == 0 {
-            let ring = HALF_LEVEL_STEPS
-                .iter()
-                .map(|&(da, db)| at(a + da, b + db))
-                .collect();
-            return Self::vertex(point, &self.regular, ring);
-        }
-        // A centroid of a half-level triangle: its three neighbours on the half level.
-        NEIGHBOURS
-            .iter()
-            .map(|&(da, db)| (a + da, b + db))
-            .filter(|&(x, y)| (x - y).rem_euclid(3) == 0)
-            .map(|(x, y)| (at(x, y), self.third.clone()))
-            .collect()
-    }
-
-    /// One ternary step (two √3 steps): the level-`(k+1)` point `point` in level-`k` points.
-    pub(crate) fn refine(&self, point: TrianglePoint) -> Result<Combination<T>, String> {
-        let mut out: BTreeMap<TrianglePoint, T> = BTreeMap::new();
-        for (h, w) in self.second(point) {
-            for (p, x) in self.first(h)? {
-                let e = out.entry(p).or_insert_with(T::zero);
-                *e = e.clone() + w.clone() * x;
-            }
-        }
-        Ok(out.into_iter().collect())
-    }
 }
 
 /// One regular tile of the patch's outer part at level [`ConeLocalMatrices::tile_level`]

@@ -28,19 +28,19 @@
 //! rational), so the solver sees precisely the f64 matrix.
 //!
 //! The grid system, the substitution and the helpers that read the matrices are
-//! [`crate::cone_patch`]'s, shared with √3 (dilation 2 here, 3 there); this module names them
-//! for the butterfly and holds its regular basis.
+//! [`crate::cone_patch`]'s, shared with √3 (dilation 2 here, 3 there), and so is the policy for
+//! solving the regular basis; this module names them for the butterfly.
 
-use num_rational::BigRational;
+use schemes::cone_local::ConeFamily;
 use schemes::TriangleScheme;
 
 pub use crate::cone_patch::{
     cone_matrices as butterfly_matrices, cone_patch_stencils as butterfly_patch_stencils,
     cone_patch_stencils_at as butterfly_patch_stencils_at,
 };
-use crate::cone_patch::{rounded_basis, ConePatchStencils, ConeSubstitution};
+use crate::cone_patch::{family_regular_basis_kind, ConePatchStencils, ConeSubstitution};
 use crate::regular_patch::StencilKind;
-use crate::triangle_system::{triangle_stencils_up_to, TriangleStencils, MAX_BASIS_RATE};
+use crate::triangle_system::TriangleStencils;
 use crate::{Scalar, StencilError};
 
 /// Position stencils at the grid points of the butterfly EV patch ([`ConePatchStencils`]).
@@ -50,15 +50,9 @@ pub type ButterflyPatchStencils<S> = ConePatchStencils<S>;
 /// ([`ConeSubstitution`], dilation 2: the level-`L` point is `2^L 2^k x` after the doublings).
 pub type ButterflySubstitution<S> = ConeSubstitution<S>;
 
-/// The butterfly's regular basis function on the rate-`d` grid, in the field `S`.
-///
-/// The regular mask is rational at every valence, so `psi` is solved exactly and then rounded,
-/// except at odd rates in an inexact field: the exact path solves each residue cycle on one
-/// support width and substitutes along the trees, while the f64 path factors whole orbits
-/// densely. With trees (even rates) that makes f64 far slower (rate 8: 17 s in f64 against
-/// 0.04 s exact; rate 24: 1.1 s exact, see docs/algorithms/butterfly.md); at an odd rate every
-/// class lies on a cycle, the orbits are the cycles, and the exact arithmetic is what costs
-/// (rate 21: 12 s exact against 0.5 s in f64, which agrees within 1e-12).
+/// The butterfly's regular basis function on the rate-`d` grid, in the field `S`: solved
+/// exactly and rounded, except at odd rates in an inexact field, where the f64 solve is the
+/// fast one ([`crate::cone_patch::solves_basis_in_field`] says why).
 pub fn regular_basis<S: Scalar>(
     scheme: &TriangleScheme,
     d: u32,
@@ -66,26 +60,22 @@ pub fn regular_basis<S: Scalar>(
     regular_basis_kind(scheme, d, StencilKind::Position)
 }
 
-/// [`regular_basis`] or one of its derivatives along the skew axes (`DerivativeU` is
-/// `d psi / d y_1` at fixed `y_2`, normalized by Schaefer–Warren section 4's
-/// `sum_j (j_1 - y_1) psi_u(y - j) = 1`, `sum_j (j_2 - y_2) psi_u(y - j) = 0`), on the rate-`d`
-/// grid, `d <= `[`MAX_BASIS_RATE`] (the exact path reaches the dual grid's `3n`).
+/// [`regular_basis`] or one of its derivatives along the skew axes, on the rate-`d` grid,
+/// `d <= `[`crate::triangle_system::MAX_BASIS_RATE`] (the exact path reaches the dual grid's
+/// `3n`): the butterfly's case of [`family_regular_basis_kind`], which holds the normalization
+/// and the policy.
 pub fn regular_basis_kind<S: Scalar>(
     scheme: &TriangleScheme,
     d: u32,
     kind: StencilKind,
 ) -> Result<TriangleStencils<S>, StencilError> {
-    let mask = scheme.regular_mask();
-    if !S::EXACT && d % 2 == 1 {
-        return triangle_stencils_up_to::<S>(&mask, d, kind, MAX_BASIS_RATE);
-    }
-    let exact = triangle_stencils_up_to::<BigRational>(&mask, d, kind, MAX_BASIS_RATE)?;
-    Ok(rounded_basis(exact))
+    family_regular_basis_kind(ConeFamily::Butterfly, scheme, d, kind)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use num_rational::BigRational;
 
     fn butterfly() -> TriangleScheme {
         TriangleScheme::by_name("butterfly").expect("catalogued")

@@ -38,13 +38,13 @@ use num_traits::{One, Zero};
 use schemes::cone_local::{ConeFamily, ConeLocalMatrices};
 use schemes::TriangleScheme;
 
-use crate::butterfly_patch::regular_basis_kind;
 use crate::exact_solve::limit_mask;
 use crate::regular_patch::StencilKind;
 use crate::scaling_system::{NormalizationRow, Relation, ScalingSystem, SparseRow};
 use crate::solve::{solve_system, Solution};
-use crate::sqrt3_patch::sqrt3_regular_basis_kind;
-use crate::triangle_system::{TriangleStencils, MAX_TRIANGLE_RATE};
+use crate::triangle_system::{
+    triangle_stencils_up_to, TriangleStencils, MAX_BASIS_RATE, MAX_TRIANGLE_RATE,
+};
 use crate::{Scalar, StencilError};
 
 /// Position stencils at the grid points of the butterfly's or √3's EV patch.
@@ -219,18 +219,47 @@ pub fn family_regular_basis<S: Scalar>(
     family_regular_basis_kind(family, scheme, d, StencilKind::Position)
 }
 
-/// The regular basis `psi` of `family`'s scheme, or one of its skew-axis derivatives, on the
-/// rate-`d` grid, each family by its own policy ([`regular_basis_kind`],
-/// [`sqrt3_regular_basis_kind`]).
+/// The regular basis `psi` of `family`'s scheme, or one of its skew-axis derivatives
+/// (`DerivativeU` is `d psi / d y_1` at fixed `y_2`, normalized by Schaefer–Warren section 4's
+/// `sum_j (j_1 - y_1) psi_u(y - j) = 1`, `sum_j (j_2 - y_2) psi_u(y - j) = 0`), on the rate-`d`
+/// grid, `d <= `[`MAX_BASIS_RATE`] (the tables' dual points need `3n`).
+///
+/// Both regular masks are rational at every valence, so `psi` is solved exactly and rounded
+/// into `S`, except where [`solves_basis_in_field`] says the field's own solve is faster. The
+/// policy is the family's, kept here (not in the scheme modules) because the shared patch and
+/// region code needs it and the scheme modules are built on that code.
 pub fn family_regular_basis_kind<S: Scalar>(
     family: ConeFamily,
     scheme: &TriangleScheme,
     d: u32,
     kind: StencilKind,
 ) -> Result<TriangleStencils<S>, StencilError> {
+    let mask = scheme.regular_mask();
+    if solves_basis_in_field::<S>(family, d) {
+        return triangle_stencils_up_to::<S>(&mask, d, kind, MAX_BASIS_RATE);
+    }
+    let exact = triangle_stencils_up_to::<BigRational>(&mask, d, kind, MAX_BASIS_RATE)?;
+    Ok(rounded_basis(exact))
+}
+
+/// Whether `family`'s regular basis at rate `d` is solved in the inexact field `S` itself
+/// rather than exactly and rounded (an exact field always solves exactly).
+///
+/// The exact path solves each residue cycle on one support width and substitutes along the
+/// trees, while the f64 path factors whole orbits densely. With trees that makes f64 far
+/// slower, so the exact path is the default. The butterfly's odd rates are the exception: there
+/// every class lies on a cycle, the orbits are the cycles, and the exact arithmetic is what
+/// costs (rate 21: 12 s exact against 0.5 s in f64, which agrees within 1e-12; at even rates
+/// rate 8 takes 17 s in f64 against 0.04 s exact, rate 24 1.1 s exact; see
+/// docs/algorithms/butterfly.md). √3's tables use the rates `3n` (multiples of 3, so the
+/// classes form trees hanging off the cycles), where the exact path is the fast one. Measured
+/// (ignored test `f64_and_exact_regular_bases_agree_at_the_table_rates` in
+/// [`crate::sqrt3_patch`], which also checks agreement within 1e-12): rate 9, 0.07 s exact
+/// against 8 s in f64; rate 15, 1 s against 3.6 s; rate 18, 0.9 s against 66 s.
+pub fn solves_basis_in_field<S: Scalar>(family: ConeFamily, d: u32) -> bool {
     match family {
-        ConeFamily::Butterfly => regular_basis_kind(scheme, d, kind),
-        ConeFamily::Sqrt3 => sqrt3_regular_basis_kind(scheme, d, kind),
+        ConeFamily::Butterfly => !S::EXACT && d % 2 == 1,
+        ConeFamily::Sqrt3 => false,
     }
 }
 

@@ -35,11 +35,12 @@ use schemes::cone_local::ConeFamily;
 use schemes::cone_regions::{ConeRegion, ConeRegions};
 use schemes::TriangleScheme;
 
-use crate::butterfly_regions::butterfly_vertex_masks;
 use crate::cone_patch::{entry, family_regular_basis_kind, irrational_weights};
+// The masks at V are built with the rest of the regions; `VertexMasks` keeps its path here.
+use crate::cone_vertex::vertex_masks;
+pub use crate::cone_vertex::VertexMasks;
 use crate::region_table::RegionStencilSet;
 use crate::regular_patch::StencilKind;
-use crate::sqrt3_regions::sqrt3_vertex_masks;
 use crate::triangle_system::{TriangleStencils, MAX_BASIS_RATE};
 use crate::{Scalar, StencilError};
 
@@ -94,18 +95,6 @@ impl<S: Scalar> RegionBasis<S> {
                 what: format!("the regular basis at rate {} lacks {kind:?}", self.n),
             })
     }
-}
-
-/// The masks at `V` itself (the corner region's `x = 0`), corner layout.
-#[derive(Clone, Debug)]
-pub struct VertexMasks<S> {
-    /// The limit-position mask: the left fixed vector of `A` summing to 1.
-    pub limit: Vec<S>,
-    /// The subdominant eigenvalue of `A` (f64): `1/2` for the butterfly,
-    /// `(2 + 2 cos(2π/K))/9` for √3.
-    pub lambda: f64,
-    /// The two tangent masks, for `d/du` and `d/dv` (the scheme's convention).
-    pub tangents: [Vec<S>; 2],
 }
 
 /// Every region of one valence, its matrices in the field `S`, ready to evaluate.
@@ -177,10 +166,7 @@ impl<S: Scalar> ConeRegionStencils<S> {
             limit,
             lambda,
             tangents,
-        } = match family {
-            ConeFamily::Butterfly => butterfly_vertex_masks::<S>(m, &failure, &what)?,
-            ConeFamily::Sqrt3 => sqrt3_vertex_masks::<S>(m, &failure, &what)?,
-        };
+        } = vertex_masks::<S>(family, m, &failure, &what)?;
         Ok(ConeRegionStencils {
             regions,
             a,

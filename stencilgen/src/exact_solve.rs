@@ -200,6 +200,47 @@ pub fn solve_dense(
     Ok(x)
 }
 
+/// A basis of the right null space of the dense rational matrix `m` (`rows x width`).
+pub(crate) fn null_space(mut m: Vec<Vec<BigRational>>, width: usize) -> Vec<Vec<BigRational>> {
+    let mut pivots = Vec::new();
+    let mut rank = 0;
+    for col in 0..width {
+        let Some(p) = (rank..m.len()).find(|&i| !m[i][col].is_zero()) else {
+            continue;
+        };
+        m.swap(rank, p);
+        let inv = m[rank][col].recip();
+        for x in m[rank].iter_mut() {
+            *x *= &inv;
+        }
+        let pivot = m[rank].clone();
+        for (i, row) in m.iter_mut().enumerate() {
+            if i == rank || row[col].is_zero() {
+                continue;
+            }
+            let f = row[col].clone();
+            for (x, y) in row.iter_mut().zip(&pivot) {
+                if !y.is_zero() {
+                    *x -= &f * y;
+                }
+            }
+        }
+        pivots.push(col);
+        rank += 1;
+    }
+    (0..width)
+        .filter(|c| !pivots.contains(c))
+        .map(|free| {
+            let mut v = vec![BigRational::zero(); width];
+            v[free] = BigRational::one();
+            for (i, &p) in pivots.iter().enumerate() {
+                v[p] = -m[i][free].clone();
+            }
+            v
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -207,6 +248,14 @@ mod tests {
 
     fn q(n: i64, d: i64) -> BigRational {
         BigRational::new(BigInt::from(n), BigInt::from(d))
+    }
+
+    #[test]
+    fn null_space_of_a_rank_one_matrix() {
+        let q = |x: i64| BigRational::from_integer(BigInt::from(x));
+        // [1 2 3] has the null space spanned by (-2, 1, 0), (-3, 0, 1).
+        let ns = null_space(vec![vec![q(1), q(2), q(3)]], 3);
+        assert_eq!(ns, vec![vec![q(-2), q(1), q(0)], vec![q(-3), q(0), q(1)]]);
     }
 
     #[test]

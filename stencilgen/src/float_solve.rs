@@ -13,7 +13,10 @@
 use nalgebra::{DMatrix, DVector};
 
 use crate::orbit_block::{BlockFailure, LocalNormalization, OrbitBlock};
-use crate::scalar::{rational_to_f64, FLOAT_TOLERANCE};
+use crate::rational::rational_to_f64;
+
+/// Largest residual an f64 solution may leave in any equation and still count as a solution.
+pub const FLOAT_TOLERANCE: f64 = 1e-9;
 
 /// Singular values below this fraction of the largest count as zero.
 const RANK_TOLERANCE: f64 = 1e-11;

@@ -29,6 +29,9 @@ pub mod butterfly_regions;
 pub mod butterfly_table;
 pub mod cone_patch;
 pub mod cone_regions;
+// Crate-private: the families' masks at the vertex, which the shared cone_regions builds
+// (its one public item, `VertexMasks`, is re-exported there).
+mod cone_vertex;
 pub mod curve_stencils;
 pub mod curve_system;
 pub mod error;

@@ -4,11 +4,14 @@
 use std::fmt::Debug;
 use std::ops::{Add, Mul, Sub};
 
-use num_bigint::BigInt;
 use num_rational::BigRational;
-use num_traits::{ToPrimitive, Zero};
+use num_traits::Zero;
 
+// The tolerance is the f64 solver's acceptance test and the conversion the rationals', so
+// both live below this module (which dispatches to the solvers); their old paths stay.
+pub use crate::float_solve::FLOAT_TOLERANCE;
 use crate::orbit_block::{BlockFailure, OrbitBlock};
+pub use crate::rational::rational_to_f64;
 
 /// A field the scaling-relation system can be solved in.
 pub trait Scalar:
@@ -35,9 +38,6 @@ pub trait Scalar:
     /// block's unknowns, step by step.
     fn solve_orbit(block: &OrbitBlock<Self>) -> Result<Vec<Vec<Self>>, BlockFailure>;
 }
-
-/// Largest residual an f64 solution may leave in any equation and still count as a solution.
-pub const FLOAT_TOLERANCE: f64 = 1e-9;
 
 impl Scalar for BigRational {
     const EXACT: bool = true;
@@ -84,30 +84,5 @@ impl Scalar for f64 {
 
     fn solve_orbit(block: &OrbitBlock<Self>) -> Result<Vec<Vec<Self>>, BlockFailure> {
         crate::float_solve::solve_orbit(block)
-    }
-}
-
-/// The f64 nearest to a rational whose numerator and denominator may both overflow f64:
-/// both are shifted down to 64 significant bits first, so the quotient keeps full precision.
-pub fn rational_to_f64(r: &BigRational) -> f64 {
-    let (num, den) = (r.numer(), r.denom());
-    let shift = |x: &BigInt| x.bits().saturating_sub(64);
-    let (sn, sd) = (shift(num), shift(den));
-    let n = (num >> sn).to_f64().unwrap_or(f64::NAN);
-    let d = (den >> sd).to_f64().unwrap_or(f64::NAN);
-    (n / d) * (sn as f64 - sd as f64).exp2()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn huge_rationals_convert_without_overflow() {
-        let big = BigInt::from(3u8).pow(1000);
-        let r = BigRational::new(big.clone() * 2, big * 3);
-        assert!((rational_to_f64(&r) - 2.0 / 3.0).abs() < 1e-15);
-        let small = BigRational::new(BigInt::from(-1), BigInt::from(5589));
-        assert_eq!(rational_to_f64(&small), -1.0 / 5589.0);
     }
 }

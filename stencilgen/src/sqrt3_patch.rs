@@ -28,19 +28,19 @@
 //! rational), so the solver sees precisely the f64 matrix.
 //!
 //! The grid system, the substitution and the helpers that read the matrices are
-//! [`crate::cone_patch`]'s, shared with the butterfly (dilation 3 here, 2 there); this module
-//! names them for √3 and holds its regular basis.
+//! [`crate::cone_patch`]'s, shared with the butterfly (dilation 3 here, 2 there), and so is the
+//! policy for solving the regular basis; this module names them for √3.
 
-use num_rational::BigRational;
+use schemes::cone_local::ConeFamily;
 use schemes::TriangleScheme;
 
 pub use crate::cone_patch::{
     cone_matrices as sqrt3_matrices, cone_patch_stencils as sqrt3_patch_stencils,
     cone_patch_stencils_at as sqrt3_patch_stencils_at,
 };
-use crate::cone_patch::{rounded_basis, ConePatchStencils, ConeSubstitution};
+use crate::cone_patch::{family_regular_basis_kind, ConePatchStencils, ConeSubstitution};
 use crate::regular_patch::StencilKind;
-use crate::triangle_system::{triangle_stencils_up_to, TriangleStencils, MAX_BASIS_RATE};
+use crate::triangle_system::TriangleStencils;
 use crate::{Scalar, StencilError};
 
 /// Position stencils at the grid points of the √3 EV patch ([`ConePatchStencils`]).
@@ -50,11 +50,8 @@ pub type Sqrt3PatchStencils<S> = ConePatchStencils<S>;
 /// dilation 3: the level-`L` point is `9 * 3^k x` after the triplings).
 pub type Sqrt3Substitution<S> = ConeSubstitution<S>;
 
-/// √3's regular (two-step, ternary) basis function on the rate-`d` grid, in the field `S`.
-///
-/// The regular mask is rational at every valence, so `psi` is solved exactly and then
-/// rounded, as for the butterfly: the exact path solves each residue cycle and substitutes
-/// along the trees, the f64 path would factor whole orbits densely.
+/// √3's regular (two-step, ternary) basis function on the rate-`d` grid, in the field `S`:
+/// always solved exactly and rounded ([`crate::cone_patch::solves_basis_in_field`] says why).
 pub fn sqrt3_regular_basis<S: Scalar>(
     scheme: &TriangleScheme,
     d: u32,
@@ -62,31 +59,24 @@ pub fn sqrt3_regular_basis<S: Scalar>(
     sqrt3_regular_basis_kind(scheme, d, StencilKind::Position)
 }
 
-/// [`sqrt3_regular_basis`] or one of its derivatives along the skew axes (`DerivativeU` is
-/// `d psi / d y_1` at fixed `y_2`, Schaefer–Warren section 4's normalization
-/// `sum_j (j_1 - y_1) psi_u(y - j) = 1`, `sum_j (j_2 - y_2) psi_u(y - j) = 0`), on the rate-`d`
-/// grid, `d <= `[`MAX_BASIS_RATE`] (the tables' dual points need `3n`).
-///
-/// Always solved exactly and rounded: at the tables' rates `3n` (multiples of 3, so the
-/// classes form trees hanging off the cycles) the exact path is the fast one, unlike the
-/// butterfly's odd rates. Measured (ignored test
-/// `f64_and_exact_regular_bases_agree_at_the_table_rates`, which also checks agreement within
-/// 1e-12): rate 9, 0.07 s exact against 8 s in f64; rate 15, 1 s against 3.6 s; rate 18,
-/// 0.9 s against 66 s.
+/// [`sqrt3_regular_basis`] or one of its derivatives along the skew axes, on the rate-`d`
+/// grid, `d <= `[`crate::triangle_system::MAX_BASIS_RATE`] (the tables' dual points need
+/// `3n`): √3's case of [`family_regular_basis_kind`], which holds the normalization and the
+/// policy.
 pub fn sqrt3_regular_basis_kind<S: Scalar>(
     scheme: &TriangleScheme,
     d: u32,
     kind: StencilKind,
 ) -> Result<TriangleStencils<S>, StencilError> {
-    let mask = scheme.regular_mask();
-    let exact = triangle_stencils_up_to::<BigRational>(&mask, d, kind, MAX_BASIS_RATE)?;
-    Ok(rounded_basis(exact))
+    family_regular_basis_kind(ConeFamily::Sqrt3, scheme, d, kind)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::triangle_system::triangle_stencils;
+    use crate::triangle_system::{triangle_stencils_up_to, MAX_BASIS_RATE};
+    use num_rational::BigRational;
 
     fn sqrt3() -> TriangleScheme {
         TriangleScheme::by_name("sqrt3").expect("catalogued")
