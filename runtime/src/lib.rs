@@ -11,8 +11,9 @@
 //! let mut tessellator = surface.tessellator(&subtess::Rates::Uniform(8))?;
 //! let mut positions = mesh.positions_f32();
 //! positions[0][2] -= 0.5; // animate: move a control point, keep the topology
-//! let frame = tessellator.evaluate(&positions)?;
-//! assert_eq!(frame.triangles().len(), tessellator.triangle_count());
+//! let triangles = tessellator.triangle_count();
+//! let frame = tessellator.evaluate(&positions)?; // borrows the tessellator until the next frame
+//! assert_eq!(frame.triangles().len(), triangles);
 //! assert!(frame.normals().iter().all(|n| (n[0] * n[0] + n[1] * n[1] + n[2] * n[2] - 1.0).abs() < 1e-4));
 //! # Ok::<(), subtess::RuntimeError>(())
 //! ```

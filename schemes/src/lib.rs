@@ -18,18 +18,20 @@ pub mod butterfly_local;
 pub mod butterfly_regions;
 pub mod cone;
 pub mod cone_local;
-// Crate-private: the families' rules, which the shared cone modules apply (no public items
-// of its own; `ConeFamily` and `HALF_LEVEL_STEPS` are re-exported where they were).
 pub mod cone_regions;
-mod cone_rules;
 pub mod curve;
 pub mod local_matrices;
 pub mod loop_regular;
 pub mod quad;
+pub mod rational;
 pub mod sqrt3_local;
 pub mod sqrt3_regions;
 pub mod triangle;
 pub mod triangle_local;
+
+// Crate-private: the families' rules, which the shared cone modules apply (no public items
+// of its own; `ConeFamily` and `HALF_LEVEL_STEPS` are re-exported where they were).
+mod cone_rules;
 
 pub use bivariate::BivariateMask;
 pub use curve::{Component, CurveScheme, Term, Translates};

@@ -1,35 +1,19 @@
-//! Rational numbers as written on the command line and in JSON: `p/q`, or an integer `p`
-//! (DESIGN.md conventions); and their nearest f64, for rationals too large for a plain
-//! division.
+//! Rational numbers as written on the command line and in JSON (DESIGN.md conventions; the
+//! grammar is `schemes::rational`'s), and their nearest f64, for rationals too large for a
+//! plain division.
 
 use num_bigint::BigInt;
 use num_rational::BigRational;
-use num_traits::{ToPrimitive, Zero};
+use num_traits::ToPrimitive;
 
 use crate::StencilError;
 
-/// Parse `p/q` or `p` (optional sign on `p`; `q > 0`).
+/// Parse a rational in the one grammar of the command lines ([`schemes::rational::parse_rational`]:
+/// `p/q`, an integer, or an exact decimal).
 pub fn parse_rational(text: &str) -> Result<BigRational, StencilError> {
-    let bad = |why: &str| StencilError::OutOfDomain {
+    schemes::rational::parse_rational(text).map_err(|why| StencilError::OutOfDomain {
         what: format!("`{text}` is not a rational number p/q: {why}"),
-    };
-    let (p, q) = match text.trim().split_once('/') {
-        Some((p, q)) => (p.trim(), q.trim()),
-        None => (text.trim(), "1"),
-    };
-    let p: BigInt = p
-        .parse()
-        .map_err(|_| bad("the numerator is not an integer"))?;
-    let q: BigInt = q
-        .parse()
-        .map_err(|_| bad("the denominator is not an integer"))?;
-    if q.is_zero() {
-        return Err(bad("the denominator is zero"));
-    }
-    if q < BigInt::zero() {
-        return Err(bad("the denominator is negative"));
-    }
-    Ok(BigRational::new(p, q))
+    })
 }
 
 /// The f64 nearest to a rational whose numerator and denominator may both overflow f64:
@@ -74,7 +58,13 @@ mod tests {
             parse_rational("-3/5").map(|r| r.to_string()),
             Ok("-3/5".to_owned())
         );
-        for bad in ["", "1/0", "a/2", "1/2/3", "0.5", "1/-2"] {
+        // Decimals are exact rationals too (the grammar is schemes::rational's, shared with
+        // `subtess`).
+        assert_eq!(
+            parse_rational("0.5").map(|r| r.to_string()),
+            Ok("1/2".to_owned())
+        );
+        for bad in ["", "1/0", "a/2", "1/2/3", "1/-2"] {
             assert!(parse_rational(bad).is_err(), "{bad}");
         }
     }

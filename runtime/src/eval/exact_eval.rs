@@ -116,68 +116,18 @@ type Point = [BigRational; 3];
 /// Position, `d/du`, `d/dv` in patch parameters.
 type Derivatives = ([f64; 3], [f64; 3], [f64; 3]);
 
-/// Parse a parameter value: `p/q`, an integer, or a decimal like `0.25` (taken exactly, not
-/// through a float), which must lie in `[0, 1]`. DESIGN.md: rational parameters are written
-/// `p/q` on the command line and in JSON.
+/// Parse a parameter value in the one rational grammar ([`schemes::rational::parse_rational`]:
+/// `p/q`, an integer, or a decimal like `0.25` taken exactly, not through a float), which must
+/// lie in `[0, 1]`, a face's parameter domain. DESIGN.md: rational parameters are written `p/q`
+/// on the command line and in JSON.
 pub fn parse_rational(text: &str) -> Result<BigRational, RuntimeError> {
-    let bad = |reason: &str| RuntimeError::InvalidParameter {
+    let bad = |reason: String| RuntimeError::InvalidParameter {
         name: format!("`{text}`"),
-        reason: reason.to_owned(),
+        reason,
     };
-    let s = text.trim();
-    if s.is_empty() {
-        return Err(bad(
-            "it is empty; write a rational p/q, an integer or a decimal",
-        ));
-    }
-    let integer = |digits: &str, what: &str| -> Result<BigInt, RuntimeError> {
-        let unsigned = digits.strip_prefix(['+', '-']).unwrap_or(digits);
-        if unsigned.is_empty() || !unsigned.bytes().all(|b| b.is_ascii_digit()) {
-            return Err(bad(&format!("the {what} `{digits}` is not an integer")));
-        }
-        digits
-            .parse::<BigInt>()
-            .map_err(|_| bad(&format!("the {what} `{digits}` is not an integer")))
-    };
-    let value = if let Some((p, q)) = s.split_once('/') {
-        let (p, q) = (p.trim(), q.trim());
-        let numerator = integer(p, "numerator")?;
-        if q.starts_with(['+', '-']) {
-            return Err(bad("the denominator must be written without a sign"));
-        }
-        let denominator = integer(q, "denominator")?;
-        if denominator.is_zero() {
-            return Err(bad("the denominator is 0"));
-        }
-        BigRational::new(numerator, denominator)
-    } else if let Some((whole, fraction)) = s.split_once('.') {
-        let negative = whole.starts_with('-');
-        let digits = whole.strip_prefix(['+', '-']).unwrap_or(whole);
-        if (digits.is_empty() && fraction.is_empty())
-            || !digits
-                .bytes()
-                .chain(fraction.bytes())
-                .all(|b| b.is_ascii_digit())
-        {
-            return Err(bad(
-                "it is not a number; write a rational p/q, an integer or a decimal like 0.25",
-            ));
-        }
-        let all: BigInt = format!("{digits}{fraction}")
-            .parse()
-            .map_err(|_| bad("it is not a decimal number"))?;
-        let scale = num_traits::pow(BigInt::from(10), fraction.len());
-        let magnitude = BigRational::new(all, scale);
-        if negative {
-            -magnitude
-        } else {
-            magnitude
-        }
-    } else {
-        BigRational::from_integer(integer(s, "value")?)
-    };
+    let value = schemes::rational::parse_rational(text).map_err(|e| bad(e.to_string()))?;
     if value.is_negative() || value > BigRational::one() {
-        return Err(bad(&format!(
+        return Err(bad(format!(
             "{value} is outside [0, 1]; a face's parameters lie in [0, 1]"
         )));
     }
