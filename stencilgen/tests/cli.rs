@@ -118,7 +118,7 @@ fn stencil_bad_input() {
         ),
         (
             "stencil --scheme catmull-clark --valence 5 --u 1/0 --v 0",
-            "denominator is zero",
+            "denominator is 0",
         ),
         (
             "stencil --scheme catmull-clark --valence 2 --u 0 --v 0",

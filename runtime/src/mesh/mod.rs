@@ -7,6 +7,7 @@ pub mod source;
 #[cfg(test)]
 pub(crate) mod test_meshes;
 pub mod topology;
+pub mod triangle_grid;
 pub mod triangle_mesh;
 pub mod triangle_topology;
 

@@ -64,12 +64,11 @@
 //! * Between samples of `G`: `e_f` is a maximum over samples, not over the continuum; the tests
 //!   measure the output again on other grids (dual points at rates 23 and 19).
 
-use std::collections::HashMap;
-
 use rayon::prelude::*;
 use table_format::{PointSet, SectionKey, StencilKind};
 
 use crate::mesh::topology::{Mesh, NONE};
+use crate::mesh::triangle_grid::TriangleGrid;
 use crate::mesh::triangle_mesh::TriangleMesh;
 use crate::scheme::patch::{dual_index_in_patch, FacePatch};
 use crate::stencil_table::StencilTable;
@@ -752,7 +751,7 @@ pub fn measure_deviation(
             reason: "it has no triangles".to_owned(),
         });
     }
-    let cells = TriangleCells::new(tessellation);
+    let cells = TriangleGrid::from_mesh(tessellation);
     let per_face = patches
         .par_iter()
         .map(|patch| -> Result<f64, RuntimeError> {
@@ -761,124 +760,11 @@ pub fn measure_deviation(
             Ok(samples
                 .positions
                 .iter()
-                .map(|&p| cells.distance(p))
+                .map(|&p| cells.nearest_distance(p))
                 .fold(0.0, f64::max))
         })
         .collect::<Result<Vec<_>, _>>()?;
     Ok(per_face.into_iter().fold(0.0, f64::max))
-}
-
-/// Triangles bucketed in a uniform grid of cubic cells (by bounding box).
-pub(crate) struct TriangleCells {
-    triangles: Vec<[[f64; 3]; 3]>,
-    size: f64,
-    cells: HashMap<[i64; 3], Vec<u32>>,
-    /// Cell-index bounds of all triangles.
-    low: [i64; 3],
-    high: [i64; 3],
-}
-
-impl TriangleCells {
-    /// Bucket the triangles of `mesh` (cells about twice the mean triangle size).
-    pub(crate) fn new(mesh: &TriangleMesh) -> Self {
-        let position = |i: u32| mesh.positions[i as usize].map(f64::from);
-        let triangles: Vec<[[f64; 3]; 3]> = mesh
-            .triangles
-            .iter()
-            .map(|t| [position(t[0]), position(t[1]), position(t[2])])
-            .collect();
-        let extent = |t: &[[f64; 3]; 3]| {
-            (0..3)
-                .map(|c| {
-                    let (lo, hi) = bounds(t, c);
-                    hi - lo
-                })
-                .fold(0.0, f64::max)
-        };
-        let mean = triangles.iter().map(extent).sum::<f64>() / triangles.len() as f64;
-        let size = if mean > 0.0 { 2.0 * mean } else { 1.0 };
-        let mut cells: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
-        let (mut low, mut high) = ([i64::MAX; 3], [i64::MIN; 3]);
-        for (k, t) in triangles.iter().enumerate() {
-            let mut range = [(0i64, 0i64); 3];
-            for (c, r) in range.iter_mut().enumerate() {
-                let (lo, hi) = bounds(t, c);
-                *r = ((lo / size).floor() as i64, (hi / size).floor() as i64);
-                low[c] = low[c].min(r.0);
-                high[c] = high[c].max(r.1);
-            }
-            for x in range[0].0..=range[0].1 {
-                for y in range[1].0..=range[1].1 {
-                    for z in range[2].0..=range[2].1 {
-                        cells.entry([x, y, z]).or_default().push(k as u32);
-                    }
-                }
-            }
-        }
-        TriangleCells {
-            triangles,
-            size,
-            cells,
-            low,
-            high,
-        }
-    }
-
-    /// The distance from `p` to the nearest triangle: cells in shells of growing Chebyshev
-    /// radius `r` around `p`'s cell, until the best distance found is at most the distance from
-    /// `p` to the searched block's surface (nothing outside the block can be nearer).
-    pub(crate) fn distance(&self, p: [f64; 3]) -> f64 {
-        let home = p.map(|x| (x / self.size).floor() as i64);
-        let reach = (0..3)
-            .map(|c| {
-                (home[c] - self.low[c])
-                    .abs()
-                    .max((self.high[c] - home[c]).abs())
-            })
-            .max()
-            .unwrap_or(0);
-        let mut best = f64::INFINITY;
-        for r in 0..=reach {
-            for x in home[0] - r..=home[0] + r {
-                for y in home[1] - r..=home[1] + r {
-                    for z in home[2] - r..=home[2] + r {
-                        let shell = (x - home[0])
-                            .abs()
-                            .max((y - home[1]).abs())
-                            .max((z - home[2]).abs());
-                        if shell != r {
-                            continue;
-                        }
-                        if let Some(list) = self.cells.get(&[x, y, z]) {
-                            for &t in list {
-                                best = best
-                                    .min(point_triangle_distance(p, &self.triangles[t as usize]));
-                            }
-                        }
-                    }
-                }
-            }
-            // Everything within the distance from p to the searched block's surface was seen.
-            let gap = (0..3)
-                .map(|c| {
-                    let low = (home[c] - r) as f64 * self.size;
-                    let high = (home[c] + r + 1) as f64 * self.size;
-                    (p[c] - low).min(high - p[c])
-                })
-                .fold(f64::INFINITY, f64::min);
-            if best <= gap {
-                break;
-            }
-        }
-        best
-    }
-}
-
-fn bounds(t: &[[f64; 3]; 3], c: usize) -> (f64, f64) {
-    (
-        t[0][c].min(t[1][c]).min(t[2][c]),
-        t[0][c].max(t[1][c]).max(t[2][c]),
-    )
 }
 
 pub use crate::mesh::geometry::point_triangle_distance;

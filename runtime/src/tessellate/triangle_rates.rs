@@ -75,14 +75,13 @@ use rayon::prelude::*;
 use table_format::{PointSet, SectionKey, StencilKind};
 
 use crate::mesh::topology::NONE;
+use crate::mesh::triangle_grid::TriangleGrid;
 use crate::mesh::triangle_mesh::TriangleMesh;
 use crate::scheme::triangle::isolation::TriangleIsolation;
 use crate::scheme::triangle::patch::{dual_in_patch, dual_index, primal_in_patch, primal_index};
 use crate::stencil_table::StencilTable;
 use crate::tessellate::kernel::merge_rows;
-use crate::tessellate::rates::{
-    check_tolerance, select_rates, sorted_candidates, ToleranceRates, TriangleCells,
-};
+use crate::tessellate::rates::{check_tolerance, select_rates, sorted_candidates, ToleranceRates};
 use crate::tessellate::triangle_dual_grid::{zigzag_cell, TriangleStencils, MAX_TRIANGLE_RATE};
 use crate::RuntimeError;
 
@@ -665,7 +664,7 @@ pub fn measure_triangle_deviation(
             reason: "it has no triangles".to_owned(),
         });
     }
-    let cells = TriangleCells::new(tessellation);
+    let cells = TriangleGrid::from_mesh(tessellation);
     let samples = SampleGrid {
         rates: vec![grid],
         params: Vec::new(),
@@ -676,7 +675,7 @@ pub fn measure_triangle_deviation(
             Ok(ctx
                 .samples(f, &samples)?
                 .iter()
-                .map(|&p| cells.distance(p))
+                .map(|&p| cells.nearest_distance(p))
                 .fold(0.0, f64::max))
         })
         .collect::<Result<Vec<_>, _>>()?;
