@@ -18,6 +18,8 @@
 
 use nalgebra::DMatrix;
 
+use schemes::tangent_frame::frame_masks;
+
 use crate::extraordinary_patch::LocalMatrices;
 use crate::scalar::rational_to_f64;
 use crate::StencilError;
@@ -66,42 +68,23 @@ pub fn ev_tangents(matrices: &LocalMatrices) -> Result<EvTangents, StencilError>
         let t = step * ((i % edges) as f64);
         [t.cos(), t.sin()]
     };
-    let image = |w: &[f64]| -> [f64; 2] {
-        let points = (0..edges)
-            .map(|i| (w[1 + i], edge(i)))
-            .chain((0..faces).map(|i| {
-                let (e, f) = (edge(i), edge(i + 1));
-                (w[1 + edges + i], [e[0] + f[0], e[1] + f[1]])
-            }));
-        points.fold([0.0, 0.0], |acc, (weight, p)| {
-            [acc[0] + weight * p[0], acc[1] + weight * p[1]]
-        })
-    };
-    let (g0, g1) = (image(&basis[0]), image(&basis[1]));
-    let det = g0[0] * g1[1] - g0[1] * g1[0];
-    if det.abs() < 1e-12 {
-        return Err(failure(
-            "the eigenvectors do not span the reference net's plane",
-        ));
-    }
-    // The mask c0 w0 + c1 w1 with image `target`: solve [g0 g1]^T c = target.
-    let mask = |target: [f64; 2]| -> Vec<f64> {
-        let c0 = (target[0] * g1[1] - target[1] * g1[0]) / det;
-        let c1 = (g0[0] * target[1] - g0[1] * target[0]) / det;
-        let mut m: Vec<f64> = basis[0]
-            .iter()
-            .zip(&basis[1])
-            .map(|(a, b)| c0 * a + c1 * b)
-            .collect();
-        m.resize(matrices.size(), 0.0);
-        m
-    };
+    let net: Vec<(usize, [f64; 2])> = (0..edges)
+        .map(|i| (1 + i, edge(i)))
+        .chain((0..faces).map(|i| {
+            let (e, f) = (edge(i), edge(i + 1));
+            (1 + edges + i, [e[0] + f[0], e[1] + f[1]])
+        }))
+        .collect();
     let sector = matrices.sector as usize;
-    Ok(EvTangents {
-        lambda: l1,
-        du: mask(edge(sector)),
-        dv: mask(edge(sector + 1)),
-    })
+    let [du, dv] = frame_masks(
+        [&basis[0], &basis[1]],
+        &net,
+        [1.0, 1.0],
+        [edge(sector), edge(sector + 1)],
+        matrices.size(),
+    )
+    .ok_or_else(|| failure("the eigenvectors do not span the reference net's plane"))?;
+    Ok(EvTangents { lambda: l1, du, dv })
 }
 
 /// The two largest eigenvalues of `a1` whose modulus is not 1 (real parts), by a bounded

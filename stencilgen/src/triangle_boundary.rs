@@ -41,6 +41,7 @@
 //! `docs/algorithms/triangle-schemes.md`).
 
 use nalgebra::DMatrix;
+use schemes::tangent_frame::frame_masks;
 use schemes::triangle_local::{TriangleLocalMatrices, TriangleNeighbourhood};
 
 use crate::ev_tangents::left_null_space;
@@ -165,34 +166,22 @@ pub fn loop_boundary_tangents(
         let a = step * i as f64;
         [a.cos(), a.sin()]
     };
-    let image = |w: &[f64]| {
-        (0..=k).fold([0.0, 0.0], |acc, i| {
-            let e = edge(i);
-            [acc[0] + w[1 + i] * e[0], acc[1] + w[1 + i] * e[1]]
-        })
-    };
-    let (g0, g1) = (image(&t), image(&c));
-    let det = g0[0] * g1[1] - g0[1] * g1[0];
-    if det.abs() < 1e-12 {
-        return Err(failure(
-            "the tangent and cross modes do not span the reference net's plane",
-        ));
-    }
-    // The mask c0 t + c1 c whose image is `target`.
-    let mask = |target: [f64; 2]| -> Vec<f64> {
-        let c0 = (target[0] * g1[1] - target[1] * g1[0]) / det;
-        let c1 = (g0[0] * target[1] - g0[1] * target[0]) / det;
-        let mut m: Vec<f64> = t.iter().zip(&c).map(|(a, b)| c0 * a + c1 * b).collect();
-        m.resize(matrices.size(), 0.0);
-        m
-    };
+    let net: Vec<(usize, [f64; 2])> = (0..=k).map(|i| (1 + i, edge(i))).collect();
     let s = sector as usize;
+    let [du, dv] = frame_masks(
+        [&t, &c],
+        &net,
+        [1.0, 1.0],
+        [edge(s), edge(s + 1)],
+        matrices.size(),
+    )
+    .ok_or_else(|| failure("the tangent and cross modes do not span the reference net's plane"))?;
     Ok(LoopBoundaryTangents {
         along: 0.5,
         across,
         ring_eigenvalues,
-        du: mask(edge(s)),
-        dv: mask(edge(s + 1)),
+        du,
+        dv,
     })
 }
 

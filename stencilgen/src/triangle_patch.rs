@@ -26,6 +26,7 @@ use num_bigint::BigInt;
 use num_integer::Integer;
 use num_rational::BigRational;
 use num_traits::{One, Zero};
+use schemes::tangent_frame::frame_masks;
 use schemes::triangle_local::{TriangleLocalMatrices, TriangleNeighbourhood};
 use schemes::TriangleScheme;
 
@@ -492,27 +493,16 @@ pub(crate) fn ring_tangents(a1: &DMatrix<f64>, v: usize) -> Result<(f64, [Vec<f6
         let t = 2.0 * std::f64::consts::PI * (i % v) as f64 / v as f64;
         [t.cos(), t.sin()]
     };
-    let image = |w: &[f64]| {
-        (0..v).fold([0.0, 0.0], |acc, i| {
-            let e = edge(i);
-            [acc[0] + w[1 + i] * e[0], acc[1] + w[1 + i] * e[1]]
-        })
-    };
-    let (g0, g1) = (image(&basis[0]), image(&basis[1]));
-    let det = g0[0] * g1[1] - g0[1] * g1[0];
-    if det.abs() < 1e-12 {
-        return Err("the eigenvectors do not span the reference net's plane".to_owned());
-    }
-    let mask = |target: [f64; 2]| -> Vec<f64> {
-        let c0 = (target[0] * g1[1] - target[1] * g1[0]) / det;
-        let c1 = (g0[0] * target[1] - g0[1] * target[0]) / det;
-        basis[0]
-            .iter()
-            .zip(&basis[1])
-            .map(|(a, b)| c0 * a + c1 * b)
-            .collect()
-    };
-    Ok((l1, [mask(edge(0)), mask(edge(1))]))
+    let net: Vec<(usize, [f64; 2])> = (0..v).map(|i| (1 + i, edge(i))).collect();
+    let masks = frame_masks(
+        [&basis[0], &basis[1]],
+        &net,
+        [1.0, 1.0],
+        [edge(0), edge(1)],
+        basis[0].len(),
+    )
+    .ok_or_else(|| "the eigenvectors do not span the reference net's plane".to_owned())?;
+    Ok((l1, masks))
 }
 
 #[cfg(test)]

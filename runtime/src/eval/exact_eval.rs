@@ -87,6 +87,7 @@ use num_integer::Integer;
 use num_rational::BigRational;
 use num_traits::{One, Signed, ToPrimitive, Zero};
 use schemes::local_matrices::{LocalMatrices, Neighbourhood, SUB_PATCH_ORIGINS};
+use schemes::tangent_frame::frame_masks;
 use schemes::QuadScheme;
 
 use crate::mesh::topology::Mesh;
@@ -800,38 +801,22 @@ fn tangent_masks(matrices: &LocalMatrices, level: usize) -> Option<(Vec<f64>, Ve
         let t = step * ((i % edges) as f64);
         [t.cos(), t.sin()]
     };
-    let image = |w: &[f64]| -> [f64; 2] {
-        let mut acc = [0.0, 0.0];
-        for i in 0..edges {
-            let e = edge(i);
-            acc[0] += w[1 + i] * e[0];
-            acc[1] += w[1 + i] * e[1];
-        }
-        for i in 0..faces {
+    let net: Vec<(usize, [f64; 2])> = (0..edges)
+        .map(|i| (1 + i, edge(i)))
+        .chain((0..faces).map(|i| {
             let (e, f) = (edge(i), edge(i + 1));
-            acc[0] += w[1 + edges + i] * (e[0] + f[0]);
-            acc[1] += w[1 + edges + i] * (e[1] + f[1]);
-        }
-        acc
-    };
-    let (g0, g1) = (image(&basis[0]), image(&basis[1]));
-    let det = g0[0] * g1[1] - g0[1] * g1[0];
-    if det.is_nan() || det.abs() <= 1e-12 {
-        return None;
-    }
-    let mask = |target: [f64; 2]| -> Vec<f64> {
-        let c0 = scales[0] * (target[0] * g1[1] - target[1] * g1[0]) / det;
-        let c1 = scales[1] * (g0[0] * target[1] - g0[1] * target[0]) / det;
-        let mut m: Vec<f64> = basis[0]
-            .iter()
-            .zip(&basis[1])
-            .map(|(a, b)| c0 * a + c1 * b)
-            .collect();
-        m.resize(matrices.size(), 0.0);
-        m
-    };
+            (1 + edges + i, [e[0] + f[0], e[1] + f[1]])
+        }))
+        .collect();
     let sector = matrices.sector as usize;
-    Some((mask(edge(sector)), mask(edge(sector + 1))))
+    let [du, dv] = frame_masks(
+        [&basis[0], &basis[1]],
+        &net,
+        [scales[0], scales[1]],
+        [edge(sector), edge(sector + 1)],
+        matrices.size(),
+    )?;
+    Some((du, dv))
 }
 
 /// `count` independent null vectors of the (numerically) singular square matrix `b`, whose

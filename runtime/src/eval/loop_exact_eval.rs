@@ -39,6 +39,7 @@ use num_bigint::BigInt;
 use num_rational::BigRational;
 use num_traits::{One, Signed, ToPrimitive, Zero};
 use schemes::loop_regular::{RegularDerivative, RegularLoopPatch, REGULAR_NET};
+use schemes::tangent_frame::frame_masks;
 use schemes::triangle_local::{TriangleLocalMatrices, SUB_TRIANGLES};
 use schemes::TriangleScheme;
 
@@ -437,18 +438,18 @@ fn boundary_tangents(
         })?;
     let step = std::f64::consts::PI / k.max(2) as f64;
     let edge = |i: usize| [(step * i as f64).cos(), (step * i as f64).sin()];
-    let image = |w: &[f64]| {
-        (0..=k).fold([0.0, 0.0], |acc, i| {
-            let e = edge(i);
-            [acc[0] + w[1 + i] * e[0], acc[1] + w[1 + i] * e[1]]
-        })
-    };
-    let (g0, g1) = (image(&t), image(&c));
-    let det = g0[0] * g1[1] - g0[1] * g1[0];
-    let mask = |target: [f64; 2]| -> Vec<f64> {
-        let c0 = (target[0] * g1[1] - target[1] * g1[0]) / det;
-        let c1 = (g0[0] * target[1] - g0[1] * target[0]) / det;
-        t.iter().zip(&c).map(|(a, b)| c0 * a + c1 * b).collect()
-    };
-    Ok((mask(edge(sector)), mask(edge(sector + 1))))
+    let net: Vec<(usize, [f64; 2])> = (0..=k).map(|i| (1 + i, edge(i))).collect();
+    let [du, dv] = frame_masks(
+        [&t, &c],
+        &net,
+        [1.0, 1.0],
+        [edge(sector), edge(sector + 1)],
+        t.len(),
+    )
+    .ok_or_else(|| {
+        RuntimeError::Unsupported(format!(
+            "the tangent and cross modes at a boundary vertex with {k} triangles do not span the reference net's plane"
+        ))
+    })?;
+    Ok((du, dv))
 }

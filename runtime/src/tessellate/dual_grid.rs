@@ -542,10 +542,12 @@ impl GridPlan for DualGrid<'_> {
     fn vertex_count(&self) -> usize {
         self.vertex_count
     }
+
     /// Output triangles per frame.
     fn triangle_count(&self) -> usize {
         self.connectivity.triangle_count()
     }
+
     /// Where every output vertex is evaluated, in output order.
     fn sources(&self) -> Vec<VertexSource> {
         let mut out = Vec::with_capacity(self.vertex_count);
@@ -565,6 +567,7 @@ impl GridPlan for DualGrid<'_> {
         out.extend(self.boundary_points.iter().map(|p| p.source));
         out
     }
+
     /// Evaluate every output vertex from the control points `control` (the mesh's vertex
     /// positions): limit positions and unit normals, `vertex_count()` each.
     fn evaluate(&self, control: &[[f32; 3]], positions: &mut [[f32; 3]], normals: &mut [[f32; 3]]) {
@@ -585,6 +588,7 @@ impl GridPlan for DualGrid<'_> {
             curve_normals,
         );
     }
+
     /// Write every triangle (`triangle_count()` of them).
     fn connect(&self, triangles: &mut [[u32; 3]]) {
         self.connectivity.connect(
@@ -593,6 +597,7 @@ impl GridPlan for DualGrid<'_> {
             |s, out| connect_strip(&self.strips[s], out),
         );
     }
+
     /// How many faces take the separable (tensor-product) path.
     fn separable_faces(&self) -> usize {
         self.faces

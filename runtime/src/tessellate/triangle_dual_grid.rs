@@ -575,10 +575,12 @@ impl GridPlan for TriangleDualGrid<'_> {
     fn vertex_count(&self) -> usize {
         self.vertex_count
     }
+
     /// Output triangles per frame.
     fn triangle_count(&self) -> usize {
         self.connectivity.triangle_count()
     }
+
     /// Where every output vertex is evaluated, in output order, in the tessellated mesh's
     /// triangles: dual points over `3n`, primal points over `n`.
     fn sources(&self) -> Vec<VertexSource> {
@@ -608,6 +610,7 @@ impl GridPlan for TriangleDualGrid<'_> {
         out.extend(self.points.iter().map(|p| p.source));
         out
     }
+
     /// Evaluate every output vertex from the control points `control` (the mesh's vertex
     /// positions): limit positions and unit normals, `vertex_count()` each.
     fn evaluate(&self, control: &[[f32; 3]], positions: &mut [[f32; 3]], normals: &mut [[f32; 3]]) {
@@ -640,6 +643,7 @@ impl GridPlan for TriangleDualGrid<'_> {
             },
         );
     }
+
     /// Write every triangle (`triangle_count()` of them).
     fn connect(&self, triangles: &mut [[u32; 3]]) {
         self.connectivity.connect(
