@@ -194,7 +194,8 @@ impl Surface {
     }
 
     /// The isolated mesh's control points for input positions `positions` (one per input
-    /// vertex), into `out`; `None` when isolation took no step (the input is the control).
+    /// vertex), into `out`; `false` (and `out` untouched) when isolation took no step, so that
+    /// the input itself is the control.
     fn control_points(&self, positions: &[[f32; 3]], out: &mut Vec<[f32; 3]>) -> bool {
         match &self.refinement {
             Some(map) => {
