@@ -15,6 +15,33 @@
 //! Each scheme builds its own net (the angles, in its own arithmetic, so that the tables stay
 //! byte for byte what they were); this module does the rest.
 
+/// Neighbour `i` (modulo `edges`) of a quad vertex's reference net: on the unit circle at
+/// `i` times `2 pi / faces` inside, `pi / max(faces, 2)` on a boundary (whose `faces + 1` edge
+/// neighbours then span a half-turn).
+pub fn quad_edge(boundary: bool, edges: usize, faces: usize, i: usize) -> [f64; 2] {
+    let step = if boundary {
+        std::f64::consts::PI / faces.max(2) as f64
+    } else {
+        2.0 * std::f64::consts::PI / faces as f64
+    };
+    let t = step * ((i % edges) as f64);
+    [t.cos(), t.sin()]
+}
+
+/// The reference net of a quad vertex's ring `V, E_1..E_edges, F_1..F_faces` (layout indices
+/// `0`, `1..=edges`, then the faces): `V = 0`, the edge neighbours at [`quad_edge`], each face
+/// point the sum of its two edge neighbours.
+pub fn quad_net(boundary: bool, edges: usize, faces: usize) -> Vec<(usize, [f64; 2])> {
+    let edge = |i| quad_edge(boundary, edges, faces, i);
+    (0..edges)
+        .map(|i| (1 + i, edge(i)))
+        .chain((0..faces).map(|i| {
+            let (e, f) = (edge(i), edge(i + 1));
+            (1 + edges + i, [e[0] + f[0], e[1] + f[1]])
+        }))
+        .collect()
+}
+
 /// The image `sum_j w[j] net[j]` of a mask on a reference net given as `(index, point)` pairs,
 /// summed in the net's order.
 pub fn net_image(w: &[f64], net: &[(usize, [f64; 2])]) -> [f64; 2] {

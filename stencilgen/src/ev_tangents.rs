@@ -18,7 +18,7 @@
 
 use nalgebra::DMatrix;
 
-use schemes::tangent_frame::frame_masks;
+use schemes::tangent_frame::{frame_masks, quad_edge, quad_net};
 
 use crate::extraordinary_patch::LocalMatrices;
 use crate::scalar::rational_to_f64;
@@ -59,22 +59,9 @@ pub fn ev_tangents(matrices: &LocalMatrices) -> Result<EvTangents, StencilError>
             "the tangent plane is not spanned by two eigenvectors",
         ));
     }
-    // The reference net: V = 0, E_i at angle theta_i, F_i = E_i + E_{i+1}.
-    let step = match nb.boundary {
-        None => 2.0 * std::f64::consts::PI / faces as f64,
-        Some(_) => std::f64::consts::PI / faces.max(2) as f64,
-    };
-    let edge = |i: usize| {
-        let t = step * ((i % edges) as f64);
-        [t.cos(), t.sin()]
-    };
-    let net: Vec<(usize, [f64; 2])> = (0..edges)
-        .map(|i| (1 + i, edge(i)))
-        .chain((0..faces).map(|i| {
-            let (e, f) = (edge(i), edge(i + 1));
-            (1 + edges + i, [e[0] + f[0], e[1] + f[1]])
-        }))
-        .collect();
+    let boundary = nb.boundary.is_some();
+    let edge = |i: usize| quad_edge(boundary, edges, faces, i);
+    let net = quad_net(boundary, edges, faces);
     let sector = matrices.sector as usize;
     let [du, dv] = frame_masks(
         [&basis[0], &basis[1]],

@@ -87,7 +87,7 @@ use num_integer::Integer;
 use num_rational::BigRational;
 use num_traits::{One, Signed, ToPrimitive, Zero};
 use schemes::local_matrices::{LocalMatrices, Neighbourhood, SUB_PATCH_ORIGINS};
-use schemes::tangent_frame::frame_masks;
+use schemes::tangent_frame::{frame_masks, quad_edge, quad_net};
 use schemes::QuadScheme;
 
 use crate::mesh::topology::Mesh;
@@ -793,21 +793,9 @@ fn tangent_masks(matrices: &LocalMatrices, level: usize) -> Option<(Vec<f64>, Ve
     let level = i32::try_from(level).unwrap_or(i32::MAX);
     let scales: Vec<f64> = basis.iter().map(|(_, l)| (2.0 * l).powi(-level)).collect();
     let basis: Vec<Vec<f64>> = basis.into_iter().map(|(w, _)| w).collect();
-    let step = match nb.boundary {
-        None => 2.0 * std::f64::consts::PI / faces as f64,
-        Some(_) => std::f64::consts::PI / faces.max(2) as f64,
-    };
-    let edge = |i: usize| {
-        let t = step * ((i % edges) as f64);
-        [t.cos(), t.sin()]
-    };
-    let net: Vec<(usize, [f64; 2])> = (0..edges)
-        .map(|i| (1 + i, edge(i)))
-        .chain((0..faces).map(|i| {
-            let (e, f) = (edge(i), edge(i + 1));
-            (1 + edges + i, [e[0] + f[0], e[1] + f[1]])
-        }))
-        .collect();
+    let boundary = nb.boundary.is_some();
+    let edge = |i: usize| quad_edge(boundary, edges, faces, i);
+    let net = quad_net(boundary, edges, faces);
     let sector = matrices.sector as usize;
     let [du, dv] = frame_masks(
         [&basis[0], &basis[1]],
