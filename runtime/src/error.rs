@@ -53,6 +53,36 @@ pub enum MeshError {
         /// Its number of vertices.
         vertices: usize,
     },
+    /// A `t` tag line is malformed or names something the mesh lacks.
+    #[error("tag `{name}` (OBJ line {line}): {reason}")]
+    BadTag {
+        /// The tag's name.
+        name: String,
+        /// 1-based OBJ line.
+        line: usize,
+        /// What is wrong.
+        reason: String,
+    },
+    /// A tag names an edge the mesh does not have.
+    #[error("there is no edge between vertices {a} and {b} (0-based, as tags count)")]
+    NoSuchEdge {
+        /// 0-based end vertex.
+        a: usize,
+        /// 0-based end vertex.
+        b: usize,
+    },
+    /// A tag names a vertex the mesh does not have.
+    #[error("there is no vertex {vertex} (0-based, as tags count)")]
+    NoSuchVertex {
+        /// 0-based vertex.
+        vertex: usize,
+    },
+    /// A tag names a face the mesh does not have.
+    #[error("there is no face {face} (0-based, as tags count)")]
+    NoSuchFace {
+        /// 0-based face.
+        face: usize,
+    },
     /// The faces around a vertex form more than one fan.
     #[error("vertex {vertex} (OBJ `v` number {}) is non-manifold: its {faces} faces form more than one fan", vertex + 1)]
     NonManifoldVertex {

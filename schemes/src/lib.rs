@@ -19,6 +19,7 @@ pub mod butterfly_regions;
 pub mod cone;
 pub mod cone_local;
 pub mod cone_regions;
+pub mod crease;
 pub mod curve;
 pub mod local_matrices;
 pub mod loop_regular;
@@ -35,6 +36,7 @@ pub mod triangle_local;
 mod cone_rules;
 
 pub use bivariate::BivariateMask;
+pub use crease::{CreaseMethod, CreaseRule};
 pub use curve::{Component, CurveScheme, Term, Translates};
 pub use quad::{BoundaryMode, BoundaryRules, QuadScheme, VertexRule};
 pub use triangle::{LatticeMask, TriangleScheme, TriangleVertexRule, TriangleWeight};

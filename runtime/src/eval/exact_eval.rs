@@ -92,7 +92,7 @@ use schemes::QuadScheme;
 
 use crate::mesh::topology::Mesh;
 use crate::scheme::catmull_clark::isolate::MAX_STEPS;
-use crate::scheme::catmull_clark::refine::{refine, refined_vertex, EdgeIds};
+use crate::scheme::catmull_clark::refine::{refine, refined_vertex, LevelEdges};
 use crate::scheme::patch::face_patch;
 use crate::scheme::patch::gather_patches;
 use crate::scheme::stencil::Weight;
@@ -165,7 +165,7 @@ pub struct ExactEvaluator {
     /// `levels[0]` is the mesh, `levels[i]` its `i`-th refinement.
     levels: Vec<Mesh>,
     /// The edge numbering of each refinement step (`levels[i]` -> `levels[i + 1]`).
-    edges: Vec<EdgeIds>,
+    edges: Vec<LevelEdges>,
     scheme: QuadScheme,
     /// The operators of every patch kind met so far.
     operators: Mutex<HashMap<(Neighbourhood, u32), Arc<PatchOperators>>>,
@@ -219,7 +219,7 @@ impl ExactEvaluator {
             if gather_patches(last).is_ok() {
                 break;
             }
-            edges.push(EdgeIds::new(last));
+            edges.push(LevelEdges::new(last));
             let next = refine(last).mesh;
             levels.push(next);
         }

@@ -9,7 +9,7 @@
 
 use std::path::Path;
 
-use schemes::BoundaryMode;
+use schemes::{BoundaryMode, CreaseMethod};
 
 use crate::mesh::Mesh;
 use crate::{MeshError, RuntimeError};
@@ -157,36 +157,149 @@ pub fn read_obj(path: &Path) -> Result<ObjMesh, RuntimeError> {
     })
 }
 
+/// Whether a tag with `ints` integer arguments is well formed for `name`, or why not.
+fn check_tag(tag: &Tag, ints_per_item: usize, strings: usize) -> Result<usize, MeshError> {
+    let bad = |reason: String| MeshError::BadTag {
+        name: tag.name.clone(),
+        line: tag.line,
+        reason,
+    };
+    if tag.strings.len() < strings {
+        return Err(bad(format!("it needs {strings} string argument(s)")));
+    }
+    if ints_per_item == 0 {
+        return Ok(0);
+    }
+    if tag.ints.is_empty() || tag.ints.len() % ints_per_item != 0 {
+        return Err(bad(format!(
+            "it needs a multiple of {ints_per_item} integers, it has {}",
+            tag.ints.len()
+        )));
+    }
+    let items = tag.ints.len() / ints_per_item;
+    // One sharpness for every item, or one each (a hole has none).
+    let floats_ok = tag.name == "hole" || tag.floats.len() == 1 || tag.floats.len() == items;
+    if !floats_ok {
+        return Err(bad(format!(
+            "{items} item(s) need 1 or {items} sharpness values, it has {}",
+            tag.floats.len()
+        )));
+    }
+    if let Some(&i) = tag.ints.iter().find(|&&i| i < 0) {
+        return Err(bad(format!("index {i} is negative")));
+    }
+    Ok(items)
+}
+
 impl Mesh {
-    /// Build from a parsed OBJ file; also returns one warning per tag name this runtime does not
-    /// honour yet (creases, corners, holes, ...), and reads `interpolateboundary`.
+    /// Build from a parsed OBJ file with its tags, as OpenSubdiv's regression reader applies
+    /// them: `crease a b .. s ..` (edge sharpness, one value or one per edge), `corner v .. s ..`
+    /// (vertex sharpness), `hole f ..`, `interpolateboundary 0|1|2` (none, edge and corner,
+    /// edge only: the default), `creasemethod normal|chaikin`, `smoothtriangles
+    /// catmark|smooth`. Also returns one warning per tag name it ignores: the hierarchical edits
+    /// (`vertexedit`, `edgeedit`, `faceedit`, which OpenSubdiv 3 ignores too) and names it does
+    /// not know. Face-varying tags do not affect positions.
     pub fn from_obj(obj: &ObjMesh) -> Result<(Self, Vec<String>), MeshError> {
         let mut boundary = BoundaryMode::EdgeOnly;
+        let mut boundary_none = false;
         let mut unsupported: Vec<(String, usize)> = Vec::new();
         for tag in &obj.tags {
-            match (tag.name.as_str(), tag.ints.first()) {
-                ("interpolateboundary", Some(1)) => boundary = BoundaryMode::EdgeAndCorner,
-                ("interpolateboundary", Some(2)) => boundary = BoundaryMode::EdgeOnly,
-                // Face-varying data does not affect positions.
-                ("facevaryinginterpolateboundary" | "facevaryingpropagatecorners", _) => {}
-                (name, _) => match unsupported.iter_mut().find(|(n, _)| n == name) {
+            if tag.name == "interpolateboundary" {
+                match tag.ints[..] {
+                    [0] => (boundary, boundary_none) = (BoundaryMode::EdgeOnly, true),
+                    [1] => (boundary, boundary_none) = (BoundaryMode::EdgeAndCorner, false),
+                    [2] => (boundary, boundary_none) = (BoundaryMode::EdgeOnly, false),
+                    _ => {
+                        return Err(MeshError::BadTag {
+                            name: tag.name.clone(),
+                            line: tag.line,
+                            reason: format!("{:?} is not one integer 0, 1 or 2", tag.ints),
+                        })
+                    }
+                }
+            }
+        }
+        let mut mesh = Mesh::new(obj.positions.clone(), &obj.faces, &obj.face_lines, boundary)?;
+        // Boundary edges tagged infinitely sharp by hand: "none" keeps their faces.
+        let mut sharp_boundary: Vec<(usize, usize)> = Vec::new();
+        for tag in &obj.tags {
+            let at = |e: MeshError| MeshError::BadTag {
+                name: tag.name.clone(),
+                line: tag.line,
+                reason: e.to_string(),
+            };
+            let sharpness = |item: usize| {
+                tag.floats
+                    .get(item)
+                    .or(tag.floats.first())
+                    .map_or(0.0, |&s| s as f32)
+            };
+            match tag.name.as_str() {
+                "crease" => {
+                    for (item, pair) in tag.ints.chunks(2).take(check_tag(tag, 2, 0)?).enumerate() {
+                        let (a, b) = (pair[0] as usize, pair[1] as usize);
+                        let s = sharpness(item);
+                        mesh.set_edge_sharpness(a, b, s).map_err(at)?;
+                        if s >= schemes::crease::INFINITE {
+                            sharp_boundary.push((a.min(b), a.max(b)));
+                        }
+                    }
+                }
+                "corner" => {
+                    for (item, &v) in tag.ints.iter().take(check_tag(tag, 1, 0)?).enumerate() {
+                        mesh.set_vertex_sharpness(v as usize, sharpness(item))
+                            .map_err(at)?;
+                    }
+                }
+                "hole" => {
+                    for &f in tag.ints.iter().take(check_tag(tag, 1, 0)?) {
+                        *mesh
+                            .holes
+                            .get_mut(f as usize)
+                            .ok_or(MeshError::NoSuchFace { face: f as usize })
+                            .map_err(at)? = true;
+                    }
+                }
+                "creasemethod" | "smoothtriangles" => {
+                    check_tag(tag, 0, 1)?;
+                    match (tag.name.as_str(), tag.strings[0].as_str()) {
+                        ("creasemethod", "normal") => mesh.creasing = CreaseMethod::Uniform,
+                        ("creasemethod", "chaikin") => mesh.creasing = CreaseMethod::Chaikin,
+                        ("smoothtriangles", "catmark") => mesh.smooth_triangles = false,
+                        ("smoothtriangles", "smooth") => mesh.smooth_triangles = true,
+                        (name, value) => {
+                            return Err(MeshError::BadTag {
+                                name: name.to_owned(),
+                                line: tag.line,
+                                reason: format!("`{value}` is not one of its values"),
+                            })
+                        }
+                    }
+                }
+                // Read above; face-varying data does not affect positions.
+                "interpolateboundary"
+                | "facevaryinginterpolateboundary"
+                | "facevaryingpropagatecorners" => {}
+                name => match unsupported.iter_mut().find(|(n, _)| n == name) {
                     Some((_, count)) => *count += 1,
                     None => unsupported.push((name.to_owned(), 1)),
                 },
             }
         }
+        if boundary_none {
+            mesh.exclude_boundary_faces(&sharp_boundary);
+        }
         let warnings = unsupported
             .into_iter()
             .map(|(name, count)| {
-                format!("tag `{name}` ({count} line(s)) is not supported yet and is ignored")
+                format!("tag `{name}` ({count} line(s)) is not supported and is ignored")
             })
             .collect();
-        let mesh = Mesh::new(obj.positions.clone(), &obj.faces, &obj.face_lines, boundary)?;
         Ok((mesh, warnings))
     }
 
-    /// Read an OBJ file (with its `t` tags) into a mesh; tags this runtime does not honour yet
-    /// are ignored (see [`Mesh::read_obj_with_warnings`] for the list).
+    /// Read an OBJ file (with its `t` tags, [`Mesh::from_obj`]) into a mesh; the tags it
+    /// ignores are listed by [`Mesh::read_obj_with_warnings`].
     pub fn read_obj(path: impl AsRef<Path>) -> Result<Mesh, RuntimeError> {
         Ok(Self::read_obj_with_warnings(path)?.0)
     }

@@ -7,8 +7,14 @@
 //! every face has at least three distinct, existing vertices, every coordinate is finite, every
 //! edge has one or two faces traversing it in opposite directions, and the faces around every
 //! vertex form a single fan (a disc, or a half-disc at the boundary).
+//!
+//! The mesh also carries its sharp features (OpenSubdiv's component tags): a sharpness per edge
+//! and per vertex, and the faces that are holes. Boundary edges are infinitely sharp, and in
+//! "edge and corner" mode so is a boundary vertex with one face, as OpenSubdiv makes them
+//! before the first refinement (`schemes::crease`).
 
-use schemes::BoundaryMode;
+use schemes::crease::INFINITE;
+use schemes::{BoundaryMode, CreaseMethod};
 
 use crate::MeshError;
 
@@ -33,6 +39,17 @@ pub struct Mesh {
     pub vertex_halfedge: Vec<u32>,
     /// The boundary rule.
     pub boundary: BoundaryMode,
+    /// The sharpness of every half-edge's edge (twins equal; boundary edges infinite).
+    pub edge_sharpness: Vec<f32>,
+    /// The sharpness of every vertex (a pinned boundary corner infinite).
+    pub vertex_sharpness: Vec<f32>,
+    /// Whether each face is a hole: it shapes its neighbours but makes no surface.
+    pub holes: Vec<bool>,
+    /// How semi-sharp edges decay from level to level.
+    pub creasing: CreaseMethod,
+    /// OpenSubdiv's "smooth triangles" option (`TRI_SUB_SMOOTH`): an edge next to a triangle
+    /// weighs the triangle's centroid by 0.47 instead of 0.25, for rounder triangle regions.
+    pub smooth_triangles: bool,
 }
 
 impl Mesh {
@@ -90,16 +107,135 @@ impl Mesh {
         }
         let mut mesh = Mesh {
             vertex_halfedge: vec![NONE; positions.len()],
+            vertex_sharpness: vec![0.0; positions.len()],
             positions,
+            holes: vec![false; faces.len()],
             face_offsets,
             twin: vec![NONE; face_vertices.len()],
+            edge_sharpness: vec![0.0; face_vertices.len()],
             face_vertices,
             face_of,
             boundary,
+            creasing: CreaseMethod::Uniform,
+            smooth_triangles: false,
         };
         mesh.link_twins()?;
         mesh.check_fans()?;
+        mesh.sharpen_boundary();
         Ok(mesh)
+    }
+
+    /// Make boundary edges infinitely sharp, and one-face boundary corners too in "edge and
+    /// corner" mode (OpenSubdiv's `Crease::SharpenBoundaryEdge` and `SharpenBoundaryVertex`).
+    pub(crate) fn sharpen_boundary(&mut self) {
+        for h in 0..self.twin.len() {
+            if self.twin[h] == NONE {
+                self.edge_sharpness[h] = INFINITE;
+            }
+        }
+        if self.boundary == BoundaryMode::EdgeAndCorner {
+            for v in 0..self.positions.len() {
+                if self.is_boundary_vertex(v) && self.fan(v).len() == 1 {
+                    self.vertex_sharpness[v] = INFINITE;
+                }
+            }
+        }
+    }
+
+    /// The half-edge running from `a` to `b`, or else from `b` to `a`.
+    pub fn find_halfedge(&self, a: usize, b: usize) -> Option<usize> {
+        let from = |a: usize, b: usize| {
+            (a < self.positions.len())
+                .then(|| self.vertex_edges(a))
+                .into_iter()
+                .flatten()
+                .find(|&h| self.face_vertices[h] as usize == a && self.head(h) as usize == b)
+        };
+        from(a, b).or_else(|| from(b, a))
+    }
+
+    /// Set the sharpness of edge `(a, b)` (both its half-edges); a boundary edge stays
+    /// infinitely sharp. Negative values count as 0, as in OpenSubdiv.
+    pub fn set_edge_sharpness(&mut self, a: usize, b: usize, s: f32) -> Result<(), MeshError> {
+        let h = self
+            .find_halfedge(a, b)
+            .ok_or(MeshError::NoSuchEdge { a, b })?;
+        if self.twin[h] != NONE {
+            let s = s.max(0.0);
+            self.edge_sharpness[h] = s;
+            self.edge_sharpness[self.twin[h] as usize] = s;
+        }
+        Ok(())
+    }
+
+    /// Set the sharpness of vertex `v`; a corner pinned by the boundary rule stays pinned.
+    pub fn set_vertex_sharpness(&mut self, v: usize, s: f32) -> Result<(), MeshError> {
+        let current = self
+            .vertex_sharpness
+            .get_mut(v)
+            .ok_or(MeshError::NoSuchVertex { vertex: v })?;
+        if *current < INFINITE {
+            *current = s.max(0.0);
+        }
+        Ok(())
+    }
+
+    /// Whether any edge or vertex is sharp beyond what the boundary rule makes sharp, or any
+    /// face is a hole: whether the mesh has features the smooth rules do not describe.
+    pub fn has_sharp_features(&self) -> bool {
+        let interior_sharp =
+            (0..self.twin.len()).any(|h| self.twin[h] != NONE && self.edge_sharpness[h] > 0.0);
+        let pinned = |v: usize| {
+            self.boundary == BoundaryMode::EdgeAndCorner
+                && self.is_boundary_vertex(v)
+                && self.fan(v).len() == 1
+        };
+        let sharp_vertex =
+            (0..self.positions.len()).any(|v| self.vertex_sharpness[v] > 0.0 && !pinned(v));
+        interior_sharp || sharp_vertex || self.holes.iter().any(|&h| h)
+    }
+
+    /// OpenSubdiv's "no boundary interpolation" (`interpolateboundary 0`): every face at a
+    /// boundary vertex with a boundary edge that is not infinitely sharp by a tag becomes a
+    /// hole (`sharp_boundary`: the edges so tagged, as sorted vertex pairs).
+    pub fn exclude_boundary_faces(&mut self, sharp_boundary: &[(usize, usize)]) {
+        for v in 0..self.positions.len() {
+            if !self.is_boundary_vertex(v) {
+                continue;
+            }
+            let edges = self.vertex_edges(v);
+            let untagged = edges.iter().any(|&h| {
+                let (a, b) = (v, self.opposite(h, v) as usize);
+                self.twin[h] == NONE && !sharp_boundary.contains(&(a.min(b), a.max(b)))
+            });
+            if untagged {
+                for h in self.fan(v) {
+                    self.holes[self.face_of[h] as usize] = true;
+                }
+            }
+        }
+    }
+
+    /// The edges at vertex `v`, one half-edge each, in fan order: the fan's outgoing
+    /// half-edges, then on the boundary the incoming boundary half-edge of the last face.
+    pub fn vertex_edges(&self, v: usize) -> Vec<usize> {
+        let mut edges = self.fan(v);
+        if self.is_boundary_vertex(v) {
+            if let Some(&last) = edges.last() {
+                edges.push(self.prev(last));
+            }
+        }
+        edges
+    }
+
+    /// The other end of half-edge `h`'s edge, seen from its end vertex `v`.
+    pub fn opposite(&self, h: usize, v: usize) -> u32 {
+        let tail = self.face_vertices[h];
+        if tail as usize == v {
+            self.head(h)
+        } else {
+            tail
+        }
     }
 
     /// The vertex positions as the f32 control points a frame takes
@@ -274,6 +410,61 @@ impl Mesh {
         let boundary = self.twin.iter().filter(|&&t| t == NONE).count() as i64;
         let edges = (halfedges + boundary) / 2;
         used - edges + self.faces() as i64
+    }
+}
+
+/// Give every vertex whose faces (in `faces`) form several edge-connected fans one vertex per
+/// fan: the extra copies are appended, and `origin` (the source vertex of every vertex, one
+/// entry per vertex already) grows with them. A fan here is a maximal set of faces around the
+/// vertex joined through edges at it.
+pub fn split_fans(faces: &mut [Vec<i64>], origin: &mut Vec<u32>) {
+    use std::collections::HashMap;
+    // Corners, numbered in face order; corners at one vertex sharing an edge are joined.
+    let mut corner_of: Vec<(usize, usize)> = Vec::new();
+    for (f, face) in faces.iter().enumerate() {
+        corner_of.extend((0..face.len()).map(|i| (f, i)));
+    }
+    let mut parent: Vec<usize> = (0..corner_of.len()).collect();
+    fn root(parent: &mut [usize], mut x: usize) -> usize {
+        while parent[x] != x {
+            parent[x] = parent[parent[x]];
+            x = parent[x];
+        }
+        x
+    }
+    let mut by_edge: HashMap<(i64, i64), usize> = HashMap::new();
+    for (c, &(f, i)) in corner_of.iter().enumerate() {
+        let face = &faces[f];
+        let v = face[i];
+        for w in [
+            face[(i + 1) % face.len()],
+            face[(i + face.len() - 1) % face.len()],
+        ] {
+            match by_edge.get(&(v, w)) {
+                Some(&other) => {
+                    let (a, b) = (root(&mut parent, c), root(&mut parent, other));
+                    parent[a] = b;
+                }
+                None => {
+                    by_edge.insert((v, w), c);
+                }
+            }
+        }
+    }
+    // The first fan of a vertex keeps it; each further fan gets a copy.
+    let mut copy_of_root: HashMap<usize, i64> = HashMap::new();
+    let mut first_root: HashMap<i64, usize> = HashMap::new();
+    for (c, &(f, i)) in corner_of.iter().enumerate() {
+        let v = faces[f][i];
+        let r = root(&mut parent, c);
+        let kept = *first_root.entry(v).or_insert(r);
+        if kept != r {
+            let copy = *copy_of_root.entry(r).or_insert_with(|| {
+                origin.push(origin[v as usize]);
+                origin.len() as i64 - 1
+            });
+            faces[f][i] = copy;
+        }
     }
 }
 

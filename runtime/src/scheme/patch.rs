@@ -61,6 +61,26 @@ pub fn is_irregular(mesh: &Mesh, v: usize) -> bool {
     }
 }
 
+/// Whether the limit over face `face` is the smooth one the tables describe: no edge at its
+/// corners is sharp (other than boundary edges) and no corner is sharp (other than the
+/// one-face corners "edge and corner" pins). A face next to sharp features is evaluated by
+/// feature-adaptive refinement instead ([`crate::scheme::catmull_clark::adaptive`]); only the
+/// edges at the corners matter, since the children of the others stay outside the face's
+/// refined neighbourhoods.
+pub fn is_smooth_patch(mesh: &Mesh, face: usize) -> bool {
+    mesh.face(face).iter().all(|&v| {
+        let v = v as usize;
+        let pinned = mesh.boundary == schemes::BoundaryMode::EdgeAndCorner
+            && mesh.is_boundary_vertex(v)
+            && mesh.fan(v).len() == 1;
+        (mesh.vertex_sharpness[v] == 0.0 || pinned)
+            && mesh
+                .vertex_edges(v)
+                .iter()
+                .all(|&h| mesh.twin[h] == NONE || mesh.edge_sharpness[h] == 0.0)
+    })
+}
+
 /// The patch of quad face `face`.
 pub fn face_patch(mesh: &Mesh, face: usize) -> Result<FacePatch, MeshError> {
     let not_isolated = |reason: String| MeshError::NotIsolated { face, reason };

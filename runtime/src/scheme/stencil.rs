@@ -6,7 +6,7 @@
 //! Row `i` is `p'_i = sum_k w_k p_{j_k}` over its entries; rows are stored compressed (CSR),
 //! their entries sorted by index, no index twice, no zero weight.
 
-use std::ops::{Add, Mul};
+use std::ops::{Add, Mul, Sub};
 
 use num_bigint::BigInt;
 use num_rational::BigRational;
@@ -15,20 +15,34 @@ use rayon::prelude::*;
 
 /// The scalars refinement rules are written in: `f64` for positions and per-frame stencils,
 /// [`BigRational`] for exact evaluation. A rule written once over `W` serves both.
-pub trait Weight: Clone + Zero + Add<Output = Self> + Mul<Output = Self> + Send + Sync {
+pub trait Weight:
+    Clone + Zero + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Send + Sync
+{
     /// The weight `p / q` (`q != 0`), exact where `Self` can hold it.
     fn ratio(p: i64, q: i64) -> Self;
+
+    /// The weight of a finite `f32` (a sharpness, a fractional weight), exactly: every `f32` is
+    /// a dyadic rational.
+    fn from_f32(x: f32) -> Self;
 }
 
 impl Weight for f64 {
     fn ratio(p: i64, q: i64) -> Self {
         p as f64 / q as f64
     }
+
+    fn from_f32(x: f32) -> Self {
+        f64::from(x)
+    }
 }
 
 impl Weight for BigRational {
     fn ratio(p: i64, q: i64) -> Self {
         BigRational::new(BigInt::from(p), BigInt::from(q))
+    }
+
+    fn from_f32(x: f32) -> Self {
+        BigRational::from_float(x).unwrap_or_else(BigRational::zero)
     }
 }
 
@@ -73,6 +87,18 @@ impl<W: Weight> Stencil<W> {
             weights: vec![W::ratio(1, 1); n],
             columns: n,
         }
+    }
+
+    /// The map of rows `rows` of this one, in that order (a row may repeat).
+    pub fn select(&self, rows: &[u32]) -> Self {
+        let mut out = Stencil::new(self.columns);
+        for &r in rows {
+            let (js, ws) = self.row(r as usize);
+            out.indices.extend_from_slice(js);
+            out.weights.extend_from_slice(ws);
+            out.offsets.push(out.indices.len() as u32);
+        }
+        out
     }
 
     /// An empty map from `columns` source points; rows follow with [`Stencil::push_row`].

@@ -32,12 +32,13 @@ use table_format::{PointSet, SectionKey, StencilKind};
 
 use crate::mesh::topology::{Mesh, NONE};
 use crate::mesh::triangle_mesh::{TriangleMesh, VertexSource};
-use crate::scheme::patch::{dual_index_in_patch, FacePatch};
+use crate::scheme::catmull_clark::adaptive::{limit_stencils, LimitQuery, LimitStencil};
+use crate::scheme::patch::{dual_index_in_patch, is_smooth_patch, FacePatch};
 use crate::stencil_table::StencilTable;
 pub use crate::tessellate::kernel::TessellationTime;
 use crate::tessellate::kernel::{
-    cross, evaluate_points, for_each_range, merge_rows, unit, weighted_point, Connectivity,
-    GridPlan, PointPlan, Stencils, MAX_PATCH,
+    cross, evaluate_points, for_each_range, gathered_point, merge_rows, unit, weighted_point,
+    Connectivity, GridPlan, PointPlan, Stencils, MAX_PATCH,
 };
 use crate::RuntimeError;
 
@@ -150,6 +151,11 @@ enum FaceEval<'t> {
         control: Range<u32>,
         corner: u8,
     },
+    /// A face the tables do not describe (sharp features, a valence beyond the table's):
+    /// stencils from feature-adaptive refinement ([`crate::scheme::catmull_clark::adaptive`]),
+    /// in the face's own parameters, `control.len()` weights a point in three blocks (position,
+    /// d/du, d/dv) from `weights` in [`DualGrid::local_weights`].
+    Local { control: Range<u32>, weights: usize },
 }
 
 /// A row of output vertices `start + t * step`, `t = 0..len`, at parameters
@@ -196,7 +202,11 @@ pub struct DualGrid<'t> {
     /// Control points of the table-evaluated patches, concatenated.
     control: Vec<u32>,
     /// Boundary-curve points (vertex limit points first, then edges' interior points).
-    boundary_points: Vec<PointPlan<'t>>,
+    boundary_points: Vec<PointPlan>,
+    /// The stencils of [`FaceEval::Local`] faces.
+    local_weights: Vec<f32>,
+    /// Boundary points of local faces still to be computed (index into `boundary_points`).
+    local_points: Vec<(usize, LimitQuery)>,
     strips: Vec<Strip>,
     /// Vertex polygons and the triangle offsets of every face, strip and polygon.
     connectivity: Connectivity,
@@ -238,6 +248,27 @@ fn stencils<'t>(
         });
     }
     Ok(Stencils { position, du, dv })
+}
+
+/// Stencils on the mesh's vertices as dense f32 blocks over the union of their supports: the
+/// control points, then the position weights of every point, its d/du weights, its d/dv
+/// weights (`points x control` each).
+fn dense(stencils: &[LimitStencil]) -> (Vec<u32>, Vec<f32>) {
+    let mut control: Vec<u32> = stencils.iter().flatten().map(|&(v, _)| v).collect();
+    control.sort_unstable();
+    control.dedup();
+    let k = control.len();
+    let block = stencils.len() * k;
+    let mut weights = vec![0.0f32; 3 * block];
+    for (p, stencil) in stencils.iter().enumerate() {
+        for &(v, w) in stencil {
+            let l = control.partition_point(|&c| c < v);
+            for (kind, &x) in w.iter().enumerate() {
+                weights[kind * block + p * k + l] = x as f32;
+            }
+        }
+    }
+    (control, weights)
 }
 
 /// Triangles of a strip merging rows of `a` and `b` points.
@@ -290,6 +321,8 @@ impl<'t> DualGrid<'t> {
             bases: vec![None; MAX_RATE as usize + 1],
             control: Vec::new(),
             boundary_points: Vec::new(),
+            local_weights: Vec::new(),
+            local_points: Vec::new(),
             strips: Vec::new(),
             connectivity: Connectivity::default(),
             vertex_count: 0,
@@ -297,16 +330,23 @@ impl<'t> DualGrid<'t> {
         };
         let regular = |p: &FacePatch| !p.kind.boundary && p.kind.faces == 4 && p.corner == 0;
         let mut factored = vec![false; MAX_RATE as usize + 1];
-        for (patch, &n) in patches.iter().zip(rates) {
-            // A valence beyond the table's is refused here, by the table naming its coverage.
-            let s = stencils(table, patch, PointSet::Dual, n)?;
-            if patch.points.len() > MAX_PATCH {
-                return Err(RuntimeError::Unsupported(format!(
-                    "a patch of {} control points (valence {}); at most {MAX_PATCH}",
-                    patch.points.len(),
-                    patch.kind.faces
-                )));
-            }
+        // Faces the tables describe exactly take their stencils; the others (sharp features
+        // nearby, a valence or patch beyond the table) are refined adaptively below.
+        let mut local_faces = Vec::new();
+        for (f, (patch, &n)) in patches.iter().zip(rates).enumerate() {
+            let s = if is_smooth_patch(mesh, f) && patch.points.len() <= MAX_PATCH {
+                stencils(table, patch, PointSet::Dual, n).ok()
+            } else {
+                None
+            };
+            let Some(s) = s else {
+                local_faces.push(f);
+                grid.faces.push(FaceEval::Local {
+                    control: 0..0,
+                    weights: 0,
+                });
+                continue;
+            };
             if regular(patch) && !factored[n as usize] {
                 factored[n as usize] = true;
                 grid.bases[n as usize] = SeparableBasis::from_stencils(&s, n as usize);
@@ -328,6 +368,7 @@ impl<'t> DualGrid<'t> {
             }
         }
         grid.plan_connectivity(table, mesh, patches)?;
+        grid.plan_local(mesh, &local_faces)?;
         Ok(grid)
     }
 
@@ -367,28 +408,85 @@ impl<'t> DualGrid<'t> {
         n: u32,
         (i, j): (u32, u32),
     ) -> Result<(), RuntimeError> {
+        let source = VertexSource {
+            face: f as u32,
+            u: i,
+            v: j,
+            denominator: n,
+            subface: 0,
+        };
+        if let FaceEval::Local { .. } = self.faces[f] {
+            let (u, v) = (f64::from(i) / f64::from(n), f64::from(j) / f64::from(n));
+            let query = LimitQuery { face: f as u32, u, v };
+            self.local_points.push((self.boundary_points.len(), query));
+            self.boundary_points.push(PointPlan {
+                weights: Vec::new(),
+                control: 0..0,
+                source,
+            });
+            return Ok(());
+        }
         let s = stencils(table, patch, PointSet::Primal, n)?;
         // The primal grid's rotation into the patch: as for dual points, with n + 1 points a row.
         let (pi, pj) = dual_index_in_patch(patch.corner, i as usize, j as usize, n as usize + 1);
         let k = patch.points.len();
-        let row = (pj * (n as usize + 1) + pi) * k..(pj * (n as usize + 1) + pi + 1) * k;
         let start = self.control.len() as u32;
         self.control.extend_from_slice(&patch.points);
-        self.boundary_points.push(PointPlan {
-            stencils: Stencils {
-                position: &s.position[row.clone()],
-                du: &s.du[row.clone()],
-                dv: &s.dv[row],
-            },
-            control: start..self.control.len() as u32,
-            source: VertexSource {
-                face: f as u32,
-                u: i,
-                v: j,
-                denominator: n,
-                subface: 0,
-            },
-        });
+        let row = pj * (n as usize + 1) + pi;
+        self.boundary_points.push(PointPlan::from_row(
+            &s,
+            row,
+            k,
+            start..self.control.len() as u32,
+            source,
+        ));
+        Ok(())
+    }
+
+    /// The stencils of the local faces' dual points and of the boundary points on them, all
+    /// in one feature-adaptive refinement.
+    fn plan_local(&mut self, mesh: &Mesh, local_faces: &[usize]) -> Result<(), RuntimeError> {
+        let mut queries = Vec::new();
+        for &f in local_faces {
+            let n = self.rates[f];
+            let d = f64::from(2 * n);
+            for j in 0..n {
+                for i in 0..n {
+                    queries.push(LimitQuery {
+                        face: f as u32,
+                        u: f64::from(2 * i + 1) / d,
+                        v: f64::from(2 * j + 1) / d,
+                    });
+                }
+            }
+        }
+        queries.extend(self.local_points.iter().map(|&(_, q)| q));
+        if queries.is_empty() {
+            return Ok(());
+        }
+        let stencils = limit_stencils(mesh, &queries)?;
+        let mut at = 0;
+        for &f in local_faces {
+            let n = self.rates[f] as usize;
+            let points = &stencils[at..at + n * n];
+            at += n * n;
+            let (control, weights) = dense(points);
+            let start = self.control.len() as u32;
+            self.control.extend_from_slice(&control);
+            self.faces[f] = FaceEval::Local {
+                control: start..self.control.len() as u32,
+                weights: self.local_weights.len(),
+            };
+            self.local_weights.extend_from_slice(&weights);
+        }
+        for (&(plan, _), stencil) in self.local_points.iter().zip(&stencils[at..]) {
+            let (control, weights) = dense(std::slice::from_ref(stencil));
+            let start = self.control.len() as u32;
+            self.control.extend_from_slice(&control);
+            self.boundary_points[plan].control = start..self.control.len() as u32;
+            self.boundary_points[plan].weights = weights;
+        }
+        self.local_points.clear();
         Ok(())
     }
 
@@ -517,6 +615,22 @@ impl<'t> DualGrid<'t> {
                         let at = j * n + i;
                         (positions[at], normals[at]) = weighted_point(stencils, local, pj * n + pi);
                     }
+                }
+            }
+            FaceEval::Local {
+                control: range,
+                weights,
+            } => {
+                let points = &self.control[range.start as usize..range.end as usize];
+                let block = n * n * points.len();
+                let w = &self.local_weights[*weights..*weights + 3 * block];
+                let s = Stencils {
+                    position: &w[..block],
+                    du: &w[block..2 * block],
+                    dv: &w[2 * block..],
+                };
+                for at in 0..n * n {
+                    (positions[at], normals[at]) = gathered_point(s, points, control, at);
                 }
             }
         }

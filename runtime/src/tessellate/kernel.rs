@@ -33,12 +33,26 @@ pub(crate) struct Stencils<'t> {
     pub(crate) dv: &'t [f32],
 }
 
-/// A point evaluated on its own (the boundary curve): one row of each stencil.
+/// A point evaluated on its own (the boundary curve, limit points): its position, d/du and
+/// d/dv weights (`control.len()` each, one block after the other), copied from a table row or
+/// computed when the plan is built.
 #[derive(Clone, Debug)]
-pub(crate) struct PointPlan<'t> {
-    pub(crate) stencils: Stencils<'t>,
+pub(crate) struct PointPlan {
+    pub(crate) weights: Vec<f32>,
     pub(crate) control: Range<u32>,
     pub(crate) source: VertexSource,
+}
+
+impl PointPlan {
+    /// The point of row `row` of `s` (a patch of `k` control points).
+    pub(crate) fn from_row(s: &Stencils, row: usize, k: usize, control: Range<u32>, source: VertexSource) -> Self {
+        let rows = row * k..(row + 1) * k;
+        let mut weights = Vec::with_capacity(3 * k);
+        for block in [s.position, s.du, s.dv] {
+            weights.extend_from_slice(&block[rows.clone()]);
+        }
+        PointPlan { weights, control, source }
+    }
 }
 
 /// Run `work(item, slice)` for every item in parallel, where item `i` owns
@@ -140,12 +154,34 @@ pub(crate) fn evaluate_points(
         .zip(plans.par_iter())
         .for_each(|((p, q), plan)| {
             let points = &indices[plan.control.start as usize..plan.control.end as usize];
-            let mut local = [[0.0f32; 3]; MAX_PATCH];
-            for (l, &v) in local.iter_mut().zip(points) {
-                *l = control[v as usize];
-            }
-            (*p, *q) = weighted_point(&plan.stencils, &local[..points.len()], 0);
+            let k = points.len();
+            let (wp, rest) = plan.weights.split_at(k);
+            let (wu, wv) = rest.split_at(k);
+            (*p, *q) = gathered_point(Stencils { position: wp, du: wu, dv: wv }, points, control, 0);
         });
+}
+
+/// Position and unit normal of row `point` of `s` over the control points `points` (vertices
+/// of `control`), any number of them.
+pub(crate) fn gathered_point(
+    s: Stencils,
+    points: &[u32],
+    control: &[[f32; 3]],
+    point: usize,
+) -> ([f32; 3], [f32; 3]) {
+    let k = points.len();
+    let rows = point * k..(point + 1) * k;
+    let (wp, wu, wv) = (&s.position[rows.clone()], &s.du[rows.clone()], &s.dv[rows]);
+    let mut p = [[0.0f32; 3]; 3];
+    for (l, &v) in points.iter().enumerate() {
+        let q = control[v as usize];
+        for x in 0..3 {
+            p[0][x] += wp[l] * q[x];
+            p[1][x] += wu[l] * q[x];
+            p[2][x] += wv[l] * q[x];
+        }
+    }
+    (p[0], unit(cross(p[1], p[2])))
 }
 
 /// Position and unit normal of table point `point` (row of the stencils) from the patch's

@@ -198,7 +198,7 @@ pub struct TriangleDualGrid<'t> {
     control: Vec<u32>,
     /// Points evaluated on their own: every vertex's limit point, then the boundary curves'
     /// interior points.
-    points: Vec<PointPlan<'t>>,
+    points: Vec<PointPlan>,
     strips: Vec<TriangleStrip>,
     /// The output vertex of every mesh vertex's limit point ([`NONE`] for unused vertices).
     limit_points: Vec<u32>,
@@ -370,25 +370,17 @@ impl<'t> TriangleDualGrid<'t> {
         let (pi, pj) = primal_in_patch(patch.corner, n, i, j);
         let k = patch.points.len();
         let at = primal_index(n, pi, pj);
-        let rows = at * k..(at + 1) * k;
         let start = self.control.len() as u32;
         self.control.extend_from_slice(&patch.points);
         let index = self.first[self.rates.len()] + self.points.len() as u32;
-        self.points.push(PointPlan {
-            stencils: Stencils {
-                position: &s.position[rows.clone()],
-                du: &s.du[rows.clone()],
-                dv: &s.dv[rows],
-            },
-            control: start..self.control.len() as u32,
-            source: VertexSource {
-                face: f as u32,
-                u: i,
-                v: j,
-                denominator: n,
-                subface: 0,
-            },
-        });
+        let source = VertexSource {
+            face: f as u32,
+            u: i,
+            v: j,
+            denominator: n,
+            subface: 0,
+        };
+        self.points.push(PointPlan::from_row(&s, at, k, start..self.control.len() as u32, source));
         Ok(index)
     }
 

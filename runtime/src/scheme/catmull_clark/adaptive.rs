@@ -1,0 +1,714 @@
+//! Limit stencils by feature-adaptive refinement: the exact limit position and derivatives of
+//! any point of a quad face, whatever the features around it (any valence, darts, creases and
+//! corners of any sharpness, semi-sharp features in either crease method), as a combination of
+//! the mesh's vertices.
+//!
+//! A face whose 4 x 4 neighbourhood subdivides by the uniform cubic B-spline rules is a
+//! B-spline patch (Stam 1998, section 2): its four corners are regular (interior valence 4 with
+//! smooth edges, or a crease vertex with two faces on the face's side of an infinitely sharp
+//! crease, or a pinned corner of a one-face sector), and nothing around it is semi-sharp. An
+//! infinitely sharp edge acts as a boundary: the points beyond it are replaced by reflections
+//! (`2 P_0 - P_1`, the "phantom" points of OpenSubdiv's boundary patches), which reproduce the
+//! crease rules exactly (a crease vertex `(E_a + 6 V + E_b) / 8`, a crease edge its midpoint).
+//!
+//! Any other face is refined (`refine`, the one statement of the rules, sharpness decaying by
+//! level) and its points handed to the children that contain them, until every point lies in a
+//! B-spline patch. A point at distance `d` from the face's irregular corners needs about
+//! `log2(1 / d)` levels, plus the levels semi-sharp features take to decay: every point that is
+//! not an irregular vertex itself is reached in finitely many. Points exactly at an irregular
+//! boundary vertex take the crease or corner limit masks of OpenSubdiv's `Sdc` instead.
+//!
+//! Only a neighbourhood is refined: at each level the faces within [`RINGS`] vertex rings of the
+//! faces still holding points. A vertex's refined position depends on its one-ring only, so the
+//! three rings of margin keep every vertex of the next level's patches exact.
+
+use std::collections::{BTreeMap, BTreeSet};
+
+use schemes::crease::{is_infinite, is_sharp, CreaseRule};
+
+use crate::mesh::topology::Mesh;
+use crate::scheme::catmull_clark::refine::refine;
+use crate::scheme::stencil::Stencil;
+use crate::MeshError;
+
+/// Vertex rings kept around the faces still being refined.
+pub const RINGS: usize = 3;
+
+/// At most this many levels are refined below the mesh (a dual point at rate 64 needs 8,
+/// sharpness adds at most 10).
+pub const MAX_LEVELS: usize = 24;
+
+/// A point to evaluate: face `face` of the mesh, at its parameters `(u, v)` in `[0, 1]^2`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LimitQuery {
+    /// The face (a quad).
+    pub face: u32,
+    /// Parameter along the face's first edge.
+    pub u: f64,
+    /// Parameter along its last edge, reversed.
+    pub v: f64,
+}
+
+/// The limit at one point as weights on the mesh's vertices: `(vertex, [position, d/du,
+/// d/dv])`, sorted by vertex. At a vertex that is not smooth, `d/du` and `d/dv` are tangents
+/// along the face's frame (their cross product is the normal), not derivatives.
+pub type LimitStencil = Vec<(u32, [f64; 3])>;
+
+/// The cubic B-spline basis at `t` and its derivative, for control offsets `-1, 0, 1, 2`.
+fn bspline(t: f64) -> ([f64; 4], [f64; 4]) {
+    let s = 1.0 - t;
+    let (t2, t3) = (t * t, t * t * t);
+    (
+        [
+            s * s * s / 6.0,
+            (3.0 * t3 - 6.0 * t2 + 4.0) / 6.0,
+            (-3.0 * t3 + 3.0 * t2 + 3.0 * t + 1.0) / 6.0,
+            t3 / 6.0,
+        ],
+        [
+            -s * s / 2.0,
+            (3.0 * t2 - 4.0 * t) / 2.0,
+            (-3.0 * t2 + 2.0 * t + 1.0) / 2.0,
+            t2 / 2.0,
+        ],
+    )
+}
+
+/// A control point of a patch: a vertex, or a reflection across a sharp edge.
+type Combo = Vec<(u32, f64)>;
+
+/// Corner `k`'s position in the face's `(s, t)` grid, and its two axes (along the corner's
+/// outgoing and incoming edges).
+const BASE: [(i32, i32); 4] = [(0, 0), (1, 0), (1, 1), (0, 1)];
+const AXIS_OUT: [(i32, i32); 4] = [(1, 0), (0, 1), (-1, 0), (0, -1)];
+const AXIS_IN: [(i32, i32); 4] = [(0, 1), (-1, 0), (0, -1), (1, 0)];
+
+/// Whether sharpness `s` is 0 or infinite: nothing decays any more.
+fn settled(s: f32) -> bool {
+    !is_sharp(s) || is_infinite(s)
+}
+
+/// The 4 x 4 control points (`grid[a + 1][b + 1]` at `(a, b)`) of quad `g` if it is a B-spline
+/// patch, else `None`.
+fn bspline_patch(mesh: &Mesh, g: usize) -> Option<[[Combo; 4]; 4]> {
+    let hs = mesh.face_halfedges(g);
+    if hs.len() != 4 {
+        return None;
+    }
+    let corner: Vec<u32> = mesh.face(g).to_vec();
+    let sharp = |h: usize| is_infinite(mesh.edge_sharpness[h]);
+    let mut grid: [[Combo; 4]; 4] = Default::default();
+    let mut put =
+        |(x, y): (i32, i32), combo: Combo| grid[(x + 1) as usize][(y + 1) as usize] = combo;
+    let one = |v: u32| vec![(v, 1.0)];
+    for k in 0..4 {
+        let h = hs.start + k;
+        let v = corner[k] as usize;
+        let edges = mesh.vertex_edges(v);
+        if !settled(mesh.vertex_sharpness[v])
+            || edges.iter().any(|&e| !settled(mesh.edge_sharpness[e]))
+        {
+            return None;
+        }
+        let sharpness: Vec<f32> = edges.iter().map(|&e| mesh.edge_sharpness[e]).collect();
+        let rule = CreaseRule::of(mesh.vertex_sharpness[v], &sharpness);
+        let (next, prev, opposite) = (
+            corner[(k + 1) % 4],
+            corner[(k + 3) % 4],
+            corner[(k + 2) % 4],
+        );
+        let (out_sharp, in_sharp) = (sharp(h), sharp(mesh.prev(h)));
+        let at = |x: i32, y: i32| {
+            (
+                BASE[k].0 + x * AXIS_OUT[k].0 + y * AXIS_IN[k].0,
+                BASE[k].1 + x * AXIS_OUT[k].1 + y * AXIS_IN[k].1,
+            )
+        };
+        put(at(0, 0), one(v as u32));
+        let reflect = |a: u32, b: u32| vec![(a, 2.0), (b, -1.0)];
+        match (in_sharp, out_sharp, rule) {
+            (false, false, CreaseRule::Smooth) => {
+                if mesh.fan(v).len() != 4 {
+                    return None;
+                }
+                let n1 = mesh.twin[mesh.prev(h)] as usize;
+                let n2 = mesh.twin[mesh.prev(n1)] as usize;
+                put(at(-1, 0), one(mesh.head(n2)));
+                put(at(-1, -1), one(mesh.head(mesh.next(n2))));
+                put(at(0, -1), one(mesh.head(mesh.next(mesh.next(n2)))));
+            }
+            (false, true, CreaseRule::Crease) => {
+                // The crease runs along the outgoing edge; the face across the incoming edge
+                // is the sector's other face, and its far edge at v must be the crease.
+                let n1 = mesh.twin[mesh.prev(h)] as usize;
+                if !sharp(mesh.prev(n1)) {
+                    return None;
+                }
+                let above_left = mesh.head(mesh.next(n1));
+                let left = mesh.head(mesh.next(mesh.next(n1)));
+                put(at(-1, 0), one(left));
+                put(at(0, -1), reflect(v as u32, prev));
+                put(at(-1, -1), reflect(left, above_left));
+            }
+            (true, false, CreaseRule::Crease) => {
+                let m = mesh.twin[h] as usize;
+                if !sharp(mesh.next(m)) {
+                    return None;
+                }
+                let down = mesh.head(mesh.next(m));
+                let down_right = mesh.head(mesh.next(mesh.next(m)));
+                put(at(0, -1), one(down));
+                put(at(-1, 0), reflect(v as u32, next));
+                put(at(-1, -1), reflect(down, down_right));
+            }
+            (true, true, CreaseRule::Corner) => {
+                put(at(-1, 0), reflect(v as u32, next));
+                put(at(0, -1), reflect(v as u32, prev));
+                put(
+                    at(-1, -1),
+                    vec![(v as u32, 4.0), (next, -2.0), (prev, -2.0), (opposite, 1.0)],
+                );
+            }
+            _ => return None,
+        }
+    }
+    Some(grid)
+}
+
+/// The limit position and tangents at vertex `v`, the corner of face `g` at half-edge `h`, by
+/// OpenSubdiv's limit masks, where they are exact: a settled crease vertex (the sector of `g`
+/// between its two sharp edges) or a corner. `None` elsewhere (smooth vertices are reached by
+/// refinement or lie inside B-spline patches).
+fn vertex_limit(mesh: &Mesh, h: usize) -> Option<Vec<(u32, [f64; 3])>> {
+    let v = mesh.face_vertices[h] as usize;
+    let edges = mesh.vertex_edges(v);
+    let sharpness: Vec<f32> = edges.iter().map(|&e| mesh.edge_sharpness[e]).collect();
+    if !settled(mesh.vertex_sharpness[v]) || sharpness.iter().any(|&s| !settled(s)) {
+        return None;
+    }
+    let rule = CreaseRule::of(mesh.vertex_sharpness[v], &sharpness);
+    let me = v as u32;
+    match rule {
+        CreaseRule::Corner => {
+            // Tangents along the face's own edges at v: the normal of its corner.
+            let (out, into) = (mesh.head(h), mesh.face_vertices[mesh.prev(h)]);
+            Some(vec![
+                (me, [1.0, -1.0, -1.0]),
+                (out, [0.0, 1.0, 0.0]),
+                (into, [0.0, 0.0, 1.0]),
+            ])
+        }
+        CreaseRule::Crease => {
+            // The sector of h: the faces between the sharp edge at or before h and the next,
+            // edge i of the fan lying before face i (on the boundary, edge n after the last).
+            let fan = mesh.fan(v);
+            let n = fan.len();
+            let boundary = mesh.is_boundary_vertex(v);
+            let edge_count = if boundary { n + 1 } else { n };
+            let edge = |i: usize| {
+                if boundary && i == n {
+                    mesh.prev(fan[n - 1])
+                } else {
+                    fan[i % n]
+                }
+            };
+            let sharp_edge = |i: usize| is_infinite(mesh.edge_sharpness[edge(i % edge_count)]);
+            let j = fan.iter().position(|&e| e == h)?;
+            let start = (0..edge_count)
+                .map(|back| (j + edge_count - back) % edge_count)
+                .find(|&i| sharp_edge(i))?;
+            let len = (1..=edge_count).find(|&d| sharp_edge(start + d))?;
+            let ring: Vec<u32> = (0..=len)
+                .map(|i| mesh.opposite(edge((start + i) % edge_count), v))
+                .collect();
+            let opposite: Vec<u32> = (0..len)
+                .map(|i| mesh.head(mesh.next(fan[(start + i) % n])))
+                .collect();
+            let (e_first, e_last) = (ring[0], ring[len]);
+            let mut terms = vec![
+                (me, [2.0 / 3.0, 0.0, 0.0]),
+                (e_first, [1.0 / 6.0, 0.5, 0.0]),
+                (e_last, [1.0 / 6.0, -0.5, 0.0]),
+            ];
+            // Across the crease into the sector (OpenSubdiv's crease tangent mask, after
+            // Biermann, Levin and Zorin 2000), face weights on the faces' opposite vertices.
+            let interior = len - 1;
+            let mut across = |vertex: u32, w: f64| terms.push((vertex, [0.0, 0.0, w]));
+            match interior {
+                0 => {
+                    across(me, -6.0);
+                    across(e_first, 3.0);
+                    across(e_last, 3.0);
+                }
+                1 => {
+                    across(me, -4.0 / 6.0);
+                    across(e_first, -1.0 / 6.0);
+                    across(ring[1], 4.0 / 6.0);
+                    across(e_last, -1.0 / 6.0);
+                    across(opposite[0], 1.0 / 6.0);
+                    across(opposite[1], 1.0 / 6.0);
+                }
+                _ => {
+                    let k = (interior + 1) as f64;
+                    let theta = std::f64::consts::PI / k;
+                    let (cos, sin) = (theta.cos(), theta.sin());
+                    let denominator = 1.0 / (k * (3.0 + cos));
+                    let r = (cos + 1.0) / sin;
+                    across(me, 4.0 * r * (cos - 1.0) * denominator);
+                    across(e_first, -r * (1.0 + 2.0 * cos) * denominator);
+                    across(e_last, -r * (1.0 + 2.0 * cos) * denominator);
+                    across(opposite[0], sin * denominator);
+                    for i in 1..=interior {
+                        let (si, si1) = ((i as f64 * theta).sin(), ((i + 1) as f64 * theta).sin());
+                        across(ring[i], 4.0 * si * denominator);
+                        across(opposite[i], (si + si1) * denominator);
+                    }
+                }
+            }
+            Some(terms)
+        }
+        _ => None,
+    }
+}
+
+/// Where a query stands: on face `face` of the current level, at `(s, t)`, and `jacobian =
+/// d(s, t) / d(u, v)` back to the query's face parameters.
+#[derive(Clone, Copy, Debug)]
+struct Pending {
+    query: usize,
+    s: f64,
+    t: f64,
+    jacobian: [[f64; 2]; 2],
+}
+
+impl Pending {
+    /// The child of a refined quad that holds the point, and the point in the child's own
+    /// parameters: child `c` covers the quarter at corner `c` and runs from it
+    /// ([`crate::scheme::catmull_clark::isolate::Isolation::input_source`]).
+    fn descend(self) -> (usize, Pending) {
+        let (right, up) = (self.s > 0.5, self.t > 0.5);
+        let (c, s, t, m) = match (right, up) {
+            (false, false) => (0, 2.0 * self.s, 2.0 * self.t, [[2.0, 0.0], [0.0, 2.0]]),
+            (true, false) => (
+                1,
+                2.0 * self.t,
+                2.0 - 2.0 * self.s,
+                [[0.0, 2.0], [-2.0, 0.0]],
+            ),
+            (true, true) => (
+                2,
+                2.0 - 2.0 * self.s,
+                2.0 - 2.0 * self.t,
+                [[-2.0, 0.0], [0.0, -2.0]],
+            ),
+            (false, true) => (
+                3,
+                2.0 - 2.0 * self.t,
+                2.0 * self.s,
+                [[0.0, -2.0], [2.0, 0.0]],
+            ),
+        };
+        let j = self.jacobian;
+        let jacobian = [
+            [
+                m[0][0] * j[0][0] + m[0][1] * j[1][0],
+                m[0][0] * j[0][1] + m[0][1] * j[1][1],
+            ],
+            [
+                m[1][0] * j[0][0] + m[1][1] * j[1][0],
+                m[1][0] * j[0][1] + m[1][1] * j[1][1],
+            ],
+        ];
+        (
+            c,
+            Pending {
+                query: self.query,
+                s,
+                t,
+                jacobian,
+            },
+        )
+    }
+
+    /// The face corner the point sits on, if any.
+    fn corner(&self) -> Option<usize> {
+        match (self.s, self.t) {
+            (s, t) if s == 0.0 && t == 0.0 => Some(0),
+            (s, t) if s == 1.0 && t == 0.0 => Some(1),
+            (s, t) if s == 1.0 && t == 1.0 => Some(2),
+            (s, t) if s == 0.0 && t == 1.0 => Some(3),
+            _ => None,
+        }
+    }
+}
+
+/// The point's stencil on the current level's vertices from a B-spline patch.
+fn patch_terms(grid: &[[Combo; 4]; 4], p: &Pending) -> Vec<(u32, [f64; 3])> {
+    let (bs, ds) = bspline(p.s);
+    let (bt, dt) = bspline(p.t);
+    let j = p.jacobian;
+    let mut terms = Vec::with_capacity(16);
+    for a in 0..4 {
+        for b in 0..4 {
+            let (w, ws, wt) = (bs[a] * bt[b], ds[a] * bt[b], bs[a] * dt[b]);
+            // d/du = ds/du d/ds + dt/du d/dt; d/dv alike.
+            let (du, dv) = (j[0][0] * ws + j[1][0] * wt, j[0][1] * ws + j[1][1] * wt);
+            for &(vertex, c) in &grid[a][b] {
+                terms.push((vertex, [c * w, c * du, c * dv]));
+            }
+        }
+    }
+    terms
+}
+
+/// Compose terms on the current level's vertices with `to_input` (its rows: the level's
+/// vertices over the input's): the stencil on the input vertices, sorted, zeros dropped.
+fn on_input(terms: &[(u32, [f64; 3])], to_input: &Stencil<f64>) -> LimitStencil {
+    let mut sum: BTreeMap<u32, [f64; 3]> = BTreeMap::new();
+    for &(local, w) in terms {
+        let (js, ws) = to_input.row(local as usize);
+        for (&j, &x) in js.iter().zip(ws) {
+            let e = sum.entry(j).or_insert([0.0; 3]);
+            for c in 0..3 {
+                e[c] += w[c] * x;
+            }
+        }
+    }
+    sum.into_iter()
+        .filter(|(_, w)| w.iter().any(|&x| x != 0.0))
+        .collect()
+}
+
+/// The faces within `rings` vertex rings of `seeds`.
+fn neighbourhood(mesh: &Mesh, seeds: impl Iterator<Item = usize>, rings: usize) -> BTreeSet<usize> {
+    let mut faces: BTreeSet<usize> = seeds.collect();
+    let mut frontier: Vec<usize> = faces.iter().copied().collect();
+    for _ in 0..rings {
+        let mut next = Vec::new();
+        for &f in &frontier {
+            for &v in mesh.face(f) {
+                for h in mesh.fan(v as usize) {
+                    let g = mesh.face_of[h] as usize;
+                    if faces.insert(g) {
+                        next.push(g);
+                    }
+                }
+            }
+        }
+        frontier = next;
+    }
+    faces
+}
+
+/// The sub-mesh of `faces` (sharpness, holes and options kept; positions are not needed), the
+/// mesh vertex of each of its vertices, and its face of each mesh face. Vertices whose faces
+/// here form several fans (the rim of the neighbourhood) get one copy per fan.
+fn submesh(mesh: &Mesh, faces: &BTreeSet<usize>) -> (Mesh, Vec<u32>, BTreeMap<usize, usize>) {
+    let mut index = BTreeMap::new();
+    let mut vertices: Vec<u32> = Vec::new();
+    let mut lists: Vec<Vec<i64>> = Vec::with_capacity(faces.len());
+    let mut face_of = BTreeMap::new();
+    for (i, &f) in faces.iter().enumerate() {
+        face_of.insert(f, i);
+        lists.push(
+            mesh.face(f)
+                .iter()
+                .map(|&v| {
+                    *index.entry(v).or_insert_with(|| {
+                        vertices.push(v);
+                        vertices.len() as i64 - 1
+                    })
+                })
+                .collect(),
+        );
+    }
+    crate::mesh::topology::split_fans(&mut lists, &mut vertices);
+    let positions = vec![[0.0; 3]; vertices.len()];
+    let mut sub = Mesh::new(positions, &lists, &[], mesh.boundary).unwrap_or_else(|e| {
+        unreachable!("a neighbourhood of a valid mesh, split into fans, is valid: {e}")
+    });
+    for (i, &f) in faces.iter().enumerate() {
+        for (h, g) in sub.face_halfedges(i).zip(mesh.face_halfedges(f)) {
+            sub.edge_sharpness[h] = mesh.edge_sharpness[g];
+        }
+        sub.holes[i] = mesh.holes[f];
+    }
+    for (s, &v) in sub.vertex_sharpness.iter_mut().zip(&vertices) {
+        *s = mesh.vertex_sharpness[v as usize];
+    }
+    sub.creasing = mesh.creasing;
+    sub.smooth_triangles = mesh.smooth_triangles;
+    (sub, vertices, face_of)
+}
+
+/// The limit stencils of `queries` on an all-quad mesh, in order.
+pub fn limit_stencils(mesh: &Mesh, queries: &[LimitQuery]) -> Result<Vec<LimitStencil>, MeshError> {
+    let mut out: Vec<LimitStencil> = vec![Vec::new(); queries.len()];
+    let mut pending: BTreeMap<usize, Vec<Pending>> = BTreeMap::new();
+    for (query, q) in queries.iter().enumerate() {
+        let face = q.face as usize;
+        if face >= mesh.faces()
+            || mesh.face(face).len() != 4
+            || !(0.0..=1.0).contains(&q.u)
+            || !(0.0..=1.0).contains(&q.v)
+        {
+            return Err(MeshError::NotIsolated {
+                face,
+                reason: format!(
+                    "limit query at ({}, {}) needs a quad and parameters in [0, 1]",
+                    q.u, q.v
+                ),
+            });
+        }
+        pending.entry(face).or_default().push(Pending {
+            query,
+            s: q.u,
+            t: q.v,
+            jacobian: [[1.0, 0.0], [0.0, 1.0]],
+        });
+    }
+    // Level 0: the neighbourhood of the queried faces, its vertices selected from the input.
+    let faces = neighbourhood(mesh, pending.keys().copied(), RINGS);
+    let (mut level, vertices, face_of) = submesh(mesh, &faces);
+    let mut to_input = Stencil::<f64>::new(mesh.positions.len());
+    for &v in &vertices {
+        to_input.push_row(vec![(v, 1.0)]);
+    }
+    pending = pending.into_iter().map(|(f, p)| (face_of[&f], p)).collect();
+    for depth in 0..=MAX_LEVELS {
+        let mut next: BTreeMap<usize, Vec<Pending>> = BTreeMap::new();
+        for (g, points) in std::mem::take(&mut pending) {
+            if let Some(grid) = bspline_patch(&level, g) {
+                for p in points {
+                    out[p.query] = on_input(&patch_terms(&grid, &p), &to_input);
+                }
+                continue;
+            }
+            for p in points {
+                let at_vertex = p
+                    .corner()
+                    .and_then(|k| vertex_limit(&level, level.face_halfedges(g).start + k));
+                if let Some(terms) = at_vertex {
+                    out[p.query] = on_input(&terms, &to_input);
+                    continue;
+                }
+                let (c, child) = p.descend();
+                // Child c of face g is numbered by g's half-edge c (`refine`).
+                next.entry(level.face_halfedges(g).start + c)
+                    .or_default()
+                    .push(child);
+            }
+        }
+        if next.is_empty() {
+            return Ok(out);
+        }
+        if depth == MAX_LEVELS {
+            pending = next;
+            break;
+        }
+        let step = refine(&level);
+        let faces = neighbourhood(&step.mesh, next.keys().copied(), RINGS);
+        let (sub, vertices, face_of) = submesh(&step.mesh, &faces);
+        to_input = to_input.then(&step.stencil.select(&vertices));
+        level = sub;
+        pending = next.into_iter().map(|(f, p)| (face_of[&f], p)).collect();
+    }
+    let face = pending.keys().next().copied().unwrap_or(0);
+    Err(MeshError::NotIsolated {
+        face,
+        reason: format!("a limit point is not reached after {MAX_LEVELS} levels of refinement (an irregular vertex of a rule without a limit mask)"),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scheme::catmull_clark::isolate::isolate_with_origins;
+    use crate::scheme::patch::dual_positions;
+    use crate::stencil_table::StencilTable;
+    use schemes::crease::INFINITE;
+    use schemes::BoundaryMode;
+
+    /// A bumpy `m x m` grid of quads (boundary), or with `closed` a torus.
+    fn grid(m: i64, mode: BoundaryMode) -> Mesh {
+        let positions = (0..=m)
+            .flat_map(|j| {
+                (0..=m).map(move |i| {
+                    let (x, y) = (i as f64, j as f64);
+                    [x, y, (1.3 * x).sin() * (0.7 * y).cos() + 0.1 * x * y]
+                })
+            })
+            .collect();
+        let faces: Vec<Vec<i64>> = (0..m)
+            .flat_map(|j| {
+                (0..m).map(move |i| {
+                    let v = j * (m + 1) + i;
+                    vec![v, v + 1, v + m + 2, v + m + 1]
+                })
+            })
+            .collect();
+        Mesh::new(positions, &faces, &[], mode).expect("a valid grid")
+    }
+
+    fn apply(stencil: &LimitStencil, mesh: &Mesh) -> [[f64; 3]; 3] {
+        let mut out = [[0.0; 3]; 3];
+        for &(v, w) in stencil {
+            let p = mesh.positions[v as usize];
+            for (k, row) in out.iter_mut().enumerate() {
+                for c in 0..3 {
+                    row[c] += w[k] * p[c];
+                }
+            }
+        }
+        out
+    }
+
+    fn dual_queries(f: usize, n: usize) -> Vec<LimitQuery> {
+        (0..n * n)
+            .map(|p| LimitQuery {
+                face: f as u32,
+                u: (2 * (p % n) + 1) as f64 / (2 * n) as f64,
+                v: (2 * (p / n) + 1) as f64 / (2 * n) as f64,
+            })
+            .collect()
+    }
+
+    /// Away from sharp features the tables (Schaefer–Warren's scaling relation, solved by
+    /// `stencilgen`) and adaptive refinement are two independent routes to the same limit:
+    /// extraordinary vertices (the octahedron's valence 4 after isolation is regular; the
+    /// tetrahedron's 3), boundaries in both modes.
+    #[test]
+    fn adaptive_limits_equal_the_table_patches() {
+        let n = 5;
+        let meshes = [
+            (
+                crate::mesh::test_meshes::tetrahedron(),
+                BoundaryMode::EdgeOnly,
+            ),
+            (grid(3, BoundaryMode::EdgeOnly), BoundaryMode::EdgeOnly),
+            (
+                grid(3, BoundaryMode::EdgeAndCorner),
+                BoundaryMode::EdgeAndCorner,
+            ),
+        ];
+        for (mesh, mode) in meshes {
+            let iso = isolate_with_origins(&mesh).expect("isolates");
+            let table = StencilTable::default_for(mode).expect("embedded table");
+            for (f, patch) in iso.patches.iter().enumerate() {
+                let expected =
+                    dual_positions(&table, &iso.mesh, patch, n as u32).expect("in the table");
+                let stencils = limit_stencils(&iso.mesh, &dual_queries(f, n)).expect("reached");
+                for (p, s) in expected.iter().zip(&stencils) {
+                    let got = apply(s, &iso.mesh)[0];
+                    let d = (0..3).map(|c| (got[c] - p[c]).abs()).fold(0.0, f64::max);
+                    assert!(
+                        d < 2e-6,
+                        "{mode:?} face {f} ({:?}): {got:?} vs {p:?}",
+                        patch.kind
+                    );
+                }
+            }
+        }
+    }
+
+    /// An infinitely sharp crease is a cubic B-spline curve of its vertices (DeRose et al.
+    /// 1998): on a bumpy grid with a crease along row 2, the faces above it meet the curve
+    /// along their first edge, and its tangent there is the curve's.
+    #[test]
+    fn a_sharp_crease_is_the_cubic_b_spline_of_its_vertices() {
+        let m = 6;
+        let mut mesh = grid(m, BoundaryMode::EdgeOnly);
+        let row = |i: i64| (2 * (m + 1) + i) as usize;
+        for i in 0..m {
+            mesh.set_edge_sharpness(row(i), row(i + 1), INFINITE)
+                .expect("an edge");
+        }
+        for i in 1..m - 1 {
+            // Face (i, 2): its first edge runs from row(i) to row(i + 1).
+            let face = (2 * m + i) as u32;
+            for t in [0.0, 0.25, 0.5, 0.8] {
+                let q = LimitQuery { face, u: t, v: 0.0 };
+                let [p, du, _] = apply(&limit_stencils(&mesh, &[q]).expect("reached")[0], &mesh);
+                let (b, db) = bspline(t);
+                let mut curve = [0.0; 3];
+                let mut tangent = [0.0; 3];
+                for a in 0..4 {
+                    let x = mesh.positions[row(i - 1 + a as i64)];
+                    for c in 0..3 {
+                        curve[c] += b[a] * x[c];
+                        tangent[c] += db[a] * x[c];
+                    }
+                }
+                for c in 0..3 {
+                    assert!(
+                        (p[c] - curve[c]).abs() < 1e-12,
+                        "face {face} t {t}: {p:?} vs {curve:?}"
+                    );
+                    assert!(
+                        (du[c] - tangent[c]).abs() < 1e-11,
+                        "face {face} t {t}: {du:?} vs {tangent:?}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// Sharpness 1 is one infinitely sharp step, then smooth limits: the same points from the
+    /// mesh with an edge of sharpness 1, and from one step of the mesh with that edge
+    /// infinitely sharp whose children are then made smooth.
+    #[test]
+    fn sharpness_one_is_one_sharp_step_then_smooth() {
+        let m = 5;
+        let edge = |mesh: &mut Mesh, s: f32| {
+            for (a, b) in [(8, 9), (9, 10), (15, 9)] {
+                mesh.set_edge_sharpness(a, b, s).expect("an edge");
+            }
+            mesh.set_vertex_sharpness(20, s).expect("a vertex");
+        };
+        let mut semi = grid(m, BoundaryMode::EdgeOnly);
+        edge(&mut semi, 1.0);
+        let mut sharp = grid(m, BoundaryMode::EdgeOnly);
+        edge(&mut sharp, INFINITE);
+        let mut stepped = refine(&sharp).mesh;
+        for h in 0..stepped.twin.len() {
+            if stepped.twin[h] != crate::mesh::NONE {
+                stepped.edge_sharpness[h] = 0.0;
+            }
+        }
+        stepped.vertex_sharpness.iter_mut().for_each(|s| *s = 0.0);
+        for f in 0..semi.faces() {
+            // Face f's child at corner 0 is face offsets[f] of the refined mesh, the quarter
+            // [0, 1/2]^2 in f's parameters.
+            let child = semi.face_halfedges(f).start as u32;
+            for (u, v) in [(0.1, 0.2), (0.3, 0.45), (0.25, 0.05)] {
+                let a = apply(
+                    &limit_stencils(
+                        &semi,
+                        &[LimitQuery {
+                            face: f as u32,
+                            u,
+                            v,
+                        }],
+                    )
+                    .expect("reached")[0],
+                    &semi,
+                )[0];
+                let q = LimitQuery {
+                    face: child,
+                    u: 2.0 * u,
+                    v: 2.0 * v,
+                };
+                let b = apply(
+                    &limit_stencils(&stepped, &[q]).expect("reached")[0],
+                    &stepped,
+                )[0];
+                for c in 0..3 {
+                    assert!(
+                        (a[c] - b[c]).abs() < 1e-12,
+                        "face {f} ({u}, {v}): {a:?} vs {b:?}"
+                    );
+                }
+            }
+        }
+    }
+}
