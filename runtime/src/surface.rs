@@ -304,6 +304,11 @@ impl Surface {
                 self.scheme
             )));
         };
+        if iso.mesh.has_sharp_features() {
+            return Err(RuntimeError::Unsupported(
+                "Lai–Cheng's adaptive method on sharp features (creases, corners, holes); the dual grid (--method dual) evaluates them exactly".to_owned(),
+            ));
+        }
         let (mut adaptive, stats) =
             tessellate_adaptive(&self.table, &iso.mesh, &iso.patches, options)?;
         for source in &mut adaptive.sources {

@@ -28,6 +28,9 @@ pub fn limit_point(
     v: &BigRational,
 ) -> Result<LimitPoint, RuntimeError> {
     match scheme {
+        Scheme::CatmullClark if mesh.has_sharp_features() => Err(RuntimeError::Unsupported(
+            "exact evaluation on sharp features (creases, corners, holes); `subtess tessellate` evaluates them (feature-adaptive refinement, f64)".to_owned(),
+        )),
         Scheme::CatmullClark => exact_eval::evaluate_subface(mesh, face, subface, u, v),
         Scheme::Loop if subface == 0 => {
             loop_exact_eval::LoopExactEvaluator::new(mesh)?.evaluate(face, u, v)

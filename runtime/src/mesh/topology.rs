@@ -384,32 +384,68 @@ impl Mesh {
         Ok(())
     }
 
-    /// Number of boundary loops: cycles of boundary half-edges, each followed to the boundary
-    /// half-edge leaving its head (a manifold vertex has at most one).
+    /// Number of loops of the surface's boundary: the boundary edges of faces that are not
+    /// holes, and the edges between such faces and holes. Each is followed to the next one
+    /// leaving its head, turning through the surface faces around the head.
     pub fn boundary_loops(&self) -> usize {
+        let surface = |h: usize| !self.holes[self.face_of[h] as usize];
+        let rim =
+            |h: usize| surface(h) && (self.twin[h] == NONE || !surface(self.twin[h] as usize));
         let mut seen = vec![false; self.face_vertices.len()];
         let mut loops = 0;
         for h in 0..self.face_vertices.len() {
-            if self.twin[h] != NONE || seen[h] {
+            if !rim(h) || seen[h] {
                 continue;
             }
             loops += 1;
             let mut e = h;
             while !seen[e] {
                 seen[e] = true;
-                e = self.vertex_halfedge[self.head(e) as usize] as usize;
+                let mut g = self.next(e);
+                while !rim(g) {
+                    g = self.next(self.twin[g] as usize);
+                }
+                e = g;
             }
         }
         loops
     }
 
-    /// Euler characteristic V - E + F (unused vertices not counted).
+    /// Euler characteristic V - E + F of the surface the tessellators make: the faces that
+    /// are not holes, the edges they use, and every vertex once per run of such faces around
+    /// it (holes that leave a vertex two separate runs of faces make it two surface points).
+    /// Without holes: every used vertex, every edge, every face.
     pub fn euler_characteristic(&self) -> i64 {
-        let used = self.vertex_halfedge.iter().filter(|&&h| h != NONE).count() as i64;
-        let halfedges = self.face_vertices.len() as i64;
-        let boundary = self.twin.iter().filter(|&&t| t == NONE).count() as i64;
-        let edges = (halfedges + boundary) / 2;
-        used - edges + self.faces() as i64
+        let surface = |h: usize| !self.holes[self.face_of[h] as usize];
+        let mut edges = 0i64;
+        for h in (0..self.face_vertices.len()).filter(|&h| surface(h)) {
+            let t = self.twin[h];
+            if t == NONE || !surface(t as usize) || h < t as usize {
+                edges += 1;
+            }
+        }
+        let points: i64 = (0..self.positions.len())
+            .map(|v| {
+                let fan = self.fan(v);
+                let kept: Vec<bool> = fan.iter().map(|&h| surface(h)).collect();
+                // Runs start where a kept face follows a dropped one (or the boundary).
+                let starts = (0..kept.len())
+                    .filter(|&i| {
+                        let before = if i == 0 {
+                            (!self.is_boundary_vertex(v)).then(|| kept[kept.len() - 1])
+                        } else {
+                            Some(kept[i - 1])
+                        };
+                        kept[i] && before != Some(true)
+                    })
+                    .count();
+                // A closed fan kept whole is one run without a start.
+                let whole = !kept.is_empty() && kept.iter().all(|&k| k) && starts == 0;
+                (starts + usize::from(whole)) as i64
+            })
+            .sum();
+        let faces = self.holes.iter().filter(|&&hole| !hole).count() as i64;
+        points - edges + faces
     }
 }
 

@@ -156,6 +156,8 @@ enum FaceEval<'t> {
     /// in the face's own parameters, `control.len()` weights a point in three blocks (position,
     /// d/du, d/dv) from `weights` in [`DualGrid::local_weights`].
     Local { control: Range<u32>, weights: usize },
+    /// A hole: no points, no triangles.
+    Hole,
 }
 
 /// A row of output vertices `start + t * step`, `t = 0..len`, at parameters
@@ -311,8 +313,9 @@ impl<'t> DualGrid<'t> {
         }
         let mut first = Vec::with_capacity(patches.len() + 1);
         first.push(0u32);
-        for &n in rates {
-            first.push(first[first.len() - 1] + n * n);
+        for (&n, &hole) in rates.iter().zip(&mesh.holes) {
+            // A hole makes no surface: no points of its own.
+            first.push(first[first.len() - 1] + if hole { 0 } else { n * n });
         }
         let mut grid = DualGrid {
             rates: rates.to_vec(),
@@ -334,6 +337,10 @@ impl<'t> DualGrid<'t> {
         // nearby, a valence or patch beyond the table) are refined adaptively below.
         let mut local_faces = Vec::new();
         for (f, (patch, &n)) in patches.iter().zip(rates).enumerate() {
+            if mesh.holes[f] {
+                grid.faces.push(FaceEval::Hole);
+                continue;
+            }
             let s = if is_smooth_patch(mesh, f) && patch.points.len() <= MAX_PATCH {
                 stencils(table, patch, PointSet::Dual, n).ok()
             } else {
@@ -417,7 +424,11 @@ impl<'t> DualGrid<'t> {
         };
         if let FaceEval::Local { .. } = self.faces[f] {
             let (u, v) = (f64::from(i) / f64::from(n), f64::from(j) / f64::from(n));
-            let query = LimitQuery { face: f as u32, u, v };
+            let query = LimitQuery {
+                face: f as u32,
+                u,
+                v,
+            };
             self.local_points.push((self.boundary_points.len(), query));
             self.boundary_points.push(PointPlan {
                 weights: Vec::new(),
@@ -497,31 +508,77 @@ impl<'t> DualGrid<'t> {
         patches: &[FacePatch],
     ) -> Result<(), RuntimeError> {
         let dual_total = self.first[patches.len()];
-        // Boundary vertices' limit points, evaluated at the corner of the first face of their
-        // fan (the face whose outgoing half-edge is the boundary edge).
-        let mut limit_point = vec![NONE; mesh.positions.len()];
-        for (v, limit) in limit_point.iter_mut().enumerate() {
-            if !mesh.is_boundary_vertex(v) {
+        let hole = |f: usize| mesh.holes[f];
+        // Around every vertex, the runs of consecutive faces that make surface: the whole fan
+        // of a smooth interior vertex makes one closed polygon of corner points; a run bounded
+        // by the boundary or by holes is closed by the vertex's limit point, one per run,
+        // evaluated at the corner of the run's first face. `limit_at[h]`: the limit point of
+        // the run holding half-edge h's corner.
+        let mut limit_at = vec![NONE; mesh.face_vertices.len()];
+        for v in 0..mesh.positions.len() {
+            let fan = mesh.fan(v);
+            let open = mesh.is_boundary_vertex(v);
+            let Some(start) = (if open {
+                Some(0)
+            } else {
+                // A closed fan with a hole starts after one.
+                fan.iter()
+                    .position(|&h| hole(mesh.face_of[h] as usize))
+                    .map(|i| i + 1)
+            }) else {
+                for &h in &fan {
+                    let f = mesh.face_of[h] as usize;
+                    let corner = self.corner_point(f, h - mesh.face_halfedges(f).start);
+                    self.connectivity.polygons.push(corner);
+                }
+                self.connectivity
+                    .polygon_offsets
+                    .push(self.connectivity.polygons.len() as u32);
                 continue;
+            };
+            let mut run: Vec<usize> = Vec::new();
+            for k in 0..=fan.len() {
+                let h = (k < fan.len()).then(|| fan[(start + k) % fan.len()]);
+                match h {
+                    Some(h) if !hole(mesh.face_of[h] as usize) => run.push(h),
+                    _ if run.is_empty() => {}
+                    _ => {
+                        self.boundary = true;
+                        let first = run[0];
+                        let f = mesh.face_of[first] as usize;
+                        let corner = first - mesh.face_halfedges(f).start;
+                        // The corner of the primal grid at the face's own rate (present in any
+                        // table that has the face's dual grid).
+                        let n = self.rates[f];
+                        let (i, j) = [(0, 0), (n, 0), (n, n), (0, n)][corner];
+                        let limit = dual_total + self.boundary_points.len() as u32;
+                        self.boundary_point(table, &patches[f], f, n, (i, j))?;
+                        self.connectivity.polygons.push(limit);
+                        for &h in &run {
+                            limit_at[h] = limit;
+                            let f = mesh.face_of[h] as usize;
+                            let corner = self.corner_point(f, h - mesh.face_halfedges(f).start);
+                            self.connectivity.polygons.push(corner);
+                        }
+                        self.connectivity
+                            .polygon_offsets
+                            .push(self.connectivity.polygons.len() as u32);
+                        run.clear();
+                    }
+                }
             }
-            self.boundary = true;
-            let h = mesh.vertex_halfedge[v] as usize;
-            let f = mesh.face_of[h] as usize;
-            let corner = (h - mesh.face_halfedges(f).start) as u32;
-            // The corner of the primal grid at the face's own rate (present in any table that
-            // has the face's dual grid).
-            let n = self.rates[f];
-            let (i, j) = [(0, 0), (n, 0), (n, n), (0, n)][corner as usize];
-            *limit = dual_total + self.boundary_points.len() as u32;
-            self.boundary_point(table, &patches[f], f, n, (i, j))?;
         }
-        // Edges, each once: interior ones from their lower half-edge, boundary ones from theirs.
+        // Edges, each once: between two surface faces from their lower half-edge; along the
+        // boundary or a hole from the surface face's half-edge.
         for h in 0..mesh.face_vertices.len() {
             let t = mesh.twin[h];
             let f = mesh.face_of[h] as usize;
+            if hole(f) {
+                continue;
+            }
             let side = h - mesh.face_halfedges(f).start;
             let row = self.row(f, side);
-            if t == NONE {
+            if t == NONE || hole(mesh.face_of[t as usize] as usize) {
                 let n = self.rates[f];
                 let first = dual_total + self.boundary_points.len() as u32;
                 for s in 1..n {
@@ -535,9 +592,9 @@ impl<'t> DualGrid<'t> {
                 }
                 self.strips.push(Strip::Boundary {
                     row,
-                    tail: limit_point[mesh.face_vertices[h] as usize],
+                    tail: limit_at[h],
                     first,
-                    head: limit_point[mesh.head(h) as usize],
+                    head: limit_at[mesh.next(h)],
                 });
             } else if (t as usize) > h {
                 let t = t as usize;
@@ -552,27 +609,19 @@ impl<'t> DualGrid<'t> {
                 self.strips.push(Strip::Interior { left: row, right });
             }
         }
-        // Vertex polygons: corner points in fan order, after the limit point on the boundary.
-        for (v, &limit) in limit_point.iter().enumerate() {
-            if limit != NONE {
-                self.connectivity.polygons.push(limit);
-            }
-            for h in mesh.fan(v) {
-                let f = mesh.face_of[h] as usize;
-                let corner = self.corner_point(f, h - mesh.face_halfedges(f).start);
-                self.connectivity.polygons.push(corner);
-            }
-            self.connectivity
-                .polygon_offsets
-                .push(self.connectivity.polygons.len() as u32);
-        }
         self.vertex_count = (dual_total as usize) + self.boundary_points.len();
         let strip_count = |s: &Strip| match *s {
             Strip::Interior { left, right } => strip_triangle_count(left.len, right.len),
             Strip::Boundary { row, .. } => strip_triangle_count(row.len, row.len + 1),
         };
         self.connectivity.count(
-            self.rates.iter().map(|&n| 2 * (n as usize - 1).pow(2)),
+            self.rates.iter().zip(&mesh.holes).map(|(&n, &hole)| {
+                if hole {
+                    0
+                } else {
+                    2 * (n as usize - 1).pow(2)
+                }
+            }),
             self.strips.iter().map(strip_count),
         );
         Ok(())
@@ -617,6 +666,7 @@ impl<'t> DualGrid<'t> {
                     }
                 }
             }
+            FaceEval::Hole => {}
             FaceEval::Local {
                 control: range,
                 weights,
@@ -637,6 +687,9 @@ impl<'t> DualGrid<'t> {
     }
 
     fn connect_face(&self, f: usize, out: &mut [[u32; 3]]) {
+        if let FaceEval::Hole = self.faces[f] {
+            return;
+        }
         let n = self.rates[f];
         let mut k = 0;
         for j in 0..n.saturating_sub(1) {
@@ -666,6 +719,9 @@ impl GridPlan for DualGrid<'_> {
     fn sources(&self) -> Vec<VertexSource> {
         let mut out = Vec::with_capacity(self.vertex_count);
         for (f, &n) in self.rates.iter().enumerate() {
+            if let FaceEval::Hole = self.faces[f] {
+                continue;
+            }
             for j in 0..n {
                 for i in 0..n {
                     out.push(VertexSource {

@@ -45,13 +45,23 @@ pub(crate) struct PointPlan {
 
 impl PointPlan {
     /// The point of row `row` of `s` (a patch of `k` control points).
-    pub(crate) fn from_row(s: &Stencils, row: usize, k: usize, control: Range<u32>, source: VertexSource) -> Self {
+    pub(crate) fn from_row(
+        s: &Stencils,
+        row: usize,
+        k: usize,
+        control: Range<u32>,
+        source: VertexSource,
+    ) -> Self {
         let rows = row * k..(row + 1) * k;
         let mut weights = Vec::with_capacity(3 * k);
         for block in [s.position, s.du, s.dv] {
             weights.extend_from_slice(&block[rows.clone()]);
         }
-        PointPlan { weights, control, source }
+        PointPlan {
+            weights,
+            control,
+            source,
+        }
     }
 }
 
@@ -157,7 +167,16 @@ pub(crate) fn evaluate_points(
             let k = points.len();
             let (wp, rest) = plan.weights.split_at(k);
             let (wu, wv) = rest.split_at(k);
-            (*p, *q) = gathered_point(Stencils { position: wp, du: wu, dv: wv }, points, control, 0);
+            (*p, *q) = gathered_point(
+                Stencils {
+                    position: wp,
+                    du: wu,
+                    dv: wv,
+                },
+                points,
+                control,
+                0,
+            );
         });
 }
 

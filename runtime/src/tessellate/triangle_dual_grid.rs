@@ -380,7 +380,13 @@ impl<'t> TriangleDualGrid<'t> {
             denominator: n,
             subface: 0,
         };
-        self.points.push(PointPlan::from_row(&s, at, k, start..self.control.len() as u32, source));
+        self.points.push(PointPlan::from_row(
+            &s,
+            at,
+            k,
+            start..self.control.len() as u32,
+            source,
+        ));
         Ok(index)
     }
 

@@ -267,6 +267,43 @@ fn vertex_limit(mesh: &Mesh, h: usize) -> Option<Vec<(u32, [f64; 3])>> {
             }
             Some(terms)
         }
+        CreaseRule::Smooth | CreaseRule::Dart if !mesh.is_boundary_vertex(v) => {
+            // OpenSubdiv's smooth limit masks, the fan rotated to start at h so that the
+            // tangents follow the face's frame; face weights on the faces' opposite vertices.
+            let fan = mesh.fan(v);
+            let n = fan.len();
+            let j = fan.iter().position(|&e| e == h)?;
+            let ring: Vec<u32> = (0..n).map(|i| mesh.head(fan[(j + i) % n])).collect();
+            let opposite: Vec<u32> = (0..n)
+                .map(|i| mesh.head(mesh.next(fan[(j + i) % n])))
+                .collect();
+            if n == 2 {
+                return Some(vec![
+                    (me, [1.0, -1.0, -1.0]),
+                    (ring[0], [0.0, 1.0, 0.0]),
+                    (ring[1], [0.0, 0.0, 1.0]),
+                ]);
+            }
+            let k = n as f64;
+            let face = 1.0 / (k * (k + 5.0));
+            let mut terms = vec![(me, [1.0 - k * 5.0 * face, 0.0, 0.0])];
+            let theta = 2.0 * std::f64::consts::PI / k;
+            let lambda = 5.0 / 16.0
+                + (theta.cos() + (theta / 2.0).cos() * (2.0 * (9.0 + theta.cos())).sqrt()) / 16.0;
+            let face_scale = 1.0 / (4.0 * lambda - 1.0);
+            let tangent = |i: usize| {
+                let (c0, c1) = ((i as f64 * theta).cos(), ((i + 1) as f64 * theta).cos());
+                (4.0 * c0, face_scale * (c0 + c1))
+            };
+            for i in 0..n {
+                let (e1, f1) = tangent(i);
+                // The second tangent is the first turned by one edge.
+                let (e2, f2) = tangent((i + n - 1) % n);
+                terms.push((ring[i], [4.0 * face, e1, e2]));
+                terms.push((opposite[i], [face, f1, f2]));
+            }
+            Some(terms)
+        }
         _ => None,
     }
 }

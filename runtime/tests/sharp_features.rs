@@ -1,0 +1,168 @@
+//! Sharp features through the library facade: creases, corners, darts, semi-sharp edges and
+//! holes tessellate into manifold meshes with the boundary loops the holes make, at any rates;
+//! the surface of a face next to a feature passes through the limit the rules give.
+
+use std::collections::{HashMap, HashSet};
+
+use proptest::prelude::*;
+use schemes::crease::INFINITE;
+use schemes::BoundaryMode;
+use subtess::{Frame, Mesh, Rates, Scheme, Surface};
+
+/// A cube of side 2 (faces: -z, +z, -y, +x, +y, -x), vertex `i` at the signs of its bits.
+fn cube() -> Mesh {
+    let positions = (0..8)
+        .map(|i| {
+            let s = |b: usize| if i >> b & 1 == 1 { 1.0 } else { -1.0 };
+            [s(0), s(1), s(2)]
+        })
+        .collect();
+    let faces: Vec<Vec<i64>> = vec![
+        vec![0, 2, 3, 1],
+        vec![4, 5, 7, 6],
+        vec![0, 1, 5, 4],
+        vec![1, 3, 7, 5],
+        vec![3, 2, 6, 7],
+        vec![2, 0, 4, 6],
+    ];
+    Mesh::new(positions, &faces, &[], BoundaryMode::EdgeOnly).expect("a cube")
+}
+
+/// The cube with every kind of feature: an infinitely sharp crease loop around the top, a
+/// semi-sharp edge, a dart (one sharp edge ending inside), a semi-sharp corner, and, with
+/// `hole`, face 2 a hole.
+fn featured_cube(hole: bool) -> Mesh {
+    let mut mesh = cube();
+    for (a, b) in [(4, 5), (5, 7), (7, 6), (6, 4)] {
+        mesh.set_edge_sharpness(a, b, INFINITE).expect("an edge");
+    }
+    mesh.set_edge_sharpness(0, 1, 1.5).expect("an edge");
+    mesh.set_edge_sharpness(1, 3, INFINITE).expect("an edge");
+    mesh.set_vertex_sharpness(2, 2.25).expect("a vertex");
+    mesh.holes[2] = hole;
+    mesh
+}
+
+/// Every directed edge once (a manifold, consistently oriented output), and its boundary
+/// loops.
+fn manifold_boundary_loops(frame: &Frame) -> usize {
+    let mut directed = HashSet::new();
+    for t in frame.triangles() {
+        for k in 0..3 {
+            assert!(
+                directed.insert((t[k], t[(k + 1) % 3])),
+                "directed edge {:?} twice",
+                (t[k], t[(k + 1) % 3])
+            );
+        }
+    }
+    let next: HashMap<u32, u32> = directed
+        .iter()
+        .filter(|&&(a, b)| !directed.contains(&(b, a)))
+        .map(|&(a, b)| (a, b))
+        .collect();
+    let mut seen = HashSet::new();
+    let mut loops = 0;
+    for &start in next.keys() {
+        if seen.contains(&start) {
+            continue;
+        }
+        loops += 1;
+        let mut v = start;
+        while seen.insert(v) {
+            v = next[&v];
+        }
+    }
+    loops
+}
+
+#[test]
+fn every_feature_tessellates_closed_and_a_hole_opens_one_loop() {
+    for (hole, loops) in [(false, 0), (true, 1)] {
+        let mesh = featured_cube(hole);
+        let surface = Surface::new(&mesh, Scheme::CatmullClark).expect("a surface");
+        assert_eq!(surface.boundary_loops(), loops);
+        let mut tessellator = surface.tessellator(&Rates::Uniform(5)).expect("a plan");
+        let frame = tessellator
+            .evaluate(&mesh.positions_f32())
+            .expect("a frame");
+        assert_eq!(manifold_boundary_loops(&frame), loops, "hole {hole}");
+        assert!(frame.positions().iter().flatten().all(|c| c.is_finite()));
+    }
+}
+
+/// An infinitely sharp crease separates the surface: the top face, ringed by the crease
+/// loop, depends on its own four vertices only, all at z = 1, so its whole tessellation lies in
+/// that plane; moving every other vertex leaves it in place, and nothing rises above it.
+#[test]
+fn a_crease_loop_isolates_the_face_inside_it() {
+    let mesh = featured_cube(false);
+    let surface = Surface::new(&mesh, Scheme::CatmullClark).expect("a surface");
+    let mut tessellator = surface.tessellator(&Rates::Uniform(4)).expect("a plan");
+    let mut moved = mesh.positions_f32();
+    for p in &mut moved[..4] {
+        p[0] *= 1.7;
+        p[2] -= 0.9;
+    }
+    for positions in [mesh.positions_f32(), moved] {
+        let frame = tessellator.evaluate(&positions).expect("a frame");
+        let mut top = 0;
+        for (p, s) in frame.positions().iter().zip(frame.sources()) {
+            if s.face == 1 {
+                top += 1;
+                assert!(
+                    (p[2] - 1.0).abs() < 1e-6,
+                    "{p:?} of the top face off its plane"
+                );
+            }
+            assert!(p[2] <= 1.0 + 1e-6, "{p:?} above the crease loop");
+        }
+        assert!(top >= 16, "{top} points on the top face");
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 12, ..ProptestConfig::default() })]
+
+    /// Random per-face rates on the featured cube (with and without its hole), and on a grid
+    /// with boundary in both boundary modes and in "none" (boundary faces are holes).
+    #[test]
+    fn random_rates_stay_manifold(rates in proptest::collection::vec(1u32..7, 6), hole in any::<bool>()) {
+        let mesh = featured_cube(hole);
+        let surface = Surface::new(&mesh, Scheme::CatmullClark).expect("a surface");
+        let mut tessellator = surface.tessellator(&Rates::PerFace(rates)).expect("a plan");
+        let frame = tessellator.evaluate(&mesh.positions_f32()).expect("a frame");
+        prop_assert_eq!(manifold_boundary_loops(&frame), usize::from(hole));
+    }
+}
+
+/// `interpolateboundary 0`: a face at a boundary vertex whose boundary edges are not tagged
+/// sharp makes no surface (OpenSubdiv's `VTX_BOUNDARY_NONE`); a 4 x 4 grid keeps its inner
+/// 2 x 2 faces, one loop around them.
+#[test]
+fn no_boundary_interpolation_drops_the_boundary_faces() {
+    let mut text = String::new();
+    for j in 0..5 {
+        for i in 0..5 {
+            text += &format!("v {i} {j} {}\n", (i * j) as f64 * 0.1);
+        }
+    }
+    for j in 0..4 {
+        for i in 0..4 {
+            let v = j * 5 + i + 1;
+            text += &format!("f {} {} {} {}\n", v, v + 1, v + 6, v + 5);
+        }
+    }
+    text += "t interpolateboundary 1/0/0 0\n";
+    let obj = subtess::io::obj::parse_obj(&text).expect("valid OBJ");
+    let (mesh, warnings) = Mesh::from_obj(&obj).expect("a mesh");
+    assert!(warnings.is_empty(), "{warnings:?}");
+    let kept: Vec<usize> = (0..16).filter(|&f| !mesh.holes[f]).collect();
+    assert_eq!(kept, vec![5, 6, 9, 10]);
+    let surface = Surface::new(&mesh, Scheme::CatmullClark).expect("a surface");
+    let mut tessellator = surface.tessellator(&Rates::Uniform(3)).expect("a plan");
+    let frame = tessellator
+        .evaluate(&mesh.positions_f32())
+        .expect("a frame");
+    assert_eq!(manifold_boundary_loops(&frame), 1);
+}
