@@ -121,6 +121,85 @@ fn a_crease_loop_isolates_the_face_inside_it() {
     }
 }
 
+/// The crease loop around the top is sampled: every output point whose source lies on it (the
+/// top face's edges, the side faces' top edges) is on the closed cubic B-spline of the square
+/// `(±1, ±1, 1)` (DeRose et al. 1998: an infinitely sharp crease is the B-spline of its
+/// vertices), and both sides share those points (the output stays closed).
+#[test]
+fn the_crease_is_sampled_on_its_b_spline() {
+    let mesh = featured_cube(false);
+    let surface = Surface::new(&mesh, Scheme::CatmullClark).expect("a surface");
+    let mut tessellator = surface.tessellator(&Rates::Uniform(6)).expect("a plan");
+    let frame = tessellator
+        .evaluate(&mesh.positions_f32())
+        .expect("a frame");
+    assert_eq!(manifold_boundary_loops(&frame), 0);
+    let square = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]];
+    let bspline = |t: f64| {
+        let s = 1.0 - t;
+        [
+            s * s * s / 6.0,
+            (3.0 * t * t * t - 6.0 * t * t + 4.0) / 6.0,
+            (-3.0 * t * t * t + 3.0 * t * t + 3.0 * t + 1.0) / 6.0,
+            t * t * t / 6.0,
+        ]
+    };
+    let curve = |i: usize, t: f64| {
+        let b = bspline(t);
+        let mut p = [0.0; 2];
+        for (a, w) in b.iter().enumerate() {
+            let c = square[(i + 3 + a) % 4];
+            p[0] += w * c[0];
+            p[1] += w * c[1];
+        }
+        p
+    };
+    // The nearest point of the curve, by dense sampling refined by ternary search.
+    let distance = |q: [f64; 2]| {
+        let d = |i: usize, t: f64| {
+            let p = curve(i, t);
+            ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt()
+        };
+        (0..4)
+            .map(|i| {
+                let t0 = (0..=200)
+                    .map(|k| k as f64 / 200.0)
+                    .min_by(|&a, &b| d(i, a).total_cmp(&d(i, b)))
+                    .unwrap_or(0.0);
+                let (mut lo, mut hi) = ((t0 - 0.005).max(0.0), (t0 + 0.005).min(1.0));
+                for _ in 0..60 {
+                    let (m1, m2) = (lo + (hi - lo) / 3.0, hi - (hi - lo) / 3.0);
+                    if d(i, m1) < d(i, m2) {
+                        hi = m2
+                    } else {
+                        lo = m1
+                    }
+                }
+                d(i, lo)
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    let mut on_crease = 0;
+    for (p, s) in frame.positions().iter().zip(frame.sources()) {
+        let d = s.denominator;
+        let crease = match s.face {
+            1 => s.u == 0 || s.u == d || s.v == 0 || s.v == d,
+            2..=5 => s.v == d,
+            _ => false,
+        };
+        if crease {
+            on_crease += 1;
+            assert!(
+                (p[2] - 1.0).abs() < 1e-6,
+                "{p:?} ({s:?}) off the crease plane"
+            );
+            let e = distance([f64::from(p[0]), f64::from(p[1])]);
+            assert!(e < 1e-6, "{p:?} ({s:?}) is {e:e} off the crease's B-spline");
+        }
+    }
+    assert!(on_crease >= 4 * 6, "{on_crease} points on the crease");
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 12, ..ProptestConfig::default() })]
 

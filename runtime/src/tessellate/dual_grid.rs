@@ -30,6 +30,8 @@ use std::time::Instant;
 
 use table_format::{PointSet, SectionKey, StencilKind};
 
+use schemes::crease::is_infinite;
+
 use crate::mesh::topology::{Mesh, NONE};
 use crate::mesh::triangle_mesh::{TriangleMesh, VertexSource};
 use crate::scheme::catmull_clark::adaptive::{limit_stencils, LimitQuery, LimitStencil};
@@ -160,6 +162,17 @@ enum FaceEval<'t> {
     Hole,
 }
 
+/// What separates two consecutive faces around a vertex.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Cut {
+    /// Nothing: the surface is smooth across the edge.
+    None,
+    /// An infinitely sharp edge: one surface, two sectors.
+    Sector,
+    /// The boundary or a hole: separate sheets of surface.
+    Sheet,
+}
+
 /// A row of output vertices `start + t * step`, `t = 0..len`, at parameters
 /// `(offset + 2t) / denominator` along an edge.
 #[derive(Clone, Copy, Debug)]
@@ -181,13 +194,16 @@ enum Strip {
     /// Between two faces: both rows run along the edge in the same direction, the second lies to
     /// its right.
     Interior { left: DualRow, right: DualRow },
-    /// Along the boundary: the face's row and the curve points `t/n`: `tail`, the edge's own
-    /// `n - 1` points from `first`, `head`.
+    /// Along the boundary, a hole or a crease: the face's row and the curve points
+    /// `t / segments`: `tail`, the edge's own `segments - 1` points from `first` (listed
+    /// from head to tail when `reversed`: the crease's other side made them), `head`.
     Boundary {
         row: DualRow,
         tail: u32,
         first: u32,
         head: u32,
+        segments: u32,
+        reversed: bool,
     },
 }
 
@@ -509,67 +525,93 @@ impl<'t> DualGrid<'t> {
     ) -> Result<(), RuntimeError> {
         let dual_total = self.first[patches.len()];
         let hole = |f: usize| mesh.holes[f];
-        // Around every vertex, the runs of consecutive faces that make surface: the whole fan
-        // of a smooth interior vertex makes one closed polygon of corner points; a run bounded
-        // by the boundary or by holes is closed by the vertex's limit point, one per run,
-        // evaluated at the corner of the run's first face. `limit_at[h]`: the limit point of
-        // the run holding half-edge h's corner.
+        // An infinitely sharp edge between two surface faces is tessellated like a boundary
+        // on both sides: the crease curve is sampled, and shared by the two sides' strips.
+        let sharp = |h: usize| mesh.twin[h] != NONE && is_infinite(mesh.edge_sharpness[h]);
+        // Around every vertex, the fan is cut by the boundary and holes (separate surface
+        // sheets, each with its own limit point) and by sharp edges (sectors of one sheet,
+        // sharing its limit point). A smooth interior vertex makes one closed polygon of
+        // corner points; every sector otherwise is closed by its sheet's limit point,
+        // evaluated at the corner of the sheet's first face. `limit_at[h]`: the limit point
+        // of half-edge h's corner.
         let mut limit_at = vec![NONE; mesh.face_vertices.len()];
         for v in 0..mesh.positions.len() {
             let fan = mesh.fan(v);
+            let n = fan.len();
             let open = mesh.is_boundary_vertex(v);
-            let Some(start) = (if open {
-                Some(0)
-            } else {
-                // A closed fan with a hole starts after one.
-                fan.iter()
-                    .position(|&h| hole(mesh.face_of[h] as usize))
-                    .map(|i| i + 1)
-            }) else {
+            // The cut before fan face i, across the edge of fan[i].
+            let cut = |i: usize| {
+                if i == 0 && open {
+                    return Cut::Sheet;
+                }
+                let before = mesh.face_of[fan[(i + n - 1) % n]] as usize;
+                if hole(before) || hole(mesh.face_of[fan[i]] as usize) {
+                    Cut::Sheet
+                } else if sharp(fan[i]) {
+                    Cut::Sector
+                } else {
+                    Cut::None
+                }
+            };
+            let start = (0..n)
+                .find(|&i| cut(i) == Cut::Sheet)
+                .or_else(|| (0..n).find(|&i| cut(i) == Cut::Sector));
+            let Some(start) = start else {
                 for &h in &fan {
                     let f = mesh.face_of[h] as usize;
                     let corner = self.corner_point(f, h - mesh.face_halfedges(f).start);
                     self.connectivity.polygons.push(corner);
                 }
-                self.connectivity
-                    .polygon_offsets
-                    .push(self.connectivity.polygons.len() as u32);
+                if n > 0 {
+                    self.connectivity
+                        .polygon_offsets
+                        .push(self.connectivity.polygons.len() as u32);
+                }
                 continue;
             };
-            let mut run: Vec<usize> = Vec::new();
-            for k in 0..=fan.len() {
-                let h = (k < fan.len()).then(|| fan[(start + k) % fan.len()]);
-                match h {
-                    Some(h) if !hole(mesh.face_of[h] as usize) => run.push(h),
-                    _ if run.is_empty() => {}
-                    _ => {
-                        self.boundary = true;
-                        let first = run[0];
-                        let f = mesh.face_of[first] as usize;
-                        let corner = first - mesh.face_halfedges(f).start;
-                        // The corner of the primal grid at the face's own rate (present in any
-                        // table that has the face's dual grid).
-                        let n = self.rates[f];
-                        let (i, j) = [(0, 0), (n, 0), (n, n), (0, n)][corner];
-                        let limit = dual_total + self.boundary_points.len() as u32;
-                        self.boundary_point(table, &patches[f], f, n, (i, j))?;
+            let mut limit = NONE;
+            let mut polygon: Vec<u32> = Vec::new();
+            for k in 0..=n {
+                let i = (start + k) % n;
+                let c = if k == n { Cut::Sheet } else { cut(i) };
+                if k == 0 || c != Cut::None {
+                    if !polygon.is_empty() {
                         self.connectivity.polygons.push(limit);
-                        for &h in &run {
-                            limit_at[h] = limit;
-                            let f = mesh.face_of[h] as usize;
-                            let corner = self.corner_point(f, h - mesh.face_halfedges(f).start);
-                            self.connectivity.polygons.push(corner);
-                        }
+                        self.connectivity.polygons.append(&mut polygon);
                         self.connectivity
                             .polygon_offsets
                             .push(self.connectivity.polygons.len() as u32);
-                        run.clear();
+                    }
+                    if k == n {
+                        break;
                     }
                 }
+                if k == 0 || c == Cut::Sheet {
+                    limit = NONE;
+                }
+                let h = fan[i];
+                let f = mesh.face_of[h] as usize;
+                if hole(f) {
+                    continue;
+                }
+                let corner = h - mesh.face_halfedges(f).start;
+                if limit == NONE {
+                    self.boundary = true;
+                    // The corner of the primal grid at the face's own rate (present in any
+                    // table that has the face's dual grid).
+                    let rate = self.rates[f];
+                    let (i, j) = [(0, 0), (rate, 0), (rate, rate), (0, rate)][corner];
+                    limit = dual_total + self.boundary_points.len() as u32;
+                    self.boundary_point(table, &patches[f], f, rate, (i, j))?;
+                }
+                limit_at[h] = limit;
+                polygon.push(self.corner_point(f, corner));
             }
         }
         // Edges, each once: between two surface faces from their lower half-edge; along the
-        // boundary or a hole from the surface face's half-edge.
+        // boundary, a hole or a crease from each surface face's half-edge, the curve points
+        // made once (by the crease's lower half-edge) and shared.
+        let mut curve_of = vec![(0u32, 0u32); mesh.face_vertices.len()];
         for h in 0..mesh.face_vertices.len() {
             let t = mesh.twin[h];
             let f = mesh.face_of[h] as usize;
@@ -578,7 +620,21 @@ impl<'t> DualGrid<'t> {
             }
             let side = h - mesh.face_halfedges(f).start;
             let row = self.row(f, side);
-            if t == NONE || hole(mesh.face_of[t as usize] as usize) {
+            let across_surface = t != NONE && !hole(mesh.face_of[t as usize] as usize);
+            if !across_surface || sharp(h) {
+                let (tail, head) = (limit_at[h], limit_at[mesh.next(h)]);
+                if across_surface && (t as usize) < h {
+                    let (first, segments) = curve_of[t as usize];
+                    self.strips.push(Strip::Boundary {
+                        row,
+                        tail,
+                        first,
+                        head,
+                        segments,
+                        reversed: true,
+                    });
+                    continue;
+                }
                 let n = self.rates[f];
                 let first = dual_total + self.boundary_points.len() as u32;
                 for s in 1..n {
@@ -590,11 +646,14 @@ impl<'t> DualGrid<'t> {
                     };
                     self.boundary_point(table, &patches[f], f, n, ij)?;
                 }
+                curve_of[h] = (first, n);
                 self.strips.push(Strip::Boundary {
                     row,
-                    tail: limit_at[h],
+                    tail,
                     first,
-                    head: limit_at[mesh.next(h)],
+                    head,
+                    segments: n,
+                    reversed: false,
                 });
             } else if (t as usize) > h {
                 let t = t as usize;
@@ -612,7 +671,7 @@ impl<'t> DualGrid<'t> {
         self.vertex_count = (dual_total as usize) + self.boundary_points.len();
         let strip_count = |s: &Strip| match *s {
             Strip::Interior { left, right } => strip_triangle_count(left.len, right.len),
-            Strip::Boundary { row, .. } => strip_triangle_count(row.len, row.len + 1),
+            Strip::Boundary { row, segments, .. } => strip_triangle_count(row.len, segments + 1),
         };
         self.connectivity.count(
             self.rates.iter().zip(&mesh.holes).map(|(&n, &hole)| {
@@ -797,20 +856,23 @@ fn connect_strip(strip: &Strip, out: &mut [[u32; 3]]) {
             tail,
             first,
             head,
+            segments: m,
+            reversed,
         } => {
             let n = row.len;
-            // Dual points at (2t + 1)/2n, curve points at t/n = 2t/2n.
+            // Dual points at (2i + 1)/2n, curve points at j/m: compare (2i + 1) m with 2 j n.
             merge_rows(
                 |i| row.at(i),
                 n,
-                |i| 2 * u64::from(i) + 1,
+                |i| (2 * u64::from(i) + 1) * u64::from(m),
                 |j| match j {
                     0 => tail,
-                    j if j == n => head,
+                    j if j == m => head,
+                    j if reversed => first + (m - j) - 1,
                     j => first + j - 1,
                 },
-                n + 1,
-                |j| 2 * u64::from(j),
+                m + 1,
+                |j| 2 * u64::from(j) * u64::from(n),
                 out,
             );
         }
