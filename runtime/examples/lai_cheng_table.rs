@@ -169,7 +169,11 @@ fn main() -> Result<(), subtess::RuntimeError> {
             println!("skipped {name}: {} is absent", path.display());
             continue;
         }
-        let (mesh, _) = Mesh::from_obj(&read_obj(&path)?)?;
+        // Lai–Cheng does not take sharp features: catmark_chaikin0's row is the smooth surface
+        // of its control mesh, its crease tags dropped (the other meshes carry none).
+        let mut obj = read_obj(&path)?;
+        obj.tags.clear();
+        let (mesh, _) = Mesh::from_obj(&obj)?;
         let iso = isolate_with_origins(&mesh)?;
         let size = diagonal(&mesh);
         for fraction in [0.01, 0.003, 0.001] {

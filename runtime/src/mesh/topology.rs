@@ -199,6 +199,8 @@ impl Mesh {
     /// boundary vertex with a boundary edge that is not infinitely sharp by a tag becomes a
     /// hole (`sharp_boundary`: the edges so tagged, as sorted vertex pairs).
     pub fn exclude_boundary_faces(&mut self, sharp_boundary: &[(usize, usize)]) {
+        let mut sharp_boundary = sharp_boundary.to_vec();
+        sharp_boundary.sort_unstable();
         for v in 0..self.positions.len() {
             if !self.is_boundary_vertex(v) {
                 continue;
@@ -206,7 +208,7 @@ impl Mesh {
             let edges = self.vertex_edges(v);
             let untagged = edges.iter().any(|&h| {
                 let (a, b) = (v, self.opposite(h, v) as usize);
-                self.twin[h] == NONE && !sharp_boundary.contains(&(a.min(b), a.max(b)))
+                self.twin[h] == NONE && sharp_boundary.binary_search(&(a.min(b), a.max(b))).is_err()
             });
             if untagged {
                 for h in self.fan(v) {

@@ -26,6 +26,8 @@ use std::collections::{BTreeMap, BTreeSet};
 
 use schemes::crease::{is_infinite, is_sharp, CreaseRule};
 
+use rayon::prelude::*;
+
 use crate::mesh::topology::Mesh;
 use crate::scheme::catmull_clark::refine::refine;
 use crate::scheme::stencil::Stencil;
@@ -398,22 +400,46 @@ fn patch_terms(grid: &[[Combo; 4]; 4], p: &Pending) -> Vec<(u32, [f64; 3])> {
     terms
 }
 
-/// Compose terms on the current level's vertices with `to_input` (its rows: the level's
-/// vertices over the input's): the stencil on the input vertices, sorted, zeros dropped.
-fn on_input(terms: &[(u32, [f64; 3])], to_input: &Stencil<f64>) -> LimitStencil {
-    let mut sum: BTreeMap<u32, [f64; 3]> = BTreeMap::new();
-    for &(local, w) in terms {
-        let (js, ws) = to_input.row(local as usize);
-        for (&j, &x) in js.iter().zip(ws) {
-            let e = sum.entry(j).or_insert([0.0; 3]);
-            for c in 0..3 {
-                e[c] += w[c] * x;
-            }
+/// A dense accumulator over the input vertices, reset after each use by its touched list.
+struct Accumulator {
+    sum: Vec<[f64; 3]>,
+    touched: Vec<u32>,
+}
+
+impl Accumulator {
+    fn new(columns: usize) -> Self {
+        Accumulator {
+            sum: vec![[0.0; 3]; columns],
+            touched: Vec::new(),
         }
     }
-    sum.into_iter()
-        .filter(|(_, w)| w.iter().any(|&x| x != 0.0))
-        .collect()
+
+    /// Compose terms on the current level's vertices with `to_input` (its rows: the level's
+    /// vertices over the input's): the stencil on the input vertices, sorted, zeros dropped.
+    fn on_input(&mut self, terms: &[(u32, [f64; 3])], to_input: &Stencil<f64>) -> LimitStencil {
+        for &(local, w) in terms {
+            let (js, ws) = to_input.row(local as usize);
+            for (&j, &x) in js.iter().zip(ws) {
+                let e = &mut self.sum[j as usize];
+                if *e == [0.0; 3] {
+                    self.touched.push(j);
+                }
+                for c in 0..3 {
+                    e[c] += w[c] * x;
+                }
+            }
+        }
+        self.touched.sort_unstable();
+        self.touched.dedup();
+        let out = self
+            .touched
+            .iter()
+            .map(|&j| (j, std::mem::replace(&mut self.sum[j as usize], [0.0; 3])))
+            .filter(|(_, w)| w.iter().any(|&x| x != 0.0))
+            .collect();
+        self.touched.clear();
+        out
+    }
 }
 
 /// The faces within `rings` vertex rings of `seeds`.
@@ -513,27 +539,46 @@ pub fn limit_stencils(mesh: &Mesh, queries: &[LimitQuery]) -> Result<Vec<LimitSt
     }
     pending = pending.into_iter().map(|(f, p)| (face_of[&f], p)).collect();
     for depth in 0..=MAX_LEVELS {
+        // Each face's points either lie in a B-spline patch (or at a vertex with a limit
+        // mask) and are done, or go to the children that hold them: faces in parallel.
+        let faces: Vec<(usize, Vec<Pending>)> = std::mem::take(&mut pending).into_iter().collect();
+        let columns = mesh.positions.len();
+        type Outcome = (Vec<(usize, LimitStencil)>, Vec<(usize, Pending)>);
+        let outcomes: Vec<Outcome> = faces
+            .into_par_iter()
+            .map_init(
+                || Accumulator::new(columns),
+                |acc, (g, points)| {
+                    let (mut done, mut descended) = (Vec::new(), Vec::new());
+                    if let Some(grid) = bspline_patch(&level, g) {
+                        for p in points {
+                            done.push((p.query, acc.on_input(&patch_terms(&grid, &p), &to_input)));
+                        }
+                        return (done, descended);
+                    }
+                    for p in points {
+                        let at_vertex = p
+                            .corner()
+                            .and_then(|k| vertex_limit(&level, level.face_halfedges(g).start + k));
+                        if let Some(terms) = at_vertex {
+                            done.push((p.query, acc.on_input(&terms, &to_input)));
+                            continue;
+                        }
+                        let (c, child) = p.descend();
+                        // Child c of face g is numbered by g's half-edge c (`refine`).
+                        descended.push((level.face_halfedges(g).start + c, child));
+                    }
+                    (done, descended)
+                },
+            )
+            .collect();
         let mut next: BTreeMap<usize, Vec<Pending>> = BTreeMap::new();
-        for (g, points) in std::mem::take(&mut pending) {
-            if let Some(grid) = bspline_patch(&level, g) {
-                for p in points {
-                    out[p.query] = on_input(&patch_terms(&grid, &p), &to_input);
-                }
-                continue;
+        for (done, descended) in outcomes {
+            for (query, stencil) in done {
+                out[query] = stencil;
             }
-            for p in points {
-                let at_vertex = p
-                    .corner()
-                    .and_then(|k| vertex_limit(&level, level.face_halfedges(g).start + k));
-                if let Some(terms) = at_vertex {
-                    out[p.query] = on_input(&terms, &to_input);
-                    continue;
-                }
-                let (c, child) = p.descend();
-                // Child c of face g is numbered by g's half-edge c (`refine`).
-                next.entry(level.face_halfedges(g).start + c)
-                    .or_default()
-                    .push(child);
+            for (face, p) in descended {
+                next.entry(face).or_default().push(p);
             }
         }
         if next.is_empty() {
