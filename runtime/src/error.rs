@@ -27,16 +27,6 @@ pub enum MeshError {
         /// What is wrong.
         reason: String,
     },
-    /// An edge has more than two faces, or two faces that traverse it the same way.
-    #[error("edge ({a}, {b}) (OBJ `v` numbers {}, {}) is non-manifold or inconsistently oriented: faces {faces:?} use it in the same direction", a + 1, b + 1)]
-    NonManifoldEdge {
-        /// 0-based endpoints.
-        a: usize,
-        /// 0-based endpoints.
-        b: usize,
-        /// The faces involved.
-        faces: Vec<usize>,
-    },
     /// A face is not yet a table patch: it needs Catmull–Clark isolation steps first.
     #[error("face {face} is not an isolated patch: {reason}")]
     NotIsolated {
@@ -82,14 +72,6 @@ pub enum MeshError {
     NoSuchFace {
         /// 0-based face.
         face: usize,
-    },
-    /// The faces around a vertex form more than one fan.
-    #[error("vertex {vertex} (OBJ `v` number {}) is non-manifold: its {faces} faces form more than one fan", vertex + 1)]
-    NonManifoldVertex {
-        /// 0-based vertex.
-        vertex: usize,
-        /// Number of faces at it.
-        faces: usize,
     },
 }
 

@@ -93,6 +93,11 @@ impl Surface {
         table: StencilTable,
     ) -> Result<Surface, RuntimeError> {
         scheme.check_table(&table)?;
+        if scheme != Scheme::CatmullClark && !mesh.copies.is_empty() {
+            return Err(RuntimeError::Unsupported(format!(
+                "non-manifold topology with --scheme {scheme} (catmull-clark splits it as OpenSubdiv does)"
+            )));
+        }
         let started = Instant::now();
         let isolated = match scheme {
             Scheme::CatmullClark => Isolated::Quad(isolate_with_origins(mesh)?),
@@ -106,11 +111,12 @@ impl Surface {
             Isolated::Quad(iso) => (iso.steps, &iso.refinement),
             Isolated::Triangle(iso) => (iso.steps, &iso.refinement),
         };
-        let refinement = (steps > 0).then(|| refinement.to_f32());
+        // Without steps and split vertices the input points are the control points.
+        let refinement = (steps > 0 || !mesh.copies.is_empty()).then(|| refinement.to_f32());
         Ok(Surface {
             scheme,
             table,
-            input_vertices: mesh.positions.len(),
+            input_vertices: mesh.input_vertices(),
             input_faces: mesh.faces(),
             boundary_loops: mesh.boundary_loops(),
             refinement,

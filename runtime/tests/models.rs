@@ -70,21 +70,16 @@ fn every_opensubdiv_shape_is_read_or_refused_clearly() {
                     .map(|n| n.to_string_lossy().into_owned())
                     .unwrap_or_default();
                 println!("{name}: refused: {e}");
-                // A refusal must name a topological defect, not a parsing accident.
+                // Only a face that repeats a vertex is refused, naming the face.
                 assert!(
-                    matches!(
-                        e,
-                        subtess::MeshError::NonManifoldEdge { .. }
-                            | subtess::MeshError::NonManifoldVertex { .. }
-                            | subtess::MeshError::BadFace { .. }
-                    ),
+                    matches!(e, subtess::MeshError::BadFace { .. }),
                     "{name} refused: {e}"
                 );
             }
         }
     }
     println!("{accepted} accepted, {refused} refused");
-    assert!(accepted >= 50, "only {accepted} shapes accepted");
+    assert!(accepted >= 55, "only {accepted} shapes accepted");
 }
 
 /// Every shape the topology accepts tessellates (rate 3, and mixed rates 1..5) into a closed,

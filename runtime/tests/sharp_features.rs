@@ -245,3 +245,40 @@ fn no_boundary_interpolation_drops_the_boundary_faces() {
         .expect("a frame");
     assert_eq!(manifold_boundary_loops(&frame), 1);
 }
+
+/// A fin: three quads on one edge, a non-manifold edge OpenSubdiv makes infinitely sharp with
+/// pinned corners at its ends. Each sheet is its own patch with its own boundary, and each
+/// reaches the shared edge along the same straight segment (a crease between two pinned
+/// corners); frames take the input's six vertices.
+#[test]
+fn a_non_manifold_fin_splits_into_sheets_meeting_on_the_edge() {
+    let positions = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, -1.0, 0.0],
+        [1.0, -1.0, 0.0],
+        [1.0, 0.0, 1.0],
+        [0.0, 0.0, 1.0],
+    ];
+    let faces = vec![vec![0, 1, 2, 3], vec![1, 0, 4, 5], vec![0, 1, 6, 7]];
+    let mesh = Mesh::new(positions, &faces, &[], BoundaryMode::EdgeOnly).expect("split");
+    assert_eq!(mesh.input_vertices(), 8);
+    let surface = Surface::new(&mesh, Scheme::CatmullClark).expect("a surface");
+    assert_eq!(surface.input_vertices(), 8);
+    let n = 4;
+    let mut tessellator = surface.tessellator(&Rates::Uniform(n)).expect("a plan");
+    let frame = tessellator
+        .evaluate(&mesh.positions_f32())
+        .expect("a frame");
+    assert_eq!(manifold_boundary_loops(&frame), 3);
+    let on_edge = frame
+        .positions()
+        .iter()
+        .filter(|p| p[1].abs() < 1e-6 && p[2].abs() < 1e-6)
+        .count();
+    // Per sheet: the edge's 2^steps isolated segments, n - 1 curve points each, and their ends.
+    let segments = 1usize << surface.isolation_steps();
+    assert_eq!(on_edge, 3 * (segments * n as usize + 1));
+}

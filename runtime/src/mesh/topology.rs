@@ -47,6 +47,9 @@ pub struct Mesh {
     pub holes: Vec<bool>,
     /// How semi-sharp edges decay from level to level.
     pub creasing: CreaseMethod,
+    /// The input vertex of every vertex after the input ones: copies made to split non-manifold
+    /// vertices, one per extra fan (empty for a manifold mesh).
+    pub copies: Vec<u32>,
     /// OpenSubdiv's "smooth triangles" option (`TRI_SUB_SMOOTH`): an edge next to a triangle
     /// weighs the triangle's centroid by 0.47 instead of 0.25, for rounder triangle regions.
     pub smooth_triangles: bool,
@@ -118,9 +121,10 @@ impl Mesh {
             boundary,
             creasing: CreaseMethod::Uniform,
             smooth_triangles: false,
+            copies: Vec::new(),
         };
-        mesh.link_twins()?;
-        mesh.check_fans()?;
+        let non_manifold = mesh.link_twins()?;
+        mesh.split_non_manifold(&non_manifold);
         mesh.sharpen_boundary();
         Ok(mesh)
     }
@@ -142,40 +146,63 @@ impl Mesh {
         }
     }
 
-    /// The half-edge running from `a` to `b`, or else from `b` to `a`.
-    pub fn find_halfedge(&self, a: usize, b: usize) -> Option<usize> {
-        let from = |a: usize, b: usize| {
-            (a < self.positions.len())
-                .then(|| self.vertex_edges(a))
-                .into_iter()
-                .flatten()
-                .find(|&h| self.face_vertices[h] as usize == a && self.head(h) as usize == b)
-        };
-        from(a, b).or_else(|| from(b, a))
+    /// Input vertex `v` and its copies ([`Mesh::copies`]).
+    fn with_copies(&self, v: usize) -> impl Iterator<Item = usize> + '_ {
+        let inputs = self.input_vertices();
+        std::iter::once(v).chain(
+            self.copies
+                .iter()
+                .enumerate()
+                .filter(move |&(_, &o)| o as usize == v)
+                .map(move |(i, _)| inputs + i),
+        )
     }
 
-    /// Set the sharpness of edge `(a, b)` (both its half-edges); a boundary edge stays
-    /// infinitely sharp. Negative values count as 0, as in OpenSubdiv.
+    /// The half-edges between input vertices `a` and `b` (either way, any of their copies).
+    pub fn find_halfedges(&self, a: usize, b: usize) -> Vec<usize> {
+        if a >= self.input_vertices() || b >= self.input_vertices() {
+            return Vec::new();
+        }
+        let mut out = Vec::new();
+        for x in self.with_copies(a) {
+            for h in self.vertex_edges(x) {
+                if self.origin(self.opposite(h, x) as usize) == b {
+                    out.push(h);
+                }
+            }
+        }
+        out
+    }
+
+    /// Set the sharpness of edge `(a, b)` of the input (all its half-edges); a boundary edge
+    /// (a non-manifold one among them) stays infinitely sharp. Negative values count as 0, as
+    /// in OpenSubdiv.
     pub fn set_edge_sharpness(&mut self, a: usize, b: usize, s: f32) -> Result<(), MeshError> {
-        let h = self
-            .find_halfedge(a, b)
-            .ok_or(MeshError::NoSuchEdge { a, b })?;
-        if self.twin[h] != NONE {
-            let s = s.max(0.0);
-            self.edge_sharpness[h] = s;
-            self.edge_sharpness[self.twin[h] as usize] = s;
+        let halfedges = self.find_halfedges(a, b);
+        if halfedges.is_empty() {
+            return Err(MeshError::NoSuchEdge { a, b });
+        }
+        for h in halfedges {
+            if self.twin[h] != NONE {
+                let s = s.max(0.0);
+                self.edge_sharpness[h] = s;
+                self.edge_sharpness[self.twin[h] as usize] = s;
+            }
         }
         Ok(())
     }
 
-    /// Set the sharpness of vertex `v`; a corner pinned by the boundary rule stays pinned.
+    /// Set the sharpness of input vertex `v` (and its copies); a corner pinned by the boundary
+    /// rule or by non-manifold topology stays pinned.
     pub fn set_vertex_sharpness(&mut self, v: usize, s: f32) -> Result<(), MeshError> {
-        let current = self
-            .vertex_sharpness
-            .get_mut(v)
-            .ok_or(MeshError::NoSuchVertex { vertex: v })?;
-        if *current < INFINITE {
-            *current = s.max(0.0);
+        if v >= self.input_vertices() {
+            return Err(MeshError::NoSuchVertex { vertex: v });
+        }
+        let all: Vec<usize> = self.with_copies(v).collect();
+        for w in all {
+            if self.vertex_sharpness[w] < INFINITE {
+                self.vertex_sharpness[w] = s.max(0.0);
+            }
         }
         Ok(())
     }
@@ -240,10 +267,13 @@ impl Mesh {
         }
     }
 
-    /// The vertex positions as the f32 control points a frame takes
-    /// ([`crate::Tessellator::evaluate`]).
+    /// The input vertices' positions as the f32 control points a frame takes
+    /// ([`crate::Tessellator::evaluate`]); copies of split vertices are not among them.
     pub fn positions_f32(&self) -> Vec<[f32; 3]> {
-        self.positions.iter().map(|p| p.map(|c| c as f32)).collect()
+        self.positions[..self.input_vertices()]
+            .iter()
+            .map(|p| p.map(|c| c as f32))
+            .collect()
     }
 
     /// Number of faces.
@@ -323,7 +353,7 @@ impl Mesh {
         h != NONE && self.twin[h as usize] == NONE
     }
 
-    fn link_twins(&mut self) -> Result<(), MeshError> {
+    fn link_twins(&mut self) -> Result<Vec<usize>, MeshError> {
         // Half-edges grouped by tail (counting sort): a twin is found among its head's few
         // outgoing half-edges, without hashing every directed edge.
         let halfedges = self.face_vertices.len();
@@ -342,48 +372,158 @@ impl Mesh {
         }
         let leaving =
             |v: u32| &outgoing[start[v as usize] as usize..start[v as usize + 1] as usize];
+        // An edge is manifold when exactly two half-edges use it, one each way; any other
+        // use (three faces or more, two the same way) leaves all its half-edges unlinked, to
+        // be split apart with their vertices (`split_non_manifold`).
+        let mut non_manifold = Vec::new();
         for h in 0..halfedges {
             let (a, b) = (self.face_vertices[h], self.head(h));
-            // The same directed edge twice: the first earlier copy, as a scan in order finds it.
-            if let Some(&other) = leaving(a)
+            let same = leaving(a)
                 .iter()
-                .find(|&&g| (g as usize) < h && self.head(g as usize) == b)
-            {
-                return Err(MeshError::NonManifoldEdge {
-                    a: a as usize,
-                    b: b as usize,
-                    faces: vec![
-                        self.face_of[other as usize] as usize,
-                        self.face_of[h] as usize,
-                    ],
-                });
-            }
-            if let Some(&t) = leaving(b).iter().find(|&&g| self.head(g as usize) == a) {
-                self.twin[h] = t;
+                .filter(|&&g| self.head(g as usize) == b)
+                .count();
+            let mut reverse = leaving(b).iter().filter(|&&g| self.head(g as usize) == a);
+            match (same, reverse.next(), reverse.next()) {
+                (1, Some(&t), None) => self.twin[h] = t,
+                (1, None, None) => {}
+                _ => non_manifold.push(h),
             }
         }
-        Ok(())
+        Ok(non_manifold)
     }
 
-    fn check_fans(&mut self) -> Result<(), MeshError> {
-        let mut outgoing = vec![0usize; self.positions.len()];
+    /// One outgoing half-edge per vertex, a boundary one where there is one, so that turning
+    /// from it visits the whole fan.
+    fn pick_vertex_halfedges(&mut self) {
+        self.vertex_halfedge = vec![NONE; self.positions.len()];
         for (h, &v) in self.face_vertices.iter().enumerate() {
-            outgoing[v as usize] += 1;
             let current = self.vertex_halfedge[v as usize];
-            // Prefer a boundary half-edge (no twin) as the start of the fan.
             if current == NONE || (self.twin[h] == NONE && self.twin[current as usize] != NONE) {
                 self.vertex_halfedge[v as usize] = h as u32;
             }
         }
-        for (v, &count) in outgoing.iter().enumerate() {
-            if count > 0 && self.fan(v).len() != count {
-                return Err(MeshError::NonManifoldVertex {
-                    vertex: v,
-                    faces: count,
-                });
+    }
+
+    /// Split non-manifold vertices as OpenSubdiv's surfaces split there: a vertex whose faces
+    /// form several fans (a bowtie, or the ends of a non-manifold edge, whose half-edges
+    /// `non_manifold` were left unlinked) gets one vertex per fan, the copies appended and
+    /// recorded in [`Mesh::copies`]. The vertex and its copies are made infinitely sharp
+    /// corners (OpenSubdiv's sharpening of non-manifold vertices), except along a non-manifold
+    /// crease: exactly two non-manifold edges and no boundary edge, where every copy follows
+    /// the crease rule along them.
+    fn split_non_manifold(&mut self, non_manifold: &[usize]) {
+        self.pick_vertex_halfedges();
+        let original = self.positions.len();
+        let mut outgoing: Vec<Vec<usize>> = vec![Vec::new(); original];
+        for (h, &v) in self.face_vertices.iter().enumerate() {
+            outgoing[v as usize].push(h);
+        }
+        let mut sharpen: Vec<usize> = Vec::new();
+        for (v, all) in outgoing.iter().enumerate() {
+            if all.is_empty() || self.fan(v).len() == all.len() {
+                continue;
+            }
+            // Group the outgoing half-edges into fans: back to a fan's start, then forward.
+            let mut fan_of = vec![usize::MAX; all.len()];
+            let mut fans: Vec<Vec<usize>> = Vec::new();
+            for (i, &h) in all.iter().enumerate() {
+                if fan_of[i] != usize::MAX {
+                    continue;
+                }
+                let mut start = h;
+                loop {
+                    let t = self.twin[start];
+                    if t == NONE {
+                        break;
+                    }
+                    let back = self.next(t as usize);
+                    if back == h {
+                        break;
+                    }
+                    start = back;
+                }
+                let mut fan = vec![start];
+                let mut g = start;
+                loop {
+                    let t = self.twin[self.prev(g)];
+                    if t == NONE || t as usize == start {
+                        break;
+                    }
+                    g = t as usize;
+                    fan.push(g);
+                }
+                for &g in &fan {
+                    // `all` lists the half-edges in increasing order.
+                    if let Ok(j) = all.binary_search(&g) {
+                        fan_of[j] = fans.len();
+                    }
+                }
+                fans.push(fan);
+            }
+            for fan in fans.iter().skip(1) {
+                let copy = self.positions.len() as u32;
+                self.positions.push(self.positions[v]);
+                self.copies.push(v as u32);
+                for &h in fan {
+                    self.face_vertices[h] = copy;
+                }
+            }
+            sharpen.push(v);
+        }
+        // Ends of non-manifold edges whose faces still form one fan are non-manifold too.
+        let mut is_sharpened = vec![false; original];
+        for &v in &sharpen {
+            is_sharpened[v] = true;
+        }
+        let mut non_manifold_edges: Vec<Vec<(usize, usize)>> = vec![Vec::new(); original];
+        for &h in non_manifold {
+            let (a, b) = (
+                self.origin(self.face_vertices[h] as usize),
+                self.origin(self.head(h) as usize),
+            );
+            for v in [a, b] {
+                is_sharpened[v] = true;
+                non_manifold_edges[v].push((a.min(b), a.max(b)));
             }
         }
-        Ok(())
+        let mut manifold_boundary = vec![false; original];
+        for h in 0..self.twin.len() {
+            if self.twin[h] == NONE && non_manifold.binary_search(&h).is_err() {
+                manifold_boundary[self.origin(self.face_vertices[h] as usize)] = true;
+                manifold_boundary[self.origin(self.head(h) as usize)] = true;
+            }
+        }
+        self.vertex_sharpness.resize(self.positions.len(), 0.0);
+        for w in 0..self.positions.len() {
+            let v = self.origin(w);
+            if !is_sharpened[v] {
+                continue;
+            }
+            let edges = &mut non_manifold_edges[v];
+            edges.sort_unstable();
+            edges.dedup();
+            let crease = edges.len() == 2 && !manifold_boundary[v];
+            if !crease {
+                self.vertex_sharpness[w] = INFINITE;
+            }
+        }
+        self.pick_vertex_halfedges();
+    }
+
+    /// The input vertex vertex `v` stands for: itself, or the vertex it is a copy of.
+    pub fn origin(&self, v: usize) -> usize {
+        let inputs = self.positions.len() - self.copies.len();
+        if v < inputs {
+            v
+        } else {
+            self.copies[v - inputs] as usize
+        }
+    }
+
+    /// Number of input vertices: the mesh's vertices without the copies that split
+    /// non-manifold vertices.
+    pub fn input_vertices(&self) -> usize {
+        self.positions.len() - self.copies.len()
     }
 
     /// Number of loops of the surface's boundary: the boundary edges of faces that are not
@@ -565,14 +705,33 @@ mod tests {
         let e = Mesh::new(p.clone(), &[vec![0, 1, 1, 2]], &[], BoundaryMode::EdgeOnly)
             .expect_err("repeated");
         assert!(e.to_string().contains("appears twice"), "{e}");
+    }
+
+    /// Non-manifold input is split as OpenSubdiv's surfaces split: a non-manifold edge leaves
+    /// every face its own copy of the edge (infinitely sharp), its ends one vertex per fan, all
+    /// pinned corners; a bowtie vertex one vertex per fan, pinned.
+    #[test]
+    fn non_manifold_vertices_split_into_pinned_copies() {
+        let (p, _) = grid(1);
         // Three faces on edge (0, 1).
         let mut p3 = p.clone();
         p3.push([0.5, -1.0, 0.0]);
         p3.push([0.5, 0.0, 1.0]);
         let faces = vec![vec![0, 1, 3, 2], vec![1, 0, 4], vec![0, 1, 5]];
-        let e =
-            Mesh::new(p3, &faces, &[], BoundaryMode::EdgeOnly).expect_err("three faces on an edge");
-        assert!(matches!(e, MeshError::NonManifoldEdge { .. }), "{e}");
+        let m = Mesh::new(p3, &faces, &[], BoundaryMode::EdgeOnly).expect("split");
+        assert_eq!(m.input_vertices(), 6);
+        assert_eq!(m.copies, vec![0, 0, 1, 1]);
+        assert!(m.twin.iter().all(|&t| t == NONE));
+        for v in 0..m.positions.len() {
+            let expected = if m.origin(v) <= 1 { INFINITE } else { 0.0 };
+            assert_eq!(m.vertex_sharpness[v], expected, "vertex {v}");
+            // Every vertex is one fan now.
+            assert_eq!(
+                m.fan(v).len(),
+                m.face_vertices.iter().filter(|&&w| w as usize == v).count()
+            );
+        }
+        assert_eq!(m.euler_characteristic(), 3);
         // Two triangles touching at one vertex only.
         let p2 = vec![
             [0.0; 3],
@@ -581,22 +740,16 @@ mod tests {
             [-1.0, 0.0, 0.0],
             [0.0, -1.0, 0.0],
         ];
-        let e = Mesh::new(
+        let m = Mesh::new(
             p2,
             &[vec![0, 1, 2], vec![0, 3, 4]],
             &[],
             BoundaryMode::EdgeOnly,
         )
-        .expect_err("bowtie");
-        assert!(
-            matches!(
-                e,
-                MeshError::NonManifoldVertex {
-                    vertex: 0,
-                    faces: 2
-                }
-            ),
-            "{e}"
-        );
+        .expect("split");
+        assert_eq!(m.copies, vec![0]);
+        assert_eq!(m.vertex_sharpness[0], INFINITE);
+        assert_eq!(m.vertex_sharpness[5], INFINITE);
+        assert_eq!(m.boundary_loops(), 2);
     }
 }

@@ -358,7 +358,9 @@ pub trait GridPlan: Sync + Send + std::fmt::Debug {
             sources: self.sources(),
             triangles: vec![[0; 3]; self.triangle_count()],
         };
-        self.evaluate(&mesh.positions_f32(), &mut out.positions, &mut out.normals);
+        // Every vertex of the mesh is a control point, copies of split vertices included.
+        let control: Vec<[f32; 3]> = mesh.positions.iter().map(|p| p.map(|c| c as f32)).collect();
+        self.evaluate(&control, &mut out.positions, &mut out.normals);
         self.connect(&mut out.triangles);
         out
     }

@@ -34,7 +34,7 @@ pub struct Isolation {
     pub input_sides: Vec<u32>,
     /// Every vertex of `mesh` as a combination of the input mesh's vertices: the refinement
     /// steps composed, so a moved input maps to the isolated control points without refining
-    /// again (the identity when no step was taken).
+    /// again (the identity when no step was taken and no vertex was split).
     pub refinement: Stencil<f64>,
 }
 
@@ -81,7 +81,11 @@ pub fn isolate_with_origins(mesh: &Mesh) -> Result<Isolation, MeshError> {
     let mut current = mesh.clone();
     let mut origin: Vec<u32> = (0..mesh.faces() as u32).collect();
     let mut corners = vec![[0u8; MAX_STEPS]; mesh.faces()];
-    let mut refinement = Stencil::identity(mesh.positions.len());
+    // Vertices that split non-manifold ones start as copies of their input vertex.
+    let mut refinement = Stencil::new(mesh.input_vertices());
+    for v in 0..mesh.positions.len() {
+        refinement.push_row(vec![(mesh.origin(v) as u32, 1.0)]);
+    }
     let input_sides = (0..mesh.faces())
         .map(|f| mesh.face(f).len() as u32)
         .collect();
