@@ -180,20 +180,20 @@ pub(crate) fn evaluate_points(
         });
 }
 
-/// Position and unit normal of row `point` of `s` over the control points `points` (vertices
-/// of `control`), any number of them.
-pub(crate) fn gathered_point(
-    s: Stencils,
-    points: &[u32],
-    control: &[[f32; 3]],
+/// Position and unit normal of row `point` of `s`, a stencil of `k` weights a point, over the
+/// control points `q(0..k)`: the position, and the cross product of the two derivatives.
+#[inline(always)]
+fn stencil_point(
+    s: &Stencils,
+    k: usize,
     point: usize,
+    q: impl Fn(usize) -> [f32; 3],
 ) -> ([f32; 3], [f32; 3]) {
-    let k = points.len();
     let rows = point * k..(point + 1) * k;
     let (wp, wu, wv) = (&s.position[rows.clone()], &s.du[rows.clone()], &s.dv[rows]);
     let mut p = [[0.0f32; 3]; 3];
-    for (l, &v) in points.iter().enumerate() {
-        let q = control[v as usize];
+    for l in 0..k {
+        let q = q(l);
         for x in 0..3 {
             p[0][x] += wp[l] * q[x];
             p[1][x] += wu[l] * q[x];
@@ -203,6 +203,17 @@ pub(crate) fn gathered_point(
     (p[0], unit(cross(p[1], p[2])))
 }
 
+/// Position and unit normal of row `point` of `s` over the control points `points` (vertices
+/// of `control`), any number of them.
+pub(crate) fn gathered_point(
+    s: Stencils,
+    points: &[u32],
+    control: &[[f32; 3]],
+    point: usize,
+) -> ([f32; 3], [f32; 3]) {
+    stencil_point(&s, points.len(), point, |l| control[points[l] as usize])
+}
+
 /// Position and unit normal of table point `point` (row of the stencils) from the patch's
 /// control points.
 pub(crate) fn weighted_point(
@@ -210,19 +221,7 @@ pub(crate) fn weighted_point(
     control: &[[f32; 3]],
     point: usize,
 ) -> ([f32; 3], [f32; 3]) {
-    let k = control.len();
-    let rows = point * k..(point + 1) * k;
-    let (wp, wu, wv) = (&s.position[rows.clone()], &s.du[rows.clone()], &s.dv[rows]);
-    let mut p = [[0.0f32; 3]; 3];
-    for l in 0..k {
-        let q = control[l];
-        for x in 0..3 {
-            p[0][x] += wp[l] * q[x];
-            p[1][x] += wu[l] * q[x];
-            p[2][x] += wv[l] * q[x];
-        }
-    }
-    (p[0], unit(cross(p[1], p[2])))
+    stencil_point(s, control.len(), point, |l| control[l])
 }
 
 /// Running totals of `counts`: item `i` owns `[ends[i-1], ends[i])`.
