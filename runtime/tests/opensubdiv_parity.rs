@@ -59,6 +59,8 @@
 //! compared (not refused).
 #![cfg(feature = "opensubdiv")]
 
+mod common;
+
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -74,16 +76,7 @@ const RATE: u32 = 4;
 
 /// `shared/models/opensubdiv` beside the repository (skipped, with a notice, where absent).
 fn models() -> Option<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/models/opensubdiv");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        println!(
-            "skipping: {} is absent (it ships beside the repository, not in it)",
-            dir.display()
-        );
-        None
-    }
+    common::models().map(|dir| dir.join("opensubdiv"))
 }
 
 /// One `t` line: `t name nints/nfloats/nstrings ints.. floats.. strings..`.
