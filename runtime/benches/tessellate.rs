@@ -14,7 +14,9 @@
 //!   refined four times by Loop.
 #![allow(missing_docs)] // criterion_group! generates an undocumented function
 
-#[path = "../tests/common/mod.rs"]
+// The integration tests' meshes; the benchmark uses a few of them.
+#[allow(dead_code)]
+#[path = "../tests/integration/common/mod.rs"]
 mod common;
 
 use std::path::Path;

@@ -40,7 +40,7 @@
 //! not affine deviates): what texture coordinates and shading see.
 //!
 //! On a uniform grid on `z = a x^2` this is the closed form `e_f(n) = a / 4n^2` whenever `n`
-//! divides 24 (the midpoints of the cells are samples); `runtime/tests/rates.rs` checks it.
+//! divides 24 (the midpoints of the cells are samples); `runtime/tests/integration/rates.rs` checks it.
 //!
 //! The **tolerance rate** of face `f` is the smallest allowed `n` with `e_f(n) <= T`
 //! ([`tolerance_rates`]: `n` in `1..=24`; [`tolerance_rates_among`]: any set, e.g. the powers of

@@ -1,6 +1,4 @@
 //! Meshes and checks shared by the runtime's integration tests.
-// Each test binary uses its own subset.
-#![allow(dead_code)]
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};

@@ -9,7 +9,7 @@
 //! the region layouts and their rotations, and the triangle dual grid's point maps together,
 //! without the solver that made the table.
 
-mod common;
+use crate::common;
 
 use proptest::prelude::*;
 use subtess::mesh::topology::Mesh;

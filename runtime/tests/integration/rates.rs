@@ -2,7 +2,7 @@
 //! monotone in the tolerance and minimal (checked against a closed form), flat regions get
 //! rate 1; view rates follow the pinhole formula.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 use std::sync::OnceLock;

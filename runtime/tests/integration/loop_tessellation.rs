@@ -15,7 +15,7 @@
 //!   source, and every normal along the input triangle's normal — which checks the rotations
 //!   into the patches, the patch corners' order and the exact child parameters.
 
-mod common;
+use crate::common;
 
 use std::collections::HashMap;
 

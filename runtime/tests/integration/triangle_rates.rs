@@ -3,7 +3,7 @@
 //! independent method), rates are monotone in the tolerance and minimal, faces that cannot meet
 //! it are reported. The closed forms on a quadratic lattice are unit tests of the module.
 
-mod common;
+use crate::common;
 
 use std::sync::OnceLock;
 
@@ -216,7 +216,7 @@ fn unmet_faces_are_reported_and_bad_input_refused() {
 }
 
 /// Spot (`../shared/models/crane`): rates and the measured deviation for a few tolerances
-/// (`cargo test -p subtess --test triangle_rates -- --ignored --nocapture`; the numbers
+/// (`cargo test -p subtess --test integration triangle_rates -- --ignored --nocapture`; the numbers
 /// are in docs/cli.md).
 #[test]
 #[ignore = "a report on a real model: about a minute"]

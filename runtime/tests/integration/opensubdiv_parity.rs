@@ -2,7 +2,7 @@
 //! on every OpenSubdiv regression shape in `shared/models/opensubdiv/` (their `t` tags applied).
 //!
 //! `scripts/install-opensubdiv-deps.sh && CMAKE_BUILD_PARALLEL_LEVEL=2 CARGO_BUILD_JOBS=2 cargo
-//! test -p subtess --features opensubdiv --test opensubdiv_parity -- --nocapture` (the feature
+//! test -p subtess --features opensubdiv --test integration opensubdiv_parity -- --nocapture` (the feature
 //! builds OpenSubdiv from C++ source, about 20 minutes on 2 cores; the test itself takes about
 //! 4 minutes, most of it `catmark_pole360`). Environment: `SUBTESS_PARITY_TABLE=path` also
 //! writes the table as markdown; `SUBTESS_PARITY_ONLY=text` compares only the shapes whose name
@@ -59,7 +59,7 @@
 //! compared (not refused).
 #![cfg(feature = "opensubdiv")]
 
-mod common;
+use crate::common;
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};

@@ -1,0 +1,25 @@
+//! The runtime's integration tests, one binary: every module links the embedded tables, and
+//! one binary instead of one per file keeps the test build small (a table-linking binary is
+//! about 100 MB) and links once.
+
+mod common;
+
+mod bezier;
+mod boundary_tessellation;
+mod butterfly_tessellation;
+mod cli;
+mod exact_eval;
+mod lai_cheng;
+mod loop_tessellation;
+mod mesh_output;
+mod models;
+#[cfg(feature = "opensubdiv")]
+mod opensubdiv_parity;
+mod patches;
+mod rates;
+mod sharp_features;
+mod sqrt3_tessellation;
+mod surface;
+mod tables;
+mod tessellate;
+mod triangle_rates;
