@@ -32,6 +32,7 @@ pub mod error;
 pub mod eval;
 pub mod io;
 pub mod mesh;
+pub mod render;
 pub mod scheme;
 pub mod stencil_table;
 mod surface;
