@@ -1,6 +1,6 @@
 //! Bézier patch input, bicubic evaluation, displacement maps, edge tests and the adaptive
-//! tessellator of Espino et al. (`subtess::tessellate::bezier`). Tests on the Utah teapot and teacup are
-//! skipped, with a notice, where `../shared/models` is absent.
+//! tessellator of Espino et al. (`subtess::tessellate::bezier`). Tests on the Utah teapot and
+//! teacup need `../shared/models` and are ignored where it was absent at build time.
 //!
 //! Where expected numbers come from: the patch counts and the open seams are those of
 //! `../shared/models/README.md` (32 / 26 patches; the teapot's open rim, lid edge, handle and
@@ -9,7 +9,7 @@
 //! the code under test; the distance cases are worked by hand.
 
 use std::collections::{HashMap, HashSet};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use proptest::prelude::*;
 use subtess::mesh::triangle_mesh::TriangleMesh;
@@ -25,22 +25,10 @@ use subtess::RuntimeError;
 
 type P3 = [f64; 3];
 
-fn models() -> Option<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/models/bezier");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        println!(
-            "skipping: {} is absent (it ships beside the repository, not in it)",
-            dir.display()
-        );
-        None
-    }
-}
-
-fn load(name: &str) -> Option<BezierPatches> {
-    let path = models()?.join(name);
-    Some(BezierPatches::read(&path).unwrap_or_else(|e| panic!("{e}")))
+/// A patch file from `../shared/models/bezier`.
+fn load(name: &str) -> BezierPatches {
+    let path = crate::common::models().join("bezier").join(name);
+    BezierPatches::read(&path).unwrap_or_else(|e| panic!("{e}"))
 }
 
 // ---------------------------------------------------------------- independent references
@@ -105,12 +93,12 @@ fn random_patch(seed: u64) -> BicubicPatch {
 // ---------------------------------------------------------------- parsers
 
 #[test]
+#[cfg_attr(
+    not(shared_models),
+    ignore = "needs ../shared/models beside the repository"
+)]
 fn teapot_in_both_formats_gives_identical_patches_and_teacup_has_26() {
-    let (Some(txt), Some(bpt), Some(cup)) =
-        (load("teapot.txt"), load("teapot.bpt"), load("teacup.txt"))
-    else {
-        return;
-    };
+    let (txt, bpt, cup) = (load("teapot.txt"), load("teapot.bpt"), load("teacup.txt"));
     assert_eq!(txt.len(), 32);
     assert_eq!(bpt.len(), 32);
     assert_eq!(txt, bpt, "every control point identical, same order");
@@ -288,10 +276,12 @@ fn bernstein_basis_is_a_partition_of_unity() {
 }
 
 #[test]
+#[cfg_attr(
+    not(shared_models),
+    ignore = "needs ../shared/models beside the repository"
+)]
 fn degenerate_teapot_patches_have_finite_unit_limit_normals() {
-    let Some(teapot) = load("teapot.txt") else {
-        return;
-    };
+    let teapot = load("teapot.txt");
     for p in [20, 21, 22, 23, 28, 29, 30, 31] {
         let patch = &teapot.patches[p];
         let s = (0..4)
@@ -614,10 +604,12 @@ fn check_seams(patches: &BezierPatches, options: &BezierOptions, loops: usize) {
 }
 
 #[test]
+#[cfg_attr(
+    not(shared_models),
+    ignore = "needs ../shared/models beside the repository"
+)]
 fn teapot_and_teacup_are_watertight_except_their_open_seams() {
-    let (Some(teapot), Some(teacup)) = (load("teapot.txt"), load("teacup.txt")) else {
-        return;
-    };
+    let (teapot, teacup) = (load("teapot.txt"), load("teacup.txt"));
     for test in EdgeTest::ALL {
         for th in [1.0, 0.05, 0.01] {
             let options = BezierOptions {
@@ -640,12 +632,13 @@ proptest! {
     /// Over thresholds, tests and map resolutions the teapot stays watertight where its
     /// patches meet and its boundary is exactly its six open seams.
     #[test]
+    #[cfg_attr(not(shared_models), ignore = "needs ../shared/models beside the repository")]
     fn teapot_seams_are_the_same_for_every_threshold(
         log_th in -2.3f64..0.0,
         test in 0usize..4,
         m in 4usize..20,
     ) {
-        let Some(teapot) = load("teapot.txt") else { return Ok(()); };
+        let teapot = load("teapot.txt");
         let options = BezierOptions {
             test: EdgeTest::ALL[test],
             threshold: 10f64.powf(log_th),
@@ -658,10 +651,12 @@ proptest! {
 }
 
 #[test]
+#[cfg_attr(
+    not(shared_models),
+    ignore = "needs ../shared/models beside the repository"
+)]
 fn map_tests_decide_before_evaluating_and_flat_throws_candidates_away() {
-    let Some(teacup) = load("teacup.txt") else {
-        return;
-    };
+    let teacup = load("teacup.txt");
     for test in EdgeTest::ALL {
         let options = BezierOptions {
             test,
@@ -697,10 +692,12 @@ fn map_tests_decide_before_evaluating_and_flat_throws_candidates_away() {
 }
 
 #[test]
+#[cfg_attr(
+    not(shared_models),
+    ignore = "needs ../shared/models beside the repository"
+)]
 fn a_triangle_budget_searches_the_threshold() {
-    let Some(teacup) = load("teacup.txt") else {
-        return;
-    };
+    let teacup = load("teacup.txt");
     for test in [EdgeTest::Map4p, EdgeTest::Flat] {
         let options = BezierOptions {
             test,

@@ -202,6 +202,10 @@ proptest! {
 }
 
 #[test]
+#[cfg_attr(
+    not(shared_models),
+    ignore = "needs ../shared/models beside the repository"
+)]
 fn spot_tessellates_to_a_closed_manifold_at_mixed_rates() {
     let table = StencilTable::default_butterfly().expect("embedded table");
     check_spot_at_mixed_rates(RegionScheme::Butterfly, &table, 3);
@@ -209,10 +213,10 @@ fn spot_tessellates_to_a_closed_manifold_at_mixed_rates() {
 
 /// A full table written by `stencilgen tables --schemes butterfly --n 1..24` (named by the
 /// environment variable `BUTTERFLY_TABLE`): the same check at rate 16, and the manifold and
-/// outward-normal checks at every rate from 9 to 24. `BUTTERFLY_TABLE=FILE cargo test --release -p subtess --test
-/// butterfly_tessellation -- --ignored`.
+/// outward-normal checks at every rate from 9 to 24. `BUTTERFLY_TABLE=FILE cargo test --release -p
+/// subtess --test integration butterfly_tessellation -- --ignored`.
 #[test]
-#[ignore]
+#[ignore = "needs a full butterfly table named by BUTTERFLY_TABLE"]
 fn a_full_table_passes_through_every_refined_vertex() {
     let Some(path) = std::env::var_os("BUTTERFLY_TABLE") else {
         println!("skipping: BUTTERFLY_TABLE is not set");

@@ -276,13 +276,12 @@ fn eval_prints_the_limit_point() {
 
 /// `--bezier`: Espino et al.'s tessellator from the same command, with its own `--stats`.
 #[test]
+#[cfg_attr(
+    not(shared_models),
+    ignore = "needs ../shared/models beside the repository"
+)]
 fn bezier_patches_from_the_command_line() {
-    let teapot =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/models/bezier/teapot.bpt");
-    if !teapot.exists() {
-        println!("skipping: {} is absent", teapot.display());
-        return;
-    }
+    let teapot = crate::common::models().join("bezier/teapot.bpt");
     let out_path = temp("teapot.ply");
     let out = succeeds(&format!(
         "tessellate --bezier {} -o {} --test map4p --triangles 3000 --stats",
@@ -300,6 +299,11 @@ fn bezier_patches_from_the_command_line() {
         .expect("written")
         .starts_with(b"ply"));
     let _ = std::fs::remove_file(out_path);
+}
+
+/// `--bezier`'s options without `--bezier`, and no input at all, are refused.
+#[test]
+fn bezier_options_need_bezier_input() {
     for args in [
         "tessellate data/cube.obj -o x.obj --threshold 3",
         "tessellate -o x.obj",
@@ -312,13 +316,12 @@ fn bezier_patches_from_the_command_line() {
 /// A mesh that pins its corners (`t interpolateboundary 1 0`) tessellates with the embedded
 /// tables, no table file needed.
 #[test]
+#[cfg_attr(
+    not(shared_models),
+    ignore = "needs ../shared/models beside the repository"
+)]
 fn pinned_corners_work_out_of_the_box() {
-    let shape = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/models/opensubdiv/catmark_edgecorner.obj");
-    if !shape.exists() {
-        println!("skipping: {} is absent", shape.display());
-        return;
-    }
+    let shape = crate::common::models().join("opensubdiv/catmark_edgecorner.obj");
     let obj = temp("edgecorner.obj");
     let out = succeeds(&format!(
         "tessellate {} -o {} --rate 3 --stats",

@@ -805,30 +805,23 @@ fn bad_requests_are_errors_that_say_what_is_wrong() {
     assert!(e.contains("3 corners"), "{e}");
 }
 
-/// Real models: OpenSubdiv shapes and, when present, Keenan Crane's Spot.
+/// Real models: OpenSubdiv shapes and Keenan Crane's Spot.
 #[test]
+#[cfg_attr(
+    not(shared_models),
+    ignore = "needs ../shared/models beside the repository"
+)]
 fn real_models_evaluate_consistently_with_their_isolated_meshes() {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/models");
-    let mut models: Vec<std::path::PathBuf> = [
-        "catmark_pyramid",
-        "catmark_tent",
-        "catmark_edgecorner",
-        "catmark_flap",
+    let dir = crate::common::models();
+    let models = [
+        "opensubdiv/catmark_pyramid.obj",
+        "opensubdiv/catmark_tent.obj",
+        "opensubdiv/catmark_edgecorner.obj",
+        "opensubdiv/catmark_flap.obj",
+        "crane/spot_control_mesh.obj",
     ]
-    .iter()
-    .map(|n| dir.join("opensubdiv").join(format!("{n}.obj")))
-    .collect();
-    let spot = dir.join("crane/spot_control_mesh.obj");
-    if spot.exists() {
-        models.push(spot);
-    } else {
-        println!("notice: {} is missing; Spot is skipped", spot.display());
-    }
+    .map(|file| dir.join(file));
     for path in models {
-        if !path.exists() {
-            println!("notice: {} is missing; skipped", path.display());
-            continue;
-        }
         let obj = subtess::io::obj::read_obj(&path).expect("reads");
         let (mesh, _) = Mesh::from_obj(&obj).expect("valid");
         // A subset of the faces on a big model.

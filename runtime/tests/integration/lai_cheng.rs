@@ -6,7 +6,7 @@
 //! topology (Euler characteristics, edge pairing) or from invariance (scaling by 8 is exact in
 //! floating point), never from the code under test.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use num_bigint::BigInt;
 use num_rational::BigRational;
@@ -34,15 +34,9 @@ fn cube() -> Mesh {
     load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("data/cube.obj"))
 }
 
-fn spot() -> Option<Mesh> {
-    let path: PathBuf = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/models/crane/spot_control_mesh.obj");
-    if path.is_file() {
-        Some(load(&path))
-    } else {
-        println!("skipping Spot: {} is absent", path.display());
-        None
-    }
+/// Crane's Spot, from `../shared/models`.
+fn spot() -> Mesh {
+    load(&crate::common::models().join("crane/spot_control_mesh.obj"))
 }
 
 fn table() -> StencilTable {
@@ -235,8 +229,12 @@ fn the_cube_meets_the_tolerance_everywhere_sampled() {
 }
 
 #[test]
+#[cfg_attr(
+    not(shared_models),
+    ignore = "needs ../shared/models beside the repository"
+)]
 fn spot_meets_the_tolerance_everywhere_sampled() {
-    let Some(mesh) = spot() else { return };
+    let mesh = spot();
     let scale = size(&mesh);
     let iso = isolate(&mesh);
     let t = 0.002 * scale;
@@ -269,14 +267,12 @@ fn spot_meets_the_tolerance_everywhere_sampled() {
 /// polygon of the four faces with the deepest extraordinary squares, exactly at 4 x 4 points,
 /// and every face at the table's points, within its polygon's bound.
 #[test]
+#[cfg_attr(
+    not(shared_models),
+    ignore = "needs ../shared/models beside the repository"
+)]
 fn the_penguin_meets_the_extraordinary_bound() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/models/odedstein/penguin_control_mesh.obj");
-    if !path.is_file() {
-        println!("skipping the penguin: {} is absent", path.display());
-        return;
-    }
-    let mesh = load(&path);
+    let mesh = load(&crate::common::models().join("odedstein/penguin_control_mesh.obj"));
     let scale = size(&mesh);
     let iso = isolate(&mesh);
     let t = 0.003 * scale;
@@ -305,41 +301,49 @@ fn the_penguin_meets_the_extraordinary_bound() {
     assert!(worst <= t + 2e-6 * scale && exact <= t);
 }
 
+/// The cube's adaptive output is closed (`check_watertight`).
+#[test]
+fn the_cube_gives_watertight_polygons_and_triangles() {
+    check_watertight("cube", &cube());
+}
+
+#[test]
+#[cfg_attr(
+    not(shared_models),
+    ignore = "needs ../shared/models beside the repository"
+)]
+fn spot_gives_watertight_polygons_and_triangles() {
+    check_watertight("spot", &spot());
+}
+
 /// Global ids make the output closed: every polygon edge and every triangle edge is used once
 /// in each direction, and the Euler characteristic is the input's.
-#[test]
-fn closed_inputs_give_watertight_polygons_and_triangles() {
-    let mut meshes = vec![("cube", cube())];
-    if let Some(s) = spot() {
-        meshes.push(("spot", s));
-    }
-    for (name, mesh) in meshes {
-        let scale = size(&mesh);
-        let iso = isolate(&mesh);
-        for (t, relative) in [(0.05, false), (0.01, false), (0.001, false), (0.02, true)] {
-            let opts = AdaptiveOptions {
-                tolerance: if relative { t } else { t * scale },
-                relative,
-                ..Default::default()
-            };
-            let (out, stats) =
-                tessellate_adaptive(&table(), &iso.mesh, &iso.patches, &opts).expect("ok");
-            assert!(
-                out.is_watertight(),
-                "{name} T = {t}: polygons not watertight"
-            );
-            let triangles = out.to_triangle_mesh();
-            assert!(triangles.is_watertight(), "{name} T = {t}: triangles");
-            assert_eq!(
-                triangles.euler_characteristic(),
-                mesh.euler_characteristic(),
-                "{name} T = {t}"
-            );
-            assert_eq!(stats.triangles, triangles.triangles.len());
-            // A polygon with m vertices gives m - 2 triangles.
-            let expected: usize = out.polygons.iter().map(|p| p.vertices.len() - 2).sum();
-            assert_eq!(stats.triangles, expected);
-        }
+fn check_watertight(name: &str, mesh: &Mesh) {
+    let scale = size(mesh);
+    let iso = isolate(mesh);
+    for (t, relative) in [(0.05, false), (0.01, false), (0.001, false), (0.02, true)] {
+        let opts = AdaptiveOptions {
+            tolerance: if relative { t } else { t * scale },
+            relative,
+            ..Default::default()
+        };
+        let (out, stats) =
+            tessellate_adaptive(&table(), &iso.mesh, &iso.patches, &opts).expect("ok");
+        assert!(
+            out.is_watertight(),
+            "{name} T = {t}: polygons not watertight"
+        );
+        let triangles = out.to_triangle_mesh();
+        assert!(triangles.is_watertight(), "{name} T = {t}: triangles");
+        assert_eq!(
+            triangles.euler_characteristic(),
+            mesh.euler_characteristic(),
+            "{name} T = {t}"
+        );
+        assert_eq!(stats.triangles, triangles.triangles.len());
+        // A polygon with m vertices gives m - 2 triangles.
+        let expected: usize = out.polygons.iter().map(|p| p.vertices.len() - 2).sum();
+        assert_eq!(stats.triangles, expected);
     }
 }
 

@@ -416,8 +416,12 @@ fn non_triangles_and_non_manifold_input_are_named() {
 }
 
 #[test]
+#[cfg_attr(
+    not(shared_models),
+    ignore = "needs ../shared/models beside the repository"
+)]
 fn the_models_tessellate_to_manifolds_on_the_input() {
-    let Some(dir) = models() else { return };
+    let dir = models();
     let stencils = FlatStencils::new();
     for (file, euler, loops) in [
         ("crane/spot_triangulated.obj", 2, 0),
@@ -439,9 +443,12 @@ fn the_models_tessellate_to_manifolds_on_the_input() {
 }
 
 #[test]
+#[cfg_attr(
+    not(shared_models),
+    ignore = "needs ../shared/models beside the repository"
+)]
 fn the_hand_has_one_boundary_loop_of_16_edges_with_2_3_and_4_triangles() {
-    let Some(dir) = models() else { return };
-    let m = load(&dir.join("odedstein/hand_lowres.obj"));
+    let m = load(&models().join("odedstein/hand_lowres.obj"));
     let boundary: Vec<usize> = (0..m.positions.len())
         .filter(|&v| m.is_boundary_vertex(v))
         .collect();
@@ -474,8 +481,9 @@ proptest! {
 
     /// Random per-face rates 1..=12 on Spot (closed, genus 0) and the hand (one boundary loop).
     #[test]
+    #[cfg_attr(not(shared_models), ignore = "needs ../shared/models beside the repository")]
     fn random_rates_on_the_models(hand in any::<bool>(), seed in proptest::collection::vec(1u32..=12, 1..400)) {
-        let Some(dir) = models() else { return Ok(()) };
+        let dir = models();
         let stencils = FlatStencils::new();
         let file = if hand { "odedstein/hand_lowres.obj" } else { "crane/spot_triangulated.obj" };
         let m = load(&dir.join(file));
@@ -729,9 +737,15 @@ mod with_the_table {
         ] {
             check_limit_points(&m, name);
         }
-        if let Some(dir) = models() {
-            check_limit_points(&load(&dir.join("crane/spot_triangulated.obj")), "spot");
-        }
+    }
+
+    #[test]
+    #[cfg_attr(
+        not(shared_models),
+        ignore = "needs ../shared/models beside the repository"
+    )]
+    fn spots_interior_limit_points_are_loops_closed_form() {
+        check_limit_points(&load(&models().join("crane/spot_triangulated.obj")), "spot");
     }
 }
 
@@ -913,9 +927,15 @@ mod boundary_with_the_table {
         check_edges_agree(&single_triangle(), "single triangle");
         check_edges_agree(&eared_disc(), "eared disc");
         check_edges_agree(&icosahedron(), "icosahedron");
-        if let Some(dir) = models() {
-            check_edges_agree(&load(&dir.join("odedstein/hand_lowres.obj")), "hand");
-        }
+    }
+
+    #[test]
+    #[cfg_attr(
+        not(shared_models),
+        ignore = "needs ../shared/models beside the repository"
+    )]
+    fn neighbouring_triangles_of_the_hand_agree_on_their_shared_edges() {
+        check_edges_agree(&hand(), "hand");
     }
 
     /// Every `stride`-th output vertex (mixed rates) against exact evaluation at its source on
@@ -965,9 +985,15 @@ mod boundary_with_the_table {
         check_exact_evaluation(&disc(), "disc", 3);
         check_exact_evaluation(&single_triangle(), "single triangle", 1);
         check_exact_evaluation(&eared_disc(), "eared disc", 1);
-        if let Some(dir) = models() {
-            check_exact_evaluation(&load(&dir.join("odedstein/hand_lowres.obj")), "hand", 97);
-        }
+    }
+
+    #[test]
+    #[cfg_attr(
+        not(shared_models),
+        ignore = "needs ../shared/models beside the repository"
+    )]
+    fn every_output_vertex_of_the_hand_is_the_exact_limit_surface_at_its_source() {
+        check_exact_evaluation(&hand(), "hand", 97);
     }
 
     #[test]
@@ -977,8 +1003,19 @@ mod boundary_with_the_table {
         // patches next to them.
         check_boundary_curve(&single_triangle(), "single triangle");
         check_boundary_curve(&eared_disc(), "eared disc");
-        if let Some(dir) = models() {
-            check_boundary_curve(&load(&dir.join("odedstein/hand_lowres.obj")), "hand");
-        }
+    }
+
+    #[test]
+    #[cfg_attr(
+        not(shared_models),
+        ignore = "needs ../shared/models beside the repository"
+    )]
+    fn the_hands_boundary_curve_is_the_cubic_bspline_of_its_boundary_polygon() {
+        check_boundary_curve(&hand(), "hand");
+    }
+
+    /// Oded Stein's hand (one boundary loop), from `../shared/models`.
+    fn hand() -> Mesh {
+        load(&models().join("odedstein/hand_lowres.obj"))
     }
 }

@@ -1,6 +1,8 @@
-//! Real meshes from `../shared/models` (skipped, with a notice, where that folder is absent):
-//! every OpenSubdiv shape is read or refused with a clear message, and the Catmull–Clark
-//! refinement reproduces Pixar's Hbr reference refinements and Crane's Spot.
+//! Real meshes from `../shared/models` (every test here is ignored where that folder was absent
+//! at build time): every OpenSubdiv shape is read or refused with a clear message, and the
+//! Catmull–Clark refinement reproduces Pixar's Hbr reference refinements and Crane's Spot.
+
+use crate::common::models;
 
 use std::path::{Path, PathBuf};
 
@@ -11,19 +13,6 @@ use subtess::scheme::catmull_clark::refine::refine;
 use subtess::stencil_table::StencilTable;
 use subtess::tessellate::dual_grid::tessellate;
 
-fn models() -> Option<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/models");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        println!(
-            "skipping: {} is absent (it ships beside the repository, not in it)",
-            dir.display()
-        );
-        None
-    }
-}
-
 fn load(path: &Path) -> (Mesh, Vec<String>) {
     let obj = read_obj(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     Mesh::from_obj(&obj).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
@@ -32,8 +21,12 @@ fn load(path: &Path) -> (Mesh, Vec<String>) {
 /// Every OpenSubdiv regression shape parses; topology either validates or is refused with a
 /// message naming the defect (the `nonman_*` shapes are deliberately non-manifold).
 #[test]
+#[cfg_attr(
+    not(shared_models),
+    ignore = "needs ../shared/models beside the repository"
+)]
 fn every_opensubdiv_shape_is_read_or_refused_clearly() {
-    let Some(dir) = models() else { return };
+    let dir = models();
     let mut entries: Vec<PathBuf> = std::fs::read_dir(dir.join("opensubdiv"))
         .expect("readable")
         .filter_map(|e| e.ok().map(|e| e.path()))
@@ -87,8 +80,12 @@ fn every_opensubdiv_shape_is_read_or_refused_clearly() {
 /// characteristic is the input's. Shapes that pin their corners use the embedded corner table. Shapes are refused, with the reason, only
 /// when isolation fails.
 #[test]
+#[cfg_attr(
+    not(shared_models),
+    ignore = "needs ../shared/models beside the repository"
+)]
 fn every_accepted_opensubdiv_shape_tessellates_watertight() {
-    let Some(dir) = models() else { return };
+    let dir = models();
     let table = StencilTable::default_catmull_clark().expect("embedded table");
     let mut entries: Vec<PathBuf> = std::fs::read_dir(dir.join("opensubdiv"))
         .expect("readable")
@@ -185,8 +182,12 @@ fn point_set_distance(ours: &[[f64; 3]], reference: &[[f64; 3]]) -> f64 {
 /// sets, to 1e-5 of the model size, for every reference shape: creases (semi-sharp and
 /// infinite), corners, darts and both boundary modes, all with their tags.
 #[test]
+#[cfg_attr(
+    not(shared_models),
+    ignore = "needs ../shared/models beside the repository"
+)]
 fn refinement_reproduces_hbr_reference() {
-    let Some(dir) = models() else { return };
+    let dir = models();
     let mut names: Vec<String> = std::fs::read_dir(dir.join("opensubdiv_hbr_reference"))
         .expect("readable")
         .filter_map(|e| e.ok().map(|e| e.file_name().to_string_lossy().into_owned()))
@@ -221,8 +222,12 @@ fn refinement_reproduces_hbr_reference() {
 
 /// Crane's `spot_quadrangulated.obj` is two Catmull–Clark steps of `spot_control_mesh.obj`.
 #[test]
+#[cfg_attr(
+    not(shared_models),
+    ignore = "needs ../shared/models beside the repository"
+)]
 fn refinement_reproduces_spot() {
-    let Some(dir) = models() else { return };
+    let dir = models();
     let (control, _) = load(&dir.join("crane/spot_control_mesh.obj"));
     let (reference, _) = load(&dir.join("crane/spot_quadrangulated.obj"));
     let twice = refine(&refine(&control).mesh).mesh;

@@ -74,9 +74,9 @@ const PARALLEL_TANGENTS: f64 = 1e-2;
 const ISOLATION_LEVEL: usize = 10;
 const RATE: u32 = 4;
 
-/// `shared/models/opensubdiv` beside the repository (skipped, with a notice, where absent).
-fn models() -> Option<PathBuf> {
-    common::models().map(|dir| dir.join("opensubdiv"))
+/// `shared/models/opensubdiv` beside the repository.
+fn models() -> PathBuf {
+    common::models().join("opensubdiv")
 }
 
 /// One `t` line: `t name nints/nfloats/nstrings ints.. floats.. strings..`.
@@ -973,8 +973,12 @@ fn table(rows: &[Row]) -> String {
 }
 
 #[test]
+#[cfg_attr(
+    not(shared_models),
+    ignore = "needs ../shared/models beside the repository"
+)]
 fn limit_surface_matches_opensubdiv() {
-    let Some(dir) = models() else { return };
+    let dir = models();
     let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
         .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
         .filter_map(|e| e.ok().map(|e| e.path()))

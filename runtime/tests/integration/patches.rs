@@ -2,24 +2,17 @@
 //! Hbr): the limit surface of a face equals that of its four children at corresponding
 //! parameters, for interior extraordinary vertices and for boundaries.
 
-use std::path::Path;
-
 use subtess::io::obj::read_obj;
 use subtess::mesh::topology::Mesh;
 use subtess::scheme::catmull_clark::refine::refine;
 use subtess::scheme::patch::{dual_positions, face_patch};
 use subtess::stencil_table::StencilTable;
 
-fn model(relative: &str) -> Option<Mesh> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/models")
-        .join(relative);
-    if !path.exists() {
-        println!("skipping: {} is absent", path.display());
-        return None;
-    }
+/// A mesh from `../shared/models`.
+fn model(relative: &str) -> Mesh {
+    let path = crate::common::models().join(relative);
     let obj = read_obj(&path).unwrap_or_else(|e| panic!("{e}"));
-    Some(Mesh::from_obj(&obj).unwrap_or_else(|e| panic!("{e}")).0)
+    Mesh::from_obj(&obj).unwrap_or_else(|e| panic!("{e}")).0
 }
 
 /// Child `c` of a quad covers the quarter at corner `c`; its dual point (i, j) at rate n is the
@@ -85,33 +78,39 @@ fn check_refinement_invariance(name: &str, mesh: Mesh, table: &StencilTable) {
 }
 
 #[test]
+#[cfg_attr(
+    not(shared_models),
+    ignore = "needs ../shared/models beside the repository"
+)]
 fn spot_limit_surface_is_invariant_under_refinement() {
-    if let Some(mesh) = model("crane/spot_control_mesh.obj") {
-        check_refinement_invariance(
-            "spot",
-            mesh,
-            &StencilTable::default_catmull_clark().expect("embedded table"),
-        );
-    }
+    check_refinement_invariance(
+        "spot",
+        model("crane/spot_control_mesh.obj"),
+        &StencilTable::default_catmull_clark().expect("embedded table"),
+    );
 }
 
 #[test]
+#[cfg_attr(
+    not(shared_models),
+    ignore = "needs ../shared/models beside the repository"
+)]
 fn boundary_limit_surfaces_are_invariant_under_refinement() {
     let table = StencilTable::default_catmull_clark().expect("embedded table");
     for name in ["opensubdiv/catmark_flap.obj", "opensubdiv/catmark_tent.obj"] {
-        if let Some(mesh) = model(name) {
-            check_refinement_invariance(name, mesh, &table);
-        }
+        check_refinement_invariance(name, model(name), &table);
     }
 }
 
 /// `catmark_edgecorner` pins its corners ("interpolateboundary 1"): the default ("edge only")
 /// table is refused for it, and a table made with `--corners` evaluates it.
 #[test]
+#[cfg_attr(
+    not(shared_models),
+    ignore = "needs ../shared/models beside the repository"
+)]
 fn pinned_corners_need_a_corner_table() {
-    let Some(mesh) = model("opensubdiv/catmark_edgecorner.obj") else {
-        return;
-    };
+    let mesh = model("opensubdiv/catmark_edgecorner.obj");
     let isolated = refine(&refine(&mesh).mesh).mesh;
     let default = StencilTable::default_catmull_clark().expect("embedded table");
     let corner_face = (0..isolated.faces())

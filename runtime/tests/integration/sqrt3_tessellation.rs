@@ -227,6 +227,10 @@ proptest! {
 }
 
 #[test]
+#[cfg_attr(
+    not(shared_models),
+    ignore = "needs ../shared/models beside the repository"
+)]
 fn spot_tessellates_to_a_closed_manifold_at_mixed_rates() {
     let table = StencilTable::default_sqrt3().expect("embedded table");
     check_spot_at_mixed_rates(RegionScheme::Sqrt3, &table, 2);

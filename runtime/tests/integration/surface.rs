@@ -17,19 +17,10 @@ fn data(name: &str) -> PathBuf {
         .join(name)
 }
 
-/// A mesh from `../shared/models`, or `None` with a notice when that folder is absent.
-fn shared(relative: &str) -> Option<Mesh> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/models")
-        .join(relative);
-    if !path.exists() {
-        eprintln!(
-            "SKIPPED: {} is absent (../shared ships beside the repository)",
-            path.display()
-        );
-        return None;
-    }
-    Some(Mesh::read_obj(&path).unwrap_or_else(|e| panic!("{relative}: {e}")))
+/// A mesh from `../shared/models`.
+fn shared(relative: &str) -> Mesh {
+    let path = crate::common::models().join(relative);
+    Mesh::read_obj(&path).unwrap_or_else(|e| panic!("{relative}: {e}"))
 }
 
 /// The diagonal of the bounding box.
@@ -213,24 +204,25 @@ fn the_triangle_schemes_through_the_facade() {
 }
 
 #[test]
+#[cfg_attr(
+    not(shared_models),
+    ignore = "needs ../shared/models beside the repository"
+)]
 fn spot_and_a_boundary_mesh_through_the_facade() {
-    if let Some(spot) = shared("crane/spot_control_mesh.obj") {
-        check("spot control mesh", &spot, Scheme::CatmullClark, 4);
-    }
-    if let Some(spot) = shared("crane/spot_triangulated.obj") {
-        check("spot triangulated, loop", &spot, Scheme::Loop, 3);
-    }
-    if let Some(hand) = shared("odedstein/hand_lowres.obj") {
-        let surface = Surface::new(&hand, Scheme::Loop).expect("hand");
-        assert!(surface.boundary_loops() > 0, "the hand has a boundary");
-        check("hand (boundary), loop", &hand, Scheme::Loop, 3);
-        check(
-            "hand (boundary), catmull-clark",
-            &hand,
-            Scheme::CatmullClark,
-            3,
-        );
-    }
+    let spot = shared("crane/spot_control_mesh.obj");
+    check("spot control mesh", &spot, Scheme::CatmullClark, 4);
+    let spot = shared("crane/spot_triangulated.obj");
+    check("spot triangulated, loop", &spot, Scheme::Loop, 3);
+    let hand = shared("odedstein/hand_lowres.obj");
+    let surface = Surface::new(&hand, Scheme::Loop).expect("hand");
+    assert!(surface.boundary_loops() > 0, "the hand has a boundary");
+    check("hand (boundary), loop", &hand, Scheme::Loop, 3);
+    check(
+        "hand (boundary), catmull-clark",
+        &hand,
+        Scheme::CatmullClark,
+        3,
+    );
 }
 
 #[test]

@@ -127,17 +127,21 @@ pub fn torus(m: usize, n: usize) -> Mesh {
     mesh(p, &faces)
 }
 
-pub fn models() -> Option<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/models");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        println!(
-            "skipping: {} is absent (it ships beside the repository, not in it)",
-            dir.display()
-        );
-        None
-    }
+/// `../shared/models`, the real meshes beside the repository (or the folder
+/// `SUBTESS_SHARED_MODELS` named at build time; `runtime/build.rs`). Tests that read it carry
+/// `#[cfg_attr(not(shared_models), ignore = "needs ../shared/models beside the repository")]`:
+/// without the folder they are built ignored, so reaching here without it means it went away
+/// after the build.
+pub fn models() -> PathBuf {
+    let dir = PathBuf::from(env!("SUBTESS_MODELS_DIR"));
+    assert!(
+        dir.is_dir(),
+        "{} is absent: it ships beside the repository, not in it. The tests that need it are \
+         ignored when it is absent at build time; after adding or removing it, `touch \
+         runtime/build.rs` so that they are rebuilt",
+        dir.display()
+    );
+    dir
 }
 
 pub fn load(path: &Path) -> Mesh {
@@ -468,11 +472,9 @@ pub fn worst_normal_angle(
 }
 
 /// Spot isolated by `scheme` in `steps` steps, at rates 1 and 2 alternating in runs of odd
-/// lengths (so that neighbours differ), tessellates to a closed manifold. Skips with a notice
-/// without `../shared`.
+/// lengths (so that neighbours differ), tessellates to a closed manifold. Needs `../shared`.
 pub fn check_spot_at_mixed_rates(scheme: RegionScheme, table: &StencilTable, steps: usize) {
-    let Some(dir) = models() else { return };
-    let m = load(&dir.join("crane/spot_triangulated.obj"));
+    let m = load(&models().join("crane/spot_triangulated.obj"));
     let iso = subtess::scheme::region_isolate::isolate_regions(&m, scheme)
         .unwrap_or_else(|e| panic!("spot: {e}"));
     assert_eq!(iso.steps, steps);
