@@ -1,6 +1,7 @@
 //! `subtess`: the command line, a thin client of the library's facade (`subtess::Surface`):
 //! `subtess tessellate`, `subtess eval`, `subtess bench`, `subtess tables info` (docs/cli.md).
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -22,6 +23,40 @@ use subtess::{
 struct Cli {
     #[command(subcommand)]
     command: Command,
+}
+
+/// The most worker threads `subtess bench --threads` accepts (docs/reliability.md): far above
+/// any core count the work scales to, low enough that a typo cannot start 20,000 threads.
+const MAX_THREADS: usize = 256;
+
+/// `--threads`: 1..=[`MAX_THREADS`].
+fn threads_arg(text: &str) -> Result<usize, String> {
+    match text.parse::<usize>() {
+        Ok(n @ 1..=MAX_THREADS) => Ok(n),
+        Ok(n) => Err(format!("{n} threads: the limit is 1..={MAX_THREADS}")),
+        Err(_) => Err(format!("a number of threads in 1..={MAX_THREADS}")),
+    }
+}
+
+/// Write one line on stdout. A closed pipe (`subtess tables info | head -1`) ends the
+/// program quietly with status 0, as Unix tools do; any other write error is an error.
+fn print_line(line: std::fmt::Arguments) -> Result<(), RuntimeError> {
+    let mut stdout = std::io::stdout().lock();
+    match writeln!(stdout, "{line}").and_then(|()| stdout.flush()) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => std::process::exit(0),
+        Err(source) => Err(RuntimeError::Io {
+            path: "standard output".to_owned(),
+            source,
+        }),
+    }
+}
+
+/// `println!` through [`print_line`]: returns the write's result.
+macro_rules! out {
+    ($($arg:tt)*) => {
+        print_line(format_args!($($arg)*))
+    };
 }
 
 /// `--scheme`: a scheme with a table; a catalogued scheme without one is named as such.
@@ -57,8 +92,8 @@ enum Command {
         /// Mixed per-input-face rates instead (3, 5, 8, 12, 7, 16 in turn).
         #[arg(long, conflicts_with = "rate")]
         mixed: bool,
-        /// Worker threads (default: one per core).
-        #[arg(long)]
+        /// Worker threads, 1..=256 (default: one per core).
+        #[arg(long, value_parser = threads_arg)]
         threads: Option<usize>,
         /// Subdivision steps of the scheme applied to the input first (to reach a given face
         /// count; two √3 steps each for sqrt3).
@@ -335,7 +370,7 @@ fn tessellate_command(args: TessellateArgs) -> Result<(), RuntimeError> {
             (tessellator.triangle_count() as f64 / seconds.max(1e-12)).into();
         stats["watertight"] = watertight.into();
         stats["tolerance"] = args.tolerance.into();
-        println!("{stats}");
+        out!("{stats}")?;
     }
     Ok(())
 }
@@ -380,7 +415,7 @@ fn bezier_command(file: &Path, args: &TessellateArgs) -> Result<(), RuntimeError
     let (triangles, stats) = tessellate_bezier(&patches, &options)?;
     write_mesh(&triangles, &args.output)?;
     if args.stats {
-        println!("{}", stats.to_json());
+        out!("{}", stats.to_json())?;
     }
     Ok(())
 }
@@ -410,7 +445,7 @@ fn adaptive_command(args: &TessellateArgs, surface: &Surface) -> Result<(), Runt
         report["watertight"] =
             serde_json::json!(surface.boundary_loops() == 0 && adaptive.is_watertight());
         report["isolation_seconds"] = serde_json::json!(surface.isolation_seconds());
-        println!("{report}");
+        out!("{report}")?;
     }
     Ok(())
 }
@@ -483,7 +518,7 @@ fn bench_command(args: BenchArgs) -> Result<(), RuntimeError> {
     report["max_seconds"] = seconds[seconds.len() - 1].into();
     report["triangles_per_second"] =
         (tessellator.triangle_count() as f64 / median.max(1e-12)).into();
-    println!("{report}");
+    out!("{report}")?;
     Ok(())
 }
 
@@ -511,11 +546,11 @@ fn eval_command(
             "du": point.du,
             "dv": point.dv,
         });
-        println!("{report}");
+        out!("{report}")?;
     } else {
-        println!("position {:?}", point.position);
-        println!("du       {:?}", point.du);
-        println!("dv       {:?}", point.dv);
+        out!("position {:?}", point.position)?;
+        out!("du       {:?}", point.du)?;
+        out!("dv       {:?}", point.dv)?;
     }
     Ok(())
 }
@@ -535,32 +570,33 @@ fn tables_info(file: Option<PathBuf>, scheme: Scheme) -> Result<(), RuntimeError
         .iter()
         .map(|e| u64::from(e.points) * u64::from(e.width))
         .sum();
-    println!("table:      {name}");
-    println!(
+    out!("table:      {name}")?;
+    out!(
         "format:     version {}, little-endian, checksum {:#018x} (verified)",
-        index.version, index.checksum
-    );
-    println!("scheme:     {}", index.meta.scheme.name());
-    println!(
+        index.version,
+        index.checksum
+    )?;
+    out!("scheme:     {}", index.meta.scheme.name())?;
+    out!(
         "boundary:   {}",
         if index.meta.corners {
             "edge and corner (one-face vertices pinned)"
         } else {
             "edge only"
         }
-    );
-    println!("precision:  {}", index.meta.precision);
-    println!("covers:     {}", index.coverage());
-    println!(
+    )?;
+    out!("precision:  {}", index.meta.precision)?;
+    out!("covers:     {}", index.coverage())?;
+    out!(
         "sections:   {} (primal and dual grids; positions, d/du, d/dv)",
         index.entries.len()
-    );
-    println!("weights:    {weights}");
-    println!(
+    )?;
+    out!("weights:    {weights}")?;
+    out!(
         "size:       {} bytes ({:.1} MiB)",
         table.bytes().len(),
         table.bytes().len() as f64 / (1024.0 * 1024.0)
-    );
+    )?;
     Ok(())
 }
 

@@ -86,12 +86,27 @@ impl StencilTable {
         })
     }
 
-    /// Read and validate a table file.
+    /// Read and validate a table file. The fixed-size header is read and checked first
+    /// ([`table_format::check_header`]: magic, version, the declared size against the file's
+    /// length and [`table_format::MAX_FILE_SIZE`]); only then is the rest read.
     pub fn read(path: &Path) -> Result<Self, RuntimeError> {
-        let bytes = AlignedBytes::read(path).map_err(|source| RuntimeError::Io {
+        use std::io::Read;
+        let io = |source| RuntimeError::Io {
             path: path.display().to_string(),
             source,
-        })?;
+        };
+        let mut file = std::fs::File::open(path).map_err(io)?;
+        let len = file.metadata().map_err(io)?.len();
+        let mut head = Vec::with_capacity(table_format::HEADER_SIZE);
+        file.by_ref()
+            .take(table_format::HEADER_SIZE as u64)
+            .read_to_end(&mut head)
+            .map_err(io)?;
+        table_format::check_header(&head, len)?;
+        // At most MAX_FILE_SIZE (4 GiB), checked above.
+        let len = usize::try_from(len)
+            .map_err(|_| table_format::TableError::TooLarge { declared: len })?;
+        let bytes = AlignedBytes::read_from(head.as_slice().chain(file), len).map_err(io)?;
         let index = TableIndex::parse(bytes.as_bytes())?;
         Ok(StencilTable {
             storage: Storage::Owned(bytes),
@@ -142,5 +157,52 @@ impl TriangleStencils for StencilTable {
             )));
         }
         self.weights(key)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A sparse file of `len` bytes (no disk used) that starts with `head`.
+    fn sparse(name: &str, head: &[u8], len: u64) -> std::path::PathBuf {
+        use std::io::Write;
+        let path =
+            std::env::temp_dir().join(format!("subtess-table-{}-{name}", std::process::id()));
+        let mut file = std::fs::File::create(&path).expect("temp file");
+        file.write_all(head).expect("header");
+        file.set_len(len).expect("sparse length");
+        path
+    }
+
+    /// Issue 20: a 100 GiB sparse file given as a table is refused from its 64-byte header
+    /// (before the fix the reader allocated the file's whole length first).
+    #[test]
+    fn absurd_files_are_refused_from_the_header() {
+        let huge = 100u64 << 30;
+        let real = tables::default_catmull_clark();
+        let head = &real[..table_format::HEADER_SIZE];
+        // A real header on a file of another length.
+        let path = sparse("mismatch", head, huge);
+        let e = StencilTable::read(&path).expect_err("length disagrees with the header");
+        std::fs::remove_file(&path).ok();
+        assert!(e.to_string().contains("file size"), "{e}");
+        // A header that declares the absurd length itself.
+        let mut declared = head.to_vec();
+        declared[32..40].copy_from_slice(&huge.to_le_bytes());
+        let path = sparse("declared", &declared, huge);
+        let e = StencilTable::read(&path).expect_err("over the limit");
+        std::fs::remove_file(&path).ok();
+        assert!(e.to_string().contains("4 GiB"), "{e}");
+        // Not a table at all.
+        let path = sparse("zeros", &[], huge);
+        let e = StencilTable::read(&path).expect_err("no magic");
+        std::fs::remove_file(&path).ok();
+        assert!(e.to_string().contains("not a subtess stencil table"), "{e}");
+        // A real table still reads.
+        let path = sparse("real", real, real.len() as u64);
+        let table = StencilTable::read(&path).expect("a valid table");
+        std::fs::remove_file(&path).ok();
+        assert_eq!(table.bytes(), real);
     }
 }

@@ -33,6 +33,9 @@ pub const HEADER_SIZE: usize = 64;
 pub const ENTRY_SIZE: usize = 40;
 /// Every section starts at a multiple of this.
 pub const SECTION_ALIGN: usize = 64;
+/// The largest table file a reader accepts, 4 GiB (the embedded default tables are 1–60 MB). A
+/// header declaring more is refused by [`check_header`] before the rest of the file is read.
+pub const MAX_FILE_SIZE: u64 = 4 << 30;
 /// Written as a little-endian u32 at offset 12: reads back as this only on a little-endian
 /// reading of a little-endian file.
 pub const ENDIAN_MARK: u32 = 0x0102_0304;
@@ -69,6 +72,12 @@ pub enum TableError {
         needed: u64,
         /// Bytes present.
         len: u64,
+    },
+    /// The header declares a file larger than [`MAX_FILE_SIZE`].
+    #[error("the table's header declares {declared} bytes, more than the {MAX_FILE_SIZE} bytes (4 GiB) a table may have")]
+    TooLarge {
+        /// The file size in the header.
+        declared: u64,
     },
     /// The checksum over everything after the header does not match.
     #[error("the table is corrupt: checksum {computed:#018x} over bytes {HEADER_SIZE}.. does not match the stored {stored:#018x}")]
@@ -553,53 +562,11 @@ impl TableIndex {
     /// Validate `bytes` as a table (see [`Table::parse`]).
     pub fn parse(bytes: &[u8]) -> Result<Self, TableError> {
         let len = bytes.len() as u64;
-        if bytes.len() < MAGIC.len() || bytes[..MAGIC.len()] != MAGIC {
-            return Err(TableError::BadMagic {
-                found: bytes[..bytes.len().min(MAGIC.len())].to_vec(),
-            });
-        }
-        if bytes.len() < HEADER_SIZE {
-            return Err(TableError::Truncated {
-                what: "the header".to_owned(),
-                needed: HEADER_SIZE as u64,
-                len,
-            });
-        }
+        check_header(bytes, len)?;
         let version = u32_at(bytes, 8);
-        if version != VERSION {
-            return Err(TableError::UnsupportedVersion {
-                found: version,
-                supported: VERSION,
-            });
-        }
-        let mark = u32_at(bytes, 12);
-        if mark != ENDIAN_MARK {
-            return Err(TableError::Endianness { found: mark });
-        }
-        let header_size = u32_at(bytes, 16);
-        if header_size as usize != HEADER_SIZE {
-            return Err(TableError::BadField {
-                field: "header size",
-                value: u64::from(header_size),
-            });
-        }
         let count = u32_at(bytes, 20) as u64;
         let index_offset = u64_at(bytes, 24);
-        let file_size = u64_at(bytes, 32);
         let stored = u64_at(bytes, 40);
-        if file_size > len {
-            return Err(TableError::Truncated {
-                what: "the file size in the header".to_owned(),
-                needed: file_size,
-                len,
-            });
-        }
-        if file_size < len {
-            return Err(TableError::BadField {
-                field: "file size",
-                value: file_size,
-            });
-        }
         let computed = xxhash_rust::xxh3::xxh3_64(&bytes[HEADER_SIZE..]);
         if computed != stored {
             return Err(TableError::Checksum { stored, computed });
@@ -851,6 +818,64 @@ fn ranges(set: &std::collections::BTreeSet<u32>) -> String {
     parts.join(", ")
 }
 
+/// Check a table's fixed-size header: `head` is the file's first [`HEADER_SIZE`] bytes (or all
+/// of them, if it has fewer) and `len` the file's length. Checks the magic, the version, the
+/// endianness mark, the header size, and the file size the header declares against `len` and
+/// [`MAX_FILE_SIZE`]. A reader calls it before reading the rest, so that a file of absurd size
+/// (a 100 GB sparse file given as a table) is refused without being read.
+pub fn check_header(head: &[u8], len: u64) -> Result<(), TableError> {
+    if head.len() < MAGIC.len() || head[..MAGIC.len()] != MAGIC {
+        return Err(TableError::BadMagic {
+            found: head[..head.len().min(MAGIC.len())].to_vec(),
+        });
+    }
+    if head.len() < HEADER_SIZE {
+        return Err(TableError::Truncated {
+            what: "the header".to_owned(),
+            needed: HEADER_SIZE as u64,
+            len,
+        });
+    }
+    let version = u32_at(head, 8);
+    if version != VERSION {
+        return Err(TableError::UnsupportedVersion {
+            found: version,
+            supported: VERSION,
+        });
+    }
+    let mark = u32_at(head, 12);
+    if mark != ENDIAN_MARK {
+        return Err(TableError::Endianness { found: mark });
+    }
+    let header_size = u32_at(head, 16);
+    if header_size as usize != HEADER_SIZE {
+        return Err(TableError::BadField {
+            field: "header size",
+            value: u64::from(header_size),
+        });
+    }
+    let file_size = u64_at(head, 32);
+    if file_size > MAX_FILE_SIZE {
+        return Err(TableError::TooLarge {
+            declared: file_size,
+        });
+    }
+    if file_size > len {
+        return Err(TableError::Truncated {
+            what: "the file size in the header".to_owned(),
+            needed: file_size,
+            len,
+        });
+    }
+    if file_size < len {
+        return Err(TableError::BadField {
+            field: "file size",
+            value: file_size,
+        });
+    }
+    Ok(())
+}
+
 /// An owned, 8-byte-aligned byte buffer, so that a table read from a file (one copy) can be
 /// parsed and viewed without further copies.
 #[derive(Clone, Debug, Default)]
@@ -877,6 +902,15 @@ impl AlignedBytes {
         let len = usize::try_from(file.metadata()?.len()).unwrap_or(usize::MAX);
         let mut words = vec![0u64; len.div_ceil(8)];
         file.read_exact(&mut bytemuck::cast_slice_mut::<u64, u8>(&mut words)[..len])?;
+        Ok(AlignedBytes { words, len })
+    }
+
+    /// Read exactly `len` bytes from `reader` into an aligned buffer (a table reader reads the
+    /// header first, checks it with [`check_header`], then passes the header chained with the
+    /// rest of the file).
+    pub fn read_from(mut reader: impl std::io::Read, len: usize) -> std::io::Result<Self> {
+        let mut words = vec![0u64; len.div_ceil(8)];
+        reader.read_exact(&mut bytemuck::cast_slice_mut::<u64, u8>(&mut words)[..len])?;
         Ok(AlignedBytes { words, len })
     }
 

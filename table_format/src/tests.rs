@@ -75,6 +75,39 @@ fn wrong_magic() {
     assert!(matches!(parse(b"PNG"), Err(TableError::BadMagic { .. })));
 }
 
+/// Issue 20: the header alone decides whether a file is worth reading. A declared size above
+/// [`MAX_FILE_SIZE`] or one that disagrees with the file's length is refused from the first
+/// [`HEADER_SIZE`] bytes (a reader checks these before it reads a 100 GB file).
+#[test]
+fn header_checked_against_the_file_length_and_the_limit() {
+    let b = sample();
+    let head = &b[..HEADER_SIZE];
+    assert_eq!(check_header(head, b.len() as u64), Ok(()));
+    let huge = 100u64 << 30;
+    let e = check_header(head, huge).expect_err("longer than declared");
+    assert!(
+        matches!(
+            e,
+            TableError::BadField {
+                field: "file size",
+                ..
+            }
+        ),
+        "{e}"
+    );
+    let e = check_header(head, 10).expect_err("shorter than declared");
+    assert!(matches!(e, TableError::Truncated { .. }), "{e}");
+    let mut big = head.to_vec();
+    big[32..40].copy_from_slice(&huge.to_le_bytes());
+    let e = check_header(&big, huge).expect_err("over the limit");
+    assert_eq!(e, TableError::TooLarge { declared: huge });
+    assert!(e.to_string().contains("4 GiB"), "{e}");
+    assert!(matches!(
+        check_header(&[0u8; 64], huge),
+        Err(TableError::BadMagic { .. })
+    ));
+}
+
 #[test]
 fn newer_and_older_versions() {
     for v in [0u32, VERSION - 1, VERSION + 1, 99] {

@@ -113,10 +113,13 @@ fn parse_tag(words: Vec<&str>, line: usize) -> Result<Tag, RuntimeError> {
         return Err(err(format!("tag counts `{}` are not `i/f/s`", words[1])));
     };
     let args = &words[2..];
-    if args.len() != ni + nf + ns {
+    // The counts come from the file: add them without wrapping, and compare the total with
+    // the arguments present before anything is sized from it.
+    let announced = ni.checked_add(nf).and_then(|n| n.checked_add(ns));
+    if announced != Some(args.len()) {
+        let announced = announced.map_or_else(|| "more".to_owned(), |n| n.to_string());
         return Err(err(format!(
-            "tag `{name}` announces {} arguments and has {}",
-            ni + nf + ns,
+            "tag `{name}` announces {announced} arguments and has {}",
             args.len()
         )));
     }
@@ -336,6 +339,22 @@ mod tests {
             ("v 0 0 0\nf 0 1 2\n", 2, "index 0"),
             ("\n\nwat 1 2\n", 3, "unknown OBJ statement"),
             ("t crease 2/1/0 0 1\n", 1, "announces 3 arguments"),
+            // Counts that wrap `usize` when added (issue 20): an error, not a panic.
+            (
+                "v 0 0 0\nt crease 18446744073709551615/1/0\n",
+                2,
+                "announces more arguments and has 0",
+            ),
+            (
+                "t crease 18446744073709551615/18446744073709551615/2 a b\n",
+                1,
+                "announces more",
+            ),
+            (
+                "t crease 1/18446744073709551615/1 0 x\n",
+                1,
+                "announces more",
+            ),
         ] {
             match parse_obj(text) {
                 Err(RuntimeError::Obj {

@@ -37,14 +37,24 @@ pub fn cross<T: Float>(a: [T; 3], b: [T; 3]) -> [T; 3] {
 }
 
 /// `v` scaled to unit length, or zero where it has none (a degenerate tangent pair gives a
-/// zero normal rather than NaN).
+/// zero normal rather than NaN, and so does a non-finite `v`). Every output normal goes through
+/// here. The squared length is used directly only when it is a normal float; otherwise (a
+/// cross product of tangents of a surface of size 2e10 or 1e-11 overflows or underflows `f32`
+/// when squared) `v` is first divided by its largest component, so any finite `v` other than
+/// zero gets a unit result.
 pub fn normalize<T: Float>(v: [T; 3]) -> [T; 3] {
-    let length = norm(v);
-    if length > T::zero() {
-        v.map(|x| x / length)
-    } else {
-        [T::zero(); 3]
+    let squared = dot(v, v);
+    if squared.is_normal() {
+        let length = squared.sqrt();
+        return v.map(|x| x / length);
     }
+    let largest = v[0].abs().max(v[1].abs()).max(v[2].abs());
+    if !(largest > T::zero() && v.iter().all(|x| x.is_finite())) {
+        return [T::zero(); 3];
+    }
+    let w = v.map(|x| x / largest);
+    let length = norm(w);
+    w.map(|x| x / length)
 }
 
 /// Euclidean distance between two points.
@@ -128,4 +138,38 @@ pub fn closest_point_on_triangle(p: Point3, a: Point3, b: Point3, c: Point3) -> 
 /// The distance from `p` to the triangle `t` ([`closest_point_on_triangle`]).
 pub fn point_triangle_distance(p: Point3, t: &[Point3; 3]) -> f64 {
     norm(sub(p, closest_point_on_triangle(p, t[0], t[1], t[2])))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn assert_unit(n: [f32; 3], expected: [f32; 3]) {
+        for k in 0..3 {
+            assert!((n[k] - expected[k]).abs() < 1e-6, "{n:?} != {expected:?}");
+        }
+    }
+
+    /// Issue 20: the normals of a cube of side 2e10 or 1e-11 were `0 0 0`, the squared length
+    /// overflowing or underflowing `f32`. Every finite nonzero vector normalizes to unit length.
+    #[test]
+    fn normalize_any_finite_scale() {
+        let h = std::f32::consts::FRAC_1_SQRT_2;
+        for s in [1.0f32, 4e20, 3e38, 1e-22, 1e-40, f32::MIN_POSITIVE] {
+            assert_unit(normalize([s, 0.0, -s]), [h, 0.0, -h]);
+            assert_unit(normalize([0.0, s, 0.0]), [0.0, 1.0, 0.0]);
+            let tangents = cross([s.sqrt(), 0.0, 0.0], [0.0, s.sqrt(), 0.0]);
+            if tangents[2] > 0.0 && tangents[2].is_finite() {
+                assert_unit(normalize(tangents), [0.0, 0.0, 1.0]);
+            }
+        }
+        let n = normalize([1e300f64, 1e300, 0.0]);
+        assert!(
+            (n[0] - std::f64::consts::FRAC_1_SQRT_2).abs() < 1e-15,
+            "{n:?}"
+        );
+        for v in [[0.0f32; 3], [f32::INFINITY, 0.0, 0.0], [f32::NAN, 1.0, 0.0]] {
+            assert_eq!(normalize(v), [0.0; 3], "{v:?}");
+        }
+    }
 }

@@ -9,6 +9,7 @@ mod boundary_tessellation;
 mod butterfly_tessellation;
 mod cli;
 mod exact_eval;
+mod hostile;
 mod lai_cheng;
 mod loop_tessellation;
 mod mesh_output;

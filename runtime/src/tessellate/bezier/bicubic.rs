@@ -162,7 +162,7 @@ impl BicubicPatch {
         let tol = 1e-24 * s * s;
         let first = cross(self.partial(u, v, 1, 0), self.partial(u, v, 0, 1));
         if norm(first) > tol {
-            return scale(1.0 / norm(first), first);
+            return crate::mesh::geometry::normalize(first);
         }
         let dir = |t: f64| -> f64 {
             if t <= 0.0 {

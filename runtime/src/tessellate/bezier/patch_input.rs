@@ -76,6 +76,12 @@ impl<'a> Lines<'a> {
         ))
     }
 
+    /// How many lines (blank or not) are left: at most the number of items that may still be
+    /// read, so the bound on every preallocation from a count the file declares.
+    fn remaining(&self) -> usize {
+        self.inner.clone().count()
+    }
+
     /// The next non-blank line, if any.
     fn rest(&mut self) -> Option<(usize, &'a str)> {
         for (k, line) in self.inner.by_ref() {
@@ -146,7 +152,9 @@ impl BezierPatches {
         if count == 0 {
             return Err(lines.error(count_line, "the file declares no patches"));
         }
-        let mut indices = Vec::with_capacity(count);
+        // One line per patch: a count larger than the lines left cannot be met, and is not
+        // trusted with an allocation (the loop below reports the short file).
+        let mut indices = Vec::with_capacity(count.min(lines.remaining()));
         for p in 0..count {
             let (line, t) = lines.expect(&format!("patch {} of {count}", p + 1))?;
             let fields: Vec<&str> = t.split(',').collect();
@@ -188,7 +196,7 @@ impl BezierPatches {
         if vertices == 0 {
             return Err(lines.error(vertex_line, "the file declares no vertices"));
         }
-        let mut points = Vec::with_capacity(vertices);
+        let mut points = Vec::with_capacity(vertices.min(lines.remaining()));
         for v in 0..vertices {
             let (line, t) = lines.expect(&format!("vertex {} of {vertices}", v + 1))?;
             let fields: Vec<&str> = t.split(',').collect();
@@ -200,7 +208,7 @@ impl BezierPatches {
                 format!("unexpected content after the {vertices} vertices: `{t}`"),
             ));
         }
-        let mut patches = Vec::with_capacity(count);
+        let mut patches = Vec::with_capacity(indices.len());
         for (p, (line, row)) in indices.iter().enumerate() {
             let mut control = [[0.0; 3]; 16];
             for (c, &i) in control.iter_mut().zip(row) {
@@ -226,7 +234,8 @@ impl BezierPatches {
         if count == 0 {
             return Err(lines.error(count_line, "the file declares no patches"));
         }
-        let mut patches = Vec::with_capacity(count);
+        // 17 lines per patch (`du dv` and 16 points) bound what the rest of the file can hold.
+        let mut patches = Vec::with_capacity(count.min(lines.remaining() / 17));
         for p in 0..count {
             let (line, t) = lines.expect(&format!("the degree line `du dv` of patch {}", p + 1))?;
             let degrees: Vec<&str> = t.split_whitespace().collect();
@@ -297,5 +306,48 @@ impl BezierPatches {
     pub fn diagonal(&self) -> f64 {
         let (lo, hi) = self.bounding_box();
         super::bicubic::norm(super::bicubic::sub(hi, lo))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The message of a parse error, which must name `line`.
+    fn error_at(result: Result<BezierPatches, RuntimeError>, line: usize) -> String {
+        match result {
+            Err(RuntimeError::ParseFile {
+                line: l, message, ..
+            }) => {
+                assert_eq!(l, line, "{message}");
+                message
+            }
+            other => panic!("expected a parse error at line {line}: {other:?}"),
+        }
+    }
+
+    /// Issue 20: a declared count of 10^10 (1.3 TB of patches) is refused when the data runs
+    /// out, without allocating for the count first (before the fix this aborted allocating).
+    #[test]
+    fn huge_declared_counts_do_not_preallocate() {
+        let one_patch = "1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16\n";
+        let m = error_at(
+            BezierPatches::parse_newell(&format!("10000000000\n{one_patch}"), "t"),
+            3,
+        );
+        assert!(m.contains("patch 2 of 10000000000"), "{m}");
+        let m = error_at(
+            BezierPatches::parse_newell(&format!("1\n{one_patch}10000000000\n1,2,3\n"), "t"),
+            5,
+        );
+        assert!(m.contains("vertex 2 of 10000000000"), "{m}");
+        let m = error_at(BezierPatches::parse_bpt("10000000000\n3 3\n", "t.bpt"), 3);
+        assert!(m.contains("control point 1 of 16 of patch 1"), "{m}");
+        // A count beyond u64: not a number of patches at all.
+        let m = error_at(
+            BezierPatches::parse_bpt("99999999999999999999999\n", "t.bpt"),
+            1,
+        );
+        assert!(m.contains("expected the number of patches"), "{m}");
     }
 }

@@ -13,15 +13,8 @@ pub(crate) use crate::mesh::geometry::{cross, norm, sub};
 /// A bicubic net, `b[4 j + i]`.
 pub type Net = [Point; 16];
 
-/// `a` scaled to unit length, or zero when it has none.
-pub(crate) fn unit(a: Point) -> Point {
-    let n = norm(a);
-    if n > 0.0 && n.is_finite() {
-        [a[0] / n, a[1] / n, a[2] / n]
-    } else {
-        [0.0; 3]
-    }
-}
+/// `a` scaled to unit length, or zero when it has none (the one normalization, at any scale).
+pub(crate) use crate::mesh::geometry::normalize as unit;
 
 fn lerp(a: Point, b: Point, t: f64) -> Point {
     std::array::from_fn(|c| a[c] + t * (b[c] - a[c]))
