@@ -137,6 +137,96 @@ enum Command {
         #[command(subcommand)]
         command: TablesCommand,
     },
+    /// Draw triangle meshes (OBJ, PLY, GLB) into a PNG, side by side, seen by one orbit
+    /// camera: z-buffer, smooth shading, a checkerboard where the mesh has texture
+    /// coordinates.
+    Render {
+        /// Input meshes (.obj, .ply, .glb), drawn left to right.
+        #[arg(required = true)]
+        meshes: Vec<PathBuf>,
+        /// Output PNG.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// `WxH`: pixels per mesh (at most 8192 a side).
+        #[arg(long, default_value = "800x600", value_parser = size_arg)]
+        size: (u32, u32),
+        /// `AZ,EL[,DIST]`: azimuth around +y and elevation in degrees, distance in radii of
+        /// the meshes' bounding sphere (default: the sphere fills 90% of the smaller side).
+        #[arg(long, default_value = "30,20", value_parser = view_arg, allow_hyphen_values = true)]
+        view: (f64, f64, Option<f64>),
+        /// Darken every triangle's edges.
+        #[arg(long)]
+        wireframe: bool,
+        /// Take +z as up (CAD files) instead of +y.
+        #[arg(long)]
+        z_up: bool,
+    },
+}
+
+/// `--size WxH`.
+fn size_arg(text: &str) -> Result<(u32, u32), String> {
+    let (w, h) = text.split_once('x').ok_or("WxH, e.g. 800x600")?;
+    let side = |t: &str| match t.parse::<u32>() {
+        Ok(n @ 1..=subtess::render::MAX_SIDE) => Ok(n),
+        _ => Err(format!(
+            "`{t}`: a side of 1..={} pixels",
+            subtess::render::MAX_SIDE
+        )),
+    };
+    Ok((side(w)?, side(h)?))
+}
+
+/// `--view AZ,EL[,DIST]`.
+fn view_arg(text: &str) -> Result<(f64, f64, Option<f64>), String> {
+    let numbers = text
+        .split(',')
+        .map(|t| t.trim().parse::<f64>().ok().filter(|x| x.is_finite()))
+        .collect::<Option<Vec<f64>>>()
+        .ok_or("AZ,EL[,DIST]: finite numbers")?;
+    match numbers[..] {
+        [az, el] => Ok((az, el, None)),
+        [az, el, d] if d > 1.0 => Ok((az, el, Some(d))),
+        [_, _, d] => Err(format!(
+            "distance {d}: more than 1 radius (outside the sphere)"
+        )),
+        _ => Err("AZ,EL[,DIST]".to_string()),
+    }
+}
+
+/// `subtess render`: every mesh drawn by one camera around all of them, side by side.
+fn render_command(
+    meshes: &[PathBuf],
+    output: &Path,
+    (width, height): (u32, u32),
+    (azimuth, elevation, distance): (f64, f64, Option<f64>),
+    wireframe: bool,
+    z_up: bool,
+) -> Result<(), RuntimeError> {
+    let options = subtess::render::RenderOptions {
+        width,
+        height,
+        azimuth,
+        elevation,
+        z_up,
+        distance,
+        wireframe,
+    };
+    let meshes = meshes
+        .iter()
+        .map(|path| subtess::io::mesh_input::read_triangles(path))
+        .collect::<Result<Vec<_>, _>>()?;
+    let all: Vec<[f32; 3]> = meshes
+        .iter()
+        .flat_map(|m| m.positions.iter().copied())
+        .collect();
+    let camera = subtess::render::Camera::orbit(&all, &options);
+    let panels = meshes
+        .iter()
+        .map(|m| subtess::render::render(m, &camera, &options))
+        .collect::<Result<Vec<_>, _>>()?;
+    let image = subtess::render::Image::beside(&panels)
+        .ok_or_else(|| RuntimeError::Unsupported("panels of different heights".to_string()))?;
+    image.write_png(output)
 }
 
 /// `subtess tessellate`'s arguments.
@@ -633,5 +723,13 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
         Command::Tables {
             command: TablesCommand::Info { file, scheme },
         } => tables_info(file, scheme),
+        Command::Render {
+            meshes,
+            output,
+            size,
+            view,
+            wireframe,
+            z_up,
+        } => render_command(&meshes, &output, size, view, wireframe, z_up),
     }
 }

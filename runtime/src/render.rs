@@ -1,6 +1,7 @@
 //! A small software rasterizer for looking at meshes (`subtess render`): a perspective orbit
-//! camera around the mesh's bounding sphere, a z-buffer, smooth two-sided Lambert shading from
-//! area-weighted vertex normals, an optional wireframe, a checkerboard where the mesh has
+//! camera around the mesh's bounding sphere, a z-buffer, two-sided Lambert shading, smooth from
+//! area-weighted vertex normals except across edges sharper than about 35 degrees (a control
+//! mesh's facets stay flat), an optional wireframe, a checkerboard where the mesh has
 //! texture coordinates, 3 x 3 supersampling, and a PNG out.
 //!
 //! Deterministic: the image is cut into bands of rows rasterized in parallel, each band drawing
@@ -22,10 +23,12 @@ pub struct RenderOptions {
     pub width: u32,
     /// Image height in pixels.
     pub height: u32,
-    /// Camera azimuth around the up axis (+y), degrees; 0 looks along -z.
+    /// Camera azimuth around the up axis, degrees; 0 looks along -z (+y up) or +y (+z up).
     pub azimuth: f64,
-    /// Camera elevation above the xz plane, degrees.
+    /// Camera elevation above the plane normal to the up axis, degrees.
     pub elevation: f64,
+    /// Whether +z is up (as in CAD files) rather than +y (as in most OBJ files).
+    pub z_up: bool,
     /// Distance from the bounding sphere's centre in units of its radius; `None` frames the
     /// sphere in the image.
     pub distance: Option<f64>,
@@ -40,6 +43,7 @@ impl Default for RenderOptions {
             height: 600,
             azimuth: 30.0,
             elevation: 20.0,
+            z_up: false,
             distance: None,
             wireframe: false,
         }
@@ -104,13 +108,26 @@ impl Camera {
             .distance
             .unwrap_or_else(|| (1.0 + fill * fill).sqrt() / fill);
         let (az, el) = (options.azimuth.to_radians(), options.elevation.to_radians());
-        let back = [el.cos() * az.sin(), el.sin(), el.cos() * az.cos()];
+        let (back, world_up, pole) = if options.z_up {
+            (
+                [el.cos() * az.sin(), -el.cos() * az.cos(), el.sin()],
+                [0.0, 0.0, 1.0],
+                [0.0, 1.0, 0.0],
+            )
+        } else {
+            (
+                [el.cos() * az.sin(), el.sin(), el.cos() * az.cos()],
+                [0.0, 1.0, 0.0],
+                [0.0, 0.0, -1.0],
+            )
+        };
         let eye = std::array::from_fn(|c| centre[c] + distance * radius * back[c]);
         let forward = back.map(|x| -x);
+        // Straight above or below, "up" on the screen is the horizontal axis the camera faced.
         let world_up = if el.cos().abs() < 1e-9 {
-            [0.0, 0.0, -el.sin().signum()]
+            pole.map(|x| x * el.sin().signum())
         } else {
-            [0.0, 1.0, 0.0]
+            world_up
         };
         let right = unit(cross(forward, world_up));
         let up = cross(right, forward);
@@ -175,6 +192,36 @@ pub struct Image {
 }
 
 impl Image {
+    /// The images side by side, left to right, on one row; `None` unless all have one height
+    /// (or if the width overflows).
+    pub fn beside(images: &[Image]) -> Option<Image> {
+        let height = images.first()?.height;
+        if images.iter().any(|i| i.height != height) {
+            return None;
+        }
+        let width = images
+            .iter()
+            .try_fold(0u32, |sum, i| sum.checked_add(i.width))?;
+        let mut rgb = Vec::with_capacity(3 * width as usize * height as usize);
+        for y in 0..height as usize {
+            for image in images {
+                let row = 3 * image.width as usize;
+                rgb.extend_from_slice(&image.rgb[y * row..(y + 1) * row]);
+            }
+        }
+        let coverage = images
+            .iter()
+            .map(|i| i.coverage * f64::from(i.width))
+            .sum::<f64>()
+            / f64::from(width);
+        Some(Image {
+            width,
+            height,
+            rgb,
+            coverage,
+        })
+    }
+
     /// Encode as PNG.
     pub fn png(&self) -> Result<Vec<u8>, RuntimeError> {
         let mut out = Vec::new();
@@ -209,15 +256,24 @@ const SURFACE: [f64; 3] = [0.72, 0.77, 0.86];
 const CHECKER_DARK: [f64; 3] = [0.25, 0.28, 0.36];
 const WIRE: [f64; 3] = [0.1, 0.1, 0.12];
 
+/// A triangle's normal scaled by twice its area.
+fn face_normal(mesh: &Triangles, t: &[u32; 3]) -> [f64; 3] {
+    let p = t.map(|v| mesh.positions[v as usize].map(f64::from));
+    cross(
+        std::array::from_fn(|c| p[1][c] - p[0][c]),
+        std::array::from_fn(|c| p[2][c] - p[0][c]),
+    )
+}
+
+/// Where a triangle's normal and its corner's vertex normal differ by more than this angle's
+/// cosine (about 35 degrees), the corner is shaded with the triangle's own normal.
+const CREASE_COS: f64 = 0.82;
+
 /// Area-weighted vertex normals (the cross products summed, then normalized).
 fn vertex_normals(mesh: &Triangles) -> Vec<[f64; 3]> {
     let mut normals = vec![[0.0f64; 3]; mesh.positions.len()];
     for t in &mesh.triangles {
-        let p = t.map(|v| mesh.positions[v as usize].map(f64::from));
-        let n = cross(
-            std::array::from_fn(|c| p[1][c] - p[0][c]),
-            std::array::from_fn(|c| p[2][c] - p[0][c]),
-        );
+        let n = face_normal(mesh, t);
         for &v in t {
             for c in 0..3 {
                 normals[v as usize][c] += n[c];
@@ -234,8 +290,13 @@ struct Sample {
     colour: [f64; 3],
 }
 
-/// Render `mesh` as `options` says.
-pub fn render(mesh: &Triangles, options: &RenderOptions) -> Result<Image, RuntimeError> {
+/// Render `mesh` seen by `camera` (made for `options`' image size, e.g. by [`Camera::orbit`]
+/// around this mesh or around several drawn side by side).
+pub fn render(
+    mesh: &Triangles,
+    camera: &Camera,
+    options: &RenderOptions,
+) -> Result<Image, RuntimeError> {
     for (name, side) in [("width", options.width), ("height", options.height)] {
         if !(1..=MAX_SIDE).contains(&side) {
             return Err(RuntimeError::InvalidParameter {
@@ -244,7 +305,6 @@ pub fn render(mesh: &Triangles, options: &RenderOptions) -> Result<Image, Runtim
             });
         }
     }
-    let camera = Camera::orbit(&mesh.positions, options);
     let normals = vertex_normals(mesh);
     let projected: Vec<Option<[f64; 3]>> =
         mesh.positions.iter().map(|&p| camera.project(p)).collect();
@@ -285,6 +345,16 @@ pub fn render(mesh: &Triangles, options: &RenderOptions) -> Result<Image, Runtim
                     continue;
                 }
                 let edges = [[b, c], [c, a], [a, b]];
+                // Smooth across gentle angles, flat across sharp ones (a control mesh's edges).
+                let flat = unit(face_normal(mesh, t));
+                let corners = t.map(|v| {
+                    let n = normals[v as usize];
+                    if dot(n, flat) > CREASE_COS {
+                        n
+                    } else {
+                        flat
+                    }
+                });
                 let lengths = edges.map(|[p, q]| (q[0] - p[0]).hypot(q[1] - p[1]));
                 for y in ymin..=ymax as usize {
                     let py = y as f64 + 0.5;
@@ -305,7 +375,7 @@ pub fn render(mesh: &Triangles, options: &RenderOptions) -> Result<Image, Runtim
                         }
                         let weights = [e[0] / a[2], e[1] / b[2], e[2] / c[2]].map(|k| k / inverse);
                         let n = unit(std::array::from_fn(|k| {
-                            (0..3).map(|i| weights[i] * normals[t[i] as usize][k]).sum()
+                            (0..3).map(|i| weights[i] * corners[i][k]).sum()
                         }));
                         let lambert = dot(n, light).abs();
                         let mut base = SURFACE;
@@ -321,11 +391,12 @@ pub fn render(mesh: &Triangles, options: &RenderOptions) -> Result<Image, Runtim
                         }
                         let mut colour = base.map(|b| b * (0.25 + 0.75 * lambert));
                         if options.wireframe {
+                            // Lines about 0.7 pixels wide, half opaque.
                             let near = (0..3)
                                 .map(|i| e[i] * area.abs() / lengths[i])
                                 .fold(f64::INFINITY, f64::min);
-                            if near < 0.6 * s {
-                                colour = WIRE;
+                            if near < 0.35 * s {
+                                colour = std::array::from_fn(|k| 0.5 * (colour[k] + WIRE[k]));
                             }
                         }
                         *sample = Sample {
@@ -392,11 +463,12 @@ mod tests {
             wireframe: true,
             ..RenderOptions::default()
         };
-        let a = render(&cube, &options)
+        let camera = Camera::orbit(&cube.positions, &options);
+        let a = render(&cube, &camera, &options)
             .expect("renders")
             .png()
             .expect("encodes");
-        let b = render(&cube, &options)
+        let b = render(&cube, &camera, &options)
             .expect("renders")
             .png()
             .expect("encodes");
@@ -405,7 +477,7 @@ mod tests {
             .build()
             .expect("a pool");
         let c = pool
-            .install(|| render(&cube, &options))
+            .install(|| render(&cube, &camera, &options))
             .expect("renders")
             .png()
             .expect("encodes");
@@ -460,11 +532,12 @@ mod tests {
                 height: 150,
                 azimuth,
                 elevation,
+                z_up: false,
                 distance,
                 wireframe: false,
             };
-            let image = render(&cube, &options).expect("renders");
             let camera = Camera::orbit(&cube.positions, &options);
+            let image = render(&cube, &camera, &options).expect("renders");
             let points = cube
                 .positions
                 .iter()

@@ -666,3 +666,54 @@ fn triangle_schemes_take_a_tolerance() {
         let _ = std::fs::remove_file(path);
     }
 }
+
+/// `subtess render` draws every format `tessellate` writes, side by side, into the same bytes
+/// every time, and refuses sizes and views it cannot draw.
+#[test]
+fn render_draws_what_tessellate_writes() {
+    let (ply, glb, png, again) = (
+        temp("render.ply"),
+        temp("render.glb"),
+        temp("render.png"),
+        temp("render-again.png"),
+    );
+    for out in [&ply, &glb] {
+        succeeds(&format!(
+            "tessellate data/cube.obj -o {} --rate 4",
+            out.display()
+        ));
+    }
+    for target in [&png, &again] {
+        succeeds(&format!(
+            "render data/cube.obj {} {} -o {} --size 64x48 --view 20,-10 --wireframe",
+            ply.display(),
+            glb.display(),
+            target.display()
+        ));
+    }
+    let (a, b) = (
+        std::fs::read(&png).expect("a PNG"),
+        std::fs::read(&again).expect("a PNG"),
+    );
+    assert_eq!(&a[..8], b"\x89PNG\r\n\x1a\n");
+    assert_eq!(a, b, "the same inputs give the same bytes");
+    // Width 3 x 64 = 192, height 48: the IHDR chunk after the signature and its length/type.
+    assert_eq!(u32::from_be_bytes([a[16], a[17], a[18], a[19]]), 192);
+    assert_eq!(u32::from_be_bytes([a[20], a[21], a[22], a[23]]), 48);
+    for path in [&ply, &glb, &png, &again] {
+        std::fs::remove_file(path).ok();
+    }
+    let out = temp("refused.png");
+    for (args, message) in [
+        ("--size 0x10", "a side of 1..="),
+        ("--size 100000x10", "a side of 1..="),
+        ("--view 10", "AZ,EL"),
+        ("--view 10,20,0.5", "more than 1 radius"),
+    ] {
+        let err = fails(&format!("render data/cube.obj -o {} {args}", out.display()));
+        assert!(err.contains(message), "{args}: {err}");
+    }
+    let err = fails(&format!("render data/cube_rates.txt -o {}", out.display()));
+    assert!(err.contains("reads .obj, .ply and .glb"), "{err}");
+    assert!(!out.exists(), "no image for a refused command");
+}
