@@ -14,6 +14,7 @@ use std::path::Path;
 use rayon::prelude::*;
 
 use crate::io::mesh_input::Triangles;
+use crate::mesh::geometry::{cross, dot, normalize as unit, sub};
 use crate::RuntimeError;
 
 /// What to draw and how.
@@ -156,28 +157,6 @@ impl Camera {
     }
 }
 
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn unit(a: [f64; 3]) -> [f64; 3] {
-    let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    if scale == 0.0 {
-        return a;
-    }
-    let b = a.map(|x| x / scale);
-    let l = dot(b, b).sqrt();
-    b.map(|x| x / l)
-}
-
 /// An RGB image, 8 bits per channel, rows top to bottom.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Image {
@@ -259,10 +238,7 @@ const WIRE: [f64; 3] = [0.1, 0.1, 0.12];
 /// A triangle's normal scaled by twice its area.
 fn face_normal(mesh: &Triangles, t: &[u32; 3]) -> [f64; 3] {
     let p = t.map(|v| mesh.positions[v as usize].map(f64::from));
-    cross(
-        std::array::from_fn(|c| p[1][c] - p[0][c]),
-        std::array::from_fn(|c| p[2][c] - p[0][c]),
-    )
+    cross(sub(p[1], p[0]), sub(p[2], p[0]))
 }
 
 /// Where a triangle's normal and its corner's vertex normal differ by more than this angle's
