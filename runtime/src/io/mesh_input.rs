@@ -1,11 +1,12 @@
 //! Triangle meshes in: what `subtess render` draws. OBJ through the one OBJ reader
-//! ([`crate::io::obj`], polygons split into fans), and the two binary formats `subtess
+//! ([`crate::io::obj`], polygons split into fans, `vt` texture coordinates kept), and the two binary formats `subtess
 //! tessellate` writes ([`crate::io::mesh_output`]): PLY (ASCII or binary little-endian, any
 //! scalar types, `x y z` per vertex, `s t` as texture coordinates when present, a
 //! `vertex_indices` list per face) and GLB (glTF 2.0 binary: the first primitive of the first
 //! mesh, `POSITION`, optional `TEXCOORD_0`, `indices` or none). Every count is checked against
 //! the bytes that must hold it before anything is allocated from it.
 
+use std::collections::HashMap;
 use std::path::Path;
 
 use serde_json::Value;
@@ -71,23 +72,57 @@ fn bad(path: &Path, reason: String) -> RuntimeError {
     }
 }
 
+/// An OBJ file's faces as fans of triangles. Where every face names texture coordinates, each
+/// distinct (vertex, texture coordinate) pair of the corners becomes one vertex, so that seams
+/// keep both sides' coordinates.
 fn obj_triangles(path: &Path) -> Result<Triangles, RuntimeError> {
     let obj = read_obj(path)?;
-    let positions = obj.positions.iter().map(|p| p.map(|c| c as f32)).collect();
-    let mut triangles = Vec::new();
+    let textured = !obj.faces.is_empty() && obj.face_uvs.iter().all(|f| !f.is_empty());
+    let mut out = Triangles::default();
+    let mut uvs = Vec::new();
+    let mut vertex_of: HashMap<(i64, i64), u32> = HashMap::new();
     for (f, face) in obj.faces.iter().enumerate() {
-        let index = |i: i64| {
-            u32::try_from(i).map_err(|_| bad(path, format!("face {f} has vertex index {i}")))
-        };
-        for k in 1..face.len().saturating_sub(1) {
-            triangles.push([index(face[0])?, index(face[k])?, index(face[k + 1])?]);
+        let mut corners = Vec::with_capacity(face.len());
+        for (k, &v) in face.iter().enumerate() {
+            let position = usize::try_from(v)
+                .ok()
+                .and_then(|v| obj.positions.get(v))
+                .ok_or_else(|| {
+                    bad(
+                        path,
+                        format!("face {f} names vertex {v}, which is not read"),
+                    )
+                })?;
+            let t = if textured { obj.face_uvs[f][k] } else { -1 };
+            let uv = if textured {
+                let uv = usize::try_from(t)
+                    .ok()
+                    .and_then(|t| obj.uvs.get(t))
+                    .ok_or_else(|| {
+                        bad(
+                            path,
+                            format!("face {f} names texture coordinate {t}, which is not read"),
+                        )
+                    })?;
+                Some(uv.map(|c| c as f32))
+            } else {
+                None
+            };
+            let next = u32::try_from(out.positions.len())
+                .map_err(|_| bad(path, "more than 2^32 vertices".to_string()))?;
+            let index = *vertex_of.entry((v, t)).or_insert_with(|| {
+                out.positions.push(position.map(|c| c as f32));
+                uvs.extend(uv);
+                next
+            });
+            corners.push(index);
+        }
+        for k in 1..corners.len().saturating_sub(1) {
+            out.triangles.push([corners[0], corners[k], corners[k + 1]]);
         }
     }
-    Ok(Triangles {
-        positions,
-        triangles,
-        uvs: None,
-    })
+    out.uvs = textured.then_some(uvs);
+    Ok(out)
 }
 
 /// A PLY scalar type: its size in bytes and whether it is an integer.
@@ -422,6 +457,22 @@ mod tests {
         assert_eq!(t.positions.len(), 4);
         assert_eq!(t.triangles, vec![[0, 1, 2], [0, 2, 3]]);
         assert_eq!(t.uvs.expect("uvs")[2], [1.0, 1.0]);
+    }
+
+    /// The shipped textured cube: every edge a seam, so each face's four corners are their own
+    /// vertices (24), with the coordinates of the file.
+    #[test]
+    fn obj_texture_coordinates_split_vertices_at_seams() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/cube_uv.obj");
+        let t = read_triangles(&path).expect("reads");
+        assert_eq!(t.positions.len(), 24);
+        assert_eq!(t.triangles.len(), 12);
+        let uvs = t.uvs.expect("texture coordinates");
+        assert_eq!(uvs.len(), 24);
+        assert!((uvs[0][0] - 0.02).abs() < 1e-6 && (uvs[0][1] - 0.02).abs() < 1e-6);
+        let plain = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/cube.obj");
+        let t = read_triangles(&plain).expect("reads");
+        assert_eq!((t.positions.len(), t.triangles.len(), t.uvs), (8, 12, None));
     }
 
     #[test]

@@ -1,10 +1,11 @@
 //! Wavefront OBJ input: positions, polygonal faces (triangles, quads, n-gons) and
 //! OpenSubdiv-style `t` tag lines.
 //!
-//! Read: `v x y z [w]`, `f a a/b a/b/c a//c ...` (1-based, or negative = relative to the vertices
-//! read so far), `t name i/f/s ints... floats... strings...` (OpenSubdiv's `shape_utils`
-//! convention; indices in tags are 0-based). Ignored as irrelevant to the surface: `vt`, `vn`,
-//! `vp`, `g`, `o`, `s`, `mtllib`, `usemtl`, `l` and comments. Anything else is an error naming the
+//! Read: `v x y z [w]`, `vt u v [w]`, `f a a/b a/b/c a//c ...` (1-based, or negative = relative
+//! to the items read so far; a face's texture coordinates are kept when every corner names
+//! one), `t name i/f/s ints... floats... strings...` (OpenSubdiv's `shape_utils`
+//! convention; indices in tags are 0-based). Ignored as irrelevant to the surface: `vn`, `vp`,
+//! `g`, `o`, `s`, `mtllib`, `usemtl`, `l` and comments. Anything else is an error naming the
 //! line, so a file in another dialect is not silently misread.
 
 use std::path::Path;
@@ -36,6 +37,11 @@ pub struct ObjMesh {
     pub positions: Vec<[f64; 3]>,
     /// Faces as 0-based vertex indices (not yet checked against `positions`).
     pub faces: Vec<Vec<i64>>,
+    /// Texture coordinates (`vt`).
+    pub uvs: Vec<[f64; 2]>,
+    /// Every face's corners as 0-based indices into `uvs` (not yet checked against it), or
+    /// empty where the face names none.
+    pub face_uvs: Vec<Vec<i64>>,
     /// The 1-based line of each face, for messages.
     pub face_lines: Vec<usize>,
     /// Tag lines.
@@ -69,26 +75,60 @@ pub fn parse_obj(text: &str) -> Result<ObjMesh, RuntimeError> {
                 }
                 mesh.positions.push([coords[0], coords[1], coords[2]]);
             }
-            "f" => {
-                let count = mesh.positions.len() as i64;
-                let corners: Vec<i64> = words
+            "vt" => {
+                let coords: Vec<f64> = words
                     .map(|w| {
-                        let first = w.split('/').next().unwrap_or("");
-                        let i: i64 = first
-                            .parse()
-                            .map_err(|_| err(format!("`{w}` is not a vertex reference")))?;
-                        match i {
-                            0 => Err(err("vertex index 0 (OBJ indices start at 1)".to_owned())),
-                            i if i > 0 => Ok(i - 1),
-                            i => Ok(count + i),
-                        }
+                        w.parse::<f64>()
+                            .map_err(|_| err(format!("`{w}` is not a number")))
                     })
                     .collect::<Result<_, _>>()?;
+                if !(1..=3).contains(&coords.len()) {
+                    return Err(err(format!(
+                        "a texture coordinate needs 1 to 3 numbers, this one has {}",
+                        coords.len()
+                    )));
+                }
+                mesh.uvs
+                    .push([coords[0], coords.get(1).copied().unwrap_or(0.0)]);
+            }
+            "f" => {
+                // 1-based, or negative: relative to the items read so far.
+                let index = |word: &str, what: &str, count: usize| {
+                    let i: i64 = word
+                        .parse()
+                        .map_err(|_| err(format!("`{word}` is not a {what} reference")))?;
+                    match i {
+                        0 => Err(err(format!("{what} index 0 (OBJ indices start at 1)"))),
+                        i if i > 0 => Ok(i - 1),
+                        i => Ok(count as i64 + i),
+                    }
+                };
+                let (mut corners, mut uvs) = (Vec::new(), Vec::new());
+                for w in words {
+                    let mut parts = w.split('/');
+                    corners.push(index(
+                        parts.next().unwrap_or(""),
+                        "vertex",
+                        mesh.positions.len(),
+                    )?);
+                    match parts.next() {
+                        Some(t) if !t.is_empty() => {
+                            uvs.push(index(t, "texture coordinate", mesh.uvs.len())?)
+                        }
+                        _ => {}
+                    }
+                }
+                // A face that names texture coordinates at some corners only has none: its
+                // surface does not depend on them.
+                if uvs.len() != corners.len() {
+                    uvs.clear();
+                }
                 mesh.faces.push(corners);
+                mesh.face_uvs.push(uvs);
                 mesh.face_lines.push(line);
             }
             "t" => mesh.tags.push(parse_tag(words.collect(), line)?),
-            "vt" | "vn" | "vp" | "g" | "o" | "s" | "mtllib" | "usemtl" | "l" => {}
+            "vn" | "vp" | "g" | "o" | "s" | "mtllib" | "usemtl" | "l" => {}
             other => return Err(err(format!("unknown OBJ statement `{other}`"))),
         }
     }
@@ -329,6 +369,20 @@ mod tests {
         assert_eq!(m.tags[0].name, "crease");
         assert_eq!(m.tags[0].ints, vec![0, 1]);
         assert_eq!(m.tags[0].floats, vec![2.5]);
+        // One corner names no texture coordinate: the face has none.
+        assert_eq!(m.face_uvs, vec![Vec::<i64>::new()]);
+    }
+
+    #[test]
+    fn reads_texture_coordinates_per_corner() {
+        let text =
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt 1 0 0\nvt 0.5 1\nf 1/1 2/-2/1 3/3\nf 1 2 3\n";
+        let m = parse_obj(text).expect("valid");
+        assert_eq!(m.uvs, vec![[0.0, 0.0], [1.0, 0.0], [0.5, 1.0]]);
+        assert_eq!(m.face_uvs, vec![vec![0, 1, 2], vec![]]);
+        for text in ["vt\n", "vt 1 2 3 4\n", "vt x\n"] {
+            assert!(parse_obj(text).is_err(), "{text:?}");
+        }
     }
 
     #[test]
@@ -337,6 +391,11 @@ mod tests {
             ("v 0 0\n", 1, "3 coordinates"),
             ("v 0 0 0\nf 1 x 2\n", 2, "`x`"),
             ("v 0 0 0\nf 0 1 2\n", 2, "index 0"),
+            (
+                "v 0 0 0\nvt 0 0\nf 1/0 1/1 1/1\n",
+                3,
+                "texture coordinate index 0",
+            ),
             ("\n\nwat 1 2\n", 3, "unknown OBJ statement"),
             ("t crease 2/1/0 0 1\n", 1, "announces 3 arguments"),
             // Counts that wrap `usize` when added (issue 20): an error, not a panic.
