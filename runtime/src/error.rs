@@ -17,6 +17,17 @@ pub enum MeshError {
         /// Its position.
         position: [f64; 3],
     },
+    /// A coordinate's magnitude exceeds [`crate::mesh::topology::MAX_COORDINATE`]: beyond what
+    /// `f32` output and its normals hold.
+    #[error("vertex {vertex} (OBJ `v` number {}) has a coordinate beyond {limit:e} in magnitude {position:?} (the output is f32: positions and normals must stay finite)", vertex + 1)]
+    TooLarge {
+        /// 0-based vertex.
+        vertex: usize,
+        /// Its position.
+        position: [f64; 3],
+        /// The bound.
+        limit: f64,
+    },
     /// A face is malformed.
     #[error("face {face} (OBJ line {line}): {reason}")]
     BadFace {
@@ -129,6 +140,19 @@ pub enum RuntimeError {
         /// The cause.
         source: std::io::Error,
     },
+    /// An output (a tessellation, a refinement, an adaptive tessellation) would exceed a
+    /// budget (docs/reliability.md): what was estimated, the limit, and how to raise it.
+    #[error("{what} would be too large: about {estimate}; the limit is {limit} ({raise})")]
+    OverBudget {
+        /// The output.
+        what: String,
+        /// Its estimated size.
+        estimate: String,
+        /// The limit it exceeds.
+        limit: String,
+        /// The flag that raises the limit, or why it cannot be raised.
+        raise: String,
+    },
     /// A parameter is malformed or outside its domain (a rational `u` or `v`, a face, a corner,
     /// a tolerance, a camera, a set of rates).
     #[error("invalid {name}: {reason}")]
@@ -140,6 +164,19 @@ pub enum RuntimeError {
     },
 }
 
+/// The most characters of an offending token or line an error message quotes.
+pub const EXCERPT_CHARS: usize = 60;
+
+/// `text` as an error message quotes it: whole when it has at most [`EXCERPT_CHARS`]
+/// characters, else its first [`EXCERPT_CHARS`] followed by `...` and its length in bytes (a
+/// 200 MB token was echoed whole). Every parser's message quotes through here.
+pub fn excerpt(text: &str) -> String {
+    match text.char_indices().nth(EXCERPT_CHARS) {
+        None => text.to_owned(),
+        Some((end, _)) => format!("{}... ({} bytes)", &text[..end], text.len()),
+    }
+}
+
 impl RuntimeError {
     /// An out-of-range tessellator option (a threshold, a resolution, a budget), said in full.
     pub fn invalid_option(reason: String) -> Self {
@@ -147,5 +184,22 @@ impl RuntimeError {
             name: "option".to_owned(),
             reason,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn excerpts_are_short() {
+        assert_eq!(excerpt("abc"), "abc");
+        let exact = "x".repeat(EXCERPT_CHARS);
+        assert_eq!(excerpt(&exact), exact);
+        let long = "é".repeat(1_000_000);
+        let quoted = excerpt(&long);
+        assert!(quoted.starts_with(&"é".repeat(EXCERPT_CHARS)), "{quoted}");
+        assert!(quoted.ends_with("... (2000000 bytes)"), "{quoted}");
+        assert!(quoted.len() < 2 * EXCERPT_CHARS + 30);
     }
 }

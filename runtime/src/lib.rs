@@ -28,6 +28,7 @@
 //! Espino et al.), [`eval`] (exact evaluation), and the facade ([`Surface`]). The layers are
 //! public for tools and tests that need one piece; the root names are the stable contract.
 
+pub mod budget;
 pub mod error;
 pub mod eval;
 pub mod io;
@@ -38,6 +39,7 @@ pub mod stencil_table;
 mod surface;
 pub mod tessellate;
 
+pub use budget::{OutputEstimate, DEFAULT_MAX_TRIANGLES};
 pub use error::{MeshError, RuntimeError};
 pub use eval::exact_eval::{parse_rational, LimitPoint};
 pub use io::mesh_output::MeshFormat;

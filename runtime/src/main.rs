@@ -7,11 +7,13 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use clap::{Parser, Subcommand, ValueEnum};
+use subtess::budget::refined_faces;
 use subtess::io::mesh_output::write_mesh;
 use subtess::tessellate::lai_cheng::write_obj_polygons;
 use subtess::{
     eval, parse_rational, tessellate_bezier, AdaptiveOptions, BezierOptions, BezierPatches, Mesh,
-    MeshFormat, Rates, RuntimeError, Scheme, StencilTable, Surface, Tessellator, ViewCamera,
+    MeshFormat, OutputEstimate, Rates, RuntimeError, Scheme, StencilTable, Surface, Tessellator,
+    ViewCamera,
 };
 
 #[derive(Parser)]
@@ -99,6 +101,9 @@ enum Command {
         /// count; two √3 steps each for sqrt3).
         #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=6))]
         refine: u32,
+        /// Refuse a refinement or a plan estimated above N output triangles (docs/reliability.md).
+        #[arg(long, default_value_t = subtess::DEFAULT_MAX_TRIANGLES, value_parser = clap::value_parser!(u64).range(1..))]
+        max_triangles: u64,
         /// Frames to time.
         #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..))]
         frames: u32,
@@ -294,6 +299,14 @@ struct TessellateArgs {
     /// Adaptive: write triangles; without it an .obj output holds the polygons (n-gons).
     #[arg(long)]
     triangulate: bool,
+    /// Dual grid: refuse an output estimated above N triangles, before allocating it
+    /// (docs/reliability.md: 200 million, about 16 GB, by default).
+    #[arg(long, default_value_t = subtess::DEFAULT_MAX_TRIANGLES, value_parser = clap::value_parser!(u64).range(1..))]
+    max_triangles: u64,
+    /// Adaptive: fail when meeting the tolerance needs more than N polygons (docs/reliability.md:
+    /// 20 million, about 15 GB, by default).
+    #[arg(long, default_value_t = subtess::tessellate::lai_cheng::DEFAULT_MAX_POLYGONS as u64, value_parser = clap::value_parser!(u64).range(1..))]
+    max_polygons: u64,
 }
 
 #[derive(Subcommand)]
@@ -352,8 +365,9 @@ fn read_rates(path: &Path, input_faces: usize) -> Result<Vec<u32>, RuntimeError>
         .map(|(i, word)| match word.parse::<u32>() {
             Ok(n) if (1..=24).contains(&n) => Ok(n),
             _ => Err(bad(format!(
-                "rate {} is `{word}`, not an integer in 1..=24",
-                i + 1
+                "rate {} is `{}`, not an integer in 1..=24",
+                i + 1,
+                subtess::error::excerpt(word)
             ))),
         })
         .collect::<Result<Vec<u32>, _>>()?;
@@ -432,7 +446,7 @@ fn tessellate_command(args: TessellateArgs) -> Result<(), RuntimeError> {
     } else {
         Rates::Uniform(args.rate)
     };
-    let mut tessellator = surface.tessellator(&rates)?;
+    let mut tessellator = surface.tessellator_within(&rates, args.max_triangles)?;
     if let (Some(unmet @ 1..), Some(t), Some(largest)) = (
         tessellator.faces_over_tolerance(),
         args.tolerance,
@@ -522,6 +536,7 @@ fn adaptive_command(args: &TessellateArgs, surface: &Surface) -> Result<(), Runt
         tolerance,
         relative: args.relative,
         triangulate: args.triangulate,
+        max_polygons: usize::try_from(args.max_polygons).unwrap_or(usize::MAX),
         ..AdaptiveOptions::default()
     };
     let (adaptive, stats) = surface.tessellate_adaptive(&options)?;
@@ -564,6 +579,7 @@ struct BenchArgs {
     mixed: bool,
     threads: Option<usize>,
     steps: u32,
+    max_triangles: u64,
     frames: u32,
     table: Option<PathBuf>,
     scheme: Scheme,
@@ -572,6 +588,20 @@ struct BenchArgs {
 /// `subtess bench`: per-frame work from the input control points.
 fn bench_command(args: BenchArgs) -> Result<(), RuntimeError> {
     let mut input = load_mesh(&args.mesh)?;
+    // The refined mesh and its plan, estimated before refining: the largest rate on every face.
+    let largest_rate = if args.mixed { 16 } else { args.rate };
+    let face_sizes = input
+        .face_offsets
+        .windows(2)
+        .map(|w| (w[1] - w[0]) as usize);
+    let faces = refined_faces(args.scheme, face_sizes, args.steps);
+    OutputEstimate::uniform(args.scheme.is_triangle(), faces, largest_rate).check(
+        &format!(
+            "--refine {} then rate {largest_rate} ({} faces after refinement)",
+            args.steps, faces
+        ),
+        args.max_triangles,
+    )?;
     for _ in 0..args.steps {
         input = args.scheme.refine(&input)?;
     }
@@ -588,7 +618,8 @@ fn bench_command(args: BenchArgs) -> Result<(), RuntimeError> {
         (Rates::Uniform(args.rate), args.rate.to_string())
     };
     let surface = pool.install(|| load_surface(&input, args.scheme, &args.table))?;
-    let mut tessellator = pool.install(|| surface.tessellator(&rates))?;
+    let mut tessellator =
+        pool.install(|| surface.tessellator_within(&rates, args.max_triangles))?;
     let control = input.positions_f32();
     // The input is valid (it was evaluated into the surface), so a frame cannot fail.
     tessellator.evaluate(&control)?;
@@ -624,7 +655,7 @@ fn eval_command(
     let (u, v) = uv
         .split_once(',')
         .ok_or_else(|| RuntimeError::InvalidParameter {
-            name: format!("--uv `{uv}`"),
+            name: format!("--uv `{}`", subtess::error::excerpt(uv)),
             reason: "two rationals `U,V` wanted".to_owned(),
         })?;
     let (u, v) = (parse_rational(u.trim())?, parse_rational(v.trim())?);
@@ -699,6 +730,7 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
             mixed,
             threads,
             refine,
+            max_triangles,
             frames,
             table,
             scheme,
@@ -708,6 +740,7 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
             mixed,
             threads,
             steps: refine,
+            max_triangles,
             frames,
             table,
             scheme,

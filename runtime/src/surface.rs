@@ -10,6 +10,7 @@
 
 use std::time::Instant;
 
+use crate::budget::OutputEstimate;
 use crate::mesh::triangle_mesh::TriangleMesh;
 use crate::mesh::{Mesh, VertexSource};
 use crate::scheme::catmull_clark::isolate::{isolate_with_origins, Isolation};
@@ -213,6 +214,18 @@ impl Surface {
         }
     }
 
+    /// The size of a dual-grid tessellation at `rates` (one per isolated face), holes
+    /// excluded.
+    fn estimate_rates(&self, rates: &[u32]) -> OutputEstimate {
+        let holes = &self.mesh().holes;
+        let rates = rates
+            .iter()
+            .enumerate()
+            .filter(|&(f, _)| !holes.get(f).copied().unwrap_or(false))
+            .map(|(_, &n)| n);
+        OutputEstimate::dual_grid(self.scheme.is_triangle(), rates)
+    }
+
     /// Per isolated face rates, and how many faces miss a tolerance.
     fn face_rates(&self, rates: &Rates) -> Result<(Vec<u32>, Option<usize>), RuntimeError> {
         let faces = self.faces();
@@ -264,10 +277,25 @@ impl Surface {
     }
 
     /// Plan a dual-grid tessellation at `rates`: table lookups, connectivity and the triangles
-    /// (the topology does not change between frames), built once.
+    /// (the topology does not change between frames), built once. Refused before anything of
+    /// the output's size is allocated when its estimate exceeds
+    /// [`crate::DEFAULT_MAX_TRIANGLES`] ([`Surface::tessellator_within`] takes another limit).
     pub fn tessellator(&self, rates: &Rates) -> Result<Tessellator<'_>, RuntimeError> {
+        self.tessellator_within(rates, crate::DEFAULT_MAX_TRIANGLES)
+    }
+
+    /// [`Surface::tessellator`] with at most about `max_triangles` output triangles: the
+    /// output is estimated from the per-face rates ([`OutputEstimate::dual_grid`]) before the
+    /// plan is built, and refused above the limit with the estimate in the message.
+    pub fn tessellator_within(
+        &self,
+        rates: &Rates,
+        max_triangles: u64,
+    ) -> Result<Tessellator<'_>, RuntimeError> {
         let started = Instant::now();
         let (rates, faces_over_tolerance) = self.face_rates(rates)?;
+        self.estimate_rates(&rates)
+            .check("the tessellation", max_triangles)?;
         let grid: Box<dyn GridPlan + '_> = match &self.isolated {
             Isolated::Quad(iso) => {
                 Box::new(DualGrid::new(&self.table, &iso.mesh, &iso.patches, &rates)?)

@@ -117,16 +117,38 @@ type Point = [BigRational; 3];
 /// Position, `d/du`, `d/dv` in patch parameters.
 type Derivatives = ([f64; 3], [f64; 3], [f64; 3]);
 
+/// The most bits of a parameter's numerator and denominator, in lowest terms
+/// ([`parse_rational`]; docs/reliability.md).
+pub const MAX_RATIONAL_BITS: u64 = 64;
+
+/// The most characters of a parameter's text ([`parse_rational`]): room for two 20-digit
+/// integers and a slash, with some leading zeros.
+pub const MAX_RATIONAL_CHARS: usize = 64;
+
 /// Parse a parameter value in the one rational grammar ([`schemes::rational::parse_rational`]:
 /// `p/q`, an integer, or a decimal like `0.25` taken exactly, not through a float), which must
-/// lie in `[0, 1]`, a face's parameter domain. DESIGN.md: rational parameters are written `p/q`
-/// on the command line and in JSON.
+/// lie in `[0, 1]`, a face's parameter domain, with at most [`MAX_RATIONAL_CHARS`] characters
+/// and a numerator and denominator of at most [`MAX_RATIONAL_BITS`] bits. DESIGN.md: rational
+/// parameters are written `p/q` on the command line and in JSON.
 pub fn parse_rational(text: &str) -> Result<BigRational, RuntimeError> {
     let bad = |reason: String| RuntimeError::InvalidParameter {
-        name: format!("`{text}`"),
+        name: format!("`{}`", crate::error::excerpt(text)),
         reason,
     };
+    // Bounded before parsing: big integers parse in time quadratic in their digits (a
+    // `1/2^k` with a million digits took over a minute).
+    if text.trim().len() > MAX_RATIONAL_CHARS {
+        return Err(bad(format!(
+            "{} characters; a parameter is at most {MAX_RATIONAL_CHARS} (numerator and denominator of at most {MAX_RATIONAL_BITS} bits)",
+            text.trim().len()
+        )));
+    }
     let value = schemes::rational::parse_rational(text).map_err(|e| bad(e.to_string()))?;
+    if value.numer().bits() > MAX_RATIONAL_BITS || value.denom().bits() > MAX_RATIONAL_BITS {
+        return Err(bad(format!(
+            "in lowest terms its numerator or denominator has more than {MAX_RATIONAL_BITS} bits (each must fit 64 bits: 1/2^63 is the finest power of two)"
+        )));
+    }
     if value.is_negative() || value > BigRational::one() {
         return Err(bad(format!(
             "{value} is outside [0, 1]; a face's parameters lie in [0, 1]"

@@ -12,6 +12,7 @@ use std::path::Path;
 
 use schemes::{BoundaryMode, CreaseMethod};
 
+use crate::error::excerpt;
 use crate::mesh::Mesh;
 use crate::{MeshError, RuntimeError};
 
@@ -64,7 +65,7 @@ pub fn parse_obj(text: &str) -> Result<ObjMesh, RuntimeError> {
                 let coords: Vec<f64> = words
                     .map(|w| {
                         w.parse::<f64>()
-                            .map_err(|_| err(format!("`{w}` is not a number")))
+                            .map_err(|_| err(format!("`{}` is not a number", excerpt(w))))
                     })
                     .collect::<Result<_, _>>()?;
                 if !(3..=4).contains(&coords.len()) {
@@ -79,7 +80,7 @@ pub fn parse_obj(text: &str) -> Result<ObjMesh, RuntimeError> {
                 let coords: Vec<f64> = words
                     .map(|w| {
                         w.parse::<f64>()
-                            .map_err(|_| err(format!("`{w}` is not a number")))
+                            .map_err(|_| err(format!("`{}` is not a number", excerpt(w))))
                     })
                     .collect::<Result<_, _>>()?;
                 if !(1..=3).contains(&coords.len()) {
@@ -94,9 +95,9 @@ pub fn parse_obj(text: &str) -> Result<ObjMesh, RuntimeError> {
             "f" => {
                 // 1-based, or negative: relative to the items read so far.
                 let index = |word: &str, what: &str, count: usize| {
-                    let i: i64 = word
-                        .parse()
-                        .map_err(|_| err(format!("`{word}` is not a {what} reference")))?;
+                    let i: i64 = word.parse().map_err(|_| {
+                        err(format!("`{}` is not a {what} reference", excerpt(word)))
+                    })?;
                     match i {
                         0 => Err(err(format!("{what} index 0 (OBJ indices start at 1)"))),
                         i if i > 0 => Ok(i - 1),
@@ -129,7 +130,7 @@ pub fn parse_obj(text: &str) -> Result<ObjMesh, RuntimeError> {
             }
             "t" => mesh.tags.push(parse_tag(words.collect(), line)?),
             "vn" | "vp" | "g" | "o" | "s" | "mtllib" | "usemtl" | "l" => {}
-            other => return Err(err(format!("unknown OBJ statement `{other}`"))),
+            other => return Err(err(format!("unknown OBJ statement `{}`", excerpt(other)))),
         }
     }
     Ok(mesh)
@@ -146,11 +147,14 @@ fn parse_tag(words: Vec<&str>, line: usize) -> Result<Tag, RuntimeError> {
         .split('/')
         .map(|c| {
             c.parse()
-                .map_err(|_| err(format!("tag counts `{counts}` are not `i/f/s`")))
+                .map_err(|_| err(format!("tag counts `{}` are not `i/f/s`", excerpt(counts))))
         })
         .collect::<Result<_, _>>()?;
     let [ni, nf, ns] = counts[..] else {
-        return Err(err(format!("tag counts `{}` are not `i/f/s`", words[1])));
+        return Err(err(format!(
+            "tag counts `{}` are not `i/f/s`",
+            excerpt(words[1])
+        )));
     };
     let args = &words[2..];
     // The counts come from the file: add them without wrapping, and compare the total with
@@ -159,7 +163,8 @@ fn parse_tag(words: Vec<&str>, line: usize) -> Result<Tag, RuntimeError> {
     if announced != Some(args.len()) {
         let announced = announced.map_or_else(|| "more".to_owned(), |n| n.to_string());
         return Err(err(format!(
-            "tag `{name}` announces {announced} arguments and has {}",
+            "tag `{}` announces {announced} arguments and has {}",
+            excerpt(name),
             args.len()
         )));
     }
@@ -167,12 +172,15 @@ fn parse_tag(words: Vec<&str>, line: usize) -> Result<Tag, RuntimeError> {
         .iter()
         .map(|w| {
             w.parse()
-                .map_err(|_| err(format!("`{w}` is not an integer")))
+                .map_err(|_| err(format!("`{}` is not an integer", excerpt(w))))
         })
         .collect::<Result<_, _>>()?;
     let floats = args[ni..ni + nf]
         .iter()
-        .map(|w| w.parse().map_err(|_| err(format!("`{w}` is not a number"))))
+        .map(|w| {
+            w.parse()
+                .map_err(|_| err(format!("`{}` is not a number", excerpt(w))))
+        })
         .collect::<Result<_, _>>()?;
     let strings = args[ni + nf..].iter().map(|s| (*s).to_owned()).collect();
     Ok(Tag {
@@ -314,7 +322,7 @@ impl Mesh {
                             return Err(MeshError::BadTag {
                                 name: name.to_owned(),
                                 line: tag.line,
-                                reason: format!("`{value}` is not one of its values"),
+                                reason: format!("`{}` is not one of its values", excerpt(value)),
                             })
                         }
                     }
@@ -335,7 +343,10 @@ impl Mesh {
         let warnings = unsupported
             .into_iter()
             .map(|(name, count)| {
-                format!("tag `{name}` ({count} line(s)) is not supported and is ignored")
+                format!(
+                    "tag `{}` ({count} line(s)) is not supported and is ignored",
+                    excerpt(&name)
+                )
             })
             .collect();
         Ok((mesh, warnings))

@@ -55,10 +55,46 @@ pub struct Mesh {
     pub smooth_triangles: bool,
 }
 
+/// The largest coordinate magnitude an input vertex may have (docs/reliability.md): output is
+/// `f32` (at most 3.4e38), and each normal is the cross product of two `f32` tangents of about
+/// the surface's size, which overflows near 1.8e19 (a cube scaled by 1e19 still got unit
+/// normals, by 1e25 zero ones). Refinement combines at most a few points with weights of
+/// bounded sum, so every refined position of an input within the bound stays finite in `f64`.
+pub const MAX_COORDINATE: f64 = 1e18;
+
 impl Mesh {
     /// Build and validate from faces given as vertex indices. `lines` (the faces' OBJ lines)
-    /// only labels errors.
+    /// only labels errors. Every coordinate must be finite and at most [`MAX_COORDINATE`] in
+    /// magnitude.
     pub fn new(
+        positions: Vec<[f64; 3]>,
+        faces: &[Vec<i64>],
+        lines: &[usize],
+        boundary: BoundaryMode,
+    ) -> Result<Self, MeshError> {
+        let within = |c: &f64| c.abs() <= MAX_COORDINATE;
+        let beyond = |p: &[f64; 3]| !p.iter().all(within);
+        if let Some((vertex, p)) = positions.iter().enumerate().find(|(_, p)| beyond(p)) {
+            return Err(if p.iter().all(|c| c.is_finite()) {
+                MeshError::TooLarge {
+                    vertex,
+                    position: *p,
+                    limit: MAX_COORDINATE,
+                }
+            } else {
+                MeshError::NonFinite {
+                    vertex,
+                    position: *p,
+                }
+            });
+        }
+        Self::refined(positions, faces, lines, boundary)
+    }
+
+    /// [`Mesh::new`] for a mesh made by refining a valid one: its positions, combinations of
+    /// input positions within [`MAX_COORDINATE`], may exceed it by a small factor (the
+    /// butterfly's weights are not all positive) but are finite.
+    pub(crate) fn refined(
         positions: Vec<[f64; 3]>,
         faces: &[Vec<i64>],
         lines: &[usize],
@@ -689,6 +725,22 @@ mod tests {
             Mesh::new(bad, &f, &[], BoundaryMode::EdgeOnly),
             Err(MeshError::NonFinite { vertex: 2, .. })
         ));
+        for c in [1.5e18, -1e30, 1e308, f64::MAX] {
+            let mut far = p.clone();
+            far[1][0] = c;
+            let e = Mesh::new(far, &f, &[], BoundaryMode::EdgeOnly).expect_err("beyond the bound");
+            assert!(matches!(e, MeshError::TooLarge { vertex: 1, .. }), "{e}");
+            assert!(e.to_string().contains("OBJ `v` number 2"), "{e}");
+        }
+        let mut inf = p.clone();
+        inf[1][0] = f64::INFINITY;
+        assert!(matches!(
+            Mesh::new(inf, &f, &[], BoundaryMode::EdgeOnly),
+            Err(MeshError::NonFinite { vertex: 1, .. })
+        ));
+        let mut edge = p.clone();
+        edge[1][0] = -MAX_COORDINATE;
+        Mesh::new(edge, &f, &[], BoundaryMode::EdgeOnly).expect("at the bound");
         let e = Mesh::new(p.clone(), &[vec![0, 1]], &[7], BoundaryMode::EdgeOnly)
             .expect_err("two vertices");
         assert!(matches!(

@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
-use subtess::{Mesh, Rates, Scheme, Surface};
+use subtess::{Mesh, Rates, RuntimeError, Scheme, Surface};
 
 fn subtess(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_subtess"))
@@ -192,8 +192,9 @@ fn normals_are_unit_at_any_scale() {
         ("cube", cube.as_str(), Scheme::CatmullClark),
         ("octahedron", octahedron, Scheme::Loop),
     ] {
-        // Half-sides 1e10 and 5e-12: sides 2e10 and 1e-11 for the cube.
-        for s in [1.0, 1e10, 5e-12] {
+        // Half-sides 1e10 and 5e-12: sides 2e10 and 1e-11 for the cube; 1e18 puts its
+        // vertices at the largest magnitude accepted (`MAX_COORDINATE`).
+        for s in [1.0, 1e10, 5e-12, 1e18] {
             let path = write(&format!("{name}-{s}.obj"), &scaled_obj(text, s));
             let mesh = Mesh::read_obj(&path).expect("a valid mesh");
             std::fs::remove_file(&path).ok();
@@ -214,5 +215,229 @@ fn normals_are_unit_at_any_scale() {
                 assert!(outward > 0.0, "{name} scaled by {s}: normal {n:?} at {p:?}");
             }
         }
+    }
+}
+
+/// A 1M-quad grid at `--rate 24`, `bench --refine 6` and large √3 refinements aborted
+/// allocating gigabytes: the output was never estimated. Now the plan's estimate (and, for
+/// `bench --refine`, the face count after refinement) is refused above `--max-triangles`
+/// (200 million by default) before anything of its size is allocated.
+#[test]
+fn outputs_over_the_triangle_budget_are_refused() {
+    let cube = data("cube.obj");
+    let cube = cube.to_str().expect("a UTF-8 path");
+    let out = temp("budget-out.obj");
+    let out = out.to_str().expect("a UTF-8 path");
+    // Isolation splits the cube's 6 faces into 24: at rate 24, 24 * 2 * 24 * 25 = 28800
+    // triangles estimated (27,644 made).
+    let stderr = refused(&[
+        "tessellate",
+        cube,
+        "--rate",
+        "24",
+        "--max-triangles",
+        "28000",
+        "-o",
+        out,
+    ]);
+    assert!(stderr.contains("28800 triangles"), "{stderr}");
+    assert!(stderr.contains("--max-triangles N raises it"), "{stderr}");
+    assert!(!Path::new(out).exists());
+    let made = subtess(&[
+        "tessellate",
+        cube,
+        "--rate",
+        "24",
+        "--max-triangles",
+        "28800",
+        "-o",
+        out,
+    ]);
+    assert!(made.status.success(), "{made:?}");
+    std::fs::remove_file(out).ok();
+    // The default budget: √3 on the octahedron refined 6 times (two √3 steps each) has
+    // 8 * 9^6 = 4,251,528 faces, about 816 million triangles at rate 8.
+    let stderr = refused(&[
+        "bench",
+        data("octahedron.obj").to_str().expect("a UTF-8 path"),
+        "--scheme",
+        "sqrt3",
+        "--refine",
+        "6",
+        "--rate",
+        "8",
+        "--frames",
+        "1",
+    ]);
+    assert!(
+        stderr.contains("4251528 faces after refinement"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("the limit is 200000000 triangles"),
+        "{stderr}"
+    );
+    // Catmull–Clark: 6 * 4^6 = 24576 faces, 29,491,200 triangles at rate 24.
+    let stderr = refused(&[
+        "bench",
+        cube,
+        "--refine",
+        "6",
+        "--rate",
+        "24",
+        "--max-triangles",
+        "1000000",
+        "--frames",
+        "1",
+    ]);
+    assert!(stderr.contains("29491200 triangles"), "{stderr}");
+    // The library refuses before planning, with the same error.
+    let mesh = Mesh::read_obj(data("cube.obj")).expect("cube.obj");
+    let surface = Surface::new(&mesh, Scheme::CatmullClark).expect("a surface");
+    assert!(matches!(
+        surface.tessellator_within(&Rates::Uniform(24), 28000),
+        Err(RuntimeError::OverBudget { .. })
+    ));
+    assert!(surface
+        .tessellator_within(&Rates::Uniform(24), 28800)
+        .is_ok());
+}
+
+/// `--method adaptive --tolerance 1e-7` on a cube grew to 4.5 GB and aborted: the squares
+/// were split down to depth 16 whatever their number. Now the polygons are counted as they
+/// are made, and the run fails at `--max-polygons` (20 million by default) naming the
+/// tolerance it could not meet.
+#[test]
+fn adaptive_tessellation_stops_at_its_polygon_cap() {
+    let out = temp("adaptive-cap.obj");
+    let stderr = refused(&[
+        "tessellate",
+        data("cube.obj").to_str().expect("a UTF-8 path"),
+        "--method",
+        "adaptive",
+        "--tolerance",
+        "1e-7",
+        "--max-polygons",
+        "10000",
+        "-o",
+        out.to_str().expect("a UTF-8 path"),
+    ]);
+    assert!(stderr.contains("distance tolerance 0.0000001"), "{stderr}");
+    assert!(stderr.contains("more than 10000 polygons"), "{stderr}");
+    assert!(stderr.contains("--max-polygons N raises it"), "{stderr}");
+    assert!(!out.exists());
+}
+
+/// Coordinates near 1e308 reached an `unreachable!` in refinement (the refined positions
+/// overflowed to infinity), and above 3.4e38 the f32 output was `inf`, written with exit 0.
+/// Now every coordinate must be at most `MAX_COORDINATE` = 1e18 in magnitude, checked when
+/// the mesh is read, the vertex named.
+#[test]
+fn positions_beyond_f32_are_refused() {
+    let cube = std::fs::read_to_string(data("cube.obj")).expect("cube.obj");
+    let out = temp("far-out.obj");
+    for s in [2e18, 1e30, 1e300, 1.7e308] {
+        let path = write(&format!("far-{s:e}.obj"), &scaled_obj(&cube, s));
+        for scheme in ["catmull-clark", "loop"] {
+            let stderr = refused(&[
+                "tessellate",
+                path.to_str().expect("a UTF-8 path"),
+                "--scheme",
+                scheme,
+                "-o",
+                out.to_str().expect("a UTF-8 path"),
+            ]);
+            assert!(stderr.contains("vertex 0 (OBJ `v` number 1)"), "{stderr}");
+            assert!(stderr.contains("beyond 1e18"), "{stderr}");
+            assert!(!out.exists());
+        }
+        let stderr = refused(&[
+            "bench",
+            path.to_str().expect("a UTF-8 path"),
+            "--refine",
+            "2",
+            "--frames",
+            "1",
+        ]);
+        assert!(stderr.contains("beyond 1e18"), "{stderr}");
+        std::fs::remove_file(&path).ok();
+    }
+}
+
+/// `subtess eval --uv 1/2^k` with a million digits took over a minute (this test takes 100,000, under the
+/// 128 KiB a command-line argument may have) (big integers parse
+/// in time quadratic in their digits). Now a parameter has at most 64 characters and a
+/// numerator and denominator of at most 64 bits.
+#[test]
+fn eval_rationals_are_bounded() {
+    let cube = data("cube.obj");
+    let cube = cube.to_str().expect("a UTF-8 path");
+    let huge = format!("1/1{},0", "0".repeat(100_000));
+    let started = std::time::Instant::now();
+    let stderr = refused(&["eval", cube, "--face", "0", "--uv", &huge]);
+    assert!(started.elapsed().as_secs() < 20);
+    assert!(stderr.contains("a parameter is at most 64"), "{stderr}");
+    assert!(stderr.len() < 400, "{stderr}");
+    // 2^64 = 18446744073709551616 has 65 bits; 2^63 is taken.
+    let stderr = refused(&[
+        "eval",
+        cube,
+        "--face",
+        "0",
+        "--uv",
+        "1/18446744073709551616,0",
+    ]);
+    assert!(stderr.contains("more than 64 bits"), "{stderr}");
+    let out = subtess(&[
+        "eval",
+        cube,
+        "--face",
+        "0",
+        "--uv",
+        "1/9223372036854775808,1/3",
+    ]);
+    assert!(out.status.success(), "{out:?}");
+}
+
+/// Error messages echoed a whole 200 MB token. Now the OBJ reader, the Bézier readers and the
+/// rates file quote at most `EXCERPT_CHARS` = 60 characters of it, then `...` and its length.
+#[test]
+fn long_tokens_are_quoted_short() {
+    let token = "x".repeat(1_000_000);
+    let cube = std::fs::read_to_string(data("cube.obj")).expect("cube.obj");
+    let obj = write("long-token.obj", &format!("v 1 2 {token}\n{cube}"));
+    let newell = write("long-token", &format!("1\n{token}{}\n", ",1".repeat(15)));
+    let rates = write("long-token-rates.txt", &format!("1 2 3 {token} 5 6\n"));
+    let out = temp("long-token-out.obj");
+    let out = out.to_str().expect("a UTF-8 path");
+    let cube_path = data("cube.obj");
+    let runs: [Vec<&str>; 3] = [
+        vec!["tessellate", obj.to_str().expect("a UTF-8 path"), "-o", out],
+        vec![
+            "tessellate",
+            "--bezier",
+            newell.to_str().expect("a UTF-8 path"),
+            "-o",
+            out,
+        ],
+        vec![
+            "tessellate",
+            cube_path.to_str().expect("a UTF-8 path"),
+            "--rates",
+            rates.to_str().expect("a UTF-8 path"),
+            "-o",
+            out,
+        ],
+    ];
+    for args in &runs {
+        let stderr = refused(args);
+        assert!(stderr.len() < 600, "{args:?}: {} bytes", stderr.len());
+        assert!(
+            stderr.contains(&format!("{}... (1000000 bytes)", &token[..60])),
+            "{args:?}: {stderr}"
+        );
+    }
+    for path in [obj, newell, rates] {
+        std::fs::remove_file(path).ok();
     }
 }

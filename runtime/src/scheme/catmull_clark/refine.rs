@@ -296,7 +296,7 @@ pub fn refine(mesh: &Mesh) -> Refinement {
             ]);
         }
     }
-    let mut refined = Mesh::new(positions, &faces, &[], mesh.boundary)
+    let mut refined = Mesh::refined(positions, &faces, &[], mesh.boundary)
         .unwrap_or_else(|e| unreachable!("refining a valid mesh gives a valid mesh: {e}"));
     refined.edge_sharpness = edge_sharpness;
     for (child, &s) in refined

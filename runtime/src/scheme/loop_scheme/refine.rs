@@ -117,7 +117,7 @@ pub fn loop_refine(mesh: &Mesh) -> Result<LoopRefinement, MeshError> {
     let stencil = rows::<f64>(mesh, &split);
     let positions = stencil.apply(&mesh.positions);
     let faces = split.child_faces(mesh, nv);
-    let mesh = Mesh::new(positions, &faces, &[], mesh.boundary)?;
+    let mesh = Mesh::refined(positions, &faces, &[], mesh.boundary)?;
     Ok(LoopRefinement {
         mesh,
         edges: split.edges,

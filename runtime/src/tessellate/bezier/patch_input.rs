@@ -7,6 +7,7 @@
 use std::path::Path;
 
 use super::bicubic::{BicubicPatch, Point3};
+use crate::error::excerpt;
 use crate::RuntimeError;
 
 /// A set of bicubic Bézier patches, in file order.
@@ -97,7 +98,7 @@ impl<'a> Lines<'a> {
         let (line, t) = self.expect(what)?;
         let n: usize = t
             .parse()
-            .map_err(|_| self.error(line, format!("expected {what}, found `{t}`")))?;
+            .map_err(|_| self.error(line, format!("expected {what}, found `{}`", excerpt(t))))?;
         Ok((line, n))
     }
 
@@ -118,12 +119,14 @@ impl<'a> Lines<'a> {
         }
         let mut p = [0.0; 3];
         for (k, f) in fields.iter().enumerate() {
-            let x: f64 = f
-                .trim()
-                .parse()
-                .map_err(|_| self.error(line, format!("`{}` is not a number", f.trim())))?;
+            let x: f64 = f.trim().parse().map_err(|_| {
+                self.error(line, format!("`{}` is not a number", excerpt(f.trim())))
+            })?;
             if !x.is_finite() {
-                return Err(self.error(line, format!("coordinate `{}` is not finite", f.trim())));
+                return Err(self.error(
+                    line,
+                    format!("coordinate `{}` is not finite", excerpt(f.trim())),
+                ));
             }
             p[k] = x;
         }
@@ -179,7 +182,7 @@ impl BezierPatches {
                 let i: usize = f.parse().map_err(|_| {
                     lines.error(
                         line,
-                        format!("patch {}: `{f}` is not a vertex index", p + 1),
+                        format!("patch {}: `{}` is not a vertex index", p + 1, excerpt(f)),
                     )
                 })?;
                 if i == 0 {
@@ -205,7 +208,10 @@ impl BezierPatches {
         if let Some((line, t)) = lines.rest() {
             return Err(lines.error(
                 line,
-                format!("unexpected content after the {vertices} vertices: `{t}`"),
+                format!(
+                    "unexpected content after the {vertices} vertices: `{}`",
+                    excerpt(t)
+                ),
             ));
         }
         let mut patches = Vec::with_capacity(indices.len());
@@ -254,7 +260,7 @@ impl BezierPatches {
                 _ => {
                     return Err(lines.error(
                         line,
-                        format!("patch {}: expected the degree line `du dv`, found `{t}`", p + 1),
+                        format!("patch {}: expected the degree line `du dv`, found `{}`", p + 1, excerpt(t)),
                     ))
                 }
             }
@@ -270,7 +276,10 @@ impl BezierPatches {
         if let Some((line, t)) = lines.rest() {
             return Err(lines.error(
                 line,
-                format!("unexpected content after the {count} patches: `{t}`"),
+                format!(
+                    "unexpected content after the {count} patches: `{}`",
+                    excerpt(t)
+                ),
             ));
         }
         Ok(BezierPatches { patches })

@@ -49,6 +49,7 @@ mod operators;
 mod polygons;
 
 use std::collections::HashMap;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 use rayon::prelude::*;
@@ -72,6 +73,11 @@ pub const MAX_DEPTH: u32 = 24;
 /// The parameter grid every point lies on: `GRID = 2^MAX_DEPTH` steps per patch side.
 const GRID: u32 = 1 << MAX_DEPTH;
 
+/// The default [`AdaptiveOptions::max_polygons`]: 20 million. The adaptive tessellation peaked
+/// at 738 MB for 986,496 polygons (the cube at tolerance 1e-5), about 750 bytes per polygon, so
+/// the largest output allowed takes about 15 GB and a 24 GiB machine survives it.
+pub const DEFAULT_MAX_POLYGONS: usize = 20_000_000;
+
 /// How to tessellate.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AdaptiveOptions {
@@ -94,6 +100,10 @@ pub struct AdaptiveOptions {
     /// Squares are always split down to this depth (`<= max_depth`); 0 for the adaptive
     /// method, `= max_depth` for the uniform tessellation the A/U ratio compares with.
     pub min_depth: u32,
+    /// The most polygons (leaf squares) the tessellation may make: when meeting the tolerance
+    /// needs more, it stops splitting and fails with [`RuntimeError::OverBudget`] naming the
+    /// tolerance it could not meet (`--max-polygons`; default [`DEFAULT_MAX_POLYGONS`]).
+    pub max_polygons: usize,
 }
 
 impl Default for AdaptiveOptions {
@@ -104,6 +114,7 @@ impl Default for AdaptiveOptions {
             triangulate: false,
             max_depth: 16,
             min_depth: 0,
+            max_polygons: DEFAULT_MAX_POLYGONS,
         }
     }
 }
@@ -285,6 +296,8 @@ struct FaceWork<'a> {
     corner: usize,
     leaves: Vec<Leaf>,
     marked: Vec<Marked>,
+    /// Leaves made so far by all faces together.
+    polygons: &'a AtomicUsize,
 }
 
 impl FaceWork<'_> {
@@ -306,8 +319,16 @@ impl FaceWork<'_> {
         }
     }
 
+    /// Whether a square is a leaf: flat enough (or at `max_depth`), or the polygon budget is
+    /// spent (then the whole tessellation fails once every face has stopped).
     fn done(&self, depth: u32, bound: f64, tolerance: f64) -> bool {
-        depth >= self.options.min_depth && (bound <= tolerance || depth >= self.options.max_depth)
+        self.over_budget()
+            || depth >= self.options.min_depth
+                && (bound <= tolerance || depth >= self.options.max_depth)
+    }
+
+    fn over_budget(&self) -> bool {
+        self.polygons.load(Ordering::Relaxed) > self.options.max_polygons
     }
 
     /// Record the leaf `[p0, p0 + size] x [q0, q0 + size]` (patch coordinates) and mark its
@@ -322,6 +343,7 @@ impl FaceWork<'_> {
         tolerance: f64,
         extraordinary: bool,
     ) {
+        self.polygons.fetch_add(1, Ordering::Relaxed);
         let size = GRID >> depth;
         let patch_corners = [
             (p0, q0),
@@ -718,7 +740,8 @@ pub fn tessellate_adaptive(
         let ops = Operators::new(mesh, kind)?;
         operators.insert(kind, ops);
     }
-    // Pass 1 (parallel): the adaptive marking of every face.
+    // Pass 1 (parallel): the adaptive marking of every face, within the polygon budget.
+    let polygons = AtomicUsize::new(0);
     let work: Vec<(Vec<Leaf>, Vec<Marked>)> = patches
         .par_iter()
         .map(|patch| -> Result<(Vec<Leaf>, Vec<Marked>), RuntimeError> {
@@ -743,6 +766,7 @@ pub fn tessellate_adaptive(
                 corner: patch.corner,
                 leaves: Vec::new(),
                 marked: Vec::new(),
+                polygons: &polygons,
             };
             match ops.regular_patch(&points) {
                 Some(net) => face.regular(&net, 0, 0, 0),
@@ -751,9 +775,32 @@ pub fn tessellate_adaptive(
                     face.extraordinary(ops, points, normal);
                 }
             }
+            if face.over_budget() {
+                return Ok((Vec::new(), Vec::new()));
+            }
             Ok((face.leaves, face.marked))
         })
         .collect::<Result<_, _>>()?;
+    if polygons.load(Ordering::Relaxed) > options.max_polygons {
+        return Err(RuntimeError::OverBudget {
+            what: format!(
+                "the adaptive tessellation meeting the {} tolerance {}",
+                if options.relative {
+                    "relative"
+                } else {
+                    "distance"
+                },
+                options.tolerance
+            ),
+            estimate: format!(
+                "more than {} polygons (it stopped there, {} faces)",
+                options.max_polygons,
+                mesh.faces()
+            ),
+            limit: format!("{} polygons", options.max_polygons),
+            raise: "--max-polygons N raises it, a larger --tolerance needs fewer".to_owned(),
+        });
+    }
     // Pass 2: global ids (section 5), first evaluation wins, in face order.
     let mut ids: HashMap<PointKey, u32> = HashMap::new();
     let mut out = AdaptiveMesh::default();
