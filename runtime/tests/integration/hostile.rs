@@ -323,7 +323,7 @@ fn adaptive_tessellation_stops_at_its_polygon_cap() {
         out.to_str().expect("a UTF-8 path"),
     ]);
     assert!(stderr.contains("distance tolerance 0.0000001"), "{stderr}");
-    assert!(stderr.contains("more than 10000 polygons"), "{stderr}");
+    assert!(stderr.contains("the limit is 10000 polygons"), "{stderr}");
     assert!(stderr.contains("--max-polygons N raises it"), "{stderr}");
     assert!(!out.exists());
 }

@@ -793,8 +793,8 @@ pub fn tessellate_adaptive(
                 options.tolerance
             ),
             estimate: format!(
-                "more than {} polygons (it stopped there, {} faces)",
-                options.max_polygons,
+                "{} polygons over {} faces when it stopped, squares still over the tolerance",
+                polygons.load(Ordering::Relaxed),
                 mesh.faces()
             ),
             limit: format!("{} polygons", options.max_polygons),
