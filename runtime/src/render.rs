@@ -13,6 +13,7 @@ use std::path::Path;
 
 use rayon::prelude::*;
 
+use crate::io::atomic::write_atomically;
 use crate::io::mesh_input::Triangles;
 use crate::mesh::geometry::{cross, dot, normalize as unit, sub};
 use crate::RuntimeError;
@@ -214,19 +215,15 @@ impl Image {
         Ok(out)
     }
 
-    /// Write as a PNG file (to a temporary name first, so that a failed write leaves no
-    /// truncated file under `path`).
+    /// Write as a PNG file, all or nothing ([`crate::io::atomic`]).
     pub fn write_png(&self, path: &Path) -> Result<(), RuntimeError> {
         let bytes = self.png()?;
-        let io = |source| RuntimeError::Io {
-            path: path.display().to_string(),
-            source,
-        };
-        let partial = path.with_extension("png.partial");
-        let mut file = std::fs::File::create(&partial).map_err(io)?;
-        file.write_all(&bytes).map_err(io)?;
-        file.sync_all().map_err(io)?;
-        std::fs::rename(&partial, path).map_err(io)
+        write_atomically(path, |w| {
+            w.write_all(&bytes).map_err(|source| RuntimeError::Io {
+                path: path.display().to_string(),
+                source,
+            })
+        })
     }
 }
 

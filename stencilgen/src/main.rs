@@ -545,10 +545,24 @@ fn write_bytes(
     bytes: &[u8],
     started: std::time::Instant,
 ) -> Result<(), StencilError> {
-    std::fs::write(path, bytes).map_err(|e| StencilError::Io {
-        path: path.display().to_string(),
-        message: e.to_string(),
-    })?;
+    // All or nothing: a failed write (a full disk) removes the temporary file and never
+    // leaves a truncated table under the real name.
+    let mut partial = path.as_os_str().to_owned();
+    partial.push(".partial");
+    let partial = std::path::PathBuf::from(partial);
+    let written = std::fs::File::create(&partial)
+        .and_then(|mut file| {
+            std::io::Write::write_all(&mut file, bytes)?;
+            file.sync_all()
+        })
+        .and_then(|()| std::fs::rename(&partial, path));
+    if let Err(e) = written {
+        let _ = std::fs::remove_file(&partial);
+        return Err(StencilError::Io {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        });
+    }
     eprintln!(
         "wrote {} ({} bytes, {:.1} MiB) in {:.1?}",
         path.display(),

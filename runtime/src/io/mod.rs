@@ -2,6 +2,7 @@
 //! meshes in (OBJ, PLY, GLB) for `subtess render`. Bézier patch input lives with its
 //! tessellator ([`crate::tessellate::bezier`]).
 
+pub mod atomic;
 pub mod mesh_input;
 pub mod mesh_output;
 pub mod obj;

@@ -6,6 +6,7 @@ use std::path::Path;
 
 use super::bezier_net::{norm, sub, Point};
 use super::AdaptiveMesh;
+use crate::io::atomic::write_atomically;
 use crate::RuntimeError;
 
 /// Twice the signed area of the parameter triangle `(a, b, c)` (exact on the integer grid).
@@ -77,29 +78,29 @@ pub fn write_obj_polygons(mesh: &AdaptiveMesh, path: &Path) -> Result<(), Runtim
         path: path.display().to_string(),
         source,
     };
-    let file = std::fs::File::create(path).map_err(io)?;
-    let mut w = std::io::BufWriter::new(file);
-    writeln!(
-        w,
-        "# subtess Lai-Cheng adaptive tessellation: {} vertices, {} polygons",
-        mesh.positions.len(),
-        mesh.polygons.len()
-    )
-    .map_err(io)?;
-    for p in &mesh.positions {
-        writeln!(w, "v {} {} {}", p[0], p[1], p[2]).map_err(io)?;
-    }
-    for n in &mesh.normals {
-        writeln!(w, "vn {} {} {}", n[0], n[1], n[2]).map_err(io)?;
-    }
-    for polygon in &mesh.polygons {
-        write!(w, "f").map_err(io)?;
-        for &i in &polygon.vertices {
-            write!(w, " {0}//{0}", i + 1).map_err(io)?;
+    write_atomically(path, |w| {
+        writeln!(
+            w,
+            "# subtess Lai-Cheng adaptive tessellation: {} vertices, {} polygons",
+            mesh.positions.len(),
+            mesh.polygons.len()
+        )
+        .map_err(io)?;
+        for p in &mesh.positions {
+            writeln!(w, "v {} {} {}", p[0], p[1], p[2]).map_err(io)?;
         }
-        writeln!(w).map_err(io)?;
-    }
-    w.flush().map_err(io)
+        for n in &mesh.normals {
+            writeln!(w, "vn {} {} {}", n[0], n[1], n[2]).map_err(io)?;
+        }
+        for polygon in &mesh.polygons {
+            write!(w, "f").map_err(io)?;
+            for &i in &polygon.vertices {
+                write!(w, " {0}//{0}", i + 1).map_err(io)?;
+            }
+            writeln!(w).map_err(io)?;
+        }
+        Ok(())
+    })
 }
 
 #[cfg(test)]
