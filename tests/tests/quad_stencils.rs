@@ -16,8 +16,6 @@ use stencilgen::scalar::rational_to_f64;
 use stencilgen::substitution::Substitution;
 use subtess_tests::bspline::{q, uniform_bspline, uniform_bspline_derivative};
 
-const RATES: [u32; 7] = [1, 2, 3, 5, 7, 12, 24];
-
 fn scheme(name: &str) -> QuadScheme {
     QuadScheme::by_name(name).expect("catalogued")
 }
@@ -43,13 +41,13 @@ fn point(a: i64, b: i64, n: u32) -> (BigRational, BigRational) {
 
 /// The grid solve (scaling relation as a system) equals plain substitution
 /// `psi(t) R_b A^k` exactly, at every primal and dual point, for positions and both
-/// derivatives, every valence 3..=8 and n in {1, 2, 3, 5, 7, 12, 24}.
-fn grid_solve_equals_substitution(name: &str) {
+/// derivatives, every valence 3..=8 and each n of `rates`.
+fn grid_solve_equals_substitution(name: &str, rates: &[u32]) {
     let s = scheme(name);
     for v in 3..=8 {
         let mut substitution = Substitution::<BigRational>::new(&s, Neighbourhood::interior(v), 0)
             .expect("substitution");
-        for n in RATES {
+        for &n in rates {
             for kind in StencilKind::ALL {
                 let grid = exact(&s, v, n, kind);
                 for (&(a, b), stencil) in grid.points.iter().zip(&grid.stencils) {
@@ -71,14 +69,25 @@ fn grid_solve_equals_substitution(name: &str) {
     }
 }
 
+/// By default the rates below 24; rate 24 (85% of the time, 36 s in the dev profile) runs
+/// with `cargo test -p subtess-tests --test quad_stencils -- --ignored`.
+const SUBSTITUTION_RATES: [u32; 6] = [1, 2, 3, 5, 7, 12];
+
 #[test]
 fn catmull_clark_grid_solve_equals_substitution() {
-    grid_solve_equals_substitution("catmull-clark");
+    grid_solve_equals_substitution("catmull-clark", &SUBSTITUTION_RATES);
 }
 
 #[test]
 fn sw_nonpoly_quad_grid_solve_equals_substitution() {
-    grid_solve_equals_substitution("sw-nonpoly-quad");
+    grid_solve_equals_substitution("sw-nonpoly-quad", &SUBSTITUTION_RATES);
+}
+
+#[test]
+#[ignore = "rate 24 of the grid = substitution check; the rates below run by default"]
+fn grid_solve_equals_substitution_at_rate_24() {
+    grid_solve_equals_substitution("catmull-clark", &[24]);
+    grid_solve_equals_substitution("sw-nonpoly-quad", &[24]);
 }
 
 /// Positions of the layout points at valence 4, in sector-0 grid coordinates.
