@@ -75,10 +75,12 @@ impl StencilTable {
         self.corners.is_some() || self.index.meta.corners
     }
 
-    /// Validate a table held in memory (copied once into an aligned buffer).
+    /// Validate a table held in memory (copied once into an aligned buffer), every weight
+    /// finite included.
     pub fn from_bytes(bytes: &[u8]) -> Result<Self, RuntimeError> {
         let bytes = AlignedBytes::from_slice(bytes);
         let index = TableIndex::parse(bytes.as_bytes())?;
+        index.check_finite(bytes.as_bytes())?;
         Ok(StencilTable {
             storage: Storage::Owned(bytes),
             index,
@@ -88,7 +90,8 @@ impl StencilTable {
 
     /// Read and validate a table file. The fixed-size header is read and checked first
     /// ([`table_format::check_header`]: magic, version, the declared size against the file's
-    /// length and [`table_format::MAX_FILE_SIZE`]); only then is the rest read.
+    /// length and [`table_format::MAX_FILE_SIZE`]); only then is the rest read, then every
+    /// weight checked to be finite ([`table_format::TableIndex::check_finite`]).
     pub fn read(path: &Path) -> Result<Self, RuntimeError> {
         use std::io::Read;
         let io = |source| RuntimeError::Io {
@@ -108,6 +111,7 @@ impl StencilTable {
             .map_err(|_| table_format::TableError::TooLarge { declared: len })?;
         let bytes = AlignedBytes::read_from(head.as_slice().chain(file), len).map_err(io)?;
         let index = TableIndex::parse(bytes.as_bytes())?;
+        index.check_finite(bytes.as_bytes())?;
         Ok(StencilTable {
             storage: Storage::Owned(bytes),
             index,

@@ -313,3 +313,31 @@ proptest! {
         let _ = parse(&b);
     }
 }
+
+/// A NaN or an infinite weight written into a table passes the checksum (it was written so)
+/// but not `check_finite`, which names the section and the point.
+#[test]
+fn non_finite_weights_are_found_behind_a_valid_checksum() {
+    let meta = TableMeta {
+        scheme: SchemeId::CatmullClark,
+        precision: Precision::F32,
+        corners: false,
+    };
+    let k = key(StencilKind::Position, PointSet::Dual, 3, 2);
+    for bad in [f64::NAN, f64::INFINITY, -1e300] {
+        let mut weights = vec![0.25; 4 * 14];
+        weights[2 * 14 + 5] = bad;
+        let bytes = encode(meta, &[(k, 14, weights)]).expect("written");
+        let aligned = AlignedBytes::from_slice(&bytes);
+        let index = TableIndex::parse(aligned.as_bytes()).expect("the checksum holds");
+        match index.check_finite(aligned.as_bytes()) {
+            Err(TableError::NonFinite { key, point }) => {
+                assert_eq!((key, point), (k, 2), "{bad}");
+            }
+            other => panic!("{bad}: {other:?}"),
+        }
+    }
+    let sample = AlignedBytes::from_slice(&sample());
+    let index = TableIndex::parse(sample.as_bytes()).expect("valid");
+    index.check_finite(sample.as_bytes()).expect("all finite");
+}

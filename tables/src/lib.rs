@@ -87,4 +87,20 @@ mod tests {
             assert_eq!(&bytes[..8], b"SUBTESS\0");
         }
     }
+
+    /// The runtime does not scan the embedded tables for NaN at load (files it does): the
+    /// generator's output is checked here once.
+    #[test]
+    fn embedded_weights_are_finite() {
+        for bytes in [
+            super::default_catmull_clark(),
+            super::default_catmull_clark_corners(),
+            super::default_loop(),
+            super::default_butterfly(),
+            super::default_sqrt3(),
+        ] {
+            let index = table_format::TableIndex::parse(bytes).expect("valid");
+            index.check_finite(bytes).expect("finite");
+        }
+    }
 }

@@ -441,3 +441,31 @@ fn long_tokens_are_quoted_short() {
         std::fs::remove_file(path).ok();
     }
 }
+
+/// A table written with a NaN weight has a valid checksum: `tables info` said "verified" and
+/// the surface came out NaN. Files are now scanned for non-finite weights.
+#[test]
+fn tables_with_non_finite_weights_are_refused() {
+    use table_format::{encode, Precision, SchemeId, SectionKey, StencilKind, TableMeta};
+    let meta = TableMeta {
+        scheme: SchemeId::CatmullClark,
+        precision: Precision::F32,
+        corners: false,
+    };
+    let key = SectionKey {
+        kind: StencilKind::Position,
+        points: table_format::PointSet::Dual,
+        boundary: false,
+        faces: 3,
+        sector: 0,
+        n: 1,
+    };
+    let mut weights = vec![0.0; 14];
+    weights[3] = f64::NAN;
+    let bytes = encode(meta, &[(key, 14, weights)]).expect("written");
+    let path = temp("nan.subtess");
+    std::fs::write(&path, bytes).expect("temp file");
+    let stderr = refused(&["tables", "info", path.to_str().expect("a UTF-8 path")]);
+    std::fs::remove_file(&path).ok();
+    assert!(stderr.contains("not finite"), "{stderr}");
+}
