@@ -739,8 +739,8 @@ impl TableIndex {
     /// Every weight of every section of `bytes` (the bytes this index was parsed from) is
     /// finite. The checksum only says the bytes are the ones written: a table written with a
     /// NaN or an infinity passes it, and would put NaN into every point it touches. A full
-    /// scan (about 30 ms for 100 MB), so for tables read from files; the embedded ones come
-    /// from the build's own generator.
+    /// scan (of the order of the checksum's time), so for tables read from files; the
+    /// embedded ones come from the build's own generator.
     pub fn check_finite(&self, bytes: &[u8]) -> Result<(), TableError> {
         for entry in &self.entries {
             let bad = match self.meta.precision {
