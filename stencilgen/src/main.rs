@@ -237,9 +237,9 @@ fn run(cli: Cli) -> Result<(), StencilError> {
             output,
         } => {
             let set = StencilSetSpec {
-                valences: parse_set("--valences", &valences)?,
+                valences: parse_set("--valences", &valences, MAX_TABLE_VALENCE)?,
                 boundary_faces: if boundary {
-                    parse_set("--boundary-faces", &boundary_faces)?
+                    parse_set("--boundary-faces", &boundary_faces, MAX_TABLE_VALENCE)?
                 } else {
                     Vec::new()
                 },
@@ -248,8 +248,9 @@ fn run(cli: Cli) -> Result<(), StencilError> {
                 } else {
                     BoundaryMode::EdgeOnly
                 },
-                rates: parse_set("--n", &n)?,
+                rates: parse_set("--n", &n, stencilgen::curve_stencils::MAX_RATE)?,
             };
+            check_table_size(&set)?;
             let precision = if precision == "f64" {
                 Precision::F64
             } else {
@@ -483,17 +484,24 @@ fn triangle_json<S: Scalar>(s: &TriangleStencils<S>, value: impl Fn(&S) -> Value
 }
 
 /// A set of positive integers: `a..b` (inclusive), `a,b,c`, or `a`.
-fn parse_set(flag: &str, text: &str) -> Result<Vec<u32>, StencilError> {
+/// The largest valence or boundary face count `stencilgen tables` takes (as `stencil
+/// --valence`).
+const MAX_TABLE_VALENCE: u32 = 64;
+
+/// A range `a..b` (inclusive) or a list `a,b,c` of integers in `1..=max`; checked before any
+/// list is made from it (`--n 1..4000000000` would have been 16 GB of rates).
+fn parse_set(flag: &str, text: &str, max: u32) -> Result<Vec<u32>, StencilError> {
     let bad = || StencilError::OutOfDomain {
         what: format!(
-            "{flag} `{text}` is not a range `a..b` or a list `a,b,c` of positive integers"
+            "{flag} `{}` is not a range `a..b` or a list `a,b,c` of integers in 1..={max}",
+            excerpt(text)
         ),
     };
     let number = |s: &str| {
         s.trim()
             .parse::<u32>()
             .ok()
-            .filter(|&v| v > 0)
+            .filter(|&v| (1..=max).contains(&v))
             .ok_or_else(bad)
     };
     let values: Vec<u32> = match text.split_once("..") {
@@ -507,6 +515,47 @@ fn parse_set(flag: &str, text: &str) -> Result<Vec<u32>, StencilError> {
         None => text.split(',').map(number).collect::<Result<_, _>>()?,
     };
     Ok(values)
+}
+
+/// At most 60 characters of `text`, for messages.
+fn excerpt(text: &str) -> String {
+    match text.char_indices().nth(60) {
+        Some((at, _)) => format!("{}... ({} bytes)", &text[..at], text.len()),
+        None => text.to_owned(),
+    }
+}
+
+/// Refuse, before solving anything, a table that would exceed what the format holds
+/// ([`table_format::MAX_FILE_SIZE`], 4 GiB): every patch (valence `v` or boundary face count)
+/// at every rate `n` has `(n + 1)^2` primal and `n^2` dual points, each with at most
+/// `2 v + 8` weights (the Catmull–Clark patch; the triangle schemes' are fewer), for the
+/// position and both derivatives, in f64 at most.
+fn check_table_size(set: &StencilSetSpec) -> Result<(), StencilError> {
+    let bytes: u128 = set
+        .valences
+        .iter()
+        .chain(&set.boundary_faces)
+        .map(|&v| {
+            set.rates
+                .iter()
+                .map(|&n| {
+                    let n = u128::from(n);
+                    ((n + 1) * (n + 1) + n * n) * (2 * u128::from(v) + 8) * 3 * 8
+                })
+                .sum::<u128>()
+        })
+        .sum();
+    if bytes > u128::from(table_format::MAX_FILE_SIZE) {
+        return Err(StencilError::OutOfDomain {
+            what: format!(
+                "a table of these valences and rates would take up to {:.1} GiB, more than the \
+                 format's {} GiB; ask for fewer valences or rates",
+                bytes as f64 / f64::from(1u32 << 30),
+                table_format::MAX_FILE_SIZE >> 30
+            ),
+        });
+    }
+    Ok(())
 }
 
 /// `dir/name.ext` -> `dir/name-suffix.ext`.

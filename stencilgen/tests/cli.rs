@@ -331,3 +331,34 @@ fn loop_stencil_next_to_a_boundary_vertex() {
     assert_eq!(weight("O1"), "1/48");
     assert_eq!(weight("E1"), "0");
 }
+
+/// `stencilgen tables` bounds what it is asked for before making anything: a rate list of
+/// four billion entries, valences beyond 64, or a table beyond the format's 4 GiB are refused
+/// at once, with nothing written.
+#[test]
+fn tables_refuse_what_they_cannot_hold() {
+    let out =
+        std::env::temp_dir().join(format!("stencilgen-budget-{}.subtess", std::process::id()));
+    let o = out.display();
+    fails_with(
+        &format!("tables --n 1..4000000000 -o {o}"),
+        "integers in 1..=1024",
+    );
+    fails_with(
+        &format!("tables --valences 3..100000 -o {o}"),
+        "integers in 1..=64",
+    );
+    fails_with(
+        &format!("tables --valences 3..64 --n 1..1024 -o {o}"),
+        "GiB, more than the format's 4 GiB",
+    );
+    let long = "9".repeat(100_000);
+    let out_put = stencilgen(&format!("tables --n {long} -o {o}"));
+    let stderr = String::from_utf8_lossy(&out_put.stderr);
+    assert!(
+        !out_put.status.success() && stderr.len() < 600,
+        "{}",
+        stderr.len()
+    );
+    assert!(!out.exists(), "nothing written");
+}
