@@ -8,6 +8,7 @@ use std::path::Path;
 
 use super::bicubic::{BicubicPatch, Point3};
 use crate::error::excerpt;
+use crate::mesh::topology::MAX_COORDINATE;
 use crate::RuntimeError;
 
 /// A set of bicubic Bézier patches, in file order.
@@ -126,6 +127,17 @@ impl<'a> Lines<'a> {
                 return Err(self.error(
                     line,
                     format!("coordinate `{}` is not finite", excerpt(f.trim())),
+                ));
+            }
+            // The meshes' bound: beyond it the f32 output and its normals overflow.
+            if x.abs() > MAX_COORDINATE {
+                return Err(self.error(
+                    line,
+                    format!(
+                        "coordinate `{}` is beyond {MAX_COORDINATE:e} (what f32 output and its \
+                         normals can hold)",
+                        excerpt(f.trim())
+                    ),
                 ));
             }
             p[k] = x;
@@ -358,5 +370,22 @@ mod tests {
             1,
         );
         assert!(m.contains("expected the number of patches"), "{m}");
+    }
+
+    /// Coordinates beyond the meshes' bound (1e18) are refused naming the line, as in meshes:
+    /// their f32 output and normals would overflow.
+    #[test]
+    fn coordinates_beyond_the_bound_are_refused() {
+        let points = |x: &str| {
+            let mut text = String::from("1\n3 3\n");
+            for k in 0..16 {
+                let first = if k == 5 { x.to_string() } else { k.to_string() };
+                text.push_str(&format!("{first} 0 0\n"));
+            }
+            text
+        };
+        let m = error_at(BezierPatches::parse_bpt(&points("2e18"), "t.bpt"), 8);
+        assert!(m.contains("beyond 1e18"), "{m}");
+        assert!(BezierPatches::parse_bpt(&points("1e18"), "t.bpt").is_ok());
     }
 }
