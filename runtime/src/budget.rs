@@ -111,14 +111,12 @@ pub fn refined_faces(
     face_sizes: impl IntoIterator<Item = usize>,
     steps: u32,
 ) -> u64 {
-    let sizes: Vec<u64> = face_sizes.into_iter().map(|k| k as u64).collect();
-    let faces = sizes.len() as u64;
+    let (faces, corners) = face_sizes.into_iter().fold((0u64, 0u64), |(f, c), k| {
+        (f + 1, c.saturating_add(k as u64))
+    });
     match (scheme, steps) {
         (_, 0) => faces,
-        (Scheme::CatmullClark, _) => sizes
-            .iter()
-            .sum::<u64>()
-            .saturating_mul(4u64.saturating_pow(steps - 1)),
+        (Scheme::CatmullClark, _) => corners.saturating_mul(4u64.saturating_pow(steps - 1)),
         (Scheme::Sqrt3, _) => faces.saturating_mul(9u64.saturating_pow(steps)),
         (Scheme::Loop | Scheme::Butterfly, _) => faces.saturating_mul(4u64.saturating_pow(steps)),
     }

@@ -270,6 +270,11 @@ pub fn render(
     camera: &Camera,
     options: &RenderOptions,
 ) -> Result<Image, RuntimeError> {
+    mesh.check()
+        .map_err(|reason| RuntimeError::InvalidParameter {
+            name: "mesh to render".to_string(),
+            reason,
+        })?;
     for (name, side) in [("width", options.width), ("height", options.height)] {
         if !(1..=MAX_SIDE).contains(&side) {
             return Err(RuntimeError::InvalidParameter {
@@ -531,5 +536,32 @@ mod tests {
             );
             assert!(expected > 0.1, "the cube fills a good part of the image");
         }
+    }
+
+    /// Triangles built by a caller are checked before they are indexed: a vertex beyond the
+    /// positions or texture coordinates of another count is an error, not a panic.
+    #[test]
+    fn inconsistent_meshes_are_refused() {
+        let options = RenderOptions::default();
+        let positions = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        let camera = Camera::orbit(&positions, &options);
+        let beyond = Triangles {
+            positions: positions.clone(),
+            triangles: vec![[0, 1, 3]],
+            uvs: None,
+        };
+        let e = render(&beyond, &camera, &options).expect_err("refused");
+        assert!(e.to_string().contains("beyond the 3 vertices"), "{e}");
+        let uvs = Triangles {
+            positions,
+            triangles: vec![[0, 1, 2]],
+            uvs: Some(vec![[0.0, 0.0]]),
+        };
+        let e = render(&uvs, &camera, &options).expect_err("refused");
+        assert!(
+            e.to_string()
+                .contains("1 texture coordinates for 3 vertices"),
+            "{e}"
+        );
     }
 }

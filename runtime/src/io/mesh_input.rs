@@ -25,6 +25,31 @@ pub struct Triangles {
     pub uvs: Option<Vec<[f32; 2]>>,
 }
 
+impl Triangles {
+    /// Whether every triangle names a vertex there is, and the texture coordinates (if any)
+    /// are one per vertex: what drawing the triangles indexes by.
+    pub fn check(&self) -> Result<(), String> {
+        if let Some(t) = self
+            .triangles
+            .iter()
+            .find(|t| t.iter().any(|&v| v as usize >= self.positions.len()))
+        {
+            return Err(format!(
+                "triangle {t:?} names a vertex beyond the {} vertices",
+                self.positions.len()
+            ));
+        }
+        match &self.uvs {
+            Some(uvs) if uvs.len() != self.positions.len() => Err(format!(
+                "{} texture coordinates for {} vertices",
+                uvs.len(),
+                self.positions.len()
+            )),
+            _ => Ok(()),
+        }
+    }
+}
+
 /// Read the triangles of an `.obj`, `.ply` or `.glb` file (by extension).
 pub fn read_triangles(path: &Path) -> Result<Triangles, RuntimeError> {
     let extension = path
@@ -42,19 +67,7 @@ pub fn read_triangles(path: &Path) -> Result<Triangles, RuntimeError> {
             ))
         }
     };
-    if let Some(t) = out
-        .triangles
-        .iter()
-        .find(|t| t.iter().any(|&v| v as usize >= out.positions.len()))
-    {
-        return Err(bad(
-            path,
-            format!(
-                "triangle {t:?} names a vertex beyond the {} vertices",
-                out.positions.len()
-            ),
-        ));
-    }
+    out.check().map_err(|reason| bad(path, reason))?;
     Ok(out)
 }
 
@@ -292,7 +305,7 @@ fn parse_ply(bytes: &[u8]) -> Result<Triangles, String> {
                         if !(0.0..=1e6).contains(&n) {
                             return Err(format!("a list of {n} items"));
                         }
-                        let mut polygon = Vec::with_capacity(n as usize);
+                        let mut polygon = Vec::with_capacity((n as usize).min(body.left()));
                         for _ in 0..n as usize {
                             polygon.push(body.next(item)?);
                         }
