@@ -352,32 +352,21 @@ fn load_surface(
     }
 }
 
-/// Per-input-face rates from a text file.
+/// Per-input-face rates from a text file ([`subtess::tessellate::rates::parse_rates`]), its
+/// messages naming the file.
 fn read_rates(path: &Path, input_faces: usize) -> Result<Vec<u32>, RuntimeError> {
     let text = std::fs::read_to_string(path).map_err(|source| RuntimeError::Io {
         path: path.display().to_string(),
         source,
     })?;
-    let bad = |message: String| RuntimeError::Unsupported(format!("{}: {message}", path.display()));
-    let rates = text
-        .split_whitespace()
-        .enumerate()
-        .map(|(i, word)| match word.parse::<u32>() {
-            Ok(n) if (1..=24).contains(&n) => Ok(n),
-            _ => Err(bad(format!(
-                "rate {} is `{}`, not an integer in 1..=24",
-                i + 1,
-                subtess::error::excerpt(word)
-            ))),
-        })
-        .collect::<Result<Vec<u32>, _>>()?;
-    if rates.len() != input_faces {
-        return Err(bad(format!(
-            "{} rates for a mesh of {input_faces} faces",
-            rates.len()
-        )));
-    }
-    Ok(rates)
+    subtess::tessellate::rates::parse_rates(&text, input_faces).map_err(|e| match e {
+        RuntimeError::ParseFile { line, message, .. } => RuntimeError::ParseFile {
+            path: path.display().to_string(),
+            line,
+            message,
+        },
+        other => other,
+    })
 }
 
 /// `--view PX,PY,PZ,TX,TY,TZ,FOV,HEIGHT,EDGE`.

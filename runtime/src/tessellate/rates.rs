@@ -90,6 +90,55 @@ pub const POWER_OF_TWO_RATES: [u32; 5] = [1, 2, 4, 8, 16];
 /// primal points `k/24` and dual points `(2k+1)/48` of every face.
 pub const SELECTION_GRID: u32 = 24;
 
+/// Per-input-face rates from the text of a rates file (`subtess tessellate --rates FILE`): one
+/// integer in `1..=`[`MAX_SELECTED_RATE`] per input face, in face order, separated by any
+/// whitespace (spaces or lines, as the writer likes).
+///
+/// A bad token is reported as [`RuntimeError::ParseFile`] at its line (path `rates`; the CLI
+/// puts the file's name there) and quoted through [`crate::error::excerpt`]; so are a file with
+/// fewer rates than `input_faces` (at its last line) and one with more (at the first rate too
+/// many). Nothing is allocated beyond `input_faces` rates, however long the text.
+pub fn parse_rates(text: &str, input_faces: usize) -> Result<Vec<u32>, RuntimeError> {
+    let error = |line: usize, message: String| RuntimeError::ParseFile {
+        path: "rates".to_owned(),
+        line,
+        message,
+    };
+    let mut rates = Vec::with_capacity(input_faces.min(text.len() / 2 + 1));
+    let mut last_line = 0;
+    for (index, line) in text.lines().enumerate() {
+        last_line = index + 1;
+        for word in line.split_whitespace() {
+            let n = rates.len() + 1;
+            if n > input_faces {
+                return Err(error(
+                    last_line,
+                    format!("more than {input_faces} rates for a mesh of {input_faces} faces (rate {n} is `{}`)", crate::error::excerpt(word)),
+                ));
+            }
+            match word.parse::<u32>() {
+                Ok(rate) if (1..=MAX_SELECTED_RATE).contains(&rate) => rates.push(rate),
+                _ => {
+                    return Err(error(
+                        last_line,
+                        format!(
+                            "rate {n} is `{}`, not an integer in 1..={MAX_SELECTED_RATE}",
+                            crate::error::excerpt(word)
+                        ),
+                    ))
+                }
+            }
+        }
+    }
+    if rates.len() != input_faces {
+        return Err(error(
+            last_line,
+            format!("{} rates for a mesh of {input_faces} faces", rates.len()),
+        ));
+    }
+    Ok(rates)
+}
+
 /// Per-face rates chosen for a tolerance.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ToleranceRates {
@@ -897,4 +946,57 @@ pub fn view_rates(mesh: &Mesh, camera: &ViewCamera) -> Result<Vec<u32>, RuntimeE
             }
         })
         .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn message(text: &str, faces: usize) -> String {
+        match parse_rates(text, faces) {
+            Ok(rates) => panic!("{text:?} parsed as {rates:?}"),
+            Err(e) => e.to_string(),
+        }
+    }
+
+    #[test]
+    fn rates_are_read_in_face_order_across_lines() {
+        let rates = parse_rates("1 2\r\n\t3\n\n24 5 6\n", 6).expect("valid rates");
+        assert_eq!(rates, [1, 2, 3, 24, 5, 6]);
+        assert_eq!(
+            parse_rates("", 0).expect("no faces, no rates"),
+            Vec::<u32>::new()
+        );
+    }
+
+    #[test]
+    fn bad_rates_name_their_line() {
+        assert_eq!(
+            message("1 2\n3 x 5 6", 6),
+            "rates:2: rate 4 is `x`, not an integer in 1..=24"
+        );
+        assert_eq!(
+            message("1 2 3 4 5 25", 6),
+            "rates:1: rate 6 is `25`, not an integer in 1..=24"
+        );
+        assert_eq!(
+            message("0", 1),
+            "rates:1: rate 1 is `0`, not an integer in 1..=24"
+        );
+        assert_eq!(
+            message("-1", 1),
+            "rates:1: rate 1 is `-1`, not an integer in 1..=24"
+        );
+        assert_eq!(
+            message("1 2\n3\n", 6),
+            "rates:2: 3 rates for a mesh of 6 faces"
+        );
+        assert_eq!(
+            message("1 1\n1 1", 3),
+            "rates:2: more than 3 rates for a mesh of 3 faces (rate 4 is `1`)"
+        );
+        assert_eq!(message("", 2), "rates:0: 0 rates for a mesh of 2 faces");
+        let long = "9".repeat(1000);
+        assert!(message(&long, 1).len() < 200);
+    }
 }
