@@ -293,14 +293,16 @@ pub enum PointSet {
 }
 
 impl PointSet {
-    /// Number of points at rate `n`.
+    /// Number of points at rate `n`; `u64::MAX` where that does not fit (a primal grid at
+    /// `n = u32::MAX`, a rate a file may declare: no table holds it).
     pub fn count(self, n: u32) -> u64 {
-        let n = u64::from(n);
-        match self {
+        let n = u128::from(n);
+        let count = match self {
             PointSet::Primal => (n + 1) * (n + 1),
             PointSet::Dual | PointSet::TriangleDual => n * n,
             PointSet::TrianglePrimal => (n + 1) * (n + 2) / 2,
-        }
+        };
+        u64::try_from(count).unwrap_or(u64::MAX)
     }
 
     /// Whether the point set belongs to triangle patches.
@@ -426,7 +428,7 @@ pub fn encode(
     let mut entries = Vec::with_capacity(sorted.len());
     for (key, width, weights) in &sorted {
         let points = key.points.count(key.n);
-        if weights.len() as u64 != points * u64::from(*width) {
+        if weights.len() as u64 != points.saturating_mul(u64::from(*width)) {
             return Err(TableError::Encode(format!(
                 "{key}: {} weights for {points} points x {width}",
                 weights.len()
@@ -694,7 +696,10 @@ impl TableIndex {
                     offset: entry.offset,
                 });
             }
-            let expected = u64::from(entry.points) * u64::from(entry.width) * precision as u64;
+            // Saturating: the fields are the file's, and a length is at most the file's.
+            let expected = u64::from(entry.points)
+                .saturating_mul(u64::from(entry.width))
+                .saturating_mul(precision as u64);
             if entry.length != expected || u64::from(entry.points) != key.points.count(key.n) {
                 return Err(TableError::WrongShape {
                     index,
@@ -840,7 +845,11 @@ fn ranges(set: &std::collections::BTreeSet<u32>) -> String {
     let mut iter = set.iter().copied().peekable();
     while let Some(start) = iter.next() {
         let mut end = start;
-        while iter.peek() == Some(&(end + 1)) {
+        // `u32::MAX` (a field a file may hold) has no successor: checked, not wrapped.
+        while end
+            .checked_add(1)
+            .is_some_and(|next| iter.peek() == Some(&next))
+        {
             end += 1;
             iter.next();
         }

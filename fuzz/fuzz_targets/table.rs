@@ -1,0 +1,56 @@
+//! The stencil-table reader (`StencilTable::from_bytes`: header, index, checksum, every weight
+//! finite), then a few sections' weights read back. The first byte chooses what the target
+//! mends before reading the rest as a table, so that mutations get past the checks a random
+//! change almost never passes: bit 0 writes the xxh3 checksum of the bytes after the header
+//! into the header, bit 1 writes the length as the declared file size.
+
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+use subtess::StencilTable;
+use table_format::{Precision, HEADER_SIZE};
+
+/// Where the header keeps the declared file size and the checksum (docs/table-format.md).
+const FILE_SIZE_AT: usize = 32;
+const CHECKSUM_AT: usize = 40;
+
+fuzz_target!(|data: &[u8]| {
+    let [mode, rest @ ..] = data else {
+        return;
+    };
+    let mut bytes = rest.to_vec();
+    if bytes.len() >= HEADER_SIZE {
+        if mode & 2 != 0 {
+            let len = bytes.len() as u64;
+            bytes[FILE_SIZE_AT..FILE_SIZE_AT + 8].copy_from_slice(&len.to_le_bytes());
+        }
+        if mode & 1 != 0 {
+            let sum = xxhash_rust::xxh3::xxh3_64(&bytes[HEADER_SIZE..]);
+            bytes[CHECKSUM_AT..CHECKSUM_AT + 8].copy_from_slice(&sum.to_le_bytes());
+        }
+    }
+    let Ok(table) = StencilTable::from_bytes(&bytes) else {
+        return;
+    };
+    let index = table.index();
+    let _ = index.coverage();
+    for entry in index.entries.iter().take(8) {
+        let expected = u64::from(entry.points) * u64::from(entry.width);
+        match index.meta.precision {
+            Precision::F32 => {
+                let weights = table
+                    .weights(&entry.key)
+                    .expect("an indexed f32 section reads");
+                assert_eq!(weights.len() as u64, expected);
+                assert!(weights.iter().all(|w| w.is_finite()));
+            }
+            Precision::F64 => {
+                let weights = index
+                    .weights_f64(table.bytes(), &entry.key)
+                    .expect("an indexed f64 section reads");
+                assert_eq!(weights.len() as u64, expected);
+                assert!(weights.iter().all(|w| w.is_finite()));
+            }
+        }
+    }
+});
