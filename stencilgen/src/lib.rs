@@ -63,3 +63,16 @@ pub mod triangle_table;
 pub use curve_stencils::{curve_stencils, BasisFunction, CurveStencils};
 pub use error::StencilError;
 pub use scalar::Scalar;
+
+/// The most characters of an offending argument a message quotes.
+pub const EXCERPT_CHARS: usize = 60;
+
+/// `text` as a message quotes it: whole when it has at most [`EXCERPT_CHARS`] characters,
+/// else its first [`EXCERPT_CHARS`] followed by `...` and its length in bytes (a
+/// million-character argument is not echoed back).
+pub fn excerpt(text: &str) -> String {
+    match text.char_indices().nth(EXCERPT_CHARS) {
+        Some((at, _)) => format!("{}... ({} bytes)", &text[..at], text.len()),
+        None => text.to_owned(),
+    }
+}

@@ -31,7 +31,7 @@ use stencilgen::table::{build_table, TableSpec};
 use stencilgen::triangle_patch::TriangleSubstitution;
 use stencilgen::triangle_system::{triangle_stencils, TriangleStencils};
 use stencilgen::triangle_table::{build_triangle_table, TriangleTableSpec};
-use stencilgen::{curve_stencils, CurveStencils, Scalar, StencilError};
+use stencilgen::{curve_stencils, excerpt, CurveStencils, Scalar, StencilError};
 use table_format::Precision;
 
 #[derive(Parser)]
@@ -515,14 +515,6 @@ fn parse_set(flag: &str, text: &str, max: u32) -> Result<Vec<u32>, StencilError>
         None => text.split(',').map(number).collect::<Result<_, _>>()?,
     };
     Ok(values)
-}
-
-/// At most 60 characters of `text`, for messages.
-fn excerpt(text: &str) -> String {
-    match text.char_indices().nth(60) {
-        Some((at, _)) => format!("{}... ({} bytes)", &text[..at], text.len()),
-        None => text.to_owned(),
-    }
 }
 
 /// Refuse, before solving anything, a table that would exceed what the format holds

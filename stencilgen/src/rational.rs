@@ -8,12 +8,38 @@ use num_traits::ToPrimitive;
 
 use crate::StencilError;
 
+/// The most characters (after trimming) a rational argument may have, checked before
+/// parsing: big integers parse in time quadratic in their digits.
+pub const MAX_RATIONAL_CHARS: usize = 64;
+
+/// The most bits the numerator and the denominator of a rational argument may have, in
+/// lowest terms: `1/2^63` is the finest power of two (subtess's `eval` takes the same).
+pub const MAX_RATIONAL_BITS: u64 = 64;
+
 /// Parse a rational in the one grammar of the command lines ([`schemes::rational::parse_rational`]:
-/// `p/q`, an integer, or an exact decimal).
+/// `p/q`, an integer, or an exact decimal), of at most [`MAX_RATIONAL_CHARS`] characters and
+/// with a numerator and denominator of at most [`MAX_RATIONAL_BITS`] bits. Messages quote the
+/// text through [`crate::excerpt`].
 pub fn parse_rational(text: &str) -> Result<BigRational, StencilError> {
-    schemes::rational::parse_rational(text).map_err(|why| StencilError::OutOfDomain {
-        what: format!("`{text}` is not a rational number p/q: {why}"),
-    })
+    let bad = |why: String| StencilError::OutOfDomain {
+        what: format!(
+            "`{}` is not a rational number p/q: {why}",
+            crate::excerpt(text)
+        ),
+    };
+    let chars = text.trim().chars().count();
+    if chars > MAX_RATIONAL_CHARS {
+        return Err(bad(format!(
+            "{chars} characters; a rational argument is at most {MAX_RATIONAL_CHARS} (numerator and denominator of at most {MAX_RATIONAL_BITS} bits)"
+        )));
+    }
+    let value = schemes::rational::parse_rational(text).map_err(|why| bad(why.to_string()))?;
+    if value.numer().bits() > MAX_RATIONAL_BITS || value.denom().bits() > MAX_RATIONAL_BITS {
+        return Err(bad(format!(
+            "in lowest terms its numerator or denominator has more than {MAX_RATIONAL_BITS} bits"
+        )));
+    }
+    Ok(value)
 }
 
 /// The f64 nearest to a rational whose numerator and denominator may both overflow f64:
@@ -38,6 +64,30 @@ mod tests {
         assert!((rational_to_f64(&r) - 2.0 / 3.0).abs() < 1e-15);
         let small = BigRational::new(BigInt::from(-1), BigInt::from(5589));
         assert_eq!(rational_to_f64(&small), -1.0 / 5589.0);
+    }
+
+    #[test]
+    fn rationals_are_bounded_in_characters_and_bits() {
+        let finest = format!("1/{}", BigInt::from(2u8).pow(63));
+        assert_eq!(parse_rational(&finest).map(|r| r.denom().bits()), Ok(64));
+        let too_fine = format!("1/{}", BigInt::from(2u8).pow(64));
+        let message = parse_rational(&too_fine).expect_err("65 bits").to_string();
+        assert!(message.contains("more than 64 bits"), "{message}");
+        // 2^64/2^64 is 1 in lowest terms.
+        let one = format!("{0}/{0}", BigInt::from(2u8).pow(64));
+        assert_eq!(
+            parse_rational(&one).map(|r| r.to_string()),
+            Ok("1".to_owned())
+        );
+        let long = format!("1/1{}", "0".repeat(1_000_000));
+        let message = parse_rational(&long).expect_err("too long").to_string();
+        assert!(message.contains("1000003 characters"), "{message}");
+        assert!(message.len() < 300, "{}", message.len());
+        let spaced = format!("  {}  ", "1".repeat(MAX_RATIONAL_CHARS - 1) + "/");
+        assert!(!parse_rational(&spaced)
+            .expect_err("no denominator")
+            .to_string()
+            .contains("characters"));
     }
 
     #[test]

@@ -362,3 +362,28 @@ fn tables_refuse_what_they_cannot_hold() {
     );
     assert!(!out.exists(), "nothing written");
 }
+
+/// `stencil`'s rational `--u`/`--v` are bounded as subtess's `eval` parameters are (issue 20):
+/// at most 64 characters, checked before parsing (a 100,000-digit denominator is refused at
+/// once, quoted short), and a numerator and denominator of at most 64 bits in lowest terms.
+#[test]
+fn stencil_rationals_are_bounded() {
+    let started = std::time::Instant::now();
+    let long = format!("1/1{}", "0".repeat(100_000));
+    let out = stencilgen(&format!(
+        "stencil --scheme catmull-clark --valence 5 --u {long} --v 0"
+    ));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "a 100,003-character --u succeeded");
+    assert!(stderr.contains("100003 characters"), "{stderr}");
+    assert!(stderr.len() < 600, "{} bytes of message", stderr.len());
+    assert!(started.elapsed().as_secs() < 5, "{:?}", started.elapsed());
+    fails_with(
+        "stencil --scheme catmull-clark --valence 5 --u 0 --v 1/36893488147419103232",
+        "more than 64 bits",
+    );
+    // 2^63 is the largest power of two a 64-bit denominator holds.
+    let finest =
+        json("stencil --scheme catmull-clark --valence 5 --u 1/9223372036854775808 --v 0 --json");
+    assert_eq!(finest["u"], "1/9223372036854775808");
+}
