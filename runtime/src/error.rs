@@ -28,6 +28,9 @@ pub enum MeshError {
         /// The bound.
         limit: f64,
     },
+    /// A face-varying channel (texture coordinates) does not fit its mesh.
+    #[error("texture coordinates: {0}")]
+    FaceVarying(String),
     /// A face is malformed.
     #[error("face {face} (OBJ line {line}): {reason}")]
     BadFace {

@@ -43,6 +43,7 @@ pub use budget::{OutputEstimate, DEFAULT_MAX_TRIANGLES};
 pub use error::{MeshError, RuntimeError};
 pub use eval::exact_eval::{parse_rational, LimitPoint};
 pub use io::mesh_output::MeshFormat;
+pub use mesh::face_varying::{FaceVarying, FaceVaryingMode};
 pub use mesh::triangle_mesh::TriangleMesh;
 pub use mesh::{Mesh, VertexSource};
 pub use scheme::Scheme;

@@ -11,9 +11,9 @@ use subtess::budget::refined_faces;
 use subtess::io::mesh_output::write_mesh;
 use subtess::tessellate::lai_cheng::write_obj_polygons;
 use subtess::{
-    eval, parse_rational, tessellate_bezier, AdaptiveOptions, BezierOptions, BezierPatches, Mesh,
-    MeshFormat, OutputEstimate, Rates, RuntimeError, Scheme, StencilTable, Surface, Tessellator,
-    ViewCamera,
+    eval, parse_rational, tessellate_bezier, AdaptiveOptions, BezierOptions, BezierPatches,
+    FaceVaryingMode, Mesh, MeshFormat, OutputEstimate, Rates, RuntimeError, Scheme, StencilTable,
+    Surface, Tessellator, ViewCamera,
 };
 
 #[derive(Parser)]
@@ -64,6 +64,14 @@ macro_rules! out {
 /// `--scheme`: a scheme with a table; a catalogued scheme without one is named as such.
 fn scheme_arg(name: &str) -> Result<Scheme, String> {
     name.parse::<Scheme>().map_err(|e| e.to_string())
+}
+
+/// `--uv-interpolation`.
+fn uv_interpolation_arg(name: &str) -> Result<FaceVaryingMode, String> {
+    FaceVaryingMode::parse(name).ok_or_else(|| {
+        let names: Vec<&str> = FaceVaryingMode::ALL.iter().map(|m| m.name()).collect();
+        format!("one of {} (or 0..5)", names.join(", "))
+    })
 }
 
 /// `--method`.
@@ -271,6 +279,12 @@ struct TessellateArgs {
     /// A stencil table file instead of the embedded default.
     #[arg(long)]
     table: Option<PathBuf>,
+    /// Where the texture coordinates (the mesh's `vt`, catmull-clark) are linear instead of
+    /// smooth: none, corners-only, corners-plus1, corners-plus2, boundaries or all
+    /// (OpenSubdiv's face-varying linear interpolation, 0..5; default: the file's `t
+    /// facevaryinginterpolateboundary`, else all).
+    #[arg(long = "uv-interpolation", value_parser = uv_interpolation_arg)]
+    uv_interpolation: Option<FaceVaryingMode>,
     /// Print statistics as JSON on stdout.
     #[arg(long)]
     stats: bool,
@@ -409,7 +423,16 @@ fn tessellate_command(args: TessellateArgs) -> Result<(), RuntimeError> {
             ))
         }
     };
-    let input = load_mesh(mesh)?;
+    let mut input = load_mesh(mesh)?;
+    if let (Some(mode), Some(channel)) = (args.uv_interpolation, &mut input.face_varying) {
+        channel.mode = mode;
+    }
+    if input.face_varying.is_some() && args.scheme.is_triangle() {
+        eprintln!(
+            "warning: texture coordinates are interpolated with catmull-clark only; the --scheme {} output has none",
+            args.scheme
+        );
+    }
     if args.method == Method::Adaptive && args.scheme.is_triangle() {
         return Err(RuntimeError::Unsupported(format!(
             "--scheme {} tessellates with the dual grid at --rate, --rates, --tolerance or --view (no --method adaptive yet)",
@@ -462,6 +485,8 @@ fn tessellate_command(args: TessellateArgs) -> Result<(), RuntimeError> {
         stats["triangles_per_second"] =
             (tessellator.triangle_count() as f64 / seconds.max(1e-12)).into();
         stats["watertight"] = watertight.into();
+        stats["uvs"] = surface.has_uvs().into();
+        stats["seam_vertices"] = output.seam_copies.len().into();
         stats["tolerance"] = args.tolerance.into();
         out!("{stats}")?;
     }

@@ -13,6 +13,7 @@ use std::time::Instant;
 use crate::budget::OutputEstimate;
 use crate::mesh::triangle_mesh::TriangleMesh;
 use crate::mesh::{Mesh, VertexSource};
+use crate::scheme::catmull_clark::face_varying::ChannelIsolation;
 use crate::scheme::catmull_clark::isolate::{isolate_with_origins, Isolation};
 use crate::scheme::loop_scheme::isolate::isolate_loop;
 use crate::scheme::region_isolate::isolate_regions;
@@ -77,6 +78,8 @@ pub struct Surface {
     boundary_loops: usize,
     /// Input vertices to isolated vertices; `None` when isolation took no step.
     refinement: Option<Stencil<f32>>,
+    /// The texture coordinates' channel (Catmull–Clark), refined as the positions were.
+    channel: Option<ChannelIsolation>,
     isolation_seconds: f64,
 }
 
@@ -114,7 +117,12 @@ impl Surface {
         };
         // Without steps and split vertices the input points are the control points.
         let refinement = (steps > 0 || !mesh.copies.is_empty()).then(|| refinement.to_f32());
+        let channel = match &isolated {
+            Isolated::Quad(iso) => ChannelIsolation::new(mesh, iso)?,
+            Isolated::Triangle(_) => None,
+        };
         Ok(Surface {
+            channel,
             scheme,
             table,
             input_vertices: mesh.input_vertices(),
@@ -163,6 +171,13 @@ impl Surface {
     /// composing the refinement map.
     pub fn isolation_seconds(&self) -> f64 {
         self.isolation_seconds
+    }
+
+    /// Whether tessellations carry texture coordinates: the mesh has a face-varying channel
+    /// ([`Mesh::face_varying`]) and the scheme is Catmull–Clark (the triangle schemes ignore
+    /// it).
+    pub fn has_uvs(&self) -> bool {
+        self.channel.is_some()
     }
 
     /// Number of boundary loops of the input (0: closed, and a watertight output is expected).
@@ -297,9 +312,15 @@ impl Surface {
         self.estimate_rates(&rates)
             .check("the tessellation", max_triangles)?;
         let grid: Box<dyn GridPlan + '_> = match &self.isolated {
-            Isolated::Quad(iso) => {
-                Box::new(DualGrid::new(&self.table, &iso.mesh, &iso.patches, &rates)?)
-            }
+            Isolated::Quad(iso) => Box::new(DualGrid::with_channel(
+                &self.table,
+                &iso.mesh,
+                &iso.patches,
+                &rates,
+                self.channel
+                    .as_ref()
+                    .map(|c| c.mesh.face_vertices.as_slice()),
+            )?),
             Isolated::Triangle(iso) => Box::new(TriangleDualGrid::new(
                 &self.table,
                 &iso.mesh,
@@ -311,7 +332,12 @@ impl Surface {
         let mut triangles = vec![[0u32; 3]; grid.triangle_count()];
         grid.connect(&mut triangles);
         let sources = grid.sources();
+        let uvs = match &self.channel {
+            Some(channel) => channel.values(&sources, |s| self.input_source(s))?,
+            None => Vec::new(),
+        };
         let sources = sources.into_iter().map(|s| self.input_source(s)).collect();
+        let seam_copies = grid.seam_copies().to_vec();
         Ok(Tessellator {
             surface: self,
             grid,
@@ -322,6 +348,8 @@ impl Surface {
             normals: vec![[0.0; 3]; vertices],
             triangles,
             sources,
+            uvs,
+            seam_copies,
             plan_seconds: started.elapsed().as_secs_f64(),
         })
     }
@@ -365,6 +393,9 @@ pub struct Tessellator<'s> {
     normals: Vec<[f32; 3]>,
     triangles: Vec<[u32; 3]>,
     sources: Vec<VertexSource>,
+    /// Texture coordinates (constant: planned once), or empty.
+    uvs: Vec<[f32; 2]>,
+    seam_copies: Vec<[u32; 2]>,
     plan_seconds: f64,
 }
 
@@ -404,6 +435,8 @@ impl<'s> Tessellator<'s> {
             normals: &self.normals,
             triangles: &self.triangles,
             sources: &self.sources,
+            uvs: &self.uvs,
+            seam_copies: &self.seam_copies,
         })
     }
 
@@ -452,6 +485,8 @@ pub struct Frame<'a> {
     normals: &'a [[f32; 3]],
     triangles: &'a [[u32; 3]],
     sources: &'a [VertexSource],
+    uvs: &'a [[f32; 2]],
+    seam_copies: &'a [[u32; 2]],
 }
 
 impl<'a> Frame<'a> {
@@ -476,6 +511,20 @@ impl<'a> Frame<'a> {
         self.sources
     }
 
+    /// Texture coordinates, one per output vertex, when the surface has them
+    /// ([`Surface::has_uvs`]): the face-varying limit surface at each vertex's source, in the
+    /// channel's mode. Vertices are split along texture seams only
+    /// ([`Frame::seam_copies`]).
+    pub fn uvs(&self) -> Option<&'a [[f32; 2]]> {
+        (!self.uvs.is_empty()).then_some(self.uvs)
+    }
+
+    /// Output vertices that repeat another's position on the other side of a texture seam,
+    /// `[copy, original]`: the same position and normal bits, their own texture coordinates.
+    pub fn seam_copies(&self) -> &'a [[u32; 2]] {
+        self.seam_copies
+    }
+
     /// A copy as the tessellators' [`TriangleMesh`] (for the writers in [`crate::io`]).
     pub fn to_triangle_mesh(&self) -> TriangleMesh {
         TriangleMesh {
@@ -483,6 +532,8 @@ impl<'a> Frame<'a> {
             normals: self.normals.to_vec(),
             sources: self.sources.to_vec(),
             triangles: self.triangles.to_vec(),
+            uvs: self.uvs.to_vec(),
+            seam_copies: self.seam_copies.to_vec(),
         }
     }
 }

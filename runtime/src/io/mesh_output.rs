@@ -138,6 +138,15 @@ fn check_consistent(mesh: &TriangleMesh, path: &Path) -> Result<(), RuntimeError
             ),
         ));
     }
+    if !mesh.uvs.is_empty() && mesh.uvs.len() != vertices {
+        return Err(invalid(
+            path,
+            format!(
+                "inconsistent mesh: {vertices} positions, {} texture coordinates",
+                mesh.uvs.len()
+            ),
+        ));
+    }
     if let Some((t, triangle)) = mesh
         .triangles
         .iter()
@@ -165,7 +174,8 @@ fn source_uv(source: &VertexSource) -> [f32; 2] {
     }
 }
 
-/// Write `mesh` as OBJ (`v`, `vn`, `f a//a b//b c//c`).
+/// Write `mesh` as OBJ (`v`, `vn`, `f a//a b//b c//c`; with texture coordinates also `vt` and
+/// `f a/a/a b/b/b c/c/c`).
 pub fn write_obj(mesh: &TriangleMesh, path: &Path) -> Result<(), RuntimeError> {
     check_consistent(mesh, path)?;
     let io = io_error(path);
@@ -183,9 +193,17 @@ pub fn write_obj(mesh: &TriangleMesh, path: &Path) -> Result<(), RuntimeError> {
         for n in &mesh.normals {
             writeln!(w, "vn {} {} {}", n[0], n[1], n[2]).map_err(&io)?;
         }
+        for t in &mesh.uvs {
+            writeln!(w, "vt {} {}", t[0], t[1]).map_err(&io)?;
+        }
+        let textured = !mesh.uvs.is_empty();
         for t in &mesh.triangles {
             let [a, b, c] = t.map(|i| i + 1);
-            writeln!(w, "f {a}//{a} {b}//{b} {c}//{c}").map_err(&io)?;
+            if textured {
+                writeln!(w, "f {a}/{a}/{a} {b}/{b}/{b} {c}/{c}/{c}").map_err(&io)?;
+            } else {
+                writeln!(w, "f {a}//{a} {b}//{b} {c}//{c}").map_err(&io)?;
+            }
         }
         Ok(())
     })
@@ -200,7 +218,8 @@ pub const PLY_VERTEX_BYTES: usize = 37;
 /// Each vertex is a [`PLY_VERTEX_BYTES`]-byte record `float x y z nx ny nz`, `uint face`,
 /// `float u v`, `uchar subface`: position, normal, and the face and parameters it was evaluated
 /// at ([`crate::mesh::triangle_mesh::VertexSource`]: the CLI writes the input mesh's faces; `subface`
-/// is the sub-face of a non-quad face, 0 for quads). Each triangle is
+/// is the sub-face of a non-quad face, 0 for quads); with texture coordinates, 8 more bytes
+/// `float s t` follow. Each triangle is
 /// `property list uchar uint vertex_indices` (the byte 3, then three `u32`), 13 bytes.
 pub fn write_ply(mesh: &TriangleMesh, path: &Path) -> Result<(), RuntimeError> {
     check_consistent(mesh, path)?;
@@ -222,15 +241,27 @@ pub fn write_ply(mesh: &TriangleMesh, path: &Path) -> Result<(), RuntimeError> {
          property float u\n\
          property float v\n\
          property uchar subface\n\
+         {}\
          element face {}\n\
          property list uchar uint vertex_indices\n\
          end_header\n",
             mesh.positions.len(),
+            if mesh.uvs.is_empty() {
+                ""
+            } else {
+                "property float s\nproperty float t\n"
+            },
             mesh.triangles.len()
         );
         w.write_all(header.as_bytes()).map_err(&io)?;
-        for ((p, n), s) in mesh.positions.iter().zip(&mesh.normals).zip(&mesh.sources) {
-            let mut record = [0u8; PLY_VERTEX_BYTES];
+        for (i, ((p, n), s)) in mesh
+            .positions
+            .iter()
+            .zip(&mesh.normals)
+            .zip(&mesh.sources)
+            .enumerate()
+        {
+            let mut record = [0u8; PLY_VERTEX_BYTES + 8];
             let [u, v] = source_uv(s);
             let fields = [p[0], p[1], p[2], n[0], n[1], n[2]];
             for (k, x) in fields.iter().enumerate() {
@@ -240,7 +271,15 @@ pub fn write_ply(mesh: &TriangleMesh, path: &Path) -> Result<(), RuntimeError> {
             record[28..32].copy_from_slice(&u.to_le_bytes());
             record[32..36].copy_from_slice(&v.to_le_bytes());
             record[36] = s.subface;
-            w.write_all(&record).map_err(&io)?;
+            let size = match mesh.uvs.get(i) {
+                Some(t) => {
+                    record[37..41].copy_from_slice(&t[0].to_le_bytes());
+                    record[41..45].copy_from_slice(&t[1].to_le_bytes());
+                    PLY_VERTEX_BYTES + 8
+                }
+                None => PLY_VERTEX_BYTES,
+            };
+            w.write_all(&record[..size]).map_err(&io)?;
         }
         for t in &mesh.triangles {
             let mut record = [3u8; 13];
@@ -334,6 +373,16 @@ fn build_gltf(mesh: &TriangleMesh, path: &Path) -> Result<Gltf, RuntimeError> {
         json!({ "componentType": GL_FLOAT, "count": count, "type": "VEC3" }),
     );
     attributes.insert("NORMAL".into(), json!(normal));
+    if !mesh.uvs.is_empty() {
+        // glTF's texture origin is the image's top left, OBJ's its bottom left.
+        let uvs = f32_bytes(mesh.uvs.iter().flat_map(|t| [t[0], 1.0 - t[1]]));
+        let uv = add(
+            uvs,
+            GL_ARRAY_BUFFER,
+            json!({ "componentType": GL_FLOAT, "count": count, "type": "VEC2" }),
+        );
+        attributes.insert("TEXCOORD_0".into(), json!(uv));
+    }
     let uvs = f32_bytes(mesh.sources.iter().flat_map(source_uv));
     let uv = add(
         uvs,
@@ -393,7 +442,8 @@ fn json_bytes(json: &Value, path: &Path) -> Result<Vec<u8>, RuntimeError> {
 /// Write `mesh` as a glTF 2.0 binary (`.glb`).
 ///
 /// One buffer in the BIN chunk, in this order: `POSITION` (VEC3 FLOAT, with `min`/`max`),
-/// `NORMAL` (VEC3 FLOAT), `_UV_SOURCE` (VEC2 FLOAT: the source `(u, v)`), `_FACE` (SCALAR
+/// `NORMAL` (VEC3 FLOAT), with texture coordinates `TEXCOORD_0` (VEC2 FLOAT, `(s, 1 - t)`:
+/// glTF's origin is the image's top left), `_UV_SOURCE` (VEC2 FLOAT: the source `(u, v)`), `_FACE` (SCALAR
 /// FLOAT: the source face, written only while every face is below [`GLTF_FACE_LIMIT`], where
 /// `f32` holds it exactly; glTF forbids unsigned int components for custom attributes), then
 /// the indices (SCALAR UNSIGNED_INT). One bufferView each (`target` 34962 for attributes,

@@ -13,6 +13,7 @@ use std::path::Path;
 use schemes::{BoundaryMode, CreaseMethod};
 
 use crate::error::excerpt;
+use crate::mesh::face_varying::{FaceVarying, FaceVaryingMode};
 use crate::mesh::Mesh;
 use crate::{MeshError, RuntimeError};
 
@@ -242,6 +243,62 @@ fn check_tag(tag: &Tag, ints_per_item: usize, strings: usize) -> Result<usize, M
     Ok(items)
 }
 
+/// The texture coordinates of `obj` as `mesh`'s face-varying channel, when every face names
+/// them; a warning when only some do.
+fn face_varying(
+    obj: &ObjMesh,
+    mesh: &Mesh,
+    warnings: &mut Vec<String>,
+) -> Result<Option<FaceVarying>, MeshError> {
+    let mut mode = FaceVaryingMode::default();
+    for tag in obj
+        .tags
+        .iter()
+        .filter(|t| t.name == "facevaryinginterpolateboundary")
+    {
+        mode = match tag.ints[..] {
+            [k] => FaceVaryingMode::from_tag(k),
+            _ => None,
+        }
+        .ok_or_else(|| MeshError::BadTag {
+            name: tag.name.clone(),
+            line: tag.line,
+            reason: format!("{:?} is not one integer 0..=5", tag.ints),
+        })?;
+    }
+    let named = obj.face_uvs.iter().filter(|c| !c.is_empty()).count();
+    if named == 0 {
+        return Ok(None);
+    }
+    if named < obj.faces.len() {
+        let f = obj.face_uvs.iter().position(|c| c.is_empty()).unwrap_or(0);
+        warnings.push(format!(
+            "texture coordinates ignored: {named} of {} faces name them (face {f}, OBJ line {}, does not)",
+            obj.faces.len(),
+            obj.face_lines.get(f).copied().unwrap_or(0)
+        ));
+        return Ok(None);
+    }
+    let mut corners = Vec::with_capacity(mesh.face_vertices.len());
+    for (f, uvs) in obj.face_uvs.iter().enumerate() {
+        for &t in uvs {
+            if t < 0 || t as usize >= obj.uvs.len() {
+                return Err(MeshError::BadFace {
+                    face: f,
+                    line: obj.face_lines.get(f).copied().unwrap_or(0),
+                    reason: format!(
+                        "texture coordinate {} is out of range (the file has {})",
+                        t + 1,
+                        obj.uvs.len()
+                    ),
+                });
+            }
+            corners.push(t as u32);
+        }
+    }
+    FaceVarying::new(mesh, obj.uvs.clone(), corners, mode).map(Some)
+}
+
 impl Mesh {
     /// Build from a parsed OBJ file with its tags, as OpenSubdiv's regression reader applies
     /// them: `crease a b .. s ..` (edge sharpness, one value or one per edge), `corner v .. s ..`
@@ -249,7 +306,10 @@ impl Mesh {
     /// edge only: the default), `creasemethod normal|chaikin`, `smoothtriangles
     /// catmark|smooth`. Also returns one warning per tag name it ignores: the hierarchical edits
     /// (`vertexedit`, `edgeedit`, `faceedit`, which OpenSubdiv 3 ignores too) and names it does
-    /// not know. Face-varying tags do not affect positions.
+    /// not know. Texture coordinates (`vt` named by every corner of every face) become the
+    /// mesh's face-varying channel ([`Mesh::face_varying`]) with the mode of
+    /// `facevaryinginterpolateboundary k` (0..=5, OpenSubdiv's default 5 when untagged); a file
+    /// where only some faces name them gets none, with a warning.
     pub fn from_obj(obj: &ObjMesh) -> Result<(Self, Vec<String>), MeshError> {
         let mut boundary = BoundaryMode::EdgeOnly;
         let mut boundary_none = false;
@@ -327,7 +387,7 @@ impl Mesh {
                         }
                     }
                 }
-                // Read above; face-varying data does not affect positions.
+                // Read above and in `face_varying`; OpenSubdiv 3 ignores the last.
                 "interpolateboundary"
                 | "facevaryinginterpolateboundary"
                 | "facevaryingpropagatecorners" => {}
@@ -340,15 +400,14 @@ impl Mesh {
         if boundary_none {
             mesh.exclude_boundary_faces(&sharp_boundary);
         }
-        let warnings = unsupported
-            .into_iter()
-            .map(|(name, count)| {
-                format!(
-                    "tag `{}` ({count} line(s)) is not supported and is ignored",
-                    excerpt(&name)
-                )
-            })
-            .collect();
+        let mut warnings: Vec<String> = Vec::new();
+        mesh.face_varying = face_varying(obj, &mesh, &mut warnings)?;
+        warnings.extend(unsupported.into_iter().map(|(name, count)| {
+            format!(
+                "tag `{}` ({count} line(s)) is not supported and is ignored",
+                excerpt(&name)
+            )
+        }));
         Ok((mesh, warnings))
     }
 

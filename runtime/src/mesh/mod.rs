@@ -2,6 +2,7 @@
 //! helpers on `[f64; 3]` points, and the sample locations (face and exact parameters) every
 //! tessellator reports. Nothing here knows a subdivision scheme or a file format.
 
+pub mod face_varying;
 pub mod geometry;
 pub mod source;
 #[cfg(test)]

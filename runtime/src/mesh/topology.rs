@@ -16,6 +16,7 @@
 use schemes::crease::INFINITE;
 use schemes::{BoundaryMode, CreaseMethod};
 
+use crate::mesh::face_varying::FaceVarying;
 use crate::MeshError;
 
 /// "No half-edge": the twin of a boundary half-edge.
@@ -53,6 +54,10 @@ pub struct Mesh {
     /// OpenSubdiv's "smooth triangles" option (`TRI_SUB_SMOOTH`): an edge next to a triangle
     /// weighs the triangle's centroid by 0.47 instead of 0.25, for rounder triangle regions.
     pub smooth_triangles: bool,
+    /// Texture coordinates: one face-varying channel over the faces ([`FaceVarying`]), `None`
+    /// without (and on refined meshes: the channel has its own mesh,
+    /// [`crate::mesh::face_varying::channel_mesh`]).
+    pub face_varying: Option<FaceVarying>,
 }
 
 /// The largest coordinate magnitude an input vertex may have (docs/reliability.md): output is
@@ -158,6 +163,7 @@ impl Mesh {
             creasing: CreaseMethod::Uniform,
             smooth_triangles: false,
             copies: Vec::new(),
+            face_varying: None,
         };
         let non_manifold = mesh.link_twins()?;
         mesh.split_non_manifold(&non_manifold);

@@ -16,11 +16,17 @@ pub struct TriangleMesh {
     pub sources: Vec<VertexSource>,
     /// Triangles, counter-clockwise seen from outside (for counter-clockwise input faces).
     pub triangles: Vec<[u32; 3]>,
+    /// Texture coordinates, one per vertex, or empty for none.
+    pub uvs: Vec<[f32; 2]>,
+    /// Vertices that repeat another's position across a texture seam, `[copy, original]`:
+    /// split for their texture coordinates only, the same position bits.
+    pub seam_copies: Vec<[u32; 2]>,
 }
 
 impl TriangleMesh {
     /// Whether every edge is shared by exactly two triangles that traverse it in opposite
-    /// directions (a closed, consistently oriented, edge-manifold surface).
+    /// directions (a closed, consistently oriented, edge-manifold surface), in positions: a
+    /// vertex split along a texture seam counts as its original ([`TriangleMesh::seam_copies`]).
     pub fn is_watertight(&self) -> bool {
         let directed = match self.directed_edges() {
             Some(d) => d,
@@ -42,11 +48,24 @@ impl TriangleMesh {
         Some(out)
     }
 
+    /// Every vertex's position vertex: itself, or the original of a seam copy.
+    fn position_vertices(&self) -> Vec<u32> {
+        let mut of: Vec<u32> = (0..self.positions.len() as u32).collect();
+        for &[copy, original] in &self.seam_copies {
+            if let Some(slot) = of.get_mut(copy as usize) {
+                *slot = original;
+            }
+        }
+        of
+    }
+
     fn directed_edges(&self) -> Option<HashSet<(u32, u32)>> {
+        let of = self.position_vertices();
+        let at = |i: u32| of.get(i as usize).copied().unwrap_or(i);
         let mut directed = HashSet::with_capacity(3 * self.triangles.len());
         for t in &self.triangles {
             for k in 0..3 {
-                if !directed.insert((t[k], t[(k + 1) % 3])) {
+                if !directed.insert((at(t[k]), at(t[(k + 1) % 3]))) {
                     return None;
                 }
             }

@@ -230,6 +230,9 @@ pub struct DualGrid<'t> {
     connectivity: Connectivity,
     vertex_count: usize,
     boundary: bool,
+    /// Output vertices that repeat another's position on the other side of a face-varying
+    /// seam, `[copy, original]`: the same stencil, another source.
+    seam_copies: Vec<[u32; 2]>,
 }
 
 fn section(patch: &FacePatch, kind: StencilKind, points: PointSet, n: u32) -> SectionKey {
@@ -303,6 +306,28 @@ impl<'t> DualGrid<'t> {
         patches: &[FacePatch],
         rates: &[u32],
     ) -> Result<Self, RuntimeError> {
+        Self::with_channel(table, mesh, patches, rates, None)
+    }
+
+    /// [`DualGrid::new`] with output vertices split along the seams of a face-varying channel:
+    /// `channel[h]` is the channel's vertex at corner `h` of `mesh` (the face-varying channel's
+    /// mesh refined as `mesh` was, [`crate::mesh::face_varying::channel_mesh`]). A seam (an
+    /// edge whose two faces disagree at an end) is sampled like an infinitely sharp crease, and
+    /// each side gets its own copies of the curve's points and of the vertex limit points, one
+    /// per channel vertex: same stencils, so the same position bits, but each with a source on
+    /// its own side ([`DualGrid::seam_copies`]).
+    pub fn with_channel(
+        table: &'t StencilTable,
+        mesh: &Mesh,
+        patches: &[FacePatch],
+        rates: &[u32],
+        channel: Option<&[u32]>,
+    ) -> Result<Self, RuntimeError> {
+        if channel.is_some_and(|c| c.len() != mesh.face_vertices.len()) {
+            return Err(RuntimeError::Unsupported(
+                "a face-varying channel of another mesh".to_owned(),
+            ));
+        }
         if rates.len() != patches.len() || patches.len() != mesh.faces() {
             return Err(RuntimeError::Unsupported(format!(
                 "{} rates and {} patches for {} faces",
@@ -346,6 +371,7 @@ impl<'t> DualGrid<'t> {
             connectivity: Connectivity::default(),
             vertex_count: 0,
             boundary: false,
+            seam_copies: Vec::new(),
         };
         let regular = |p: &FacePatch| !p.kind.boundary && p.kind.faces == 4 && p.corner == 0;
         let mut factored = vec![false; MAX_RATE as usize + 1];
@@ -390,8 +416,15 @@ impl<'t> DualGrid<'t> {
                 });
             }
         }
-        grid.plan_connectivity(table, mesh, patches)?;
+        grid.plan_connectivity(table, mesh, patches, channel)?;
         grid.plan_local(mesh, &local_faces)?;
+        // Copies take their original's stencil (local ones are known only now).
+        let dual_total = grid.first[patches.len()];
+        for &[copy, original] in &grid.seam_copies {
+            let original = grid.boundary_points[(original - dual_total) as usize].clone();
+            let copy = &mut grid.boundary_points[(copy - dual_total) as usize];
+            (copy.weights, copy.control) = (original.weights, original.control);
+        }
         Ok(grid)
     }
 
@@ -517,17 +550,41 @@ impl<'t> DualGrid<'t> {
         Ok(())
     }
 
+    /// A copy of output vertex `original` (a boundary point) at `source`.
+    fn seam_copy(&mut self, original: u32, source: VertexSource) -> u32 {
+        let dual_total = self.first[self.rates.len()];
+        let copy = dual_total + self.boundary_points.len() as u32;
+        self.boundary_points.push(PointPlan {
+            weights: Vec::new(),
+            control: 0..0,
+            source,
+        });
+        self.seam_copies.push([copy, original]);
+        copy
+    }
+
     fn plan_connectivity(
         &mut self,
         table: &'t StencilTable,
         mesh: &Mesh,
         patches: &[FacePatch],
+        channel: Option<&[u32]>,
     ) -> Result<(), RuntimeError> {
         let dual_total = self.first[patches.len()];
         let hole = |f: usize| mesh.holes[f];
+        // A face-varying seam: the faces on either side use different channel vertices at an
+        // end of the edge.
+        let seam = |h: usize| {
+            let t = mesh.twin[h];
+            channel.is_some_and(|c| {
+                t != NONE && (c[h] != c[mesh.next(t as usize)] || c[mesh.next(h)] != c[t as usize])
+            })
+        };
         // An infinitely sharp edge between two surface faces is tessellated like a boundary
-        // on both sides: the crease curve is sampled, and shared by the two sides' strips.
-        let sharp = |h: usize| mesh.twin[h] != NONE && is_infinite(mesh.edge_sharpness[h]);
+        // on both sides: the crease curve is sampled, and shared by the two sides' strips. A
+        // seam is sampled too, each side with its own copies of the points.
+        let sharp =
+            |h: usize| mesh.twin[h] != NONE && (is_infinite(mesh.edge_sharpness[h]) || seam(h));
         // Around every vertex, the fan is cut by the boundary and holes (separate surface
         // sheets, each with its own limit point) and by sharp edges (sectors of one sheet,
         // sharing its limit point). A smooth interior vertex makes one closed polygon of
@@ -570,6 +627,8 @@ impl<'t> DualGrid<'t> {
                 continue;
             };
             let mut limit = NONE;
+            // The sheet's limit point for each channel vertex met so far.
+            let mut siblings: Vec<(u32, u32)> = Vec::new();
             let mut polygon: Vec<u32> = Vec::new();
             for k in 0..=n {
                 let i = (start + k) % n;
@@ -588,6 +647,7 @@ impl<'t> DualGrid<'t> {
                 }
                 if k == 0 || c == Cut::Sheet {
                     limit = NONE;
+                    siblings.clear();
                 }
                 let h = fan[i];
                 let f = mesh.face_of[h] as usize;
@@ -595,14 +655,28 @@ impl<'t> DualGrid<'t> {
                     continue;
                 }
                 let corner = h - mesh.face_halfedges(f).start;
+                // The corner of the primal grid at the face's own rate (present in any table
+                // that has the face's dual grid).
+                let rate = self.rates[f];
+                let (i, j) = [(0, 0), (rate, 0), (rate, rate), (0, rate)][corner];
+                let sibling = channel.map_or(0, |c| c[h]);
                 if limit == NONE {
                     self.boundary = true;
-                    // The corner of the primal grid at the face's own rate (present in any
-                    // table that has the face's dual grid).
-                    let rate = self.rates[f];
-                    let (i, j) = [(0, 0), (rate, 0), (rate, rate), (0, rate)][corner];
                     limit = dual_total + self.boundary_points.len() as u32;
                     self.boundary_point(table, &patches[f], f, rate, (i, j))?;
+                    siblings.push((sibling, limit));
+                } else if let Some(&(_, known)) = siblings.iter().find(|s| s.0 == sibling) {
+                    limit = known;
+                } else {
+                    let source = VertexSource {
+                        face: f as u32,
+                        u: i,
+                        v: j,
+                        denominator: rate,
+                        subface: 0,
+                    };
+                    limit = self.seam_copy(siblings[0].1, source);
+                    siblings.push((sibling, limit));
                 }
                 limit_at[h] = limit;
                 polygon.push(self.corner_point(f, corner));
@@ -624,7 +698,32 @@ impl<'t> DualGrid<'t> {
             if !across_surface || sharp(h) {
                 let (tail, head) = (limit_at[h], limit_at[mesh.next(h)]);
                 if across_surface && (t as usize) < h {
-                    let (first, segments) = curve_of[t as usize];
+                    let (mut first, segments) = curve_of[t as usize];
+                    if seam(h) {
+                        // This side's copies, in the other side's order: its point s lies at
+                        // (segments - s) / segments along h.
+                        let copies = first;
+                        for s in 1..segments {
+                            let a = segments - s;
+                            let (u, v) = match side {
+                                0 => (a, 0),
+                                1 => (segments, a),
+                                2 => (segments - a, segments),
+                                _ => (0, segments - a),
+                            };
+                            let source = VertexSource {
+                                face: f as u32,
+                                u,
+                                v,
+                                denominator: segments,
+                                subface: 0,
+                            };
+                            let copy = self.seam_copy(copies + s - 1, source);
+                            if s == 1 {
+                                first = copy;
+                            }
+                        }
+                    }
                     self.strips.push(Strip::Boundary {
                         row,
                         tail,
@@ -825,6 +924,10 @@ impl GridPlan for DualGrid<'_> {
             |f, out| self.connect_face(f, out),
             |s, out| connect_strip(&self.strips[s], out),
         );
+    }
+
+    fn seam_copies(&self) -> &[[u32; 2]] {
+        &self.seam_copies
     }
 
     /// How many faces take the separable (tensor-product) path.

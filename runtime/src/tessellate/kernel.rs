@@ -347,6 +347,12 @@ pub trait GridPlan: Sync + Send + std::fmt::Debug {
         0
     }
 
+    /// Output vertices repeating another's position across a face-varying seam, `[copy,
+    /// original]` (none unless the plan has a face-varying channel).
+    fn seam_copies(&self) -> &[[u32; 2]] {
+        &[]
+    }
+
     /// Evaluate and connect in one go into a fresh [`TriangleMesh`] (with sources in the
     /// tessellated mesh's faces), from `mesh`'s own positions.
     fn tessellate(&self, mesh: &Mesh) -> TriangleMesh {
@@ -356,6 +362,8 @@ pub trait GridPlan: Sync + Send + std::fmt::Debug {
             normals: vec![[0.0; 3]; vertices],
             sources: self.sources(),
             triangles: vec![[0; 3]; self.triangle_count()],
+            uvs: Vec::new(),
+            seam_copies: self.seam_copies().to_vec(),
         };
         // Every vertex of the mesh is a control point, copies of split vertices included.
         let control: Vec<[f32; 3]> = mesh.positions.iter().map(|p| p.map(|c| c as f32)).collect();

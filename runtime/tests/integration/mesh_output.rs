@@ -57,6 +57,7 @@ fn tetrahedron() -> TriangleMesh {
             source(1 << 20, 0, 10, 10),
         ],
         triangles: vec![[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]],
+        ..TriangleMesh::default()
     }
 }
 

@@ -56,6 +56,11 @@ fn deform(points: &[[f32; 3]], scale: f32) -> Vec<[f32; 3]> {
 
 /// Every facade property on one mesh and scheme at rate `n`.
 fn check(label: &str, mesh: &Mesh, scheme: Scheme, n: u32) {
+    // The reference below refines the positions alone: without texture coordinates it has no
+    // seams to split, so neither may the plan under test.
+    let mut mesh = mesh.clone();
+    mesh.face_varying = None;
+    let mesh = &mesh;
     let surface = Surface::new(mesh, scheme).unwrap_or_else(|e| panic!("{label}: {scheme}: {e}"));
     let mut tessellator = surface
         .tessellator(&Rates::Uniform(n))

@@ -2,5 +2,6 @@
 //! vertices (every face a table patch with at most one irregular corner).
 
 pub mod adaptive;
+pub mod face_varying;
 pub mod isolate;
 pub mod refine;

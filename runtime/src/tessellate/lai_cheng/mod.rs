@@ -185,6 +185,7 @@ impl AdaptiveMesh {
                 .iter()
                 .flat_map(|p| p.triangles.iter().copied())
                 .collect(),
+            ..TriangleMesh::default()
         }
     }
 
