@@ -675,17 +675,27 @@ fn eval_command(
     let (u, v) = (parse_rational(u.trim())?, parse_rational(v.trim())?);
     let input = load_mesh(mesh)?;
     let point = eval::limit_point(&input, scheme, face, corner, &u, &v)?;
+    let uv = match scheme {
+        Scheme::CatmullClark => eval::limit_uv(&input, face, corner, &u, &v)?,
+        _ => None,
+    };
     if json {
-        let report = serde_json::json!({
+        let mut report = serde_json::json!({
             "position": point.position,
             "du": point.du,
             "dv": point.dv,
         });
+        if let Some(uv) = uv {
+            report["uv"] = serde_json::json!(uv);
+        }
         out!("{report}")?;
     } else {
         out!("position {:?}", point.position)?;
         out!("du       {:?}", point.du)?;
         out!("dv       {:?}", point.dv)?;
+        if let Some(uv) = uv {
+            out!("uv       {uv:?}")?;
+        }
     }
     Ok(())
 }

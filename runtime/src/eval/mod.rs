@@ -5,8 +5,12 @@ pub mod exact_eval;
 pub mod loop_exact_eval;
 
 use num_rational::BigRational;
+use num_traits::ToPrimitive;
 
+use crate::mesh::face_varying::{channel_mesh, FaceVaryingMode};
 use crate::mesh::Mesh;
+use crate::scheme::catmull_clark::adaptive::{limit_stencils, LimitQuery};
+use crate::scheme::catmull_clark::refine::refine;
 use crate::scheme::Scheme;
 use crate::RuntimeError;
 
@@ -43,4 +47,67 @@ pub fn limit_point(
             "exact evaluation of {scheme} is not implemented yet (`subtess tessellate --scheme {scheme}` evaluates it from the table)"
         ))),
     }
+}
+
+/// The texture coordinates (the mesh's face-varying channel, Catmull–Clark) at the rational
+/// `(u, v)` of face `face` (sub-face `subface` of a non-quad face), or `None` when the mesh has
+/// none: the bilinear interpolation of the corner values under [`FaceVaryingMode::All`], else
+/// the limit of the channel's own mesh ([`channel_mesh`]), exactly and rounded once when it has
+/// no sharp feature (no pinned value, crease or hole), by feature-adaptive limit stencils in
+/// `f64` otherwise.
+pub fn limit_uv(
+    mesh: &Mesh,
+    face: usize,
+    subface: usize,
+    u: &BigRational,
+    v: &BigRational,
+) -> Result<Option<[f64; 2]>, RuntimeError> {
+    let Some(fvar) = &mesh.face_varying else {
+        return Ok(None);
+    };
+    if face >= mesh.faces() {
+        return Err(RuntimeError::InvalidParameter {
+            name: "face".to_owned(),
+            reason: format!("{face}: the mesh has {} faces", mesh.faces()),
+        });
+    }
+    let sides = mesh.face(face).len();
+    if (sides == 4 && subface != 0) || subface >= sides {
+        return Err(RuntimeError::InvalidParameter {
+            name: "sub-face".to_owned(),
+            reason: format!("{subface}: face {face} has {sides} sides"),
+        });
+    }
+    let (uf, vf) = (
+        u.to_f64().unwrap_or(f64::NAN),
+        v.to_f64().unwrap_or(f64::NAN),
+    );
+    if fvar.mode == FaceVaryingMode::All {
+        return Ok(Some(fvar.bilinear(mesh, face, subface, uf, vf)));
+    }
+    let channel = channel_mesh(mesh, fvar)?;
+    if !channel.has_sharp_features() {
+        let p = exact_eval::evaluate_subface(&channel, face, subface, u, v)?.position;
+        return Ok(Some([p[0], p[1]]));
+    }
+    // The sub-face of an n-gon is the child its first step makes at that corner.
+    let (channel, face) = if sides == 4 {
+        (channel, face)
+    } else {
+        let child = channel.face_offsets[face] as usize + subface;
+        (refine(&channel).mesh, child)
+    };
+    let query = LimitQuery {
+        face: face as u32,
+        u: uf,
+        v: vf,
+    };
+    let stencil = limit_stencils(&channel, &[query])?;
+    let mut out = [0.0; 2];
+    for &(vertex, [w, _, _]) in stencil.iter().flatten() {
+        let p = channel.positions[vertex as usize];
+        out[0] += w * p[0];
+        out[1] += w * p[1];
+    }
+    Ok(Some(out))
 }

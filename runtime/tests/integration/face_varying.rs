@@ -290,3 +290,51 @@ fn every_writer_carries_texture_coordinates() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `eval`'s texture coordinates (`subtess::eval::limit_uv`: exact rationals where the channel
+/// has no sharp feature, one adaptive query otherwise) agree with the tessellation's at the
+/// sources of its vertices, in every mode, on the atlas cube and on the disc with texture
+/// coordinates from its positions (where the exact limit's x, y are the reference).
+#[test]
+fn eval_gives_the_texture_coordinates_of_the_tessellation() {
+    use num_bigint::BigInt;
+    use num_rational::BigRational;
+    let cube = std::fs::read_to_string(data("cube_uv.obj")).expect("readable");
+    for mode in FaceVaryingMode::ALL {
+        for (label, text) in [
+            (
+                "cube",
+                format!(
+                    "{cube}\nt facevaryinginterpolateboundary 1/0/0 {}\n",
+                    mode.tag()
+                ),
+            ),
+            ("disc", uvs_from_positions(&data("disc.obj"), mode.tag())),
+        ] {
+            let mesh = mesh_from(&text);
+            let surface = Surface::new(&mesh, subtess::Scheme::CatmullClark).expect("surface");
+            let mut tess = surface.tessellator(&Rates::Uniform(3)).expect("plan");
+            let frame = tess.evaluate(&mesh.positions_f32()).expect("frame");
+            let uvs = frame.uvs().expect("texture coordinates");
+            for (i, s) in frame.sources().iter().enumerate().step_by(13) {
+                let d = BigInt::from(s.denominator);
+                let (u, v) = (
+                    BigRational::new(BigInt::from(s.u), d.clone()),
+                    BigRational::new(BigInt::from(s.v), d),
+                );
+                let face = s.face as usize;
+                let uv = subtess::eval::limit_uv(&mesh, face, usize::from(s.subface), &u, &v)
+                    .expect("evaluates")
+                    .expect("texture coordinates");
+                let off = (uv[0] - f64::from(uvs[i][0]))
+                    .abs()
+                    .max((uv[1] - f64::from(uvs[i][1])).abs());
+                assert!(
+                    off < 2e-6,
+                    "{label} {mode:?} vertex {i}: {uv:?} vs {:?}",
+                    uvs[i]
+                );
+            }
+        }
+    }
+}
