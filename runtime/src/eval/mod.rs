@@ -7,9 +7,10 @@ pub mod loop_exact_eval;
 use num_rational::BigRational;
 use num_traits::ToPrimitive;
 
-use crate::mesh::face_varying::{channel_mesh, FaceVaryingMode};
+use crate::mesh::face_varying::FaceVaryingMode;
 use crate::mesh::Mesh;
 use crate::scheme::catmull_clark::adaptive::{limit_stencils, LimitQuery};
+use crate::scheme::catmull_clark::face_varying::channel_mesh;
 use crate::scheme::catmull_clark::refine::refine;
 use crate::scheme::Scheme;
 use crate::RuntimeError;
@@ -83,7 +84,12 @@ pub fn limit_uv(
         v.to_f64().unwrap_or(f64::NAN),
     );
     if fvar.mode == FaceVaryingMode::All {
-        return Ok(Some(fvar.bilinear(mesh, face, subface, uf, vf)));
+        return Ok(Some(fvar.bilinear(
+            mesh.face_halfedges(face),
+            subface,
+            uf,
+            vf,
+        )));
     }
     let channel = channel_mesh(mesh, fvar)?;
     if !channel.has_sharp_features() {

@@ -296,7 +296,7 @@ fn face_varying(
             corners.push(t as u32);
         }
     }
-    FaceVarying::new(mesh, obj.uvs.clone(), corners, mode).map(Some)
+    FaceVarying::new(mesh.face_vertices.len(), obj.uvs.clone(), corners, mode).map(Some)
 }
 
 impl Mesh {

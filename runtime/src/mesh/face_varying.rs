@@ -1,19 +1,14 @@
-//! Face-varying data (texture coordinates): values per face corner, and the topology of the
-//! channel as OpenSubdiv derives it (`Vtr::FVarLevel::completeTopologyFromFaceValues`).
+//! Face-varying data (texture coordinates): a value index per face corner, and OpenSubdiv's
+//! modes of linear interpolation.
 //!
 //! A face-varying channel assigns every face corner a value index. Where two faces sharing an
-//! edge use different values at either end of it, the edge is *discontinuous* (a seam): the
-//! channel's surface is cut there. The channel is then a subdivision surface of its own mesh,
-//! [`channel_mesh`]: one vertex per *sibling* (a value at a vertex, over an edge-connected run
-//! of its faces), the same faces, seams and the mesh's boundary as boundaries, the mesh's edge
-//! and vertex sharpness inherited, and the vertices that the [`FaceVaryingMode`] makes linear
-//! pinned as infinitely sharp corners. The Catmull–Clark rules applied to that mesh give
-//! OpenSubdiv's face-varying limit surface (docs/algorithms/face-varying.md).
+//! edge use different values at either end of it, the edge is *discontinuous* (a seam,
+//! [`crate::Mesh::is_seam`]): the channel's surface is cut there. The channel is a subdivision
+//! surface of its own mesh (`scheme::catmull_clark::face_varying::channel_mesh`;
+//! docs/algorithms/face-varying.md).
 
-use schemes::crease::{is_infinite, INFINITE};
-use schemes::BoundaryMode;
+use std::ops::Range;
 
-use crate::mesh::topology::{Mesh, NONE};
 use crate::MeshError;
 
 /// Where the face-varying surface is linear instead of smooth: OpenSubdiv's
@@ -89,7 +84,7 @@ impl FaceVaryingMode {
     }
 
     /// Whether seams and boundaries are linear (every value on them pinned).
-    fn linear_boundaries(self) -> bool {
+    pub fn linear_boundaries(self) -> bool {
         matches!(self, Self::Boundaries | Self::All)
     }
 }
@@ -107,26 +102,23 @@ pub struct FaceVarying {
 }
 
 impl FaceVarying {
-    /// A channel over `mesh`, checked: one value per corner, every index in range, every
-    /// value finite.
+    /// A channel over a mesh of `face_corners` corners (half-edges), checked: one value per
+    /// corner, every index in range, every value finite.
     pub fn new(
-        mesh: &Mesh,
+        face_corners: usize,
         values: Vec<[f64; 2]>,
         corners: Vec<u32>,
         mode: FaceVaryingMode,
     ) -> Result<Self, MeshError> {
-        if corners.len() != mesh.face_vertices.len() {
+        if corners.len() != face_corners {
             return Err(MeshError::FaceVarying(format!(
-                "{} face-varying corners for {} face corners",
-                corners.len(),
-                mesh.face_vertices.len()
+                "{} face-varying corners for {face_corners} face corners",
+                corners.len()
             )));
         }
         if let Some(h) = corners.iter().position(|&c| c as usize >= values.len()) {
             return Err(MeshError::FaceVarying(format!(
-                "corner {} of face {} names value {} of {}",
-                h - mesh.face_halfedges(mesh.face_of[h] as usize).start,
-                mesh.face_of[h],
+                "face corner {h} names value {} of {}",
                 corners[h],
                 values.len()
             )));
@@ -144,24 +136,11 @@ impl FaceVarying {
         })
     }
 
-    /// Whether the edge of half-edge `h` is a seam: the faces on its two sides use different
-    /// values at one of its ends. A boundary edge is not a seam.
-    pub fn is_seam(&self, mesh: &Mesh, h: usize) -> bool {
-        let t = mesh.twin[h];
-        if t == NONE {
-            return false;
-        }
-        let t = t as usize;
-        self.corners[h] != self.corners[mesh.next(t)]
-            || self.corners[mesh.next(h)] != self.corners[t]
-    }
-
-    /// The bilinear value at `(u, v)` of face `f` (quads), or of the quad at corner `subface`
-    /// of an n-gon's first bilinear step (corner, next edge's midpoint, centroid, previous
-    /// edge's midpoint, the Ptex convention of [`crate::VertexSource`]): the channel under
-    /// [`FaceVaryingMode::All`].
-    pub fn bilinear(&self, mesh: &Mesh, f: usize, subface: usize, u: f64, v: f64) -> [f64; 2] {
-        let corners = mesh.face_halfedges(f);
+    /// The bilinear value at `(u, v)` of the face whose corners are the half-edges `corners`
+    /// (a quad), or of the quad at corner `subface` of an n-gon's first bilinear step (corner,
+    /// next edge's midpoint, centroid, previous edge's midpoint, the Ptex convention of
+    /// [`crate::VertexSource`]): the channel under [`FaceVaryingMode::All`].
+    pub fn bilinear(&self, corners: Range<usize>, subface: usize, u: f64, v: f64) -> [f64; 2] {
         let value = |h: usize| self.values[self.corners[h] as usize];
         let quad: [[f64; 2]; 4] = if corners.len() == 4 {
             [0, 1, 2, 3].map(|k| value(corners.start + k))
@@ -190,179 +169,4 @@ impl FaceVarying {
         }
         out
     }
-}
-
-/// Union-find over face corners.
-fn root(parent: &mut [u32], mut x: usize) -> usize {
-    while parent[x] as usize != x {
-        parent[x] = parent[parent[x] as usize];
-        x = parent[x] as usize;
-    }
-    x
-}
-
-/// What one value contributes at a vertex (OpenSubdiv's `ValueSpan`).
-#[derive(Clone, Copy, Debug, Default)]
-struct Span {
-    value: u32,
-    /// Corners using the value at the vertex.
-    size: usize,
-    /// Edge-connected runs of those corners (more than one: "disjoint", pinned).
-    runs: usize,
-    /// Infinitely sharp edges between two of its corners.
-    inf_sharp_edges: usize,
-}
-
-/// The channel's own mesh: one vertex per sibling (a value at a vertex over one edge-connected
-/// run of faces), the faces of `mesh` in order (so half-edge `h` is the same corner in both),
-/// positions `(u, v, 0)`, seams and boundaries as boundaries, the edge sharpness and holes of
-/// `mesh`, and the vertex sharpness OpenSubdiv's rules give the values: infinite where the mode
-/// makes a value linear (a pinned corner), the vertex's own elsewhere.
-///
-/// Which values are pinned, at a vertex whose channel topology differs from the mesh's (a seam
-/// ends there, several values meet, or the mode changes a boundary vertex), as in
-/// `FVarLevel::completeTopologyFromFaceValues`: every value when the mode makes boundaries
-/// linear, the vertex is infinitely sharp or non-manifold, three or more values meet (modes
-/// 2, 3), or a seam ends at an interior vertex with one value (modes 3, 4, 5); with two values
-/// in modes 2 and 3, both when either has an infinitely sharp edge inside, or (mode 3) either
-/// is a one-face corner; and a value used over several runs, one with an infinitely sharp edge
-/// inside (three sharp edges make a corner), or a one-face corner (every mode but 0). Not
-/// modelled: OpenSubdiv's "dependent" sharpness (a two-value vertex of modes 2 and 3 where one
-/// value has a semi-sharp edge inside and the other none, pinned until that sharpness decays).
-pub fn channel_mesh(mesh: &Mesh, fvar: &FaceVarying) -> Result<Mesh, MeshError> {
-    let corners = mesh.face_vertices.len();
-    let mut parent: Vec<u32> = (0..corners as u32).collect();
-    let seam: Vec<bool> = (0..corners).map(|h| fvar.is_seam(mesh, h)).collect();
-    for (h, &t) in mesh.twin.iter().enumerate() {
-        if t == NONE || seam[h] {
-            continue;
-        }
-        // Across a continuous edge the corners at each end are one sibling.
-        for (a, b) in [(h, mesh.next(t as usize)), (mesh.next(h), t as usize)] {
-            let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
-            parent[ra.max(rb)] = ra.min(rb) as u32;
-        }
-    }
-    // Sibling ids in order of their first corner.
-    let mut id = vec![NONE; corners];
-    let mut sibling_of_corner = vec![0u32; corners];
-    let mut first_corner = Vec::new();
-    for (h, sibling) in sibling_of_corner.iter_mut().enumerate() {
-        let r = root(&mut parent, h);
-        if id[r] == NONE {
-            id[r] = first_corner.len() as u32;
-            first_corner.push(h);
-        }
-        *sibling = id[r];
-    }
-    let mut sharpness: Vec<f32> = first_corner
-        .iter()
-        .map(|&h| mesh.vertex_sharpness[mesh.face_vertices[h] as usize])
-        .collect();
-    let mode = fvar.mode;
-    let corners_sharp = mode != FaceVaryingMode::None;
-    let smooth_geometry_corners = mesh.boundary != BoundaryMode::EdgeAndCorner;
-    let dependent = matches!(
-        mode,
-        FaceVaryingMode::CornersPlus1 | FaceVaryingMode::CornersPlus2
-    );
-    let sharpen_darts = mode == FaceVaryingMode::CornersPlus2 || mode.linear_boundaries();
-    // A vertex split for being non-manifold (OpenSubdiv pins all its values).
-    let mut split = vec![false; mesh.positions.len()];
-    for (i, &origin) in mesh.copies.iter().enumerate() {
-        split[origin as usize] = true;
-        split[mesh.input_vertices() + i] = true;
-    }
-    for (v, &non_manifold) in split.iter().enumerate() {
-        let fan = mesh.fan(v);
-        if fan.is_empty() {
-            continue;
-        }
-        let boundary = mesh.is_boundary_vertex(v);
-        // The corners at v are the fan's half-edges; the edges at v are each fan half-edge's
-        // own and the one into v of the fan's last face.
-        let discontinuous = fan.iter().any(|&h| seam[h] || seam[mesh.prev(h)]);
-        let mut spans: Vec<Span> = Vec::new();
-        let mut runs: Vec<u32> = Vec::new();
-        for &h in &fan {
-            let value = fvar.corners[h];
-            let at = match spans.iter().position(|s| s.value == value) {
-                Some(i) => i,
-                None => {
-                    spans.push(Span {
-                        value,
-                        ..Span::default()
-                    });
-                    spans.len() - 1
-                }
-            };
-            spans[at].size += 1;
-            let run = sibling_of_corner[h];
-            if !runs.contains(&run) {
-                runs.push(run);
-                spans[at].runs += 1;
-            }
-            // The edge h leaves v by is inside the span when continuous.
-            if mesh.twin[h] != NONE && !seam[h] && is_infinite(mesh.edge_sharpness[h]) {
-                spans[at].inf_sharp_edges += 1;
-            }
-        }
-        let mismatched = discontinuous
-            || spans.len() > 1
-            || (boundary && mode.linear_boundaries())
-            || (boundary && fan.len() == 1 && smooth_geometry_corners && corners_sharp);
-        if !mismatched {
-            continue;
-        }
-        let mut all = mode.linear_boundaries()
-            || is_infinite(mesh.vertex_sharpness[v])
-            || non_manifold
-            || (dependent && spans.len() > 2)
-            || (sharpen_darts && spans.len() == 1 && !boundary);
-        if !all && dependent && spans.len() == 2 {
-            all = spans.iter().any(|s| s.inf_sharp_edges > 0 || s.runs > 1)
-                || (mode == FaceVaryingMode::CornersPlus2 && spans.iter().any(|s| s.size == 1));
-        }
-        for &h in &fan {
-            let span = spans
-                .iter()
-                .find(|s| s.value == fvar.corners[h])
-                .copied()
-                .unwrap_or_default();
-            let pinned = all
-                || span.runs > 1
-                || span.inf_sharp_edges > 0
-                || (span.size == 1 && corners_sharp);
-            if pinned {
-                sharpness[sibling_of_corner[h] as usize] = INFINITE;
-            }
-        }
-    }
-    let positions: Vec<[f64; 3]> = first_corner
-        .iter()
-        .map(|&h| {
-            let [u, v] = fvar.values[fvar.corners[h] as usize];
-            [u, v, 0.0]
-        })
-        .collect();
-    let faces: Vec<Vec<i64>> = (0..mesh.faces())
-        .map(|f| {
-            mesh.face_halfedges(f)
-                .map(|h| i64::from(sibling_of_corner[h]))
-                .collect()
-        })
-        .collect();
-    let mut channel = Mesh::refined(positions, &faces, &[], BoundaryMode::EdgeOnly)?;
-    for h in 0..corners {
-        if channel.twin[h] != NONE {
-            channel.edge_sharpness[h] = mesh.edge_sharpness[h];
-        }
-    }
-    for (s, &p) in channel.vertex_sharpness.iter_mut().zip(&sharpness) {
-        *s = s.max(p);
-    }
-    channel.holes.clone_from(&mesh.holes);
-    channel.creasing = mesh.creasing;
-    channel.smooth_triangles = mesh.smooth_triangles;
-    Ok(channel)
 }

@@ -353,6 +353,21 @@ impl Mesh {
         }
     }
 
+    /// Whether the edge of half-edge `h` is a seam of the texture coordinates
+    /// ([`Mesh::face_varying`]): the faces on its two sides use different values at one of its
+    /// ends. A boundary edge is not a seam, nor is any edge of a mesh without texture
+    /// coordinates.
+    pub fn is_seam(&self, h: usize) -> bool {
+        let (Some(fvar), t) = (&self.face_varying, self.twin[h]) else {
+            return false;
+        };
+        if t == NONE {
+            return false;
+        }
+        let (c, t) = (&fvar.corners, t as usize);
+        c[h] != c[self.next(t)] || c[self.next(h)] != c[t]
+    }
+
     /// The vertex half-edge `h` ends at.
     pub fn head(&self, h: usize) -> u32 {
         self.face_vertices[self.next(h)]

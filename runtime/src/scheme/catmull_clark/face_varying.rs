@@ -1,5 +1,6 @@
-//! The face-varying channel (texture coordinates) of an isolated Catmull–Clark surface: the
-//! channel's mesh ([`channel_mesh`]) refined by the same steps as the positions, so that its
+//! The face-varying channel (texture coordinates) of a Catmull–Clark surface: the channel's own
+//! mesh as OpenSubdiv derives it ([`channel_mesh`], after
+//! `Vtr::FVarLevel::completeTopologyFromFaceValues`), and that mesh refined by the same steps as the positions, so that its
 //! faces and corners are the isolated mesh's, and its limit values at any points of those
 //! faces.
 //!
@@ -10,8 +11,11 @@
 //! ([`FaceVaryingMode::All`]) is the bilinear interpolation of the input face's corner values,
 //! in closed form.
 
-use crate::mesh::face_varying::{channel_mesh, FaceVarying, FaceVaryingMode};
-use crate::mesh::{Mesh, VertexSource};
+use schemes::crease::{is_infinite, INFINITE};
+use schemes::BoundaryMode;
+
+use crate::mesh::face_varying::{FaceVarying, FaceVaryingMode};
+use crate::mesh::{Mesh, VertexSource, NONE};
 use crate::scheme::catmull_clark::adaptive::{limit_stencils, LimitQuery};
 use crate::scheme::catmull_clark::isolate::Isolation;
 use crate::scheme::catmull_clark::refine::refine;
@@ -75,13 +79,8 @@ impl ChannelIsolation {
                 .map(|&s| {
                     let s = input(s);
                     let (u, v) = s.uv();
-                    let [x, y] = self.input.bilinear(
-                        &self.input_mesh,
-                        s.face as usize,
-                        usize::from(s.subface),
-                        u,
-                        v,
-                    );
+                    let corners = self.input_mesh.face_halfedges(s.face as usize);
+                    let [x, y] = self.input.bilinear(corners, usize::from(s.subface), u, v);
                     [x as f32, y as f32]
                 })
                 .collect());
@@ -107,4 +106,179 @@ impl ChannelIsolation {
             })
             .collect())
     }
+}
+
+/// Union-find over face corners.
+fn root(parent: &mut [u32], mut x: usize) -> usize {
+    while parent[x] as usize != x {
+        parent[x] = parent[parent[x] as usize];
+        x = parent[x] as usize;
+    }
+    x
+}
+
+/// What one value contributes at a vertex (OpenSubdiv's `ValueSpan`).
+#[derive(Clone, Copy, Debug, Default)]
+struct Span {
+    value: u32,
+    /// Corners using the value at the vertex.
+    size: usize,
+    /// Edge-connected runs of those corners (more than one: "disjoint", pinned).
+    runs: usize,
+    /// Infinitely sharp edges between two of its corners.
+    inf_sharp_edges: usize,
+}
+
+/// The channel's own mesh: one vertex per sibling (a value at a vertex over one edge-connected
+/// run of faces), the faces of `mesh` in order (so half-edge `h` is the same corner in both),
+/// positions `(u, v, 0)`, seams and boundaries as boundaries, the edge sharpness and holes of
+/// `mesh`, and the vertex sharpness OpenSubdiv's rules give the values: infinite where the mode
+/// makes a value linear (a pinned corner), the vertex's own elsewhere.
+///
+/// Which values are pinned, at a vertex whose channel topology differs from the mesh's (a seam
+/// ends there, several values meet, or the mode changes a boundary vertex), as in
+/// `FVarLevel::completeTopologyFromFaceValues`: every value when the mode makes boundaries
+/// linear, the vertex is infinitely sharp or non-manifold, three or more values meet (modes
+/// 2, 3), or a seam ends at an interior vertex with one value (modes 3, 4, 5); with two values
+/// in modes 2 and 3, both when either has an infinitely sharp edge inside, or (mode 3) either
+/// is a one-face corner; and a value used over several runs, one with an infinitely sharp edge
+/// inside (three sharp edges make a corner), or a one-face corner (every mode but 0). Not
+/// modelled: OpenSubdiv's "dependent" sharpness (a two-value vertex of modes 2 and 3 where one
+/// value has a semi-sharp edge inside and the other none, pinned until that sharpness decays).
+pub fn channel_mesh(mesh: &Mesh, fvar: &FaceVarying) -> Result<Mesh, MeshError> {
+    let corners = mesh.face_vertices.len();
+    let mut parent: Vec<u32> = (0..corners as u32).collect();
+    let seam: Vec<bool> = (0..corners).map(|h| mesh.is_seam(h)).collect();
+    for (h, &t) in mesh.twin.iter().enumerate() {
+        if t == NONE || seam[h] {
+            continue;
+        }
+        // Across a continuous edge the corners at each end are one sibling.
+        for (a, b) in [(h, mesh.next(t as usize)), (mesh.next(h), t as usize)] {
+            let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
+            parent[ra.max(rb)] = ra.min(rb) as u32;
+        }
+    }
+    // Sibling ids in order of their first corner.
+    let mut id = vec![NONE; corners];
+    let mut sibling_of_corner = vec![0u32; corners];
+    let mut first_corner = Vec::new();
+    for (h, sibling) in sibling_of_corner.iter_mut().enumerate() {
+        let r = root(&mut parent, h);
+        if id[r] == NONE {
+            id[r] = first_corner.len() as u32;
+            first_corner.push(h);
+        }
+        *sibling = id[r];
+    }
+    let mut sharpness: Vec<f32> = first_corner
+        .iter()
+        .map(|&h| mesh.vertex_sharpness[mesh.face_vertices[h] as usize])
+        .collect();
+    let mode = fvar.mode;
+    let corners_sharp = mode != FaceVaryingMode::None;
+    let smooth_geometry_corners = mesh.boundary != BoundaryMode::EdgeAndCorner;
+    let dependent = matches!(
+        mode,
+        FaceVaryingMode::CornersPlus1 | FaceVaryingMode::CornersPlus2
+    );
+    let sharpen_darts = mode == FaceVaryingMode::CornersPlus2 || mode.linear_boundaries();
+    // A vertex split for being non-manifold (OpenSubdiv pins all its values).
+    let mut split = vec![false; mesh.positions.len()];
+    for (i, &origin) in mesh.copies.iter().enumerate() {
+        split[origin as usize] = true;
+        split[mesh.input_vertices() + i] = true;
+    }
+    for (v, &non_manifold) in split.iter().enumerate() {
+        let fan = mesh.fan(v);
+        if fan.is_empty() {
+            continue;
+        }
+        let boundary = mesh.is_boundary_vertex(v);
+        // The corners at v are the fan's half-edges; the edges at v are each fan half-edge's
+        // own and the one into v of the fan's last face.
+        let discontinuous = fan.iter().any(|&h| seam[h] || seam[mesh.prev(h)]);
+        let mut spans: Vec<Span> = Vec::new();
+        let mut runs: Vec<u32> = Vec::new();
+        for &h in &fan {
+            let value = fvar.corners[h];
+            let at = match spans.iter().position(|s| s.value == value) {
+                Some(i) => i,
+                None => {
+                    spans.push(Span {
+                        value,
+                        ..Span::default()
+                    });
+                    spans.len() - 1
+                }
+            };
+            spans[at].size += 1;
+            let run = sibling_of_corner[h];
+            if !runs.contains(&run) {
+                runs.push(run);
+                spans[at].runs += 1;
+            }
+            // The edge h leaves v by is inside the span when continuous.
+            if mesh.twin[h] != NONE && !seam[h] && is_infinite(mesh.edge_sharpness[h]) {
+                spans[at].inf_sharp_edges += 1;
+            }
+        }
+        let mismatched = discontinuous
+            || spans.len() > 1
+            || (boundary && mode.linear_boundaries())
+            || (boundary && fan.len() == 1 && smooth_geometry_corners && corners_sharp);
+        if !mismatched {
+            continue;
+        }
+        let mut all = mode.linear_boundaries()
+            || is_infinite(mesh.vertex_sharpness[v])
+            || non_manifold
+            || (dependent && spans.len() > 2)
+            || (sharpen_darts && spans.len() == 1 && !boundary);
+        if !all && dependent && spans.len() == 2 {
+            all = spans.iter().any(|s| s.inf_sharp_edges > 0 || s.runs > 1)
+                || (mode == FaceVaryingMode::CornersPlus2 && spans.iter().any(|s| s.size == 1));
+        }
+        for &h in &fan {
+            let span = spans
+                .iter()
+                .find(|s| s.value == fvar.corners[h])
+                .copied()
+                .unwrap_or_default();
+            let pinned = all
+                || span.runs > 1
+                || span.inf_sharp_edges > 0
+                || (span.size == 1 && corners_sharp);
+            if pinned {
+                sharpness[sibling_of_corner[h] as usize] = INFINITE;
+            }
+        }
+    }
+    let positions: Vec<[f64; 3]> = first_corner
+        .iter()
+        .map(|&h| {
+            let [u, v] = fvar.values[fvar.corners[h] as usize];
+            [u, v, 0.0]
+        })
+        .collect();
+    let faces: Vec<Vec<i64>> = (0..mesh.faces())
+        .map(|f| {
+            mesh.face_halfedges(f)
+                .map(|h| i64::from(sibling_of_corner[h]))
+                .collect()
+        })
+        .collect();
+    let mut channel = Mesh::refined(positions, &faces, &[], BoundaryMode::EdgeOnly)?;
+    for h in 0..corners {
+        if channel.twin[h] != NONE {
+            channel.edge_sharpness[h] = mesh.edge_sharpness[h];
+        }
+    }
+    for (s, &p) in channel.vertex_sharpness.iter_mut().zip(&sharpness) {
+        *s = s.max(p);
+    }
+    channel.holes.clone_from(&mesh.holes);
+    channel.creasing = mesh.creasing;
+    channel.smooth_triangles = mesh.smooth_triangles;
+    Ok(channel)
 }
