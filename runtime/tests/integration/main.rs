@@ -17,6 +17,8 @@ mod loop_tessellation;
 mod mesh_output;
 mod models;
 #[cfg(feature = "opensubdiv")]
+mod opensubdiv_fvar_parity;
+#[cfg(feature = "opensubdiv")]
 mod opensubdiv_parity;
 mod patches;
 mod rates;

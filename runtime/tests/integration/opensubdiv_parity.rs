@@ -71,11 +71,11 @@ const FAITHFUL_POSITION: f64 = 1e-5;
 const FAITHFUL_NORMAL: f64 = 2e-3;
 /// `|du x dv| / (|du| |dv|)` below this: OpenSubdiv's normal is not compared.
 const PARALLEL_TANGENTS: f64 = 1e-2;
-const ISOLATION_LEVEL: usize = 10;
-const RATE: u32 = 4;
+pub(super) const ISOLATION_LEVEL: usize = 10;
+pub(super) const RATE: u32 = 4;
 
 /// `shared/models/opensubdiv` beside the repository.
-fn models() -> PathBuf {
+pub(super) fn models() -> PathBuf {
     common::models().join("opensubdiv")
 }
 
@@ -91,13 +91,17 @@ struct Tag {
 /// The shape as OpenSubdiv's regression reader (`shape_utils`) reads it: positions, faces
 /// (0-based, OBJ order), tags. Independent of subtess's reader.
 #[derive(Debug, Default)]
-struct Shape {
-    positions: Vec<[f64; 3]>,
-    faces: Vec<Vec<u32>>,
+pub(super) struct Shape {
+    pub(super) positions: Vec<[f64; 3]>,
+    pub(super) faces: Vec<Vec<u32>>,
+    /// Texture coordinates (`vt`).
+    pub(super) uvs: Vec<[f64; 2]>,
+    /// Every face's texture coordinate indices (0-based), empty where a corner names none.
+    pub(super) face_uvs: Vec<Vec<u32>>,
     tags: Vec<Tag>,
 }
 
-fn parse_shape(text: &str) -> Result<Shape, String> {
+pub(super) fn parse_shape(text: &str) -> Result<Shape, String> {
     let mut shape = Shape::default();
     for (number, line) in text.lines().enumerate() {
         let bad = |what: &str| format!("line {}: {what}: `{line}`", number + 1);
@@ -113,8 +117,37 @@ fn parse_shape(text: &str) -> Result<Shape, String> {
                 }
                 shape.positions.push([c[0], c[1], c[2]]);
             }
+            Some("vt") => {
+                let c: Vec<f64> = words
+                    .take(2)
+                    .map(|w| w.parse::<f64>().map_err(|_| bad("texture coordinate")))
+                    .collect::<Result<_, _>>()?;
+                if c.len() != 2 {
+                    return Err(bad("vt needs 2 coordinates"));
+                }
+                shape.uvs.push([c[0], c[1]]);
+            }
             Some("f") => {
                 let n = shape.positions.len() as i64;
+                let uvs: Vec<u32> = line
+                    .split_whitespace()
+                    .skip(1)
+                    .map_while(|w| {
+                        let t: i64 = w.split('/').nth(1)?.parse().ok()?;
+                        let t = if t < 0 {
+                            shape.uvs.len() as i64 + t
+                        } else {
+                            t - 1
+                        };
+                        u32::try_from(t).ok()
+                    })
+                    .collect();
+                let corners = line.split_whitespace().count() - 1;
+                shape.face_uvs.push(if uvs.len() == corners {
+                    uvs
+                } else {
+                    Vec::new()
+                });
                 let face = words
                     .map(|w| {
                         let i: i64 = w
@@ -159,7 +192,7 @@ fn parse_shape(text: &str) -> Result<Shape, String> {
                 };
                 shape.tags.push(tag);
             }
-            _ => {} // comments, vt, vn, s, g, o, mtllib, usemtl
+            _ => {} // comments, vn, s, g, o, mtllib, usemtl
         }
     }
     Ok(shape)
@@ -168,8 +201,8 @@ fn parse_shape(text: &str) -> Result<Shape, String> {
 /// OpenSubdiv's reading of the tags (`regression/common/far_utils.h`: `GetSdcOptions` and
 /// `assignComponentTags`): boundary edge-only unless `interpolateboundary` says otherwise,
 /// uniform creasing, Catmark triangles; sharpness `max(0, s)`, one value or one per item.
-struct OsdTags {
-    options: far::TopologyRefinerOptions,
+pub(super) struct OsdTags {
+    pub(super) options: far::TopologyRefinerOptions,
     crease_pairs: Vec<u32>,
     crease_sharpness: Vec<f32>,
     corners: Vec<u32>,
@@ -177,7 +210,7 @@ struct OsdTags {
     holes: Vec<u32>,
 }
 
-fn osd_tags(shape: &Shape) -> Result<OsdTags, String> {
+pub(super) fn osd_tags(shape: &Shape) -> Result<OsdTags, String> {
     let mut tags = OsdTags {
         options: far::TopologyRefinerOptions {
             scheme: far::Scheme::CatmullClark,
@@ -304,7 +337,7 @@ type Limit = Option<([f64; 3], [f64; 3], [f64; 3])>;
 
 /// The first Ptex face of every base face (`Far::PtexIndices` for Catmark: a quad has one, an
 /// n-gon n, holes included).
-fn ptex_offsets(faces: &[Vec<u32>]) -> Vec<usize> {
+pub(super) fn ptex_offsets(faces: &[Vec<u32>]) -> Vec<usize> {
     let mut offsets = Vec::with_capacity(faces.len());
     let mut next = 0;
     for f in faces {
@@ -314,7 +347,7 @@ fn ptex_offsets(faces: &[Vec<u32>]) -> Vec<usize> {
     offsets
 }
 
-fn descriptor<'a>(
+pub(super) fn descriptor<'a>(
     shape: &Shape,
     sizes: &'a [u32],
     indices: &'a [u32],

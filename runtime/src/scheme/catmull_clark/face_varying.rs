@@ -30,8 +30,8 @@ pub struct ChannelIsolation {
     pub mesh: Mesh,
     /// The input channel (for the linear mode's closed form).
     input: FaceVarying,
-    /// The input mesh's face offsets (a face's corners, for the linear mode).
-    input_mesh: Mesh,
+    /// The input mesh's [`Mesh::face_offsets`] (a face's corners, for the linear mode).
+    input_faces: Vec<u32>,
 }
 
 impl ChannelIsolation {
@@ -51,12 +51,10 @@ impl ChannelIsolation {
                 isolation.mesh.face_vertices.len()
             )));
         }
-        let mut input_mesh = input.clone();
-        input_mesh.face_varying = None;
         Ok(Some(ChannelIsolation {
             mesh,
             input: fvar.clone(),
-            input_mesh,
+            input_faces: input.face_offsets.clone(),
         }))
     }
 
@@ -79,7 +77,8 @@ impl ChannelIsolation {
                 .map(|&s| {
                     let s = input(s);
                     let (u, v) = s.uv();
-                    let corners = self.input_mesh.face_halfedges(s.face as usize);
+                    let f = s.face as usize;
+                    let corners = self.input_faces[f] as usize..self.input_faces[f + 1] as usize;
                     let [x, y] = self.input.bilinear(corners, usize::from(s.subface), u, v);
                     [x as f32, y as f32]
                 })
