@@ -116,16 +116,47 @@ fn root(parent: &mut [u32], mut x: usize) -> usize {
     x
 }
 
-/// What one value contributes at a vertex (OpenSubdiv's `ValueSpan`).
+/// What one of OpenSubdiv's siblings spans at a vertex (its `ValueSpan`).
 #[derive(Clone, Copy, Debug, Default)]
 struct Span {
-    value: u32,
-    /// Corners using the value at the vertex.
+    /// Corners of the sibling at the vertex.
     size: usize,
     /// Edge-connected runs of those corners (more than one: "disjoint", pinned).
     runs: usize,
     /// Infinitely sharp edges between two of its corners.
     inf_sharp_edges: usize,
+}
+
+/// OpenSubdiv's sibling index of each value around a vertex, in its face order (the leading
+/// boundary face first, or the lowest-numbered face; [`Mesh::fan`]'s order), as
+/// `FVarLevel::completeTopologyFromFaceValues` assigns them, shortcut included: while two
+/// values are known, a value that differs from its predecessor and from the first value is
+/// taken as new without comparing it with the second. So around `a, b, a, b` the two `b` faces
+/// are two siblings of one face each (smooth in mode 0), while the two `a` faces are one sibling
+/// over two runs (pinned); the order decides which value is `a`.
+fn osd_siblings(values: impl Iterator<Item = u32>) -> Vec<usize> {
+    let mut unique: Vec<u32> = Vec::new();
+    let mut out: Vec<usize> = Vec::new();
+    let mut previous = None;
+    for value in values {
+        let sibling = match previous {
+            Some((p, s)) if p == value => s,
+            _ if unique.len() < 2 || (unique.len() == 2 && unique[0] != value) => {
+                unique.push(value);
+                unique.len() - 1
+            }
+            _ => match unique.iter().position(|&u| u == value) {
+                Some(k) => k,
+                None => {
+                    unique.push(value);
+                    unique.len() - 1
+                }
+            },
+        };
+        out.push(sibling);
+        previous = Some((value, sibling));
+    }
+    out
 }
 
 /// The channel's own mesh: one vertex per sibling (a value at a vertex over one edge-connected
@@ -197,20 +228,10 @@ pub fn channel_mesh(mesh: &Mesh, fvar: &FaceVarying) -> Result<Mesh, MeshError> 
         // The corners at v are the fan's half-edges; the edges at v are each fan half-edge's
         // own and the one into v of the fan's last face.
         let discontinuous = fan.iter().any(|&h| seam[h] || seam[mesh.prev(h)]);
-        let mut spans: Vec<Span> = Vec::new();
+        let siblings = osd_siblings(fan.iter().map(|&h| fvar.corners[h]));
+        let mut spans = vec![Span::default(); siblings.iter().max().map_or(0, |&s| s + 1)];
         let mut runs: Vec<u32> = Vec::new();
-        for &h in &fan {
-            let value = fvar.corners[h];
-            let at = match spans.iter().position(|s| s.value == value) {
-                Some(i) => i,
-                None => {
-                    spans.push(Span {
-                        value,
-                        ..Span::default()
-                    });
-                    spans.len() - 1
-                }
-            };
+        for (&h, &at) in fan.iter().zip(&siblings) {
             spans[at].size += 1;
             let run = sibling_of_corner[h];
             if !runs.contains(&run) {
@@ -238,12 +259,8 @@ pub fn channel_mesh(mesh: &Mesh, fvar: &FaceVarying) -> Result<Mesh, MeshError> 
             all = spans.iter().any(|s| s.inf_sharp_edges > 0 || s.runs > 1)
                 || (mode == FaceVaryingMode::CornersPlus2 && spans.iter().any(|s| s.size == 1));
         }
-        for &h in &fan {
-            let span = spans
-                .iter()
-                .find(|s| s.value == fvar.corners[h])
-                .copied()
-                .unwrap_or_default();
+        for (&h, &at) in fan.iter().zip(&siblings) {
+            let span = spans[at];
             let pinned = all
                 || span.runs > 1
                 || span.inf_sharp_edges > 0
@@ -280,4 +297,22 @@ pub fn channel_mesh(mesh: &Mesh, fvar: &FaceVarying) -> Result<Mesh, MeshError> 
     channel.creasing = mesh.creasing;
     channel.smooth_triangles = mesh.smooth_triangles;
     Ok(channel)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::osd_siblings;
+
+    /// OpenSubdiv's assignment, worked by hand from `completeTopologyFromFaceValues`: runs of
+    /// one value share a sibling; a third value, or a return to a known one, is searched for,
+    /// except the second value met again right after the first, which is taken as new.
+    #[test]
+    fn siblings_follow_opensubdivs_assignment() {
+        let of = |v: &[u32]| osd_siblings(v.iter().copied());
+        assert_eq!(of(&[7, 7, 7]), [0, 0, 0]);
+        assert_eq!(of(&[1, 2, 2, 1]), [0, 1, 1, 0]);
+        assert_eq!(of(&[1, 2, 1, 2]), [0, 1, 0, 2]);
+        assert_eq!(of(&[1, 2, 3, 2]), [0, 1, 2, 1]);
+        assert_eq!(of(&[1, 2, 3, 1, 3]), [0, 1, 2, 0, 2]);
+    }
 }
