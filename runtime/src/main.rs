@@ -477,10 +477,16 @@ fn tessellate_command(args: TessellateArgs) -> Result<(), RuntimeError> {
     let frame = tessellator.evaluate(&input.positions_f32())?;
     let seconds = started.elapsed().as_secs_f64();
     let output = frame.to_triangle_mesh();
+    let writing = Instant::now();
     write_mesh(&output, &args.output)?;
+    let write_seconds = writing.elapsed().as_secs_f64();
     if args.stats {
+        let checking = Instant::now();
         let watertight = surface.boundary_loops() == 0 && output.is_watertight();
+        let check_seconds = checking.elapsed().as_secs_f64();
         let mut stats = plan_stats(&surface, &tessellator);
+        stats["write_seconds"] = write_seconds.into();
+        stats["check_seconds"] = check_seconds.into();
         stats["seconds"] = seconds.into();
         stats["triangles_per_second"] =
             (tessellator.triangle_count() as f64 / seconds.max(1e-12)).into();

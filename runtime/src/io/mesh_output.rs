@@ -22,6 +22,7 @@
 use std::io::Write;
 use std::path::Path;
 
+use rayon::prelude::*;
 use serde_json::{json, Value};
 
 use crate::io::atomic::write_atomically;
@@ -187,26 +188,73 @@ pub fn write_obj(mesh: &TriangleMesh, path: &Path) -> Result<(), RuntimeError> {
             mesh.triangles.len()
         )
         .map_err(&io)?;
-        for p in &mesh.positions {
-            writeln!(w, "v {} {} {}", p[0], p[1], p[2]).map_err(&io)?;
-        }
-        for n in &mesh.normals {
-            writeln!(w, "vn {} {} {}", n[0], n[1], n[2]).map_err(&io)?;
-        }
-        for t in &mesh.uvs {
-            writeln!(w, "vt {} {}", t[0], t[1]).map_err(&io)?;
-        }
-        let textured = !mesh.uvs.is_empty();
-        for t in &mesh.triangles {
-            let [a, b, c] = t.map(|i| i + 1);
-            if textured {
-                writeln!(w, "f {a}/{a}/{a} {b}/{b}/{b} {c}/{c}/{c}").map_err(&io)?;
-            } else {
-                writeln!(w, "f {a}//{a} {b}//{b} {c}//{c}").map_err(&io)?;
+        let floats = |tag: &'static [u8]| {
+            move |buf: &mut Vec<u8>, xs: &[f32]| {
+                let mut number = ryu::Buffer::new();
+                buf.extend_from_slice(tag);
+                for &x in xs {
+                    buf.push(b' ');
+                    buf.extend_from_slice(number.format(x).as_bytes());
+                }
+                buf.push(b'\n');
             }
-        }
+        };
+        let (v, vn, vt) = (floats(b"v"), floats(b"vn"), floats(b"vt"));
+        write_lines(w, &mesh.positions, |buf, p| v(buf, p)).map_err(&io)?;
+        write_lines(w, &mesh.normals, |buf, n| vn(buf, n)).map_err(&io)?;
+        write_lines(w, &mesh.uvs, |buf, t| vt(buf, t)).map_err(&io)?;
+        // `f a/a/a ...` with texture coordinates, `f a//a ...` without.
+        let middle: &[u8] = if mesh.uvs.is_empty() { b"//" } else { b"/" };
+        let last: &[u8] = if mesh.uvs.is_empty() { b"" } else { b"/" };
+        write_lines(w, &mesh.triangles, |buf, t| {
+            let mut number = itoa::Buffer::new();
+            buf.push(b'f');
+            for &i in t {
+                let i = number.format(u64::from(i) + 1).as_bytes();
+                buf.push(b' ');
+                buf.extend_from_slice(i);
+                buf.extend_from_slice(middle);
+                if !last.is_empty() {
+                    buf.extend_from_slice(i);
+                    buf.extend_from_slice(last);
+                }
+                buf.extend_from_slice(i);
+            }
+            buf.push(b'\n');
+        })
+        .map_err(&io)?;
         Ok(())
     })
+}
+
+/// Lines formatted per parallel task in [`write_lines`].
+const LINES_PER_TASK: usize = 1 << 14;
+
+/// Write one line per item, formatted by `line` into buffers of [`LINES_PER_TASK`] lines in
+/// parallel, a batch of buffers (two per thread) at a time, written in order: the output is the
+/// sequential one, and the memory held is a batch, not the file.
+fn write_lines<T: Sync>(
+    w: &mut impl Write,
+    items: &[T],
+    line: impl Fn(&mut Vec<u8>, &T) + Sync,
+) -> std::io::Result<()> {
+    let batch = LINES_PER_TASK * 2 * rayon::current_num_threads().max(1);
+    for group in items.chunks(batch) {
+        let buffers: Vec<Vec<u8>> = group
+            .par_chunks(LINES_PER_TASK)
+            .map(|chunk| {
+                let mut buf = Vec::with_capacity(48 * chunk.len());
+                for item in chunk {
+                    line(&mut buf, item);
+                }
+                buf
+            })
+            .collect();
+        for buf in &buffers {
+            w.write_all(buf)?;
+        }
+    }
+    Ok(())
 }
 
 /// Bytes of one PLY vertex record: `x y z nx ny nz` (f32), `face` (u32), `u v` (f32),
