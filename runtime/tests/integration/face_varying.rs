@@ -338,3 +338,39 @@ fn eval_gives_the_texture_coordinates_of_the_tessellation() {
         }
     }
 }
+
+/// Seams add limit points at vertices the positions alone would not sample: on the atlas cube,
+/// every corner (a smooth extraordinary vertex of valence 3) gets three. By the cube's
+/// symmetry the limit point lies on the diagonal through the corner and the normal is the
+/// diagonal's direction.
+#[test]
+fn seam_limit_points_at_extraordinary_vertices_are_exact() {
+    let mesh = Mesh::read_obj(data("cube_uv.obj")).expect("reads");
+    let surface = Surface::new(&mesh, subtess::Scheme::CatmullClark).expect("surface");
+    let mut tess = surface.tessellator(&Rates::Uniform(4)).expect("plan");
+    let frame = tess.evaluate(&mesh.positions_f32()).expect("frame");
+    let mut corners = 0;
+    for ((s, p), n) in frame
+        .sources()
+        .iter()
+        .zip(frame.positions())
+        .zip(frame.normals())
+    {
+        let (u, v) = s.uv();
+        if !(u == 0.0 || u == 1.0) || !(v == 0.0 || v == 1.0) {
+            continue;
+        }
+        corners += 1;
+        let diagonal = p.map(|c| c.signum() / 3f32.sqrt());
+        let off_axis = p
+            .iter()
+            .map(|c| (c.abs() - p[0].abs()).abs())
+            .fold(0.0, f32::max);
+        assert!(off_axis < 1e-6, "corner limit {p:?} off the diagonal");
+        for c in 0..3 {
+            assert!((n[c] - diagonal[c]).abs() < 1e-6, "normal {n:?} at {p:?}");
+        }
+    }
+    // 8 corners, three faces each.
+    assert_eq!(corners, 24);
+}

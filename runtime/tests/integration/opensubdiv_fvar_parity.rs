@@ -23,7 +23,8 @@ use subtess::FaceVaryingMode;
 use subtess_opensubdiv_fvar::{attach, FaceVaryingChannel};
 
 use crate::opensubdiv_parity::{
-    descriptor, models, osd_tags, parse_shape, ptex_offsets, Shape, ISOLATION_LEVEL, RATE,
+    descriptor, located_stencils, models, osd_tags, parse_shape, ptex_offsets, Shape,
+    ISOLATION_LEVEL, RATE,
 };
 
 const FAITHFUL: f64 = 1e-5;
@@ -143,44 +144,22 @@ fn theirs(
             (ptex[face] + sub, u as f32, v as f32)
         })
         .collect();
-    let found: Vec<bool> = points
-        .iter()
-        .map(|&(f, s, t)| map.find_patch(f, s, t).is_some())
-        .collect();
-    let s: Vec<f32> = points.iter().map(|p| p.1).collect();
-    let t: Vec<f32> = points.iter().map(|p| p.2).collect();
-    let locations: Vec<far::LocationArray> = (0..points.len())
-        .filter(|&i| found[i])
-        .map(|i| far::LocationArray {
-            ptex_index: points[i].0,
-            s: &s[i..=i],
-            t: &t[i..=i],
-        })
-        .collect();
-    let mut out = vec![None; points.len()];
-    if locations.is_empty() {
-        return Ok(out);
-    }
-    let table = far::LimitStencilTable::new(
+    let (found, table) = located_stencils(
         &refiner,
-        &locations,
         None,
-        None,
+        &map,
+        &points,
         far::LimitStencilTableOptions {
             interpolation_mode: far::InterpolationMode::FaceVarying,
             generate_1st_derivatives: false,
             generate_2nd_derivatives: false,
             face_varying_channel: 0,
         },
-    )
-    .map_err(|e| format!("face-varying limit stencil table: {e}"))?;
-    if table.len() != locations.len() {
-        return Err(format!(
-            "{} stencils for {} located points",
-            table.len(),
-            locations.len()
-        ));
-    }
+    )?;
+    let mut out = vec![None; points.len()];
+    let Some(table) = table else {
+        return Ok(out);
+    };
     let (sizes, offsets, cv, w) = (
         table.sizes(),
         table.offsets(),

@@ -292,8 +292,13 @@ struct Ours {
 }
 
 fn subtess_side(path: &Path, shape: &Shape) -> Result<Ours, String> {
-    let (mesh, _warnings) =
+    let (mut mesh, _warnings) =
         subtess::Mesh::read_obj_with_warnings(path).map_err(|e| e.to_string())?;
+    // Positions only: texture seams would add limit points at smooth extraordinary vertices,
+    // cone points and darts, where OpenSubdiv's level-10 end caps give approximate or
+    // undefined normals (the cube's corners: ours along the diagonal, as symmetry demands,
+    // Far's 3.6e-3 rad off); `opensubdiv_fvar_parity` compares the texture coordinates.
+    mesh.face_varying = None;
     // Copies that split non-manifold vertices are not input vertices.
     if mesh.input_vertices() != shape.positions.len() || mesh.faces() != shape.faces.len() {
         return Err(format!(
@@ -367,6 +372,46 @@ pub(super) fn descriptor<'a>(
     Ok(d)
 }
 
+/// A `Far::LimitStencilTable` at those `(ptex face, s, t)` points that have a patch in `map`:
+/// which have one, and the table (a stencil per such point, in order; `None` when none has).
+/// `patches: None` lets the factory build the patch table (with face-varying tables when the
+/// options ask for face-varying stencils).
+pub(super) fn located_stencils(
+    refiner: &far::TopologyRefiner,
+    patches: Option<&far::PatchTable>,
+    map: &far::PatchMap,
+    points: &[(usize, f32, f32)],
+    options: far::LimitStencilTableOptions,
+) -> Result<(Vec<bool>, Option<far::LimitStencilTable>), String> {
+    let found: Vec<bool> = points
+        .iter()
+        .map(|&(f, s, t)| map.find_patch(f, s, t).is_some())
+        .collect();
+    let s: Vec<f32> = points.iter().map(|p| p.1).collect();
+    let t: Vec<f32> = points.iter().map(|p| p.2).collect();
+    let locations: Vec<far::LocationArray> = (0..points.len())
+        .filter(|&i| found[i])
+        .map(|i| far::LocationArray {
+            ptex_index: points[i].0,
+            s: &s[i..=i],
+            t: &t[i..=i],
+        })
+        .collect();
+    if locations.is_empty() {
+        return Ok((found, None));
+    }
+    let table = far::LimitStencilTable::new(refiner, &locations, None, patches, options)
+        .map_err(|e| format!("limit stencil table: {e}"))?;
+    if table.len() != locations.len() {
+        return Err(format!(
+            "limit stencil table: {} stencils for {} located points",
+            table.len(),
+            locations.len()
+        ));
+    }
+    Ok((found, Some(table)))
+}
+
 /// OpenSubdiv's Far side of one shape: the adaptively refined topology and its patch table.
 struct Far {
     refiner: far::TopologyRefiner,
@@ -425,39 +470,17 @@ impl Far {
         points: &[(usize, f32, f32)],
         control: &[[f32; 3]],
     ) -> Result<Vec<Limit>, String> {
-        let found: Vec<bool> = points
-            .iter()
-            .map(|&(f, s, t)| self.map.find_patch(f, s, t).is_some())
-            .collect();
-        let s: Vec<f32> = points.iter().map(|p| p.1).collect();
-        let t: Vec<f32> = points.iter().map(|p| p.2).collect();
-        let locations: Vec<far::LocationArray> = (0..points.len())
-            .filter(|&i| found[i])
-            .map(|i| far::LocationArray {
-                ptex_index: points[i].0,
-                s: &s[i..=i],
-                t: &t[i..=i],
-            })
-            .collect();
-        let mut out = vec![None; points.len()];
-        if locations.is_empty() {
-            return Ok(out);
-        }
-        let table = far::LimitStencilTable::new(
+        let (found, table) = located_stencils(
             &self.refiner,
-            &locations,
-            None,
             Some(&self.patches),
+            &self.map,
+            points,
             far::LimitStencilTableOptions::default(),
-        )
-        .map_err(|e| format!("limit stencil table: {e}"))?;
-        if table.len() != locations.len() {
-            return Err(format!(
-                "limit stencil table: {} stencils for {} located points",
-                table.len(),
-                locations.len()
-            ));
-        }
+        )?;
+        let mut out = vec![None; points.len()];
+        let Some(table) = table else {
+            return Ok(out);
+        };
         let (sizes, offsets) = (table.sizes(), table.offsets());
         let (cv, w, wu, wv) = (
             table.control_indices(),
