@@ -56,7 +56,7 @@ pub struct Mesh {
     pub smooth_triangles: bool,
     /// Texture coordinates: one face-varying channel over the faces ([`FaceVarying`]), `None`
     /// without (and on refined meshes: the channel has its own mesh,
-    /// [`crate::mesh::face_varying::channel_mesh`]).
+    /// `scheme::catmull_clark::face_varying::channel_mesh`).
     pub face_varying: Option<FaceVarying>,
 }
 

@@ -311,11 +311,12 @@ impl<'t> DualGrid<'t> {
 
     /// [`DualGrid::new`] with output vertices split along the seams of a face-varying channel:
     /// `channel[h]` is the channel's vertex at corner `h` of `mesh` (the face-varying channel's
-    /// mesh refined as `mesh` was, [`crate::mesh::face_varying::channel_mesh`]). A seam (an
-    /// edge whose two faces disagree at an end) is sampled like an infinitely sharp crease, and
-    /// each side gets its own copies of the curve's points and of the vertex limit points, one
-    /// per channel vertex: same stencils, so the same position bits, but each with a source on
-    /// its own side ([`DualGrid::seam_copies`]).
+    /// mesh refined as `mesh` was,
+    /// [`crate::scheme::catmull_clark::face_varying::ChannelIsolation`]). A seam (an edge whose
+    /// two faces disagree at an end) is sampled like an infinitely sharp crease, and each side
+    /// gets its own copies of the curve's points and of the vertex limit points, one per channel
+    /// vertex: same stencils, so the same position bits, but each with a source on its own side
+    /// ([`GridPlan::seam_copies`]).
     pub fn with_channel(
         table: &'t StencilTable,
         mesh: &Mesh,

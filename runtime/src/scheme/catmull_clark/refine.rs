@@ -18,9 +18,9 @@
 //!   midpoints of its edges); crease `(E_a + 6 V + E_b) / 8` along its two sharp edges (the
 //!   boundary rule); corner `V`. When the rule of the vertex's child differs, the point is
 //!   `w * (parent rule) + (1 - w) * (child rule)` with the fractional weight `w`
-//!   ([`CreaseMethod::fractional_weight`]).
+//!   ([`schemes::CreaseMethod::fractional_weight`]).
 //!
-//! The children's sharpness: an edge's two halves decay by the mesh's [`CreaseMethod`], a
+//! The children's sharpness: an edge's two halves decay by the mesh's [`schemes::CreaseMethod`], a
 //! vertex's sharpness loses one unit, the edges inside a face are smooth; a hole's children are
 //! holes.
 

@@ -20,7 +20,7 @@ pub enum EdgeTest {
     Map4p,
     /// Eight-point map test: Map4p `OR |dk − d12| > th` for `k = 5..8` (see [`map8p_points`]).
     Map8p,
-    /// The baseline (Espino et al. [Espin04]; Chung & Field): evaluate the candidate vertex
+    /// The baseline (Espino et al.'s Espin04; Chung & Field): evaluate the candidate vertex
     /// and its normal, then decide ([`flat_test`]).
     Flat,
 }
