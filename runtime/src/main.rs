@@ -285,6 +285,10 @@ struct TessellateArgs {
     /// facevaryinginterpolateboundary`, else all).
     #[arg(long = "uv-interpolation", value_parser = uv_interpolation_arg)]
     uv_interpolation: Option<FaceVaryingMode>,
+    /// Ignore the mesh's texture coordinates: no `vt` in the output and no vertices split
+    /// along texture seams.
+    #[arg(long = "no-uvs", conflicts_with = "uv_interpolation")]
+    no_uvs: bool,
     /// Print statistics as JSON on stdout.
     #[arg(long)]
     stats: bool,
@@ -426,6 +430,9 @@ fn tessellate_command(args: TessellateArgs) -> Result<(), RuntimeError> {
     let mut input = load_mesh(mesh)?;
     if let (Some(mode), Some(channel)) = (args.uv_interpolation, &mut input.face_varying) {
         channel.mode = mode;
+    }
+    if args.no_uvs {
+        input.face_varying = None;
     }
     if input.face_varying.is_some() && args.scheme.is_triangle() {
         eprintln!(

@@ -374,3 +374,40 @@ fn seam_limit_points_at_extraordinary_vertices_are_exact() {
     // 8 corners, three faces each.
     assert_eq!(corners, 24);
 }
+
+/// `--no-uvs` drops the texture coordinates: no `vt`, no seam vertices, and the output of the
+/// mesh without them.
+#[test]
+fn no_uvs_drops_the_texture_coordinates() {
+    let dir = std::env::temp_dir().join(format!("subtess-no-uv-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let input = data("cube_uv.obj");
+    let plain = data("cube.obj");
+    let (with, without) = (dir.join("with.obj"), dir.join("without.obj"));
+    let stats = subtess(&[
+        "tessellate",
+        input.to_str().expect("utf-8"),
+        "-o",
+        with.to_str().expect("utf-8"),
+        "--no-uvs",
+        "--stats",
+    ]);
+    let stats: serde_json::Value = serde_json::from_str(&stats).expect("JSON");
+    assert_eq!(stats["uvs"], false);
+    assert_eq!(stats["seam_vertices"], 0);
+    subtess(&[
+        "tessellate",
+        plain.to_str().expect("utf-8"),
+        "-o",
+        without.to_str().expect("utf-8"),
+    ]);
+    let body = |p: &Path| {
+        let text = std::fs::read_to_string(p).expect("written");
+        text.lines()
+            .filter(|l| !l.starts_with('#'))
+            .map(str::to_owned)
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(body(&with), body(&without));
+    std::fs::remove_dir_all(&dir).ok();
+}
