@@ -491,10 +491,10 @@ fn json_bytes(json: &Value, path: &Path) -> Result<Vec<u8>, RuntimeError> {
 ///
 /// One buffer in the BIN chunk, in this order: `POSITION` (VEC3 FLOAT, with `min`/`max`),
 /// `NORMAL` (VEC3 FLOAT), with texture coordinates `TEXCOORD_0` (VEC2 FLOAT, `(s, 1 - t)`:
-/// glTF's origin is the image's top left), `_UV_SOURCE` (VEC2 FLOAT: the source `(u, v)`), `_FACE` (SCALAR
-/// FLOAT: the source face, written only while every face is below [`GLTF_FACE_LIMIT`], where
-/// `f32` holds it exactly; glTF forbids unsigned int components for custom attributes), then
-/// the indices (SCALAR UNSIGNED_INT). One bufferView each (`target` 34962 for attributes,
+/// glTF's origin is the image's top left), `_UV_SOURCE` (VEC2 FLOAT: the source `(u, v)`),
+/// `_FACE` (SCALAR FLOAT: the source face, written only while every face is below
+/// [`GLTF_FACE_LIMIT`], where `f32` holds it exactly; glTF forbids unsigned int components for
+/// custom attributes), then the indices (SCALAR UNSIGNED_INT). One bufferView each (`target` 34962 for attributes,
 /// 34963 for indices), one mesh with one TRIANGLES primitive, one node, one scene;
 /// `asset.generator` is `subtess VERSION`. The JSON chunk is padded with spaces and the BIN
 /// chunk with zeros to multiples of 4 bytes. A file of 4 GiB or more (about 100 million

@@ -1,8 +1,8 @@
 //! The face-varying channel (texture coordinates) of a Catmull–Clark surface: the channel's own
 //! mesh as OpenSubdiv derives it ([`channel_mesh`], after
-//! `Vtr::FVarLevel::completeTopologyFromFaceValues`), and that mesh refined by the same steps as the positions, so that its
-//! faces and corners are the isolated mesh's, and its limit values at any points of those
-//! faces.
+//! `Vtr::FVarLevel::completeTopologyFromFaceValues`), and that mesh refined by the same steps
+//! as the positions, so that its faces and corners are the isolated mesh's, and its limit
+//! values at any points of those faces.
 //!
 //! The values are evaluated once, when a tessellation is planned: they do not move with the
 //! control points. Smooth modes take exact limit stencils by feature-adaptive refinement of the
