@@ -428,3 +428,20 @@ fn invalid_cameras_are_refused() {
         assert!(e.to_string().contains("camera"), "{e}");
     }
 }
+
+/// The selection stops measuring a rate as soon as one sample exceeds the tolerance; it must
+/// still pick what trying every rate in full picks: per face the smallest `n` with
+/// `e_f(n) <= T` (and that `e_f(n)`), or 24 and `e_f(24)` when none does.
+#[test]
+fn tolerance_rates_equal_the_full_search() {
+    let (isolated, patches, _) = isolate(&cube()).expect("isolates");
+    for t in [3e-2, 1e-3, 2e-5] {
+        let chosen = tolerance_rates(table(), &isolated, &patches, t).expect("rates");
+        for f in 0..patches.len() {
+            let full = |n| face_deviation(table(), &isolated, &patches, f, n).expect("deviation");
+            let expected = (1..=24u32).find(|&n| full(n) <= t).unwrap_or(24);
+            assert_eq!(chosen.rates[f], expected, "face {f} T = {t}");
+            assert_eq!(chosen.deviations[f], full(expected), "face {f} T = {t}");
+        }
+    }
+}
