@@ -537,19 +537,25 @@ impl Template {
 
     /// `e_f(n)`: the largest distance from a sample to `L_{f,n}` at the same parameters.
     fn deviation(&self, points: &[[f64; 3]], samples: &[[f64; 3]]) -> f64 {
-        self.triangles
-            .iter()
-            .zip(&self.weights)
-            .zip(samples)
-            .map(|((t, w), s)| {
-                let mut d = 0.0;
-                for c in 0..3 {
-                    let l: f64 = (0..3).map(|k| w[k] * points[t[k] as usize][c]).sum();
-                    d += (s[c] - l) * (s[c] - l);
-                }
-                d.sqrt()
-            })
-            .fold(0.0, f64::max)
+        self.deviation_up_to(points, samples, f64::INFINITY)
+    }
+
+    /// `e_f(n)`, or, as soon as one sample deviates by more than `stop`, that sample's
+    /// deviation (a lower bound, enough to reject the rate; as the quad selection does).
+    fn deviation_up_to(&self, points: &[[f64; 3]], samples: &[[f64; 3]], stop: f64) -> f64 {
+        let mut worst = 0.0f64;
+        for ((t, w), s) in self.triangles.iter().zip(&self.weights).zip(samples) {
+            let mut d = 0.0;
+            for c in 0..3 {
+                let l: f64 = (0..3).map(|k| w[k] * points[t[k] as usize][c]).sum();
+                d += (s[c] - l) * (s[c] - l);
+            }
+            worst = worst.max(d.sqrt());
+            if worst > stop {
+                break;
+            }
+        }
+        worst
     }
 }
 
@@ -631,6 +637,8 @@ pub fn triangle_tolerance_rates_among(
         .par_iter()
         .map(|&(n, m)| Ok(((n, m), Template::new(n, m, &grid)?)))
         .collect::<Result<_, RuntimeError>>()?;
+    // Only the largest rate's deviation is reported when no rate meets the tolerance.
+    let largest = sorted.last().copied().unwrap_or(0);
     select_rates(
         iso.patches.len(),
         tolerance,
@@ -640,7 +648,12 @@ pub fn triangle_tolerance_rates_among(
             let template = templates.get(&(n, *mask)).ok_or_else(|| {
                 RuntimeError::Unsupported(format!("no sample template at rate {n}"))
             })?;
-            Ok(template.deviation(&ctx.local_points(f, n)?, samples))
+            let stop = if n == largest {
+                f64::INFINITY
+            } else {
+                tolerance
+            };
+            Ok(template.deviation_up_to(&ctx.local_points(f, n)?, samples, stop))
         },
     )
 }

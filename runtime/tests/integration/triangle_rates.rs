@@ -245,3 +245,26 @@ fn spot_report() {
         assert!(chosen.unmet.is_empty());
     }
 }
+
+/// As for quads: stopping a rate's measurement at the first sample beyond the tolerance still
+/// picks the full search's rate (the smallest table rate with `e_f(n) <= T`, else the largest)
+/// and reports its full deviation.
+#[test]
+fn triangle_tolerance_rates_equal_the_full_search() {
+    let iso = isolate_loop(&icosahedron()).expect("isolates");
+    let rates = triangle_table_rates(loop_table());
+    let largest = *rates.last().expect("rates");
+    for t in [3e-2, 1e-3, 1e-6] {
+        let chosen = triangle_tolerance_rates(loop_table(), &iso, t).expect("rates");
+        for f in 0..iso.patches.len() {
+            let full = |n| triangle_face_deviation(loop_table(), &iso, f, n).expect("deviation");
+            let expected = rates
+                .iter()
+                .copied()
+                .find(|&n| full(n) <= t)
+                .unwrap_or(largest);
+            assert_eq!(chosen.rates[f], expected, "triangle {f} T = {t}");
+            assert_eq!(chosen.deviations[f], full(expected), "triangle {f} T = {t}");
+        }
+    }
+}
