@@ -74,15 +74,20 @@ pub fn default_sqrt3() -> &'static [u8] {
 
 #[cfg(test)]
 mod tests {
-    #[test]
-    fn embedded_table_is_aligned_and_starts_with_the_magic() {
-        for bytes in [
+    /// Every embedded table.
+    fn all() -> [&'static [u8]; 5] {
+        [
             super::default_catmull_clark(),
             super::default_catmull_clark_corners(),
             super::default_loop(),
             super::default_butterfly(),
             super::default_sqrt3(),
-        ] {
+        ]
+    }
+
+    #[test]
+    fn embedded_table_is_aligned_and_starts_with_the_magic() {
+        for bytes in all() {
             assert_eq!(bytes.as_ptr() as usize % 64, 0);
             assert_eq!(&bytes[..8], b"SUBTESS\0");
         }
@@ -92,13 +97,7 @@ mod tests {
     /// generator's output is checked here once.
     #[test]
     fn embedded_weights_are_finite() {
-        for bytes in [
-            super::default_catmull_clark(),
-            super::default_catmull_clark_corners(),
-            super::default_loop(),
-            super::default_butterfly(),
-            super::default_sqrt3(),
-        ] {
+        for bytes in all() {
             let index = table_format::TableIndex::parse(bytes).expect("valid");
             index.check_finite(bytes).expect("finite");
         }

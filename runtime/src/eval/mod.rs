@@ -79,10 +79,14 @@ pub fn limit_uv(
             reason: format!("{subface}: face {face} has {sides} sides"),
         });
     }
-    let (uf, vf) = (
-        u.to_f64().unwrap_or(f64::NAN),
-        v.to_f64().unwrap_or(f64::NAN),
-    );
+    let unit = |x: &BigRational, name: &str| match x.to_f64() {
+        Some(f) if (0.0..=1.0).contains(&f) => Ok(f),
+        _ => Err(RuntimeError::InvalidParameter {
+            name: name.to_owned(),
+            reason: format!("{x} is not in [0, 1]"),
+        }),
+    };
+    let (uf, vf) = (unit(u, "u")?, unit(v, "v")?);
     if fvar.mode == FaceVaryingMode::All {
         return Ok(Some(fvar.bilinear(
             mesh.face_halfedges(face),

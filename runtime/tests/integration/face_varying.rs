@@ -411,3 +411,16 @@ fn no_uvs_drops_the_texture_coordinates() {
     assert_eq!(body(&with), body(&without));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `eval::limit_uv` refuses parameters outside the face, as `limit_point` does.
+#[test]
+fn limit_uv_refuses_parameters_outside_the_face() {
+    use num_bigint::BigInt;
+    use num_rational::BigRational;
+    let mesh = Mesh::read_obj(data("cube_uv.obj")).expect("reads");
+    let half = BigRational::new(BigInt::from(1), BigInt::from(2));
+    let outside = BigRational::new(BigInt::from(3), BigInt::from(2));
+    assert!(subtess::eval::limit_uv(&mesh, 0, 0, &half, &half).is_ok());
+    assert!(subtess::eval::limit_uv(&mesh, 0, 0, &outside, &half).is_err());
+    assert!(subtess::eval::limit_uv(&mesh, 0, 0, &half, &-half.clone()).is_err());
+}

@@ -23,8 +23,7 @@ use subtess::FaceVaryingMode;
 use subtess_opensubdiv_fvar::{attach, FaceVaryingChannel};
 
 use crate::opensubdiv_parity::{
-    descriptor, located_stencils, models, osd_tags, parse_shape, ptex_offsets, Shape,
-    ISOLATION_LEVEL, RATE,
+    descriptor, located_stencils, models, osd_tags, parse_shape, Far, Shape, RATE,
 };
 
 const FAITHFUL: f64 = 1e-5;
@@ -111,43 +110,19 @@ fn theirs(
         shape.positions.len(),
         shape.faces.len(),
     );
-    let mut refiner =
-        far::TopologyRefiner::new(desc, options).map_err(|e| format!("topology refiner: {e}"))?;
-    refiner.refine_adaptive(
-        far::AdaptiveRefinementOptions {
-            isolation_level: ISOLATION_LEVEL,
-            secondary_level: 15,
-            single_crease_patch: false,
-            infintely_sharp_patch: true,
-            consider_face_varying_channels: true,
-            order_vertices_from_faces_first: false,
-        },
-        &[],
-    );
-    let patches = far::PatchTable::new(
-        &refiner,
-        Some(far::PatchTableOptions::new().use_inf_sharp_patch(true)),
-    )
-    .map_err(|e| format!("patch table: {e}"))?;
-    let map = far::PatchMap::new(&patches).ok_or("patch map")?;
-    let ptex = ptex_offsets(&shape.faces);
+    let osd = Far::from_descriptor(shape, desc, options, true)?;
     let points: Vec<(usize, f32, f32)> = sources
         .iter()
         .map(|src| {
             let (u, v) = src.uv();
-            let face = src.face as usize;
-            let sub = if shape.faces[face].len() == 4 {
-                0
-            } else {
-                usize::from(src.subface)
-            };
-            (ptex[face] + sub, u as f32, v as f32)
+            let face = osd.ptex_face(src.face as usize, usize::from(src.subface));
+            (face, u as f32, v as f32)
         })
         .collect();
     let (found, table) = located_stencils(
-        &refiner,
+        &osd.refiner,
         None,
-        &map,
+        &osd.map,
         &points,
         far::LimitStencilTableOptions {
             interpolation_mode: far::InterpolationMode::FaceVarying,

@@ -71,7 +71,7 @@ const FAITHFUL_POSITION: f64 = 1e-5;
 const FAITHFUL_NORMAL: f64 = 2e-3;
 /// `|du x dv| / (|du| |dv|)` below this: OpenSubdiv's normal is not compared.
 const PARALLEL_TANGENTS: f64 = 1e-2;
-pub(super) const ISOLATION_LEVEL: usize = 10;
+const ISOLATION_LEVEL: usize = 10;
 pub(super) const RATE: u32 = 4;
 
 /// `shared/models/opensubdiv` beside the repository.
@@ -342,7 +342,7 @@ type Limit = Option<([f64; 3], [f64; 3], [f64; 3])>;
 
 /// The first Ptex face of every base face (`Far::PtexIndices` for Catmark: a quad has one, an
 /// n-gon n, holes included).
-pub(super) fn ptex_offsets(faces: &[Vec<u32>]) -> Vec<usize> {
+fn ptex_offsets(faces: &[Vec<u32>]) -> Vec<usize> {
     let mut offsets = Vec::with_capacity(faces.len());
     let mut next = 0;
     for f in faces {
@@ -413,10 +413,10 @@ pub(super) fn located_stencils(
 }
 
 /// OpenSubdiv's Far side of one shape: the adaptively refined topology and its patch table.
-struct Far {
-    refiner: far::TopologyRefiner,
+pub(super) struct Far {
+    pub(super) refiner: far::TopologyRefiner,
     patches: far::PatchTable,
-    map: far::PatchMap,
+    pub(super) map: far::PatchMap,
     /// The first Ptex face of every base face.
     ptex: Vec<usize>,
     /// Sides of every base face.
@@ -428,7 +428,18 @@ impl Far {
         let sizes: Vec<u32> = shape.faces.iter().map(|f| f.len() as u32).collect();
         let indices: Vec<u32> = shape.faces.iter().flatten().copied().collect();
         let desc = descriptor(shape, &sizes, &indices, tags)?;
-        let mut refiner = far::TopologyRefiner::new(desc, tags.options)
+        Far::from_descriptor(shape, desc, tags.options, false)
+    }
+
+    /// [`Far::new`] from a descriptor and options made by the caller; `face_varying`: the
+    /// adaptive refinement isolates the descriptor's face-varying channel's features too.
+    pub(super) fn from_descriptor(
+        shape: &Shape,
+        desc: far::TopologyDescriptor,
+        options: far::TopologyRefinerOptions,
+        face_varying: bool,
+    ) -> Result<Far, String> {
+        let mut refiner = far::TopologyRefiner::new(desc, options)
             .map_err(|e| format!("topology refiner: {e}"))?;
         refiner.refine_adaptive(
             far::AdaptiveRefinementOptions {
@@ -436,7 +447,7 @@ impl Far {
                 secondary_level: 15,
                 single_crease_patch: false,
                 infintely_sharp_patch: true,
-                consider_face_varying_channels: false,
+                consider_face_varying_channels: face_varying,
                 order_vertices_from_faces_first: false,
             },
             &[],
@@ -459,7 +470,7 @@ impl Far {
     }
 
     /// The Ptex face of sub-face `subface` of base face `face`.
-    fn ptex_face(&self, face: usize, subface: usize) -> usize {
+    pub(super) fn ptex_face(&self, face: usize, subface: usize) -> usize {
         self.ptex[face] + if self.sides[face] == 4 { 0 } else { subface }
     }
 
