@@ -100,22 +100,32 @@ use crate::RuntimeError;
 
 /// The limit surface at one point: position and first derivatives, in the face's own `(u, v)`
 /// (DESIGN.md conventions: `(0,0)` at the face's first vertex, `(1,0)` at its second).
+///
+/// What is exact (the exact value rounded once to f64): the position always (on meshes with
+/// sharp features too, [`super::feature_eval`]); the derivatives everywhere but at a vertex
+/// that is extraordinary or a feature. What is f64: the tangents at an extraordinary vertex
+/// (the tables' irrational masks) and at a feature vertex — a corner, a crease, a dart, a
+/// crease sector (OpenSubdiv's tangent masks, at darts and sectors of three or more faces
+/// their eigen-iteration), applied exactly and rounded once.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LimitPoint {
     /// The limit position.
     pub position: [f64; 3],
     /// `dS/du`. At an extraordinary vertex: the tables' tangent mask along the face's `u` edge
-    /// (see the module documentation), not a parametric derivative.
+    /// (see the module documentation), not a parametric derivative. At a feature vertex of a
+    /// mesh with sharp features: a tangent along the frame of the face the descent ended in
+    /// ([`super::feature_eval`]); with [`LimitPoint::dv`] it spans the tangent plane and its
+    /// cross product with it is the outward normal.
     pub du: [f64; 3],
     /// `dS/dv`, likewise.
     pub dv: [f64; 3],
 }
 
 /// An exact point.
-type Point = [BigRational; 3];
+pub(crate) type Point = [BigRational; 3];
 
 /// Position, `d/du`, `d/dv` in patch parameters.
-type Derivatives = ([f64; 3], [f64; 3], [f64; 3]);
+pub(crate) type Derivatives = ([f64; 3], [f64; 3], [f64; 3]);
 
 /// The most bits of a parameter's numerator and denominator, in lowest terms
 /// ([`parse_rational`]; docs/reliability.md).
@@ -184,8 +194,11 @@ pub fn evaluate_subface(
 /// steps [`crate::scheme::catmull_clark::isolate`] would take, and reuses that for every call.
 #[derive(Debug)]
 pub struct ExactEvaluator {
-    /// `levels[0]` is the mesh, `levels[i]` its `i`-th refinement.
+    /// `levels[0]` is the mesh, `levels[i]` its `i`-th refinement (none for a mesh with sharp
+    /// features, which [`super::feature_eval`] refines locally, point by point).
     levels: Vec<Mesh>,
+    /// Whether the mesh has sharp features ([`Mesh::has_sharp_features`]).
+    tagged: bool,
     /// The edge numbering of each refinement step (`levels[i]` -> `levels[i + 1]`).
     edges: Vec<LevelEdges>,
     scheme: QuadScheme,
@@ -212,6 +225,86 @@ struct Located {
     jacobian: [[i64; 2]; 2],
 }
 
+/// Checks a query: face `face` exists, `corner` names one of its sub-faces (0 for a quad), `u`
+/// and `v` lie in `[0, 1]`; the face's number of sides.
+pub(crate) fn check_query(
+    mesh: &Mesh,
+    face: usize,
+    corner: usize,
+    u: &BigRational,
+    v: &BigRational,
+) -> Result<usize, RuntimeError> {
+    let bad = |text: String, reason: String| RuntimeError::InvalidParameter {
+        name: format!("`{text}`"),
+        reason,
+    };
+    if face >= mesh.faces() {
+        return Err(bad(
+            format!("face {face}"),
+            format!(
+                "the mesh has {} faces, numbered from 0 in file order",
+                mesh.faces()
+            ),
+        ));
+    }
+    let (zero, one) = (BigRational::zero(), BigRational::one());
+    for (name, x) in [("u", u), ("v", v)] {
+        if *x < zero || *x > one {
+            return Err(bad(
+                format!("{name} = {x}"),
+                "a face's parameters lie in [0, 1]".to_owned(),
+            ));
+        }
+    }
+    let sides = mesh.face(face).len();
+    if sides == 4 && corner != 0 {
+        return Err(bad(
+            format!("corner {corner}"),
+            format!("face {face} is a quad: it is its own domain, use corner 0"),
+        ));
+    }
+    if corner >= sides {
+        return Err(bad(
+            format!("corner {corner}"),
+            format!("face {face} has {sides} corners (sub-faces 0..{sides})"),
+        ));
+    }
+    Ok(sides)
+}
+
+/// The quarter of a quad holding face parameters `(s, t)` (module documentation, step 1):
+/// child `c` of [`refine`], at corner `c`, the point in the child's own parameters, and the
+/// matrix `d(child parameters) / d(parent parameters)`. A point on the lines `s = 1/2` or
+/// `t = 1/2` goes to the lower quarter.
+pub(crate) fn descend(
+    s: &BigRational,
+    t: &BigRational,
+) -> (usize, BigRational, BigRational, [[i64; 2]; 2]) {
+    let half = ratio(1, 2);
+    let two = int(2);
+    match (*s > half, *t > half) {
+        (false, false) => (0, &two * s, &two * t, [[2, 0], [0, 2]]),
+        (true, false) => (1, &two * t, &two - &two * s, [[0, 2], [-2, 0]]),
+        (true, true) => (2, &two - &two * s, &two - &two * t, [[-2, 0], [0, -2]]),
+        (false, true) => (3, &two - &two * t, &two * s, [[0, -2], [2, 0]]),
+    }
+}
+
+/// Face parameters `(s, t)` in the parameters of a patch whose `(0, 0)` is the face's corner
+/// `corner` (module documentation, step 2), and the rotation `d(patch) / d(face)`.
+pub(crate) fn to_corner(
+    corner: usize,
+    s: &BigRational,
+    t: &BigRational,
+) -> (BigRational, BigRational, [[i64; 2]; 2]) {
+    match corner {
+        0 => (s.clone(), t.clone(), [[1, 0], [0, 1]]),
+        1 => (t.clone(), int(1) - s, [[0, 1], [-1, 0]]),
+        2 => (int(1) - s, int(1) - t, [[-1, 0], [0, -1]]),
+        _ => (int(1) - t, s.clone(), [[0, -1], [1, 0]]),
+    }
+}
+
 fn mul(a: [[i64; 2]; 2], b: [[i64; 2]; 2]) -> [[i64; 2]; 2] {
     let mut c = [[0; 2]; 2];
     for i in 0..2 {
@@ -222,11 +315,11 @@ fn mul(a: [[i64; 2]; 2], b: [[i64; 2]; 2]) -> [[i64; 2]; 2] {
     c
 }
 
-fn ratio(p: i64, q: i64) -> BigRational {
+pub(crate) fn ratio(p: i64, q: i64) -> BigRational {
     BigRational::ratio(p, q)
 }
 
-fn int(i: i64) -> BigRational {
+pub(crate) fn int(i: i64) -> BigRational {
     BigRational::from_integer(BigInt::from(i))
 }
 
@@ -236,7 +329,8 @@ impl ExactEvaluator {
     pub fn new(mesh: &Mesh) -> Self {
         let mut levels = vec![mesh.clone()];
         let mut edges = Vec::new();
-        while levels.len() <= MAX_STEPS {
+        let tagged = mesh.has_sharp_features();
+        while !tagged && levels.len() <= MAX_STEPS {
             let last = &levels[levels.len() - 1];
             if gather_patches(last).is_ok() {
                 break;
@@ -247,6 +341,7 @@ impl ExactEvaluator {
         }
         ExactEvaluator {
             levels,
+            tagged,
             edges,
             scheme: QuadScheme::by_name("catmull-clark")
                 .unwrap_or_else(|| unreachable!("catmull-clark is catalogued")),
@@ -310,22 +405,10 @@ impl ExactEvaluator {
         u: &BigRational,
         v: &BigRational,
     ) -> Result<LimitPoint, RuntimeError> {
-        let located = self.locate(face, corner, u, v)?;
-        let nb = if located.patch.kind.boundary {
-            Neighbourhood::boundary(located.patch.kind.faces, self.levels[0].boundary)
-        } else {
-            Neighbourhood::interior(located.patch.kind.faces)
-        };
-        let operators = self.operators(nb, located.patch.kind.sector)?;
-        let matrices = &operators.matrices;
-        if matrices.size() != located.patch.points.len() {
-            return Err(RuntimeError::Unsupported(format!(
-                "face {face}: its patch ({}) has {} control points, the layout {}",
-                matrices.describe(),
-                located.patch.points.len(),
-                matrices.size()
-            )));
+        if self.tagged {
+            return super::feature_eval::evaluate(self, face, corner, u, v);
         }
+        let located = self.locate(face, corner, u, v)?;
         let mut exact = ExactPositions::new(self);
         let points: Vec<Point> = located
             .patch
@@ -333,8 +416,14 @@ impl ExactEvaluator {
             .iter()
             .map(|&p| exact.vertex(located.level, p as usize))
             .collect();
-        let (position, du, dv) =
-            evaluate_patch(&operators, &points, &located.u, &located.v, located.level)?;
+        let (position, du, dv) = self.table_patch(
+            face,
+            &located.patch,
+            &points,
+            &located.u,
+            &located.v,
+            located.level,
+        )?;
         // d/d(face) = M^T d/d(patch); M's entries are 0 or +-2^m: exact.
         let m = located.jacobian;
         let combine = |a: i64, b: i64| -> [f64; 3] {
@@ -347,6 +436,36 @@ impl ExactEvaluator {
         })
     }
 
+    /// Position, `d/du`, `d/dv` in patch parameters `(u, v)` of the table patch `patch` (of face
+    /// `face`, for messages) with exact control points `points` in its layout, `level` steps
+    /// below the input mesh (Schaefer–Warren substitution, module documentation steps 3–4).
+    pub(crate) fn table_patch(
+        &self,
+        face: usize,
+        patch: &crate::scheme::patch::FacePatch,
+        points: &[Point],
+        u: &BigRational,
+        v: &BigRational,
+        level: usize,
+    ) -> Result<Derivatives, RuntimeError> {
+        let nb = if patch.kind.boundary {
+            Neighbourhood::boundary(patch.kind.faces, self.levels[0].boundary)
+        } else {
+            Neighbourhood::interior(patch.kind.faces)
+        };
+        let operators = self.operators(nb, patch.kind.sector)?;
+        let matrices = &operators.matrices;
+        if matrices.size() != points.len() {
+            return Err(RuntimeError::Unsupported(format!(
+                "face {face}: its patch ({}) has {} control points, the layout {}",
+                matrices.describe(),
+                points.len(),
+                matrices.size()
+            )));
+        }
+        evaluate_patch(&operators, points, u, v, level)
+    }
+
     fn locate(
         &self,
         face: usize,
@@ -354,45 +473,10 @@ impl ExactEvaluator {
         u: &BigRational,
         v: &BigRational,
     ) -> Result<Located, RuntimeError> {
-        let bad = |text: String, reason: String| RuntimeError::InvalidParameter {
-            name: format!("`{text}`"),
-            reason,
-        };
         let mesh = &self.levels[0];
-        if face >= mesh.faces() {
-            return Err(bad(
-                format!("face {face}"),
-                format!(
-                    "the mesh has {} faces, numbered from 0 in file order",
-                    mesh.faces()
-                ),
-            ));
-        }
-        let (zero, one) = (BigRational::zero(), BigRational::one());
-        for (name, x) in [("u", u), ("v", v)] {
-            if *x < zero || *x > one {
-                return Err(bad(
-                    format!("{name} = {x}"),
-                    "a face's parameters lie in [0, 1]".to_owned(),
-                ));
-            }
-        }
-        let sides = mesh.face(face).len();
+        let sides = check_query(mesh, face, corner, u, v)?;
         let (mut level, mut f) = (0, face);
-        if sides == 4 {
-            if corner != 0 {
-                return Err(bad(
-                    format!("corner {corner}"),
-                    format!("face {face} is a quad: it is its own domain, use corner 0"),
-                ));
-            }
-        } else {
-            if corner >= sides {
-                return Err(bad(
-                    format!("corner {corner}"),
-                    format!("face {face} has {sides} corners (sub-faces 0..{sides})"),
-                ));
-            }
+        if sides != 4 {
             if self.levels.len() < 2 {
                 unreachable!("a mesh with a non-quad face is refined at least once");
             }
@@ -401,17 +485,11 @@ impl ExactEvaluator {
         }
         let (mut s, mut t) = (u.clone(), v.clone());
         let mut jacobian = [[1, 0], [0, 1]];
-        let half = BigRational::new(BigInt::from(1), BigInt::from(2));
         loop {
             let current = &self.levels[level];
             match face_patch(current, f) {
                 Ok(patch) => {
-                    let (pu, pv, rotation) = match patch.corner {
-                        0 => (s, t, [[1, 0], [0, 1]]),
-                        1 => (t, int(1) - s, [[0, 1], [-1, 0]]),
-                        2 => (int(1) - s, int(1) - t, [[-1, 0], [0, -1]]),
-                        _ => (int(1) - t, s, [[0, -1], [1, 0]]),
-                    };
+                    let (pu, pv, rotation) = to_corner(patch.corner, &s, &t);
                     return Ok(Located {
                         level,
                         patch,
@@ -423,20 +501,7 @@ impl ExactEvaluator {
                 Err(e) if level + 1 >= self.levels.len() => return Err(e.into()),
                 Err(_) => {}
             }
-            // The quarter of (s, t) and its own parameters (module documentation, step 1).
-            let quarter = match (s > half, t > half) {
-                (false, false) => 0,
-                (true, false) => 1,
-                (true, true) => 2,
-                (false, true) => 3,
-            };
-            let two = int(2);
-            let (ns, nt, map) = match quarter {
-                0 => (&two * &s, &two * &t, [[2, 0], [0, 2]]),
-                1 => (&two * &t, &two - &two * &s, [[0, 2], [-2, 0]]),
-                2 => (&two - &two * &s, &two - &two * &t, [[-2, 0], [0, -2]]),
-                _ => (&two - &two * &t, &two * &s, [[0, -2], [2, 0]]),
-            };
+            let (quarter, ns, nt, map) = descend(&s, &t);
             (s, t) = (ns, nt);
             jacobian = mul(map, jacobian);
             f = current.face_offsets[f] as usize + quarter;
@@ -491,13 +556,13 @@ impl<'e> ExactPositions<'e> {
 /// Points with one common denominator per coordinate: point `j`, coordinate `c` is
 /// `num[j][c] / den[c]`. Applying a rational matrix is then integer arithmetic only.
 #[derive(Clone, Debug)]
-struct Scaled {
+pub(crate) struct Scaled {
     num: Vec<[BigInt; 3]>,
     den: [BigInt; 3],
 }
 
 impl Scaled {
-    fn new(points: &[Point]) -> Self {
+    pub(crate) fn new(points: &[Point]) -> Self {
         let den: [BigInt; 3] = std::array::from_fn(|c| {
             points
                 .iter()
@@ -585,7 +650,12 @@ fn bspline(t: &BigRational, derivative: bool) -> ([BigInt; 4], BigInt) {
 
 /// The bicubic B-spline patch of the 16 points `net` (`(p, q)` in `-1..=2`, `q` outer) at
 /// `(tu, tv)`: position, `d/dtu`, `d/dtv`, each times `factor` for the derivatives.
-fn bicubic(net: &Scaled, tu: &BigRational, tv: &BigRational, factor: &BigInt) -> [[f64; 3]; 3] {
+pub(crate) fn bicubic(
+    net: &Scaled,
+    tu: &BigRational,
+    tv: &BigRational,
+    factor: &BigInt,
+) -> [[f64; 3]; 3] {
     let evaluate = |du: bool, dv: bool| -> [f64; 3] {
         let (wu, nu) = bspline(tu, du);
         let (wv, nv) = bspline(tv, dv);
@@ -659,7 +729,7 @@ fn evaluate_patch(
 
 /// Exact Gaussian elimination: the unique solution of `rows . x = rhs` (more rows than
 /// unknowns allowed, as long as they are consistent), or `None`.
-fn solve_exact(
+pub(crate) fn solve_exact(
     mut rows: Vec<(Vec<BigRational>, BigRational)>,
     n: usize,
 ) -> Option<Vec<BigRational>> {

@@ -2,6 +2,7 @@
 //! triangle and barycentric `(u, v)`.
 
 pub mod exact_eval;
+pub mod feature_eval;
 pub mod loop_exact_eval;
 
 use num_rational::BigRational;
@@ -21,7 +22,13 @@ pub use exact_eval::{parse_rational, LimitPoint};
 /// rational `(u, v)`, in the face's own parameters, rounded once to f64.
 ///
 /// Catmull–Clark: any face; a non-quad face is parameterized by its sub-faces (the quads of
-/// its first step), `subface` picks one (docs/algorithms). Loop: barycentric `(u, v)` with
+/// its first step), `subface` picks one (docs/algorithms). With sharp features (creases and
+/// corners of any sharpness, darts, holes; [`feature_eval`]) the position stays exact: where
+/// the descent ends in a B-spline patch (reflected across infinitely sharp edges) or a smooth
+/// table patch, derivatives too; at a feature vertex (the point at a corner of the final piece)
+/// the position comes from OpenSubdiv's rational limit masks or, at a dart, the exact
+/// eigenvector, and the tangents from f64 masks (see [`LimitPoint`]). A hole face (a `hole`
+/// tag, or a boundary face under `interpolateboundary 0`) is an error: it has no surface. Loop: barycentric `(u, v)` with
 /// `u + v <= 1`, `subface` must be 0. The butterfly and √3 have non-polynomial regular bases;
 /// their exact values need the solver at run time and are refused by name.
 pub fn limit_point(
@@ -33,9 +40,6 @@ pub fn limit_point(
     v: &BigRational,
 ) -> Result<LimitPoint, RuntimeError> {
     match scheme {
-        Scheme::CatmullClark if mesh.has_sharp_features() => Err(RuntimeError::Unsupported(
-            "exact evaluation on sharp features (creases, corners, holes); `subtess tessellate` evaluates them (feature-adaptive refinement, f64)".to_owned(),
-        )),
         Scheme::CatmullClark => exact_eval::evaluate_subface(mesh, face, subface, u, v),
         Scheme::Loop if subface == 0 => {
             loop_exact_eval::LoopExactEvaluator::new(mesh)?.evaluate(face, u, v)

@@ -27,5 +27,6 @@ mod sharp_features;
 mod sqrt3_tessellation;
 mod surface;
 mod tables;
+mod tagged_exact_eval;
 mod tessellate;
 mod triangle_rates;

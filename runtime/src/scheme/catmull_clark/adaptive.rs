@@ -31,7 +31,7 @@ use rayon::prelude::*;
 
 use crate::mesh::topology::Mesh;
 use crate::scheme::catmull_clark::refine::{refine, refined_vertex, LevelEdges};
-use crate::scheme::stencil::Stencil;
+use crate::scheme::stencil::{Stencil, Weight};
 use crate::MeshError;
 
 /// Vertex rings kept around the faces still being refined.
@@ -77,8 +77,9 @@ fn bspline(t: f64) -> ([f64; 4], [f64; 4]) {
     )
 }
 
-/// A control point of a patch: a vertex, or a reflection across a sharp edge.
-type Combo = Vec<(u32, f64)>;
+/// A control point of a patch: a vertex, or a reflection across a sharp edge, as `(vertex,
+/// weight)` terms in any [`Weight`] (integer weights: exact in f64 and in rationals).
+pub(crate) type Combo<W> = Vec<(u32, W)>;
 
 /// Corner `k`'s position in the face's `(s, t)` grid, and its two axes (along the corner's
 /// outgoing and incoming edges).
@@ -91,19 +92,21 @@ fn settled(s: f32) -> bool {
     !is_sharp(s) || is_infinite(s)
 }
 
-/// The 4 x 4 control points (`grid[a + 1][b + 1]` at `(a, b)`) of quad `g` if it is a B-spline
-/// patch, else `None`.
-fn bspline_patch(mesh: &Mesh, g: usize) -> Option<[[Combo; 4]; 4]> {
+/// The 4 x 4 control points (`grid[a + 1][b + 1]` at `(a, b)`, `a` along the face's `u`) of
+/// quad `g` if it is a B-spline patch, else `None`; generic over the weight so that the exact
+/// evaluation ([`crate::eval::feature_eval`]) takes the same net in rationals.
+pub(crate) fn bspline_patch<W: Weight>(mesh: &Mesh, g: usize) -> Option<[[Combo<W>; 4]; 4]> {
     let hs = mesh.face_halfedges(g);
     if hs.len() != 4 {
         return None;
     }
     let corner: Vec<u32> = mesh.face(g).to_vec();
     let sharp = |h: usize| is_infinite(mesh.edge_sharpness[h]);
-    let mut grid: [[Combo; 4]; 4] = Default::default();
+    let mut grid: [[Combo<W>; 4]; 4] = Default::default();
     let mut put =
-        |(x, y): (i32, i32), combo: Combo| grid[(x + 1) as usize][(y + 1) as usize] = combo;
-    let one = |v: u32| vec![(v, 1.0)];
+        |(x, y): (i32, i32), combo: Combo<W>| grid[(x + 1) as usize][(y + 1) as usize] = combo;
+    let int = |k: i64| W::ratio(k, 1);
+    let one = |v: u32| vec![(v, int(1))];
     for k in 0..4 {
         let h = hs.start + k;
         let v = corner[k] as usize;
@@ -128,7 +131,7 @@ fn bspline_patch(mesh: &Mesh, g: usize) -> Option<[[Combo; 4]; 4]> {
             )
         };
         put(at(0, 0), one(v as u32));
-        let reflect = |a: u32, b: u32| vec![(a, 2.0), (b, -1.0)];
+        let reflect = |a: u32, b: u32| vec![(a, int(2)), (b, int(-1))];
         match (in_sharp, out_sharp, rule) {
             (false, false, CreaseRule::Smooth) => {
                 if mesh.fan(v).len() != 4 {
@@ -169,7 +172,12 @@ fn bspline_patch(mesh: &Mesh, g: usize) -> Option<[[Combo; 4]; 4]> {
                 put(at(0, -1), reflect(v as u32, prev));
                 put(
                     at(-1, -1),
-                    vec![(v as u32, 4.0), (next, -2.0), (prev, -2.0), (opposite, 1.0)],
+                    vec![
+                        (v as u32, int(4)),
+                        (next, int(-2)),
+                        (prev, int(-2)),
+                        (opposite, int(1)),
+                    ],
                 );
             }
             _ => return None,
@@ -178,11 +186,53 @@ fn bspline_patch(mesh: &Mesh, g: usize) -> Option<[[Combo; 4]; 4]> {
     Some(grid)
 }
 
+/// How the limit position at a vertex is known exactly ([`vertex_limit`]).
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) enum LimitPosition {
+    /// A mask of rational weights `(vertex, numerator, denominator)`: OpenSubdiv's `Sdc` limit
+    /// masks (corner `V`; crease `(E_a + 4 V + E_b) / 6`; smooth
+    /// `(n^2 V + 4 sum E + sum F) / (n (n + 5))`).
+    Mask(Vec<(u32, i64, i64)>),
+    /// The left eigenvector `l = l S`, `l . 1 = 1`, of the stationary local subdivision matrix
+    /// `S` of `shape` ([`stationary_step`]) over the one-ring `ids` (its slot order): a dart,
+    /// whose limit no closed-form mask gives.
+    Stationary {
+        /// The neighbourhood's shape.
+        shape: Stationary,
+        /// The vertex, its edge neighbours and its faces' opposite vertices, in fan order.
+        ids: Vec<u32>,
+    },
+}
+
+/// The limit at a vertex ([`vertex_limit`]): f64 position and tangent masks, and how the
+/// position is known exactly.
+#[derive(Clone, Debug)]
+pub(crate) struct VertexLimit {
+    /// `(vertex, [position, tangent 1, tangent 2])`, an index possibly repeated.
+    pub masks: Vec<(u32, [f64; 3])>,
+    /// The exact position (the same limit as the masks' first column).
+    pub position: LimitPosition,
+}
+
+/// The f64 masks of a rational position mask and `(vertex, [tangent 1, tangent 2])` terms:
+/// the position column is the rational mask itself, stated once.
+fn with_position(position: &[(u32, i64, i64)], tangents: Vec<(u32, [f64; 2])>) -> VertexLimit {
+    let masks = position
+        .iter()
+        .map(|&(v, p, q)| (v, [f64::ratio(p, q), 0.0, 0.0]))
+        .chain(tangents.into_iter().map(|(v, [a, b])| (v, [0.0, a, b])))
+        .collect();
+    VertexLimit {
+        masks,
+        position: LimitPosition::Mask(position.to_vec()),
+    }
+}
+
 /// The limit position and tangents at vertex `v`, the corner of face `g` at half-edge `h`, by
 /// OpenSubdiv's limit masks, where they are exact: a settled crease vertex (the sector of `g`
 /// between its two sharp edges) or a corner. `None` elsewhere (smooth vertices are reached by
 /// refinement or lie inside B-spline patches).
-fn vertex_limit(mesh: &Mesh, h: usize) -> Option<Vec<(u32, [f64; 3])>> {
+pub(crate) fn vertex_limit(mesh: &Mesh, h: usize) -> Option<VertexLimit> {
     let v = mesh.face_vertices[h] as usize;
     let edges = mesh.vertex_edges(v);
     let sharpness: Vec<f32> = edges.iter().map(|&e| mesh.edge_sharpness[e]).collect();
@@ -195,11 +245,10 @@ fn vertex_limit(mesh: &Mesh, h: usize) -> Option<Vec<(u32, [f64; 3])>> {
         CreaseRule::Corner => {
             // Tangents along the face's own edges at v: the normal of its corner.
             let (out, into) = (mesh.head(h), mesh.face_vertices[mesh.prev(h)]);
-            Some(vec![
-                (me, [1.0, -1.0, -1.0]),
-                (out, [0.0, 1.0, 0.0]),
-                (into, [0.0, 0.0, 1.0]),
-            ])
+            Some(with_position(
+                &[(me, 1, 1)],
+                vec![(me, [-1.0, -1.0]), (out, [1.0, 0.0]), (into, [0.0, 1.0])],
+            ))
         }
         CreaseRule::Crease => {
             // The sector of h: the faces between the sharp edge at or before h and the next,
@@ -228,15 +277,11 @@ fn vertex_limit(mesh: &Mesh, h: usize) -> Option<Vec<(u32, [f64; 3])>> {
                 .map(|i| mesh.head(mesh.next(fan[(start + i) % n])))
                 .collect();
             let (e_first, e_last) = (ring[0], ring[len]);
-            let mut terms = vec![
-                (me, [2.0 / 3.0, 0.0, 0.0]),
-                (e_first, [1.0 / 6.0, 0.5, 0.0]),
-                (e_last, [1.0 / 6.0, -0.5, 0.0]),
-            ];
+            let mut terms = vec![(e_first, [0.5, 0.0]), (e_last, [-0.5, 0.0])];
             // Across the crease into the sector (OpenSubdiv's crease tangent mask, after
             // Biermann, Levin and Zorin 2000), face weights on the faces' opposite vertices.
             let interior = len - 1;
-            let mut across = |vertex: u32, w: f64| terms.push((vertex, [0.0, 0.0, w]));
+            let mut across = |vertex: u32, w: f64| terms.push((vertex, [0.0, w]));
             match interior {
                 0 => {
                     across(me, -6.0);
@@ -268,18 +313,21 @@ fn vertex_limit(mesh: &Mesh, h: usize) -> Option<Vec<(u32, [f64; 3])>> {
                     }
                 }
             }
+            // The crease's limit point depends on the crease alone (its cubic B-spline).
+            let limit = with_position(&[(me, 2, 3), (e_first, 1, 6), (e_last, 1, 6)], terms);
             if interior >= 2 {
                 // The crease point is exact; the tangent across is Biermann et al.'s start.
-                return stationary_limit(
+                let masks = stationary_limit(
                     Stationary::Sector { faces: len },
                     me,
                     &ring,
                     &opposite,
-                    &terms,
+                    &limit.masks,
                     true,
-                );
+                )?;
+                return Some(VertexLimit { masks, ..limit });
             }
-            Some(terms)
+            Some(limit)
         }
         CreaseRule::Smooth | CreaseRule::Dart if !mesh.is_boundary_vertex(v) => {
             // OpenSubdiv's smooth limit masks, the fan rotated to start at h so that the
@@ -293,15 +341,20 @@ fn vertex_limit(mesh: &Mesh, h: usize) -> Option<Vec<(u32, [f64; 3])>> {
                 .map(|i| mesh.head(mesh.next(fan[(j + i) % n])))
                 .collect();
             if n == 2 {
-                return Some(vec![
-                    (me, [1.0, -1.0, -1.0]),
-                    (ring[0], [0.0, 1.0, 0.0]),
-                    (ring[1], [0.0, 0.0, 1.0]),
-                ]);
+                return Some(with_position(
+                    &[(me, 1, 1)],
+                    vec![
+                        (me, [-1.0, -1.0]),
+                        (ring[0], [1.0, 0.0]),
+                        (ring[1], [0.0, 1.0]),
+                    ],
+                ));
             }
+            let nn = i64::try_from(n).ok()?;
+            let face = nn.checked_mul(nn.checked_add(5)?)?;
+            let mut position = vec![(me, nn, nn + 5)];
+            let mut tangents = Vec::with_capacity(2 * n);
             let k = n as f64;
-            let face = 1.0 / (k * (k + 5.0));
-            let mut terms = vec![(me, [1.0 - k * 5.0 * face, 0.0, 0.0])];
             let theta = 2.0 * std::f64::consts::PI / k;
             let lambda = 5.0 / 16.0
                 + (theta.cos() + (theta / 2.0).cos() * (2.0 * (9.0 + theta.cos())).sqrt()) / 16.0;
@@ -314,21 +367,26 @@ fn vertex_limit(mesh: &Mesh, h: usize) -> Option<Vec<(u32, [f64; 3])>> {
                 let (e1, f1) = tangent(i);
                 // The second tangent is the first turned by one edge.
                 let (e2, f2) = tangent((i + n - 1) % n);
-                terms.push((ring[i], [4.0 * face, e1, e2]));
-                terms.push((opposite[i], [face, f1, f2]));
+                position.push((ring[i], 4, face));
+                position.push((opposite[i], 1, face));
+                tangents.push((ring[i], [e1, e2]));
+                tangents.push((opposite[i], [f1, f2]));
             }
+            let limit = with_position(&position, tangents);
             if rule == CreaseRule::Dart {
                 let sharp = (0..n).find(|&i| is_infinite(mesh.edge_sharpness[fan[(j + i) % n]]))?;
-                return stationary_limit(
-                    Stationary::Dart { n, sharp },
-                    me,
-                    &ring,
-                    &opposite,
-                    &terms,
-                    false,
-                );
+                let shape = Stationary::Dart { n, sharp };
+                let masks = stationary_limit(shape, me, &ring, &opposite, &limit.masks, false)?;
+                let ids = std::iter::once(me)
+                    .chain(ring.iter().copied())
+                    .chain(opposite.iter().copied())
+                    .collect();
+                return Some(VertexLimit {
+                    masks,
+                    position: LimitPosition::Stationary { shape, ids },
+                });
             }
-            Some(terms)
+            Some(limit)
         }
         _ => None,
     }
@@ -337,7 +395,7 @@ fn vertex_limit(mesh: &Mesh, h: usize) -> Option<Vec<(u32, [f64; 3])>> {
 /// The shape of a vertex's neighbourhood whose features are settled, so that its local
 /// subdivision matrix is the same at every level.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Stationary {
+pub(crate) enum Stationary {
     /// An interior vertex of valence `n` with one infinitely sharp edge, the one to ring
     /// neighbour `sharp`: the whole fan.
     Dart { n: usize, sharp: usize },
@@ -384,7 +442,7 @@ fn stationary_limit(
     if slot.len() != ids.len() {
         return None;
     }
-    let step = stationary_step(shape)?;
+    let step = stationary_step::<f64>(shape)?;
     if step.len() != ids.len() {
         return None;
     }
@@ -465,7 +523,7 @@ fn normalized(x: Vec<f64>) -> Vec<f64> {
 /// child in slot `k` (the vertex point, the edge points, the face points). Derived from the one
 /// statement of the rules ([`refined_vertex`]) on the one-ring alone, which holds every vertex
 /// these children read; a sector's two sharp edges are the one-ring's boundary.
-fn stationary_step(shape: Stationary) -> Option<Vec<Vec<(usize, f64)>>> {
+pub(crate) fn stationary_step<W: Weight>(shape: Stationary) -> Option<Vec<Vec<(usize, W)>>> {
     let (faces, edges) = match shape {
         Stationary::Dart { n, .. } => (n, n),
         Stationary::Sector { faces } => (faces, faces + 1),
@@ -499,7 +557,7 @@ fn stationary_step(shape: Stationary) -> Option<Vec<Vec<(usize, f64)>>> {
     let rows = children
         .into_iter()
         .map(|child| {
-            refined_vertex::<f64>(&one_ring, &level, child)
+            refined_vertex::<W>(&one_ring, &level, child)
                 .into_iter()
                 .map(|(k, w)| (k as usize, w))
                 .collect()
@@ -580,7 +638,7 @@ impl Pending {
 }
 
 /// The point's stencil on the current level's vertices from a B-spline patch.
-fn patch_terms(grid: &[[Combo; 4]; 4], p: &Pending) -> Vec<(u32, [f64; 3])> {
+fn patch_terms(grid: &[[Combo<f64>; 4]; 4], p: &Pending) -> Vec<(u32, [f64; 3])> {
     let (bs, ds) = bspline(p.s);
     let (bt, dt) = bspline(p.t);
     let j = p.jacobian;
@@ -641,7 +699,11 @@ impl Accumulator {
 }
 
 /// The faces within `rings` vertex rings of `seeds`.
-fn neighbourhood(mesh: &Mesh, seeds: impl Iterator<Item = usize>, rings: usize) -> BTreeSet<usize> {
+pub(crate) fn neighbourhood(
+    mesh: &Mesh,
+    seeds: impl Iterator<Item = usize>,
+    rings: usize,
+) -> BTreeSet<usize> {
     let mut faces: BTreeSet<usize> = seeds.collect();
     let mut frontier: Vec<usize> = faces.iter().copied().collect();
     for _ in 0..rings {
@@ -664,7 +726,10 @@ fn neighbourhood(mesh: &Mesh, seeds: impl Iterator<Item = usize>, rings: usize) 
 /// The sub-mesh of `faces` (sharpness, holes and options kept; positions are not needed), the
 /// mesh vertex of each of its vertices, and its face of each mesh face. Vertices whose faces
 /// here form several fans (the rim of the neighbourhood) get one copy per fan.
-fn submesh(mesh: &Mesh, faces: &BTreeSet<usize>) -> (Mesh, Vec<u32>, BTreeMap<usize, usize>) {
+pub(crate) fn submesh(
+    mesh: &Mesh,
+    faces: &BTreeSet<usize>,
+) -> (Mesh, Vec<u32>, BTreeMap<usize, usize>) {
     let mut index = BTreeMap::new();
     let mut vertices: Vec<u32> = Vec::new();
     let mut lists: Vec<Vec<i64>> = Vec::with_capacity(faces.len());
@@ -748,7 +813,7 @@ pub fn limit_stencils(mesh: &Mesh, queries: &[LimitQuery]) -> Result<Vec<LimitSt
                 || Accumulator::new(columns),
                 |acc, (g, points)| {
                     let (mut done, mut descended) = (Vec::new(), Vec::new());
-                    if let Some(grid) = bspline_patch(&level, g) {
+                    if let Some(grid) = bspline_patch::<f64>(&level, g) {
                         for p in points {
                             done.push((p.query, acc.on_input(&patch_terms(&grid, &p), &to_input)));
                         }
@@ -758,8 +823,8 @@ pub fn limit_stencils(mesh: &Mesh, queries: &[LimitQuery]) -> Result<Vec<LimitSt
                         let at_vertex = p
                             .corner()
                             .and_then(|k| vertex_limit(&level, level.face_halfedges(g).start + k));
-                        if let Some(terms) = at_vertex {
-                            done.push((p.query, acc.on_input(&terms, &to_input)));
+                        if let Some(limit) = at_vertex {
+                            done.push((p.query, acc.on_input(&limit.masks, &to_input)));
                             continue;
                         }
                         let (c, child) = p.descend();

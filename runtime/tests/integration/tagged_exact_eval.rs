@@ -1,0 +1,343 @@
+//! Exact evaluation on meshes with sharp features (`subtess::eval::feature_eval`) against
+//! independent references:
+//!
+//! * an infinitely sharp crease is the uniform cubic B-spline of its vertices (DeRose, Kass and
+//!   Truong 1998): the closed form in rationals, compared bit for bit;
+//! * an edge of sharpness 1 is one step of the infinitely sharp rules, then the smooth limit:
+//!   the mesh stepped with the sharp rules and evaluated by the untagged exact path
+//!   (Schaefer–Warren substitution, no feature code), compared bit for bit;
+//! * the f64 feature-adaptive limit stencils (`adaptive::limit_stencils`: f64 refinement, f64
+//!   masks, eigen-iteration at darts) on every tagged all-quad OpenSubdiv regression shape;
+//! * holes and `interpolateboundary 0` boundary faces are refused with a message.
+
+use num_rational::BigRational;
+use num_traits::ToPrimitive;
+use schemes::crease::INFINITE;
+use schemes::BoundaryMode;
+use subtess::eval::exact_eval::{ExactEvaluator, LimitPoint};
+use subtess::eval::limit_point;
+use subtess::io::obj::parse_obj;
+use subtess::mesh::topology::{Mesh, NONE};
+use subtess::scheme::catmull_clark::adaptive::{limit_stencils, LimitQuery};
+use subtess::scheme::catmull_clark::refine::refine;
+use subtess::Scheme;
+
+fn q(p: i64, d: i64) -> BigRational {
+    BigRational::new(p.into(), d.into())
+}
+
+/// An `m x m` grid of quads with boundary, vertex `(i, j)` at `j * (m + 1) + i`, heights small
+/// dyadic numbers (so that every refined point of a valence-4 grid is an exact f64).
+fn grid(m: i64) -> Mesh {
+    let positions = (0..=m)
+        .flat_map(|j| {
+            (0..=m).map(move |i| {
+                let z = ((3 * i + 5 * j + i * j) % 7) as f64 / 4.0 - 0.75;
+                [i as f64, j as f64 + 0.125 * (i % 2) as f64, z]
+            })
+        })
+        .collect();
+    let faces: Vec<Vec<i64>> = (0..m)
+        .flat_map(|j| {
+            (0..m).map(move |i| {
+                let v = j * (m + 1) + i;
+                vec![v, v + 1, v + m + 2, v + m + 1]
+            })
+        })
+        .collect();
+    Mesh::new(positions, &faces, &[], BoundaryMode::EdgeOnly).expect("a valid grid")
+}
+
+/// The uniform cubic B-spline basis at `t` (values and derivatives) on control points
+/// `-1..=2`, in rationals (the closed form, not the library's).
+fn bspline(t: &BigRational) -> ([BigRational; 4], [BigRational; 4]) {
+    let one = q(1, 1);
+    let s = &one - t;
+    let (t2, t3) = (t * t, t * t * t);
+    let sixth = q(1, 6);
+    let half = q(1, 2);
+    (
+        [
+            &s * &s * &s * &sixth,
+            (q(3, 1) * &t3 - q(6, 1) * &t2 + q(4, 1)) * &sixth,
+            (q(-3, 1) * &t3 + q(3, 1) * &t2 + q(3, 1) * t + &one) * &sixth,
+            &t3 * &sixth,
+        ],
+        [
+            -(&s * &s) * &half,
+            (q(3, 1) * &t2 - q(4, 1) * t) * &half,
+            (q(-3, 1) * &t2 + q(2, 1) * t + &one) * &half,
+            &t2 * &half,
+        ],
+    )
+}
+
+fn exact(x: f64) -> BigRational {
+    BigRational::from_float(x).expect("finite")
+}
+
+/// The sharp crease along row 2 of a 6 x 6 grid: the faces above it meet the crease along
+/// their first edge (`v = 0`); there the limit and its `d/du` are the cubic B-spline of the
+/// crease's vertices, exactly (the crease curve ends at the boundary in corners, so only the
+/// segments away from the ends are uniform).
+#[test]
+fn an_infinitely_sharp_crease_is_exactly_the_cubic_b_spline_of_its_vertices() {
+    let m = 6;
+    let mut mesh = grid(m);
+    let row = |i: i64| (2 * (m + 1) + i) as usize;
+    for i in 0..m {
+        mesh.set_edge_sharpness(row(i), row(i + 1), INFINITE)
+            .expect("an edge");
+    }
+    let evaluator = ExactEvaluator::new(&mesh);
+    let mut checked = 0;
+    for i in 1..m - 1 {
+        let face = (2 * m + i) as usize;
+        for t in [q(0, 1), q(1, 3), q(1, 2), q(5, 7), q(1, 1), q(1, 1 << 20)] {
+            let got = evaluator.evaluate(face, &t, &q(0, 1)).expect("evaluates");
+            let (b, db) = bspline(&t);
+            for c in 0..3 {
+                let (mut curve, mut tangent) = (q(0, 1), q(0, 1));
+                for a in 0..4 {
+                    let x = exact(mesh.positions[row(i - 1 + a as i64)][c]);
+                    curve += &b[a] * &x;
+                    tangent += &db[a] * &x;
+                }
+                let (curve, tangent) = (
+                    curve.to_f64().expect("finite"),
+                    tangent.to_f64().expect("finite"),
+                );
+                assert_eq!(got.position[c], curve, "face {face} u {t}: {got:?}");
+                // At the segment's ends the point is a crease vertex: its frame tangents are
+                // masks, not derivatives; inside, `d/du` is the curve's.
+                if t != q(0, 1) && t != q(1, 1) {
+                    assert_eq!(got.du[c], tangent, "face {face} u {t}: {got:?}");
+                }
+            }
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 24);
+}
+
+/// Sharpness 1 is one infinitely sharp step, then smooth limits (OpenSubdiv's semantics of
+/// sharpness): the semi-sharp mesh's exact limit equals, bit for bit, the untagged exact limit
+/// (Schaefer–Warren substitution, the path without feature code) of the grid stepped once with
+/// the infinitely sharp rules and then made smooth. On a valence-4 grid with dyadic heights the
+/// stepped positions are exact in f64 (the weights are dyadic), checked below.
+#[test]
+fn sharpness_one_is_exactly_one_sharp_step_then_smooth() {
+    let m = 5;
+    let tag = |mesh: &mut Mesh, s: f32| {
+        for (a, b) in [(8, 9), (9, 10), (15, 9), (13, 19)] {
+            mesh.set_edge_sharpness(a, b, s).expect("an edge");
+        }
+        mesh.set_vertex_sharpness(20, s).expect("a vertex");
+    };
+    let mut semi = grid(m);
+    tag(&mut semi, 1.0);
+    let mut sharp = grid(m);
+    tag(&mut sharp, INFINITE);
+    let step = refine(&sharp);
+    let mut stepped = step.mesh.clone();
+    for h in 0..stepped.twin.len() {
+        if stepped.twin[h] != NONE {
+            stepped.edge_sharpness[h] = 0.0;
+        }
+    }
+    stepped.vertex_sharpness.iter_mut().for_each(|s| *s = 0.0);
+    assert!(!stepped.has_sharp_features());
+    // The stepped positions are exact: the rational stencil gives the same numbers.
+    let exact_step = subtess::scheme::catmull_clark::refine::refinement_stencil::<BigRational>(
+        &sharp,
+        &subtess::scheme::catmull_clark::refine::LevelEdges::new(&sharp),
+    );
+    for (child, p) in stepped.positions.iter().enumerate() {
+        let (js, ws) = exact_step.row(child);
+        for (c, &x) in p.iter().enumerate() {
+            let sum = js.iter().zip(ws).fold(q(0, 1), |acc, (&j, w)| {
+                acc + w * exact(sharp.positions[j as usize][c])
+            });
+            assert_eq!(exact(x), sum, "refined vertex {child}");
+        }
+    }
+    let (semi_eval, stepped_eval) = (ExactEvaluator::new(&semi), ExactEvaluator::new(&stepped));
+    let mut checked = 0;
+    for f in 0..semi.faces() {
+        // Face f's child at corner 0 is the quarter [0, 1/2]^2 in f's parameters, with
+        // parameters (2u, 2v) and derivatives halved.
+        let child = semi.face_halfedges(f).start;
+        for (u, v) in [(q(1, 10), q(1, 5)), (q(1, 3), q(2, 5)), (q(1, 4), q(0, 1))] {
+            let a = semi_eval.evaluate(f, &u, &v).expect("evaluates");
+            let b = stepped_eval
+                .evaluate(child, &(q(2, 1) * &u), &(q(2, 1) * &v))
+                .expect("evaluates");
+            assert_eq!(a.position, b.position, "face {f} ({u}, {v})");
+            assert_eq!(a.du, b.du.map(|x| 2.0 * x), "face {f} ({u}, {v})");
+            assert_eq!(a.dv, b.dv.map(|x| 2.0 * x), "face {f} ({u}, {v})");
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 75);
+}
+
+fn apply(stencil: &[(u32, [f64; 3])], mesh: &Mesh) -> [[f64; 3]; 3] {
+    let mut out = [[0.0; 3]; 3];
+    for &(v, w) in stencil {
+        let p = mesh.positions[v as usize];
+        for (k, row) in out.iter_mut().enumerate() {
+            for c in 0..3 {
+                row[c] += w[k] * p[c];
+            }
+        }
+    }
+    out
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// The angle between `a` and `b`, `atan2(|a x b|, a . b)` (accurate near 0, unlike `acos`,
+/// whose resolution there is 1.5e-8).
+fn angle(a: [f64; 3], b: [f64; 3]) -> f64 {
+    let dot: f64 = (0..3).map(|c| a[c] * b[c]).sum();
+    let c = cross(a, b);
+    (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt().atan2(dot)
+}
+
+/// The tagged all-quad OpenSubdiv regression shapes: at the corners, an edge midpoint and a few
+/// rational points of every face (of about 100 faces a shape; holes skipped), the exact limit
+/// agrees with the f64 feature-adaptive limit stencils to 1e-12 of the bounding box's diagonal
+/// (measured: at most 1.3e-15, the pawn; 1.8e-16 or less elsewhere), and so does the normal
+/// (the cross product of the two tangents) to 1e-7 rad. Measured: 2.3e-13 rad or less, except
+/// at the boundary vertices with three faces of `catmark_quadstrips` and
+/// `catmark_gregory_test4` (7.6e-9 and 6.4e-9 rad), where the tables' tangent masks (an exact
+/// elimination in f64) meet the adaptive side's eigen-iteration, which stops when a step turns
+/// the tangents by `1 - cos < 1e-15`, about 4.5e-8 rad.
+#[test]
+#[cfg_attr(
+    not(shared_models),
+    ignore = "needs ../shared/models beside the repository"
+)]
+fn tagged_regression_shapes_agree_with_the_f64_adaptive_limit() {
+    let dir = crate::common::models().join("opensubdiv");
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .expect("the models folder")
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".obj"))
+        .collect();
+    names.sort();
+    let params = [
+        (q(0, 1), q(0, 1)),
+        (q(1, 1), q(0, 1)),
+        (q(1, 1), q(1, 1)),
+        (q(0, 1), q(1, 1)),
+        (q(1, 2), q(0, 1)),
+        (q(1, 3), q(2, 7)),
+        (q(5, 8), q(1, 2)),
+        (q(1, 1000), q(3, 5)),
+    ];
+    let mut shapes = 0;
+    for name in names {
+        let text = std::fs::read_to_string(dir.join(&name)).expect("readable");
+        if !text.lines().any(|l| l.starts_with("t ")) {
+            continue;
+        }
+        let mesh = crate::common::load(&dir.join(&name));
+        if (0..mesh.faces()).any(|f| mesh.face(f).len() != 4) {
+            continue;
+        }
+        let diagonal = crate::common::diagonal(&mesh);
+        let evaluator = ExactEvaluator::new(&mesh);
+        let (mut worst, mut worst_normal, mut points) = (0.0f64, 0.0f64, 0);
+        let started = std::time::Instant::now();
+        // About 100 faces a shape (the pawn's 588 take a minute in all).
+        let stride = mesh.faces().div_ceil(100);
+        for f in (0..mesh.faces()).step_by(stride) {
+            if mesh.holes[f] {
+                continue;
+            }
+            for (u, v) in &params {
+                let got: LimitPoint = evaluator
+                    .evaluate(f, u, v)
+                    .unwrap_or_else(|e| panic!("{name} face {f} ({u}, {v}): {e}"));
+                let query = LimitQuery {
+                    face: f as u32,
+                    u: u.to_f64().expect("in [0, 1]"),
+                    v: v.to_f64().expect("in [0, 1]"),
+                };
+                let stencil = limit_stencils(&mesh, &[query]).expect("reached");
+                let [p, du, dv] = apply(&stencil[0], &mesh);
+                let d = (0..3)
+                    .map(|c| (got.position[c] - p[c]).abs())
+                    .fold(0.0, f64::max);
+                worst = worst.max(d / diagonal);
+                let normal = angle(cross(got.du, got.dv), cross(du, dv));
+                worst_normal = worst_normal.max(normal);
+                assert!(
+                    d <= 1e-12 * diagonal,
+                    "{name} face {f} ({u}, {v}): {:?} vs {p:?}",
+                    got.position
+                );
+                assert!(
+                    normal <= 1e-7,
+                    "{name} face {f} ({u}, {v}): normal off by {normal:.2e} rad"
+                );
+                points += 1;
+            }
+        }
+        println!(
+            "{name}: {points} points, position {worst:.2e} of the diagonal, normal {worst_normal:.2e} rad, {:.2} s",
+            started.elapsed().as_secs_f64()
+        );
+        shapes += 1;
+    }
+    assert!(shapes >= 20, "{shapes} tagged all-quad shapes");
+}
+
+/// A hole face has no surface: evaluating it is refused by name, the faces beside it evaluate.
+#[test]
+fn a_hole_face_is_refused_clearly() {
+    let mut mesh = grid(3);
+    mesh.holes[4] = true;
+    let e = limit_point(&mesh, Scheme::CatmullClark, 4, 0, &q(1, 2), &q(1, 2))
+        .expect_err("a hole")
+        .to_string();
+    assert!(e.contains("face 4") && e.contains("hole"), "{e}");
+    limit_point(&mesh, Scheme::CatmullClark, 3, 0, &q(1, 2), &q(1, 2)).expect("beside the hole");
+}
+
+/// `interpolateboundary 0`: the faces at the boundary make no surface (OpenSubdiv), so
+/// evaluating one is refused; the interior face of a 3 x 3 grid is not at the boundary and
+/// evaluates.
+#[test]
+fn interpolateboundary_0_boundary_faces_are_refused_clearly() {
+    let mut text = String::new();
+    for j in 0..4 {
+        for i in 0..4 {
+            text += &format!("v {i} {j} {}\n", (i * j) % 3);
+        }
+    }
+    for j in 0..3 {
+        for i in 0..3 {
+            let v = j * 4 + i + 1;
+            text += &format!("f {} {} {} {}\n", v, v + 1, v + 5, v + 4);
+        }
+    }
+    text += "t interpolateboundary 1/0/0 0\n";
+    let obj = parse_obj(&text).expect("parses");
+    let (mesh, _) = Mesh::from_obj(&obj).expect("a mesh");
+    let e = limit_point(&mesh, Scheme::CatmullClark, 0, 0, &q(1, 3), &q(1, 3))
+        .expect_err("no surface")
+        .to_string();
+    assert!(e.contains("interpolateboundary 0"), "{e}");
+    let centre = limit_point(&mesh, Scheme::CatmullClark, 4, 0, &q(1, 2), &q(1, 2))
+        .expect("the interior face");
+    assert!(centre.position.iter().all(|c| c.is_finite()));
+}
