@@ -223,6 +223,31 @@ fn tolerance_and_view_rates() {
     let _ = std::fs::remove_file(obj);
 }
 
+/// `subtess eval` on sharp features, exactly (`eval::feature_eval`): `data/cube_creased.obj`'s
+/// top face is bounded by an infinitely sharp crease and its refined points never leave the
+/// plane `z = 1` (face points, crease midpoints and crease vertex points of points at `z = 1`),
+/// so its limit has `z = 1` exactly, and the top face is symmetric, so its centre is on the z
+/// axis; its corner at vertex 4 is the crease's limit `(E_a + 4 V + E_b) / 6 =
+/// (-2/3, -2/3, 1)`, correctly rounded; the JSON keeps its keys.
+#[test]
+fn eval_is_exact_on_sharp_features() {
+    let position = |uv: &str| -> Vec<f64> {
+        let out = succeeds(&format!("eval data/cube_creased.obj --face 1 --uv {uv} --json"));
+        let point = json(&out);
+        assert!(point["du"].as_array().is_some_and(|a| a.len() == 3));
+        assert!(point["dv"].as_array().is_some_and(|a| a.len() == 3));
+        point["position"]
+            .as_array()
+            .expect("position")
+            .iter()
+            .filter_map(|x| x.as_f64())
+            .collect()
+    };
+    assert_eq!(position("0,0"), vec![-2.0 / 3.0, -2.0 / 3.0, 1.0]);
+    assert_eq!(position("1/2,1/2"), vec![0.0, 0.0, 1.0]);
+    assert_eq!(position("1/3,2/7")[2], 1.0);
+}
+
 /// `subtess eval` (DESIGN.md contract): JSON `{"position","du","dv"}`; the centre of the cube's
 /// top face lies on the cube's z axis (symmetry); bad arguments are clear errors.
 #[test]
