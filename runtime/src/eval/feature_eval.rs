@@ -9,13 +9,13 @@
 //! control points:
 //!
 //! 1. Only a neighbourhood is refined: the faces within
-//!    [`RINGS`](crate::scheme::catmull_clark::adaptive::RINGS) vertex rings of the face holding
+//!    [`RINGS`] vertex rings of the face holding
 //!    the point. Each level's vertices are recomputed exactly from the previous level's with the
 //!    one statement of the rules ([`refined_vertex`] in [`BigRational`]: semi-sharp blends,
 //!    sharpness decay by either crease method and the fractional vertex weights are dyadic, so
 //!    every refined point is an exact rational).
 //! 2. At each level the piece holding the point stops the descent when it is
-//!    * a **B-spline patch** in the feature-aware sense ([`bspline_patch`]: regular corners,
+//!    * a **B-spline patch** in the feature-aware sense (`adaptive::bspline_patch`: regular corners,
 //!      nothing semi-sharp, control points beyond an infinitely sharp edge replaced by the
 //!      reflections `2 P_0 - P_1`, taken in rationals): the bicubic B-spline `psi(s, t) N P` is
 //!      evaluated exactly (an infinitely sharp crease is then the cubic B-spline of its
@@ -24,14 +24,14 @@
 //!      [`is_smooth_patch`]: only the edges and vertices at the face's corners decide the rules
 //!      of its refined neighbourhoods): Schaefer–Warren substitution, exactly as on untagged
 //!      meshes ([`super::exact_eval`]);
-//!    * the point **at a corner** whose settled rule has a limit mask ([`vertex_limit`]): the
+//!    * the point **at a corner** whose settled rule has a limit mask (`adaptive::vertex_limit`): the
 //!      position by OpenSubdiv's `Sdc` masks, rational — corner `V`, crease
 //!      `(E_a + 4 V + E_b) / 6`, smooth `(n^2 V + 4 sum E + sum F) / (n (n + 5))` — and at a
 //!      dart, whose limit no closed form gives, the left eigenvector `l = l S`, `l . 1 = 1` of
-//!      its stationary local subdivision matrix `S` ([`stationary_step`] in rationals), solved
+//!      its stationary local subdivision matrix `S` (`adaptive::stationary_step` in rationals), solved
 //!      exactly as a rational null vector.
 //!
-//!    Otherwise the point goes to the quarter holding it ([`descend`]) and the neighbourhood is
+//!    Otherwise the point goes to the quarter holding it (`exact_eval::descend`) and the neighbourhood is
 //!    refined once more. A point at distance `d` from the irregular features needs about
 //!    `log2(1 / d)` levels plus the levels its semi-sharp features take to decay (at most
 //!    [`MAX_LEVELS`] in all: parameters have at most 64-bit denominators, sharpness at most 10).
