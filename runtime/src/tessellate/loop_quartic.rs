@@ -282,8 +282,72 @@ fn contract(frame: &[[f32; POINTS]; MONOMIALS], local: &[[f32; 3]; POINTS]) -> F
     c
 }
 
-/// A row of constant `v`: the quartic in `u` (`p`), its `u`-derivative (`du`, cubic) and the
-/// `v`-derivative's restriction (`dv`, cubic in `u`: `c_40` has no `v`).
+/// Points evaluated together: rows, and the points along a row, in lanes the compiler keeps
+/// in vector registers (SSE's four f32).
+const LANES: usize = 4;
+
+/// `LANES` rows of constant `v` (one per lane): the quartic in `u`, `r_a(v) = sum_b c_ab v^b`
+/// (`p[a][x]`), and the `v`-derivative's restriction `s_a(v) = sum_b b c_ab v^(b-1)`
+/// (`dv[a][x]`, cubic in `u`: `c_40` has no `v`).
+struct RowChunk {
+    p: [[[f32; LANES]; 3]; DEGREE + 1],
+    dv: [[[f32; LANES]; 3]; DEGREE],
+}
+
+impl RowChunk {
+    /// The rows at `v[k]`, by Horner's rule in `v`.
+    #[inline(always)]
+    fn new(c: &FaceQuartic, v: &[f32; LANES]) -> Self {
+        let mut p = [[[0.0f32; LANES]; 3]; DEGREE + 1];
+        let mut dv = [[[0.0f32; LANES]; 3]; DEGREE];
+        for a in 0..=DEGREE {
+            let top = DEGREE - a;
+            for x in 0..3 {
+                let mut r = [c[a][top][x]; LANES];
+                for b in (0..top).rev() {
+                    for k in 0..LANES {
+                        r[k] = r[k] * v[k] + c[a][b][x];
+                    }
+                }
+                p[a][x] = r;
+                if a < DEGREE {
+                    let mut s = [top as f32 * c[a][top][x]; LANES];
+                    for b in (1..top).rev() {
+                        let w = b as f32 * c[a][b][x];
+                        for k in 0..LANES {
+                            s[k] = s[k] * v[k] + w;
+                        }
+                    }
+                    dv[a][x] = s;
+                }
+            }
+        }
+        RowChunk { p, dv }
+    }
+
+    /// Row `lane`'s coefficients: the quartic, its `u`-derivative (`a r_a`), and `s_a`.
+    #[inline(always)]
+    fn row(&self, lane: usize) -> RowQuartic {
+        let mut row = RowQuartic {
+            p: [[0.0; 3]; DEGREE + 1],
+            du: [[0.0; 3]; DEGREE],
+            dv: [[0.0; 3]; DEGREE],
+        };
+        for x in 0..3 {
+            for a in 0..=DEGREE {
+                row.p[a][x] = self.p[a][x][lane];
+            }
+            for a in 0..DEGREE {
+                row.du[a][x] = (a + 1) as f32 * self.p[a + 1][x][lane];
+                row.dv[a][x] = self.dv[a][x][lane];
+            }
+        }
+        row
+    }
+}
+
+/// One row of constant `v`: the quartic in `u` (`p`), its `u`-derivative (`du`, cubic) and the
+/// `v`-derivative's restriction (`dv`, cubic).
 #[derive(Clone, Copy, Debug)]
 struct RowQuartic {
     p: [[f32; 3]; DEGREE + 1],
@@ -292,61 +356,105 @@ struct RowQuartic {
 }
 
 impl RowQuartic {
-    /// `r_a(v) = sum_b c_ab v^b`, `s_a(v) = sum_b b c_ab v^(b-1)` by Horner's rule in `v`.
-    fn new(c: &FaceQuartic, v: f32) -> Self {
-        let mut p = [[0.0f32; 3]; DEGREE + 1];
-        let mut dv = [[0.0f32; 3]; DEGREE];
-        for a in 0..=DEGREE {
-            let top = DEGREE - a;
-            for x in 0..3 {
-                let mut r = c[a][top][x];
-                for b in (0..top).rev() {
-                    r = r * v + c[a][b][x];
+    /// Positions and unit normals at `LANES` parameters `u[k]` along the row, by Horner's rule
+    /// (`P`, `P_u`, `P_v`), the normal `unit(P_u x P_v)`.
+    #[inline(always)]
+    fn points(&self, u: &[f32; LANES]) -> ([[f32; 3]; LANES], [[f32; 3]; LANES]) {
+        let mut p = [[0.0f32; LANES]; 3];
+        let mut du = [[0.0f32; LANES]; 3];
+        let mut dv = [[0.0f32; LANES]; 3];
+        for x in 0..3 {
+            let mut q = [self.p[DEGREE][x]; LANES];
+            for a in (0..DEGREE).rev() {
+                for k in 0..LANES {
+                    q[k] = q[k] * u[k] + self.p[a][x];
                 }
-                p[a][x] = r;
             }
-            if a < DEGREE {
+            p[x] = q;
+            let mut q = [self.du[DEGREE - 1][x]; LANES];
+            let mut r = [self.dv[DEGREE - 1][x]; LANES];
+            for a in (0..DEGREE - 1).rev() {
+                for k in 0..LANES {
+                    q[k] = q[k] * u[k] + self.du[a][x];
+                    r[k] = r[k] * u[k] + self.dv[a][x];
+                }
+            }
+            du[x] = q;
+            dv[x] = r;
+        }
+        // cross(du, dv) and its length, lane by lane ([`cross`], [`unit`]'s operations).
+        let mut m = [[0.0f32; LANES]; 3];
+        let mut squared = [0.0f32; LANES];
+        for k in 0..LANES {
+            m[0][k] = du[1][k] * dv[2][k] - du[2][k] * dv[1][k];
+            m[1][k] = du[2][k] * dv[0][k] - du[0][k] * dv[2][k];
+            m[2][k] = du[0][k] * dv[1][k] - du[1][k] * dv[0][k];
+            squared[k] = m[0][k] * m[0][k] + m[1][k] * m[1][k] + m[2][k] * m[2][k];
+        }
+        let mut positions = [[0.0f32; 3]; LANES];
+        let mut normals = [[0.0f32; 3]; LANES];
+        if squared.iter().all(|s| s.is_normal()) {
+            let mut length = [0.0f32; LANES];
+            for k in 0..LANES {
+                length[k] = squared[k].sqrt();
+            }
+            for k in 0..LANES {
                 for x in 0..3 {
-                    let mut s = top as f32 * c[a][top][x];
-                    for b in (1..top).rev() {
-                        s = s * v + b as f32 * c[a][b][x];
-                    }
-                    dv[a][x] = s;
+                    positions[k][x] = p[x][k];
+                    normals[k][x] = m[x][k] / length[k];
                 }
             }
-        }
-        let mut du = [[0.0f32; 3]; DEGREE];
-        for a in 1..=DEGREE {
-            for x in 0..3 {
-                du[a - 1][x] = a as f32 * p[a][x];
+        } else {
+            // A degenerate or tiny tangent pair somewhere: unit's careful path, lane by lane.
+            for k in 0..LANES {
+                positions[k] = [p[0][k], p[1][k], p[2][k]];
+                normals[k] = unit(cross(
+                    [du[0][k], du[1][k], du[2][k]],
+                    [dv[0][k], dv[1][k], dv[2][k]],
+                ));
             }
         }
-        RowQuartic { p, du, dv }
+        (positions, normals)
     }
 
-    /// Position and unit normal at `u`.
+    /// The `count` points `u = params[first + 3t]`, written to `positions[at + stride t]`.
     #[inline(always)]
-    fn point(&self, u: f32) -> ([f32; 3], [f32; 3]) {
-        let mut p = self.p[DEGREE];
-        let mut du = self.du[DEGREE - 1];
-        let mut dv = self.dv[DEGREE - 1];
-        for a in (0..DEGREE).rev() {
-            for x in 0..3 {
-                p[x] = p[x] * u + self.p[a][x];
+    #[allow(clippy::too_many_arguments)]
+    fn write(
+        &self,
+        params: &[f32],
+        first: usize,
+        count: usize,
+        at: usize,
+        stride: usize,
+        positions: &mut [[f32; 3]],
+        normals: &mut [[f32; 3]],
+    ) {
+        let mut t0 = 0;
+        while t0 < count {
+            let lanes = LANES.min(count - t0);
+            // A short last chunk repeats its last parameter in the unused lanes.
+            let u: [f32; LANES] =
+                std::array::from_fn(|k| params[first + 3 * (t0 + k.min(lanes - 1))]);
+            let (p, q) = self.points(&u);
+            for k in 0..lanes {
+                let o = at + stride * (t0 + k);
+                positions[o] = p[k];
+                normals[o] = q[k];
             }
+            t0 += LANES;
         }
-        for a in (0..DEGREE - 1).rev() {
-            for x in 0..3 {
-                du[x] = du[x] * u + self.du[a][x];
-                dv[x] = dv[x] * u + self.dv[a][x];
-            }
-        }
-        (p, unit(cross(du, dv)))
     }
 }
 
 /// Every point of a regular face at rate `n` in the face's own order (its dual points, then its
-/// interior primal points, [`crate::tessellate::triangle_dual_grid`]): `params[k] = k / 3n`.
+/// interior primal points, [`crate::tessellate::triangle_dual_grid`]): `params[k] = k / 3n`,
+/// `k = 0..=3n`.
+///
+/// Rows of constant `v` are `v = k / 3n`: `k = 3j + 1` holds the ups of face row `j`
+/// (`up(i, j)` at `u = (3i+1)/3n`), `3j + 2` its downs (`(3i+2)/3n`; ups and downs interleave
+/// in the output, `up, down, .., up`), `3j` the interior primal points `(i/n, j/n)`, `i >= 1`;
+/// the rows' polynomials are made `LANES` at a time.
 pub(crate) fn evaluate_face(
     frame: &[[f32; POINTS]; MONOMIALS],
     local: &[[f32; 3]; POINTS],
@@ -356,33 +464,35 @@ pub(crate) fn evaluate_face(
     normals: &mut [[f32; 3]],
 ) {
     let c = contract(frame, local);
-    let mut at = 0;
-    // Face row j: up(i, j) at ((3i+1)/3n, (3j+1)/3n), down(i, j) at ((3i+2)/3n, (3j+2)/3n),
-    // interleaved up, down, .., up.
-    for j in 0..n {
-        let len = 2 * (n - j) - 1;
-        let (rows_p, rows_q) = (&mut positions[at..at + len], &mut normals[at..at + len]);
-        for (shift, start) in [(1, 0), (2, 1)] {
-            let row = RowQuartic::new(&c, params[3 * j + shift]);
-            for (t, (p, q)) in rows_p
-                .iter_mut()
-                .zip(rows_q.iter_mut())
-                .enumerate()
-                .skip(start)
-                .step_by(2)
-            {
-                (*p, *q) = row.point(params[3 * (t / 2) + shift]);
+    let interior = n * n;
+    let mut k0 = 1;
+    while k0 < 3 * n {
+        let v: [f32; LANES] = std::array::from_fn(|k| params[(k0 + k).min(3 * n)]);
+        let chunk = RowChunk::new(&c, &v);
+        for lane in 0..LANES.min(3 * n - k0) {
+            let k = k0 + lane;
+            let j = k / 3;
+            // Face row j starts at dual_index(n, 0, j, false) = j (2n - j).
+            let start = j * (2 * n - j);
+            let (first, count, at, stride) = match k % 3 {
+                1 => (1, n - j, start, 2),
+                2 => (2, n - j - 1, start + 1, 2),
+                // Interior points of row j >= 1 follow those of rows 1..j.
+                _ if j >= 1 && j + 1 < n => (
+                    3,
+                    n - j - 1,
+                    interior + (j - 1) * (n - 1) - (j - 1) * j / 2,
+                    1,
+                ),
+                _ => continue,
+            };
+            if count > 0 {
+                chunk
+                    .row(lane)
+                    .write(params, first, count, at, stride, positions, normals);
             }
         }
-        at += len;
-    }
-    // Interior primal points (i/n, j/n), i, j >= 1, row by row.
-    for j in 1..n {
-        let row = RowQuartic::new(&c, params[3 * j]);
-        for i in 1..n - j {
-            (positions[at], normals[at]) = row.point(params[3 * i]);
-            at += 1;
-        }
+        k0 += LANES;
     }
 }
 
