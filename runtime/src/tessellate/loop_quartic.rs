@@ -51,6 +51,9 @@ pub(crate) const POINTS: usize = 12;
 /// Monomials `u^a v^b` of total degree at most 4, indexed by [`monomial`].
 const MONOMIALS: usize = 15;
 
+/// [`MONOMIALS`] padded to a multiple of the vector width.
+const MONOMIAL_LANES: usize = 16;
+
 /// The degree of the pieces.
 const DEGREE: usize = 4;
 
@@ -87,8 +90,9 @@ type Coefficients = [[f64; POINTS]; MONOMIALS];
 #[derive(Clone, Debug)]
 pub(crate) struct QuarticBasis {
     by_corner: [Coefficients; 3],
-    /// `by_corner` in f32, the form the frames read.
-    pub(crate) frame: [[[f32; POINTS]; MONOMIALS]; 3],
+    /// `by_corner` in f32, transposed (`[corner][control point][monomial]`, padded with
+    /// zeros), the form the frames read.
+    pub(crate) frame: [[[f32; MONOMIAL_LANES]; POINTS]; 3],
 }
 
 impl QuarticBasis {
@@ -131,7 +135,15 @@ impl QuarticBasis {
             }
             *coefficients = interpolate(&values)?;
         }
-        let frame = by_corner.map(|c| c.map(|row| row.map(|x| x as f32)));
+        let frame = by_corner.map(|c| {
+            let mut t = [[0.0f32; MONOMIAL_LANES]; POINTS];
+            for (m, row) in c.iter().enumerate() {
+                for (l, &x) in row.iter().enumerate() {
+                    t[l][m] = x as f32;
+                }
+            }
+            t
+        });
         Some(QuarticBasis { by_corner, frame })
     }
 
@@ -259,20 +271,23 @@ fn interpolate(values: &[[f64; POINTS]]) -> Option<Coefficients> {
 type FaceQuartic = [[[f32; 3]; DEGREE + 1]; DEGREE + 1];
 
 /// The face's polynomial from its control points `local` (table order) and the coefficients
-/// `frame` of its patch corner: `c_ab = sum_l C[a,b][l] (P_l - P_0)`, plus `P_0` in `c_00`.
-fn contract(frame: &[[f32; POINTS]; MONOMIALS], local: &[[f32; 3]; POINTS]) -> FaceQuartic {
-    let mut columns = [[0.0f32; POINTS]; 3];
-    for (l, p) in local.iter().enumerate() {
+/// `frame` of its patch corner (`frame[l][monomial(a, b)]`): `c_ab = sum_l C[a,b][l] (P_l -
+/// P_0)`, plus `P_0` in `c_00`; control point by control point, all monomials at once (lanes).
+fn contract(frame: &[[f32; MONOMIAL_LANES]; POINTS], local: &[[f32; 3]; POINTS]) -> FaceQuartic {
+    let mut sums = [[0.0f32; MONOMIAL_LANES]; 3];
+    for (w, p) in frame.iter().zip(local).skip(1) {
         for x in 0..3 {
-            columns[x][l] = p[x] - local[0][x];
+            let d = p[x] - local[0][x];
+            for m in 0..MONOMIAL_LANES {
+                sums[x][m] += w[m] * d;
+            }
         }
     }
     let mut c = [[[0.0f32; 3]; DEGREE + 1]; DEGREE + 1];
     for a in 0..=DEGREE {
         for b in 0..=DEGREE - a {
-            let w = &frame[monomial(a, b)];
             for x in 0..3 {
-                c[a][b][x] = w.iter().zip(&columns[x]).map(|(w, d)| w * d).sum();
+                c[a][b][x] = sums[x][monomial(a, b)];
             }
         }
     }
@@ -456,7 +471,7 @@ impl RowQuartic {
 /// in the output, `up, down, .., up`), `3j` the interior primal points `(i/n, j/n)`, `i >= 1`;
 /// the rows' polynomials are made `LANES` at a time.
 pub(crate) fn evaluate_face(
-    frame: &[[f32; POINTS]; MONOMIALS],
+    frame: &[[f32; MONOMIAL_LANES]; POINTS],
     local: &[[f32; 3]; POINTS],
     n: usize,
     params: &[f32],
