@@ -249,11 +249,12 @@ fn interpolate(values: &[[f64; POINTS]]) -> Option<Coefficients> {
             if factor == 0.0 {
                 continue;
             }
-            for k in col..MONOMIALS {
-                a[row][k] -= factor * a[col][k];
+            let (pivot_row, pivot_rhs) = (a[col], rhs[col]);
+            for (x, p) in a[row].iter_mut().zip(&pivot_row).skip(col) {
+                *x -= factor * p;
             }
-            for l in 0..POINTS {
-                rhs[row][l] -= factor * rhs[col][l];
+            for (x, p) in rhs[row].iter_mut().zip(&pivot_rhs) {
+                *x -= factor * p;
             }
         }
     }
