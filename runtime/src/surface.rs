@@ -466,7 +466,8 @@ impl<'s> Tessellator<'s> {
         self.faces_over_tolerance
     }
 
-    /// How many quad faces take the separable (tensor-product) path (0 for triangle schemes).
+    /// How many faces take a polynomial fast path: quads the separable (tensor-product)
+    /// bicubic, Loop triangles one quartic per face (0 for the other triangle schemes).
     pub fn separable_faces(&self) -> usize {
         self.grid.separable_faces()
     }

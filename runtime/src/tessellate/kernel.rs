@@ -342,7 +342,8 @@ pub trait GridPlan: Sync + Send + std::fmt::Debug {
     /// Write every triangle (`triangle_count()` of them).
     fn connect(&self, triangles: &mut [[u32; 3]]);
 
-    /// How many faces take a separable (tensor-product) fast path.
+    /// How many faces take a polynomial fast path: for quads the separable (tensor-product)
+    /// bicubic, for Loop triangles one quartic per face.
     fn separable_faces(&self) -> usize {
         0
     }

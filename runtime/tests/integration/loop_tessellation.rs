@@ -1019,3 +1019,125 @@ mod boundary_with_the_table {
         load(&models().join("odedstein/hand_lowres.obj"))
     }
 }
+
+/// The regular faces' quartic polynomials (`runtime/src/tessellate/loop_quartic.rs`) against
+/// the same plan evaluating every face from its table stencils (`without_quartics`): the two
+/// are independent ways of evaluating the same section (the stencils are the table's rows; the
+/// quartic is interpolated from `schemes::loop_regular`'s closed form).
+mod quartic_against_stencils {
+    use super::*;
+    use subtess::stencil_table::StencilTable;
+    use subtess::tessellate::triangle_dual_grid::MIN_QUARTIC_RATE;
+
+    /// Tessellate `m` at `rates` (of its isolated mesh's triangles) both ways; the largest
+    /// position difference over the bounding box's largest side, the largest normal difference,
+    /// the quartic faces and the patch corners among them.
+    fn compare(
+        m: &Mesh,
+        rates: impl Fn(usize) -> u32,
+        label: &str,
+    ) -> (f64, f64, usize, [bool; 3]) {
+        let table = StencilTable::default_loop().expect("embedded");
+        let iso = isolate_loop(m).unwrap_or_else(|e| panic!("{label}: {e}"));
+        let rates: Vec<u32> = (0..iso.mesh.faces()).map(rates).collect();
+        let grid = TriangleDualGrid::new(&table, &iso.mesh, &iso.patches, &rates)
+            .unwrap_or_else(|e| panic!("{label}: {e}"));
+        let regular: Vec<usize> = (0..iso.patches.len())
+            .filter(|&f| {
+                let p = &iso.patches[f];
+                !p.kind.boundary
+                    && p.kind.faces == 6
+                    && p.points.len() == 12
+                    && rates[f] >= MIN_QUARTIC_RATE
+            })
+            .collect();
+        // Every regular patch of the Loop table at a rate from MIN_QUARTIC_RATE on takes the
+        // quartic: it reproduces every rate.
+        assert_eq!(grid.separable_faces(), regular.len(), "{label}");
+        let mut corners = [false; 3];
+        for &f in &regular {
+            corners[iso.patches[f].corner] = true;
+        }
+        let quartic = grid.tessellate(&iso.mesh);
+        let stencils = grid.without_quartics();
+        assert_eq!(stencils.separable_faces(), 0);
+        let reference = stencils.tessellate(&iso.mesh);
+        assert_eq!(quartic.triangles, reference.triangles, "{label}");
+        let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
+        for p in &reference.positions {
+            for c in 0..3 {
+                lo[c] = lo[c].min(f64::from(p[c]));
+                hi[c] = hi[c].max(f64::from(p[c]));
+            }
+        }
+        let size = (0..3).map(|c| hi[c] - lo[c]).fold(0.0, f64::max);
+        let largest = |a: &[[f32; 3]], b: &[[f32; 3]]| {
+            a.iter()
+                .zip(b)
+                .flat_map(|(p, q)| (0..3).map(move |c| (f64::from(p[c]) - f64::from(q[c])).abs()))
+                .fold(0.0f64, f64::max)
+        };
+        let position = largest(&quartic.positions, &reference.positions) / size;
+        let normal = largest(&quartic.normals, &reference.normals);
+        println!(
+            "{label}: {} quartic faces, position {position:.2e} of the box, normal {normal:.2e}",
+            regular.len()
+        );
+        (position, normal, regular.len(), corners)
+    }
+
+    fn check(m: &Mesh, rates: impl Fn(usize) -> u32, label: &str) -> [bool; 3] {
+        let (position, normal, faces, corners) = compare(m, rates, label);
+        assert!(faces > 0, "{label}: no regular face");
+        assert!(
+            position < 1e-6,
+            "{label}: positions differ by {position:e} of the box"
+        );
+        // Unit normals from derivatives rounded differently (differences of control points
+        // against absolute positions): within 1e-4, the tolerance of the exact-evaluation test.
+        assert!(normal < 1e-4, "{label}: normals differ by {normal:e}");
+        corners
+    }
+
+    #[test]
+    fn small_meshes_agree_at_mixed_rates() {
+        let mut corners = [false; 3];
+        for (name, m) in small_meshes() {
+            for (label, rates) in [("uniform 7", 0u32), ("mixed", 1)] {
+                let found = check(
+                    &m,
+                    |f| {
+                        if rates == 0 {
+                            7
+                        } else {
+                            1 + (f as u32 * 7) % 12
+                        }
+                    },
+                    &format!("{name}, {label}"),
+                );
+                for c in 0..3 {
+                    corners[c] |= found[c];
+                }
+            }
+        }
+        // The phantom patches of the eared disc sit at other face corners: the rotated
+        // quartics are exercised, not only corner 0's.
+        assert_eq!(corners, [true, true, false]);
+    }
+
+    #[test]
+    #[cfg_attr(
+        not(shared_models),
+        ignore = "needs ../shared/models beside the repository"
+    )]
+    fn spot_agrees_at_every_rate() {
+        let spot = load(&models().join("crane/spot_triangulated.obj"));
+        for n in [5, 6, 8, 13, 16] {
+            check(&spot, |_| n, &format!("spot at rate {n}"));
+        }
+        check(&spot, |f| 1 + (f as u32 * 5) % 16, "spot at mixed rates");
+        let hand = load(&models().join("odedstein/hand_lowres.obj"));
+        let corners = check(&hand, |f| 1 + (f as u32 * 3) % 10, "hand at mixed rates");
+        println!("hand: regular patches at corners {corners:?}");
+    }
+}
