@@ -64,6 +64,8 @@
 //! * Between samples of `G`: `e_f` is a maximum over samples, not over the continuum; the tests
 //!   measure the output again on other grids (dual points at rates 23 and 19).
 
+use std::cell::Cell;
+
 use rayon::prelude::*;
 use table_format::{PointSet, SectionKey, StencilKind};
 
@@ -223,29 +225,67 @@ impl<'a> PatchPoints<'a> {
         })
     }
 
-    /// The limit position at grid point `(i, j)` of `grid`, in the face's own indices.
-    fn at(&self, grid: &Grid, i: usize, j: usize) -> [f64; 3] {
+    /// The weights of grid point `(i, j)` of `grid`, in the face's own indices.
+    fn row<'g>(&self, grid: &'g Grid, (i, j): (usize, usize)) -> &'g [f32] {
         let (pi, pj) = dual_index_in_patch(grid.corner, i, j, grid.side);
         let k = self.control.len();
-        let row = &grid.weights[(pj * grid.side + pi) * k..][..k];
-        let mut p = [0.0; 3];
-        for (w, q) in row.iter().zip(&self.control) {
-            for c in 0..3 {
-                p[c] += f64::from(*w) * q[c];
+        &grid.weights[(pj * grid.side + pi) * k..][..k]
+    }
+
+    /// The weighted sums of the control points by `M` rows of weights at once: `M`
+    /// independent chains of additions, where one sum alone waits on its own additions.
+    fn sums<const M: usize>(&self, rows: [&[f32]; M]) -> [[f64; 3]; M] {
+        let mut out = [[0.0; 3]; M];
+        for (l, q) in self.control.iter().enumerate() {
+            for (p, row) in out.iter_mut().zip(&rows) {
+                let w = f64::from(row[l]);
+                for c in 0..3 {
+                    p[c] += w * q[c];
+                }
             }
         }
-        p
+        out
+    }
+
+    /// The limit position at grid point `(i, j)` of `grid`, in the face's own indices.
+    fn at(&self, grid: &Grid, i: usize, j: usize) -> [f64; 3] {
+        self.sums([self.row(grid, (i, j))])[0]
+    }
+
+    /// The limit positions at the grid points `ij` of `grid` (the face's own indices), appended
+    /// to `out`, four at a time.
+    fn extend(
+        &self,
+        grid: &Grid,
+        ij: impl Iterator<Item = (usize, usize)>,
+        out: &mut Vec<[f64; 3]>,
+    ) {
+        let mut ij = ij.peekable();
+        while let Some(first) = ij.next() {
+            let first = self.row(grid, first);
+            let mut rows = [first; 4];
+            let mut m = 1;
+            while m < 4 {
+                match ij.next() {
+                    Some(point) => rows[m] = self.row(grid, point),
+                    None => break,
+                }
+                m += 1;
+            }
+            out.extend_from_slice(&self.sums(rows)[..m]);
+        }
     }
 
     /// Every point of a grid, row by row (`j` outer).
     fn all(&self, points: PointSet, n: u32) -> Result<Vec<[f64; 3]>, RuntimeError> {
         let grid = self.grid(points, n)?;
-        let mut out = Vec::with_capacity(grid.side * grid.side);
-        for j in 0..grid.side {
-            for i in 0..grid.side {
-                out.push(self.at(&grid, i, j));
-            }
-        }
+        let side = grid.side;
+        let mut out = Vec::with_capacity(side * side);
+        self.extend(
+            &grid,
+            (0..side * side).map(|p| (p % side, p / side)),
+            &mut out,
+        );
         Ok(out)
     }
 }
@@ -275,6 +315,13 @@ pub fn table_positions(
 struct Samples {
     uv: Vec<[f64; 2]>,
     positions: Vec<[f64; 3]>,
+    /// Where the next early-stopping scan starts: the sample that refuted the last rate. The
+    /// next rate's deviation peaks in the same region of the face (where it bends most), so a
+    /// scan from there finds a failing rate's first sample beyond the tolerance soonest.
+    start: Cell<usize>,
+    /// Whether the last rate was refuted outside the interior (in a side strip or a corner
+    /// square): then the next rate is scanned there first.
+    outside_first: Cell<bool>,
 }
 
 impl Samples {
@@ -297,11 +344,21 @@ impl Samples {
                         )
                     };
                     uv.push([u, v]);
-                    positions.push(points.at(&g, i, j));
                 }
             }
+            let side = g.side;
+            points.extend(
+                &g,
+                (0..side * side).map(|p| (p % side, p / side)),
+                &mut positions,
+            );
         }
-        Ok(Samples { uv, positions })
+        Ok(Samples {
+            uv,
+            positions,
+            start: Cell::new(0),
+            outside_first: Cell::new(false),
+        })
     }
 }
 
@@ -370,10 +427,31 @@ fn strip_triangles(a: &[[f64; 3]], b: &[[f64; 3]], curve: bool) -> Vec<[[f64; 3]
 }
 
 impl FaceLocal {
+    /// The face's own dual points at rate `n`: all that `L_{f,n}` needs in the interior
+    /// `[h, 1-h]^2` (see [`FaceLocal::is_interior`]); [`FaceLocal::complete`] adds the rest.
+    fn interior(own: &PatchPoints, n: u32) -> Result<Self, RuntimeError> {
+        Ok(FaceLocal {
+            n: n as usize,
+            dual: own.all(PointSet::Dual, n)?,
+            beyond: Vec::new(),
+            corners: Vec::new(),
+        })
+    }
+
+    /// `L_{f,n}` around face `f` in full: its interior ([`FaceLocal::interior`]), what lies
+    /// beyond each side and the triangles around each corner.
     fn new(ctx: &Context, f: usize, n: u32) -> Result<Self, RuntimeError> {
-        let m = n as usize;
-        let own = PatchPoints::new(ctx.table, ctx.mesh, &ctx.patches[f])?;
-        let dual = own.all(PointSet::Dual, n)?;
+        let mut local = FaceLocal::interior(&ctx.points[f], n)?;
+        local.complete(ctx, f)?;
+        Ok(local)
+    }
+
+    /// Add the neighbours' rows (or the boundary curves) and the corners' triangles to the
+    /// interior of face `f`.
+    fn complete(&mut self, ctx: &Context, f: usize) -> Result<(), RuntimeError> {
+        let m = self.n;
+        let n = m as u32;
+        let own = &ctx.points[f];
         let primal = own.grid(PointSet::Primal, n)?;
         let mesh = ctx.mesh;
         let first = mesh.face_halfedges(f).start;
@@ -381,37 +459,31 @@ impl FaceLocal {
         for side in 0..4 {
             let t = mesh.twin[first + side];
             beyond.push(if t == NONE {
-                Beyond::Curve(
-                    (0..=m)
-                        .map(|t| {
-                            let (i, j) = curve_index(side, t, m);
-                            own.at(&primal, i, j)
-                        })
-                        .collect(),
-                )
+                let mut curve = Vec::with_capacity(m + 1);
+                own.extend(
+                    &primal,
+                    (0..=m).map(|t| curve_index(side, t, m)),
+                    &mut curve,
+                );
+                Beyond::Curve(curve)
             } else {
                 let t = t as usize;
                 let g = mesh.face_of[t] as usize;
                 let other = t - mesh.face_halfedges(g).start;
                 // The neighbour's row runs the other way along the shared edge.
-                let points = PatchPoints::new(ctx.table, mesh, &ctx.patches[g])?;
+                let points = &ctx.points[g];
                 let grid = points.grid(PointSet::Dual, n)?;
-                Beyond::Face(
-                    (0..m)
-                        .map(|t| {
-                            let (i, j) = row_index(other, m - 1 - t, m);
-                            points.at(&grid, i, j)
-                        })
-                        .collect(),
-                )
+                let mut row = Vec::with_capacity(m);
+                points.extend(
+                    &grid,
+                    (0..m).map(|t| row_index(other, m - 1 - t, m)),
+                    &mut row,
+                );
+                Beyond::Face(row)
             });
         }
-        let mut local = FaceLocal {
-            n: m,
-            dual,
-            beyond,
-            corners: Vec::with_capacity(4),
-        };
+        self.beyond = beyond;
+        let local = &*self;
         let strips: Vec<Vec<[[f64; 3]; 3]>> = (0..4)
             .map(|side| {
                 let row: Vec<[f64; 3]> = (0..m).map(|t| local.row(side, t)).collect();
@@ -426,7 +498,7 @@ impl FaceLocal {
             if g == f {
                 return Ok(local.d(i, j));
             }
-            let points = PatchPoints::new(ctx.table, mesh, &ctx.patches[g])?;
+            let points = &ctx.points[g];
             let grid = points.grid(PointSet::Dual, n)?;
             Ok(points.at(&grid, i, j))
         };
@@ -463,8 +535,8 @@ impl FaceLocal {
             }
             corners.push(triangles);
         }
-        local.corners = corners;
-        Ok(local)
+        self.corners = corners;
+        Ok(())
     }
 
     fn d(&self, i: usize, j: usize) -> [f64; 3] {
@@ -498,6 +570,14 @@ impl FaceLocal {
         distance(p, self.at(u, v))
     }
 
+    /// Whether `(u, v)` lies in the interior `[h, 1-h]^2`, outside the corner squares: there
+    /// `L_{f,n}` is made of the face's own dual points alone ([`FaceLocal::interior`]).
+    fn is_interior(&self, u: f64, v: f64) -> bool {
+        let h = 0.5 / self.n as f64;
+        let corner = (u <= h || u >= 1.0 - h) && (v <= h || v >= 1.0 - h);
+        self.n >= 2 && !corner && u.min(v).min(1.0 - u).min(1.0 - v) >= h
+    }
+
     /// `L_{f,n}(u, v)` outside the corner squares.
     fn at(&self, u: f64, v: f64) -> [f64; 3] {
         let n = self.n as f64;
@@ -525,7 +605,8 @@ impl FaceLocal {
             }
             let cell = |x: f64| -> (usize, f64) {
                 let t = (x * n - 0.5).clamp(0.0, n - 1.0);
-                let i = (t.floor() as usize).min(self.n - 2);
+                // `t >= 0`: truncation is the floor, without a call to `floor`.
+                let i = (t as usize).min(self.n - 2);
                 (i, t - i as f64)
             };
             let ((i, a), (j, b)) = (cell(u), cell(v));
@@ -556,7 +637,7 @@ impl FaceLocal {
                 // Cell i between the rows: quad (F_i, F_i+1, G_i+1, G_i) split as
                 // [G_i, F_i+1, F_i], [G_i, G_i+1, F_i+1]; alpha along, beta from G (0) to F (1).
                 let x = (sigma - 1.0) / 2.0;
-                let i = (x.floor() as usize).min(self.n - 2);
+                let i = (x as usize).min(self.n - 2);
                 let alpha = x - i as f64;
                 let beta = (1.0 + delta) / 2.0;
                 let (f0, f1) = (self.row(side, i), self.row(side, i + 1));
@@ -568,7 +649,7 @@ impl FaceLocal {
                 }
             }
             Beyond::Curve(c) => {
-                let j = ((sigma / 2.0).floor() as usize).min(self.n - 1);
+                let j = ((sigma / 2.0) as usize).min(self.n - 1);
                 let centre = (2 * j + 1) as f64;
                 if (sigma - centre).abs() <= 1.0 - delta {
                     // [C_j, C_{j+1}, D_j].
@@ -594,17 +675,25 @@ impl FaceLocal {
 
     /// `e_f(n)` over the samples.
     fn deviation(&self, samples: &Samples) -> f64 {
-        self.deviation_up_to(samples, f64::INFINITY)
+        self.deviation_up_to(samples, f64::INFINITY, |_| true)
     }
 
-    /// `e_f(n)` over the samples, or, as soon as one sample deviates by more than `stop`, that
-    /// sample's deviation (a lower bound of `e_f(n)`, enough to reject the rate: the selection
-    /// tries rates that mostly fail, and a failing rate usually fails at its first samples).
-    fn deviation_up_to(&self, samples: &Samples, stop: f64) -> f64 {
+    /// The largest deviation over the samples whose region passes `keep(is_interior)`, or, as
+    /// soon as one sample deviates by more than `stop`, that sample's deviation (a lower bound
+    /// of `e_f(n)`, enough to reject the rate: the selection tries rates that mostly fail, and
+    /// a failing rate usually fails at its first samples).
+    fn deviation_up_to(&self, samples: &Samples, stop: f64, keep: impl Fn(bool) -> bool) -> f64 {
+        let count = samples.uv.len().min(samples.positions.len());
+        let first = samples.start.get().min(count);
         let mut worst = 0.0f64;
-        for (&[u, v], &p) in samples.uv.iter().zip(&samples.positions) {
+        for k in (first..count).chain(0..first) {
+            let ([u, v], p) = (samples.uv[k], samples.positions[k]);
+            if !keep(self.is_interior(u, v)) {
+                continue;
+            }
             worst = worst.max(self.deviation_at(u, v, p));
             if worst > stop {
+                samples.start.set(k);
                 break;
             }
         }
@@ -612,11 +701,25 @@ impl FaceLocal {
     }
 }
 
-/// The mesh, its patches and the table: what evaluates any face.
+/// The mesh and every face's patch points: what evaluates any face.
 struct Context<'a> {
-    table: &'a StencilTable,
     mesh: &'a Mesh,
-    patches: &'a [FacePatch],
+    points: Vec<PatchPoints<'a>>,
+}
+
+impl<'a> Context<'a> {
+    fn new(
+        table: &'a StencilTable,
+        mesh: &'a Mesh,
+        patches: &'a [FacePatch],
+    ) -> Result<Self, RuntimeError> {
+        check_faces(mesh, patches)?;
+        let points = patches
+            .par_iter()
+            .map(|patch| PatchPoints::new(table, mesh, patch))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Context { mesh, points })
+    }
 }
 
 fn combine(terms: &[(f64, [f64; 3])]) -> [f64; 3] {
@@ -650,19 +753,15 @@ pub fn face_deviation(
     face: usize,
     n: u32,
 ) -> Result<f64, RuntimeError> {
-    check_faces(mesh, patches)?;
-    let patch = patches
+    let ctx = Context::new(table, mesh, patches)?;
+    let points = ctx
+        .points
         .get(face)
         .ok_or_else(|| RuntimeError::InvalidParameter {
             name: "face".to_owned(),
             reason: format!("{face} (the mesh has {} faces)", patches.len()),
         })?;
-    let ctx = Context {
-        table,
-        mesh,
-        patches,
-    };
-    let samples = Samples::new(&PatchPoints::new(table, mesh, patch)?, SELECTION_GRID)?;
+    let samples = Samples::new(points, SELECTION_GRID)?;
     Ok(FaceLocal::new(&ctx, face, n)?.deviation(&samples))
 }
 
@@ -690,14 +789,9 @@ pub fn tolerance_rates_among(
     tolerance: f64,
     candidates: &[u32],
 ) -> Result<ToleranceRates, RuntimeError> {
-    check_faces(mesh, patches)?;
     check_tolerance(tolerance)?;
     let sorted = sorted_candidates(candidates, &RATIONAL_RATES)?;
-    let ctx = Context {
-        table,
-        mesh,
-        patches,
-    };
+    let ctx = Context::new(table, mesh, patches)?;
     // A rate below the largest is only compared with the tolerance; the largest's deviation is
     // reported when no rate meets it, so it is measured in full.
     let largest = sorted.last().copied().unwrap_or(0);
@@ -705,14 +799,35 @@ pub fn tolerance_rates_among(
         patches.len(),
         tolerance,
         &sorted,
-        |f| Samples::new(&PatchPoints::new(table, mesh, &patches[f])?, SELECTION_GRID),
+        |f| Samples::new(&ctx.points[f], SELECTION_GRID),
         |f, samples, n| {
             let stop = if n == largest {
                 f64::INFINITY
             } else {
                 tolerance
             };
-            Ok(FaceLocal::new(&ctx, f, n)?.deviation_up_to(samples, stop))
+            // Most samples are interior, where the face's own dual points are all of
+            // `L_{f,n}`: a failing rate is refuted there before its neighbours' rows and its
+            // corners' polygons are evaluated, unless the last rate failed only outside.
+            let mut local = FaceLocal::interior(&ctx.points[f], n)?;
+            let mut worst = 0.0f64;
+            if !samples.outside_first.get() {
+                worst = local.deviation_up_to(samples, stop, |interior| interior);
+                if worst > stop {
+                    return Ok(worst);
+                }
+            }
+            local.complete(&ctx, f)?;
+            worst = worst.max(local.deviation_up_to(samples, stop, |interior| !interior));
+            if worst > stop {
+                samples.outside_first.set(true);
+                return Ok(worst);
+            }
+            if samples.outside_first.get() {
+                samples.outside_first.set(false);
+                worst = worst.max(local.deviation_up_to(samples, stop, |interior| interior));
+            }
+            Ok(worst)
         },
     )
 }
