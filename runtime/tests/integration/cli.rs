@@ -232,7 +232,9 @@ fn tolerance_and_view_rates() {
 #[test]
 fn eval_is_exact_on_sharp_features() {
     let position = |uv: &str| -> Vec<f64> {
-        let out = succeeds(&format!("eval data/cube_creased.obj --face 1 --uv {uv} --json"));
+        let out = succeeds(&format!(
+            "eval data/cube_creased.obj --face 1 --uv {uv} --json"
+        ));
         let point = json(&out);
         assert!(point["du"].as_array().is_some_and(|a| a.len() == 3));
         assert!(point["dv"].as_array().is_some_and(|a| a.len() == 3));
