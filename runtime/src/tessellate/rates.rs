@@ -272,7 +272,12 @@ impl<'a> PatchPoints<'a> {
                 }
                 m += 1;
             }
-            out.extend_from_slice(&self.sums(rows)[..m]);
+            if m == 4 {
+                out.extend_from_slice(&self.sums(rows));
+            } else {
+                // The last few: one at a time, rather than sums of repeated rows.
+                out.extend(rows[..m].iter().map(|&row| self.sums([row])[0]));
+            }
         }
     }
 
@@ -402,7 +407,34 @@ struct FaceLocal {
     beyond: Vec<Beyond>,
     /// Per corner: the vertex polygon's triangles, the two ends of the adjacent strips, and the
     /// face's corner cell.
-    corners: Vec<Vec<[[f64; 3]; 3]>>,
+    corners: Vec<Vec<Corner>>,
+}
+
+/// A triangle around a corner, with a ball that holds it: `|p - centre| - radius` is a lower
+/// bound of the distance from `p` to the triangle that costs a tenth of the distance itself.
+struct Corner {
+    triangle: [[f64; 3]; 3],
+    centre: [f64; 3],
+    radius: f64,
+}
+
+impl Corner {
+    fn new(triangle: [[f64; 3]; 3]) -> Self {
+        let centre = combine(&[
+            (1.0 / 3.0, triangle[0]),
+            (1.0 / 3.0, triangle[1]),
+            (1.0 / 3.0, triangle[2]),
+        ]);
+        let radius = triangle
+            .iter()
+            .map(|&q| distance(q, centre))
+            .fold(0.0, f64::max);
+        Corner {
+            triangle,
+            centre,
+            radius,
+        }
+    }
 }
 
 /// The triangles of a strip merging row `a` (`na` points at `(2i+1)/2na`) with row `b` (`nb`
@@ -535,7 +567,10 @@ impl FaceLocal {
             }
             corners.push(triangles);
         }
-        self.corners = corners;
+        self.corners = corners
+            .into_iter()
+            .map(|triangles| triangles.into_iter().map(Corner::new).collect())
+            .collect();
         Ok(())
     }
 
@@ -562,10 +597,16 @@ impl FaceLocal {
                 (false, false) => 2,
                 (true, false) => 3,
             };
-            return self.corners[corner]
-                .iter()
-                .map(|t| point_triangle_distance(p, t))
-                .fold(f64::INFINITY, f64::min);
+            // The nearest triangle: one whose ball is farther than the nearest so far cannot be
+            // nearer (the margin keeps rounding in the bound from skipping a tie).
+            let mut nearest = f64::INFINITY;
+            for t in &self.corners[corner] {
+                let centre = distance(p, t.centre);
+                if centre - t.radius - 1e-12 * (centre + t.radius) <= nearest {
+                    nearest = nearest.min(point_triangle_distance(p, &t.triangle));
+                }
+            }
+            return nearest;
         }
         distance(p, self.at(u, v))
     }
