@@ -79,6 +79,8 @@
 //! assert!((centre.position[0] - 0.5).abs() < 1e-15 && (centre.position[1] - 0.5).abs() < 1e-15);
 //! ```
 
+pub mod feature;
+
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 
@@ -102,7 +104,7 @@ use crate::RuntimeError;
 /// (DESIGN.md conventions: `(0,0)` at the face's first vertex, `(1,0)` at its second).
 ///
 /// What is exact (the exact value rounded once to f64): the position always (on meshes with
-/// sharp features too, [`super::feature_eval`]); the derivatives everywhere but at a vertex
+/// sharp features too, [`feature`]); the derivatives everywhere but at a vertex
 /// that is extraordinary or a feature. What is f64: the tangents at an extraordinary vertex
 /// (the tables' irrational masks) and at a feature vertex — a corner, a crease, a dart, a
 /// crease sector (OpenSubdiv's tangent masks, at darts and sectors of three or more faces
@@ -114,7 +116,7 @@ pub struct LimitPoint {
     /// `dS/du`. At an extraordinary vertex: the tables' tangent mask along the face's `u` edge
     /// (see the module documentation), not a parametric derivative. At a feature vertex of a
     /// mesh with sharp features: a tangent along the frame of the face the descent ended in
-    /// ([`super::feature_eval`]); with [`LimitPoint::dv`] it spans the tangent plane and its
+    /// ([`feature`]); with [`LimitPoint::dv`] it spans the tangent plane and its
     /// cross product with it is the outward normal.
     pub du: [f64; 3],
     /// `dS/dv`, likewise.
@@ -195,7 +197,7 @@ pub fn evaluate_subface(
 #[derive(Debug)]
 pub struct ExactEvaluator {
     /// `levels[0]` is the mesh, `levels[i]` its `i`-th refinement (none for a mesh with sharp
-    /// features, which [`super::feature_eval`] refines locally, point by point).
+    /// features, which [`feature`] refines locally, point by point).
     levels: Vec<Mesh>,
     /// Whether the mesh has sharp features ([`Mesh::has_sharp_features`]).
     tagged: bool,
@@ -406,7 +408,7 @@ impl ExactEvaluator {
         v: &BigRational,
     ) -> Result<LimitPoint, RuntimeError> {
         if self.tagged {
-            return super::feature_eval::evaluate(self, face, corner, u, v);
+            return feature::evaluate(self, face, corner, u, v);
         }
         let located = self.locate(face, corner, u, v)?;
         let mut exact = ExactPositions::new(self);

@@ -2,7 +2,6 @@
 //! triangle and barycentric `(u, v)`.
 
 pub mod exact_eval;
-pub mod feature_eval;
 pub mod loop_exact_eval;
 
 use num_rational::BigRational;
@@ -23,7 +22,7 @@ pub use exact_eval::{parse_rational, LimitPoint};
 ///
 /// Catmull–Clark: any face; a non-quad face is parameterized by its sub-faces (the quads of
 /// its first step), `subface` picks one (docs/algorithms). With sharp features (creases and
-/// corners of any sharpness, darts, holes; [`feature_eval`]) the position stays exact: where
+/// corners of any sharpness, darts, holes; [`exact_eval::feature`]) the position stays exact: where
 /// the descent ends in a B-spline patch (reflected across infinitely sharp edges) or a smooth
 /// table patch, derivatives too; at a feature vertex (the point at a corner of the final piece)
 /// the position comes from OpenSubdiv's rational limit masks or, at a dart, the exact

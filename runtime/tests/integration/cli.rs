@@ -223,7 +223,7 @@ fn tolerance_and_view_rates() {
     let _ = std::fs::remove_file(obj);
 }
 
-/// `subtess eval` on sharp features, exactly (`eval::feature_eval`): `data/cube_creased.obj`'s
+/// `subtess eval` on sharp features, exactly (`eval::exact_eval::feature`): `data/cube_creased.obj`'s
 /// top face is bounded by an infinitely sharp crease and its refined points never leave the
 /// plane `z = 1` (face points, crease midpoints and crease vertex points of points at `z = 1`),
 /// so its limit has `z = 1` exactly, and the top face is symmetric, so its centre is on the z

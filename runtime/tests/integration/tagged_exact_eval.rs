@@ -1,4 +1,4 @@
-//! Exact evaluation on meshes with sharp features (`subtess::eval::feature_eval`) against
+//! Exact evaluation on meshes with sharp features (`subtess::eval::exact_eval::feature`) against
 //! independent references:
 //!
 //! * an infinitely sharp crease is the uniform cubic B-spline of its vertices (DeRose, Kass and

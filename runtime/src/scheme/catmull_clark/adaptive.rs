@@ -94,7 +94,7 @@ fn settled(s: f32) -> bool {
 
 /// The 4 x 4 control points (`grid[a + 1][b + 1]` at `(a, b)`, `a` along the face's `u`) of
 /// quad `g` if it is a B-spline patch, else `None`; generic over the weight so that the exact
-/// evaluation ([`crate::eval::feature_eval`]) takes the same net in rationals.
+/// evaluation ([`crate::eval::exact_eval::feature`]) takes the same net in rationals.
 pub(crate) fn bspline_patch<W: Weight>(mesh: &Mesh, g: usize) -> Option<[[Combo<W>; 4]; 4]> {
     let hs = mesh.face_halfedges(g);
     if hs.len() != 4 {

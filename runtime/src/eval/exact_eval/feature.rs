@@ -23,7 +23,7 @@
 //!    * a **table patch with no sharp feature on its support** ([`face_patch`] and
 //!      [`is_smooth_patch`]: only the edges and vertices at the face's corners decide the rules
 //!      of its refined neighbourhoods): Schaefer–Warren substitution, exactly as on untagged
-//!      meshes ([`super::exact_eval`]);
+//!      meshes ([`super`]);
 //!    * the point **at a corner** whose settled rule has a limit mask (`adaptive::vertex_limit`): the
 //!      position by OpenSubdiv's `Sdc` masks, rational — corner `V`, crease
 //!      `(E_a + 4 V + E_b) / 6`, smooth `(n^2 V + 4 sum E + sum F) / (n (n + 5))` — and at a
@@ -57,7 +57,7 @@ use num_bigint::BigInt;
 use num_rational::BigRational;
 use num_traits::{One, ToPrimitive, Zero};
 
-use super::exact_eval::{
+use super::{
     bicubic, check_query, descend, int, ratio, solve_exact, to_corner, Derivatives, ExactEvaluator,
     LimitPoint, Point, Scaled,
 };
@@ -70,7 +70,7 @@ use crate::scheme::patch::{face_patch, is_smooth_patch};
 use crate::{MeshError, RuntimeError};
 
 /// At most this many levels are refined below the input mesh for one point: a parameter's
-/// denominator has at most 64 bits ([`super::exact_eval::MAX_RATIONAL_BITS`]), so a point lies
+/// denominator has at most 64 bits ([`super::MAX_RATIONAL_BITS`]), so a point lies
 /// at least `2^-64` from a feature vertex it is not on, plus 10 levels for a semi-sharp feature
 /// to decay (OpenSubdiv's largest finite sharpness) and margin.
 pub const MAX_LEVELS: usize = 80;
