@@ -25,6 +25,12 @@
 //!   along it; a face and its dyadic `(u, v)`). Each leaf square becomes the polygon through
 //!   every marked point on its sides, so the output is watertight by construction.
 //! * **Absolute and relative flatness** (section 6): [`AdaptiveOptions::relative`].
+//! * **Sharp features** (OpenSubdiv's tags; not in the paper): hole faces get no polygons; a
+//!   face with a sharp edge or vertex at its corners takes the feature-adaptive descent of
+//!   `feature.rs` — local refinement until each piece is a feature-aware B-spline patch
+//!   (phantom points beyond infinitely sharp edges), converted to Bézier and bounded as above,
+//!   and at feature vertices the hull of the piece's one-ring (non-negative rules), the
+//!   counterpart of the extraordinary sphere bound.
 //!
 //! ```
 //! use subtess::scheme::catmull_clark::isolate::isolate_with_origins;
@@ -137,7 +143,9 @@ pub struct PolygonRegion {
     pub denominator: u32,
     /// Subdivision depth of the square (0: the whole face).
     pub depth: u32,
-    /// Whether this is the square at an extraordinary vertex (the sphere bound).
+    /// Whether this square has a sphere (hull-diameter) bound: the square at an extraordinary
+    /// vertex, or a hull square of the feature descent (at a feature vertex, or before a
+    /// semi-sharp feature has settled).
     pub extraordinary: bool,
     /// The guaranteed bound on `|S - L|` over the square for any triangulation `L` of the
     /// polygon in parameter space ([`bezier_net::flatness_bound`], or the EV hull diameter).
