@@ -658,3 +658,28 @@ fn tagged_shapes_meet_the_tolerance() {
         }
     }
 }
+
+/// Relative flatness on a tagged shape: every leaf within `tolerance` times its diagonal (the
+/// whole face's for sphere-bounded squares), the dense samples within their bounds, closed.
+#[test]
+#[cfg_attr(
+    not(shared_models),
+    ignore = "needs ../shared/models beside the repository"
+)]
+fn relative_flatness_on_a_tagged_shape() {
+    let mesh = tagged("catmark_cube_creases1");
+    let iso = isolate(&mesh);
+    let opts = AdaptiveOptions {
+        tolerance: 0.02,
+        relative: true,
+        ..Default::default()
+    };
+    let (out, stats) = tessellate_adaptive(&table(), &iso.mesh, &iso.patches, &opts).expect("ok");
+    assert_eq!(stats.leaves_over_tolerance, 0);
+    for p in &out.polygons {
+        assert!(p.region.bound <= p.region.tolerance, "{:?}", p.region);
+        assert!(p.region.diagonal > 0.0, "{:?}", p.region);
+    }
+    check_with_limit_stencils(&iso, &out, 1e-9 * size(&mesh));
+    assert!(out.is_watertight() && out.to_triangle_mesh().is_watertight());
+}
