@@ -355,7 +355,9 @@ impl Surface {
     }
 
     /// Lai and Cheng's error-bounded adaptive tessellation (Catmull–Clark only), its sources in
-    /// the input faces' own parameters.
+    /// the input faces' own parameters; sharp features (creases, corners, darts, semi-sharp
+    /// tags, holes, boundary modes) are honoured with the same guarantee
+    /// ([`crate::tessellate::lai_cheng`], `docs/lai-cheng.md`).
     pub fn tessellate_adaptive(
         &self,
         options: &AdaptiveOptions,
@@ -366,11 +368,6 @@ impl Surface {
                 self.scheme
             )));
         };
-        if iso.mesh.has_sharp_features() {
-            return Err(RuntimeError::Unsupported(
-                "Lai–Cheng's adaptive method on sharp features (creases, corners, holes); the dual grid (--method dual) evaluates them exactly".to_owned(),
-            ));
-        }
         let (mut adaptive, stats) =
             tessellate_adaptive(&self.table, &iso.mesh, &iso.patches, options)?;
         for source in &mut adaptive.sources {

@@ -14,6 +14,7 @@ use schemes::BoundaryMode;
 use subtess::eval::exact_eval::ExactEvaluator;
 use subtess::io::obj::read_obj;
 use subtess::mesh::topology::Mesh;
+use subtess::scheme::catmull_clark::adaptive::{limit_stencils, LimitQuery};
 use subtess::scheme::catmull_clark::isolate::{isolate_with_origins, Isolation};
 use subtess::stencil_table::StencilTable;
 use subtess::tessellate::lai_cheng::{
@@ -491,4 +492,194 @@ fn uniform_depth_gives_the_uniform_count() {
     assert_eq!(out.polygons.len(), iso.mesh.faces() * 16);
     assert_eq!(stats.uniform_polygons, out.polygons.len() as f64);
     assert!(out.polygons.iter().all(|p| p.vertices.len() == 4));
+}
+
+/// A tagged OpenSubdiv shape from `../shared/models/opensubdiv`.
+fn tagged(name: &str) -> Mesh {
+    load(&crate::common::models().join(format!("opensubdiv/{name}.obj")))
+}
+
+/// Parameters along a face side: a uniform 1/16 lattice and points closing in on both ends
+/// (`2^-k`, `1 - 2^-k`, k = 5..12), where the squares at feature vertices go deep.
+fn sample_parameters() -> Vec<f64> {
+    let mut t: Vec<f64> = (0..=16).map(|i| f64::from(i) / 16.0).collect();
+    for k in 5..=12 {
+        let e = 0.5f64.powi(k);
+        t.extend([e, 1.0 - e]);
+    }
+    t
+}
+
+/// Dense limit samples of every surface face by the f64 feature-adaptive limit stencils
+/// (`adaptive::limit_stencils`, not Lai–Cheng's code), each against every polygon whose square
+/// contains it: asserts `distance <= bound + slack`; returns (samples, largest distance,
+/// largest distance / bound at hull squares).
+fn check_with_limit_stencils(iso: &Isolation, out: &AdaptiveMesh, slack: f64) -> (usize, f64, f64) {
+    let mesh = &iso.mesh;
+    let mut by_face: Vec<Vec<&AdaptivePolygon>> = vec![Vec::new(); mesh.faces()];
+    for p in &out.polygons {
+        by_face[p.region.face as usize].push(p);
+    }
+    let ts = sample_parameters();
+    let queries: Vec<LimitQuery> = (0..mesh.faces())
+        .filter(|&f| !mesh.holes[f])
+        .flat_map(|f| {
+            let ts = &ts;
+            ts.iter().flat_map(move |&u| {
+                ts.iter().map(move |&v| LimitQuery {
+                    face: f as u32,
+                    u,
+                    v,
+                })
+            })
+        })
+        .collect();
+    let stencils = limit_stencils(mesh, &queries).expect("limit stencils");
+    let (mut worst, mut worst_ratio): (f64, f64) = (0.0, 0.0);
+    for (q, stencil) in queries.iter().zip(&stencils) {
+        let mut s = [0.0; 3];
+        for &(v, w) in stencil {
+            for (x, p) in s.iter_mut().zip(mesh.positions[v as usize]) {
+                *x += w[0] * p;
+            }
+        }
+        let mut found = false;
+        for polygon in by_face[q.face as usize]
+            .iter()
+            .filter(|p| contains(p, q.u, q.v))
+        {
+            found = true;
+            let d = distance_to_polygon(out, polygon, s);
+            assert!(
+                d <= polygon.region.bound + slack,
+                "face {} at ({}, {}): distance {d} > bound {} ({:?})",
+                q.face,
+                q.u,
+                q.v,
+                polygon.region.bound,
+                polygon.region
+            );
+            worst = worst.max(d);
+            if polygon.region.extraordinary && polygon.region.bound > 0.0 {
+                worst_ratio = worst_ratio.max(d / polygon.region.bound);
+            }
+        }
+        assert!(found, "face {} ({}, {}) is in no polygon", q.face, q.u, q.v);
+    }
+    (queries.len(), worst, worst_ratio)
+}
+
+/// Boundary loops of the output: directed polygon edges without their reverse, followed.
+fn output_boundary_loops(out: &AdaptiveMesh) -> usize {
+    use std::collections::{HashMap, HashSet};
+    let mut directed = HashSet::new();
+    for p in &out.polygons {
+        let n = p.vertices.len();
+        for k in 0..n {
+            directed.insert((p.vertices[k], p.vertices[(k + 1) % n]));
+        }
+    }
+    let mut next: HashMap<u32, u32> = HashMap::new();
+    for &(a, b) in &directed {
+        if !directed.contains(&(b, a)) {
+            assert!(
+                next.insert(a, b).is_none(),
+                "vertex {a} starts two rim edges"
+            );
+        }
+    }
+    let mut seen = HashSet::new();
+    let mut loops = 0;
+    for &start in next.keys() {
+        if seen.contains(&start) {
+            continue;
+        }
+        loops += 1;
+        let mut v = start;
+        while seen.insert(v) {
+            v = next[&v];
+        }
+        assert_eq!(v, start, "a rim that does not close");
+    }
+    loops
+}
+
+/// Lai–Cheng on tagged OpenSubdiv shapes (semi-sharp and infinitely sharp creases, corners,
+/// holes, boundary modes): every dense limit sample within its polygon's bound and the
+/// tolerance, no leaf over the tolerance, polygons and triangles closed on closed shapes, and
+/// the surface's boundary loops (holes included) and Euler characteristic kept.
+#[test]
+#[cfg_attr(
+    not(shared_models),
+    ignore = "needs ../shared/models beside the repository"
+)]
+fn tagged_shapes_meet_the_tolerance() {
+    for name in [
+        "catmark_cube_creases0",
+        "catmark_cube_creases1",
+        "catmark_cube_corner0",
+        "catmark_cube_corner4",
+        "catmark_hole_test1",
+        "catmark_hole_test2",
+        "catmark_single_crease",
+        "catmark_edgecorner",
+    ] {
+        let mesh = tagged(name);
+        let scale = size(&mesh);
+        let iso = isolate(&mesh);
+        for fraction in [0.01, 0.003] {
+            let t = fraction * scale;
+            let (out, stats) =
+                tessellate_adaptive(&table(), &iso.mesh, &iso.patches, &options(t)).expect(name);
+            assert_eq!(stats.leaves_over_tolerance, 0, "{name} T = {t}");
+            let (samples, worst, hull_ratio) = check_with_limit_stencils(&iso, &out, 1e-9 * scale);
+            assert!(worst <= t, "{name}: {worst} > {t}");
+            let triangles = out.to_triangle_mesh();
+            let loops = mesh.boundary_loops();
+            if loops == 0 {
+                assert!(out.is_watertight(), "{name} T = {t}: polygons");
+                assert!(triangles.is_watertight(), "{name} T = {t}: triangles");
+            }
+            assert_eq!(output_boundary_loops(&out), loops, "{name} T = {t}");
+            assert_eq!(
+                triangles.euler_characteristic(),
+                mesh.euler_characteristic(),
+                "{name} T = {t}"
+            );
+            eprintln!(
+                "| {name} | {fraction} | {t:.3e} | {:.3e} | {samples} | {worst:.3e} | {:.3} | {hull_ratio:.3} | {} | {} | {} | {} | {loops} |",
+                stats.max_bound,
+                worst / t,
+                stats.polygons,
+                stats.triangles,
+                stats.extraordinary_leaves,
+                stats.max_depth,
+            );
+        }
+    }
+}
+
+/// Relative flatness on a tagged shape: every leaf within `tolerance` times its diagonal (the
+/// whole face's for sphere-bounded squares), the dense samples within their bounds, closed.
+#[test]
+#[cfg_attr(
+    not(shared_models),
+    ignore = "needs ../shared/models beside the repository"
+)]
+fn relative_flatness_on_a_tagged_shape() {
+    let mesh = tagged("catmark_cube_creases1");
+    let iso = isolate(&mesh);
+    let opts = AdaptiveOptions {
+        tolerance: 0.02,
+        relative: true,
+        ..Default::default()
+    };
+    let (out, stats) = tessellate_adaptive(&table(), &iso.mesh, &iso.patches, &opts).expect("ok");
+    assert_eq!(stats.leaves_over_tolerance, 0);
+    for p in &out.polygons {
+        assert!(p.region.bound <= p.region.tolerance, "{:?}", p.region);
+        assert!(p.region.diagonal > 0.0, "{:?}", p.region);
+    }
+    check_with_limit_stencils(&iso, &out, 1e-9 * size(&mesh));
+    assert!(out.is_watertight() && out.to_triangle_mesh().is_watertight());
 }

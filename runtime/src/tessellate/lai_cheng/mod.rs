@@ -25,6 +25,12 @@
 //!   along it; a face and its dyadic `(u, v)`). Each leaf square becomes the polygon through
 //!   every marked point on its sides, so the output is watertight by construction.
 //! * **Absolute and relative flatness** (section 6): [`AdaptiveOptions::relative`].
+//! * **Sharp features** (OpenSubdiv's tags; not in the paper): hole faces get no polygons; a
+//!   face with a sharp edge or vertex at its corners takes the feature-adaptive descent of
+//!   `feature.rs` — local refinement until each piece is a feature-aware B-spline patch
+//!   (phantom points beyond infinitely sharp edges), converted to Bézier and bounded as above,
+//!   and at feature vertices the hull of the piece's one-ring (non-negative rules), the
+//!   counterpart of the extraordinary sphere bound.
 //!
 //! ```
 //! use subtess::scheme::catmull_clark::isolate::isolate_with_origins;
@@ -45,6 +51,7 @@
 //! ```
 
 pub mod bezier_net;
+mod feature;
 mod operators;
 mod polygons;
 
@@ -58,7 +65,8 @@ use table_format::{PointSet, SectionKey, StencilKind};
 
 use crate::mesh::topology::{Mesh, NONE};
 use crate::mesh::triangle_mesh::{TriangleMesh, VertexSource};
-use crate::scheme::patch::{FacePatch, PatchKind};
+use crate::scheme::catmull_clark::adaptive::{limit_stencils, LimitQuery};
+use crate::scheme::patch::{is_smooth_patch, FacePatch, PatchKind};
 use crate::stencil_table::StencilTable;
 use crate::RuntimeError;
 use bezier_net::{
@@ -135,7 +143,9 @@ pub struct PolygonRegion {
     pub denominator: u32,
     /// Subdivision depth of the square (0: the whole face).
     pub depth: u32,
-    /// Whether this is the square at an extraordinary vertex (the sphere bound).
+    /// Whether this square has a sphere (hull-diameter) bound: the square at an extraordinary
+    /// vertex, or a hull square of the feature descent (at a feature vertex, or before a
+    /// semi-sharp feature has settled).
     pub extraordinary: bool,
     /// The guaranteed bound on `|S - L|` over the square for any triangulation `L` of the
     /// polygon in parameter space ([`bezier_net::flatness_bound`], or the EV hull diameter).
@@ -288,6 +298,9 @@ struct Marked {
     v: u32,
     position: Point,
     normal: Point,
+    /// Whether the position and normal are still to be evaluated (a hull square's corner next
+    /// to a feature: [`feature`]).
+    pending: bool,
 }
 
 /// The recursion over one face (section 5's `AdaptiveMarking`).
@@ -363,6 +376,7 @@ impl FaceWork<'_> {
                 v,
                 position: points[k],
                 normal: normals[k],
+                pending: false,
             });
         }
         self.leaves.push(Leaf {
@@ -374,6 +388,31 @@ impl FaceWork<'_> {
             tolerance,
             diagonal: longer_diagonal(&points),
             extraordinary,
+        });
+    }
+
+    /// Record a hull square (at a feature, [`feature`]) with face frame `frame`; its corners are
+    /// evaluated after the marking, its diagonal then.
+    fn pending_leaf(&mut self, frame: &feature::Frame, depth: u32, bound: f64, tolerance: f64) {
+        self.polygons.fetch_add(1, Ordering::Relaxed);
+        for &(u, v) in frame {
+            self.marked.push(Marked {
+                u,
+                v,
+                position: [0.0; 3],
+                normal: [0.0; 3],
+                pending: true,
+            });
+        }
+        self.leaves.push(Leaf {
+            u0: frame.iter().map(|p| p.0).min().unwrap_or(0),
+            v0: frame.iter().map(|p| p.1).min().unwrap_or(0),
+            size: GRID >> depth,
+            depth,
+            bound,
+            tolerance,
+            diagonal: 0.0,
+            extraordinary: true,
         });
     }
 
@@ -448,6 +487,42 @@ impl FaceWork<'_> {
             depth += 1;
         }
     }
+}
+
+/// How a face is tessellated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Path {
+    /// A hole: no surface.
+    Hole,
+    /// Its table patch (regular, or the extraordinary descent).
+    Table,
+    /// The feature-adaptive descent ([`feature`]).
+    Feature,
+}
+
+/// [`limit_stencils`] of `queries`, none for none (it needs a face to start from).
+fn stencils_at(
+    mesh: &Mesh,
+    queries: &[LimitQuery],
+) -> Result<Vec<crate::scheme::catmull_clark::adaptive::LimitStencil>, RuntimeError> {
+    if queries.is_empty() {
+        return Ok(Vec::new());
+    }
+    Ok(limit_stencils(mesh, queries)?)
+}
+
+/// Position and the two tangent columns of a limit stencil on `mesh`'s vertices.
+fn apply_stencil(mesh: &Mesh, stencil: &[(u32, [f64; 3])]) -> (Point, Point, Point) {
+    let mut out = [[0.0; 3]; 3];
+    for &(v, w) in stencil {
+        let p = mesh.positions[v as usize];
+        for (k, column) in out.iter_mut().enumerate() {
+            for c in 0..3 {
+                column[c] += w[k] * p[c];
+            }
+        }
+    }
+    (out[0], out[1], out[2])
 }
 
 /// Levels of the extraordinary enclosure ([`ev_enclosure`]).
@@ -732,8 +807,48 @@ pub fn tessellate_adaptive(
             mesh.faces()
         )));
     }
-    // The operators of every patch kind, built once.
-    let mut kinds: Vec<PatchKind> = patches.iter().map(|p| p.kind).collect();
+    // Which faces take which path: a hole has no surface; a face the tables describe (no sharp
+    // feature on its support) its table patch; any other the feature descent.
+    let path: Vec<Path> = (0..mesh.faces())
+        .map(|f| {
+            if mesh.holes[f] {
+                Path::Hole
+            } else if is_smooth_patch(mesh, f) {
+                Path::Table
+            } else {
+                Path::Feature
+            }
+        })
+        .collect();
+    // The whole feature face's diagonal, for relative flatness at its hull squares (as the
+    // extraordinary square uses its whole patch's).
+    let feature_faces: Vec<usize> = (0..mesh.faces())
+        .filter(|&f| path[f] == Path::Feature)
+        .collect();
+    let corner_queries: Vec<LimitQuery> = feature_faces
+        .iter()
+        .flat_map(|&f| {
+            [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)].map(|(u, v)| LimitQuery {
+                face: f as u32,
+                u,
+                v,
+            })
+        })
+        .collect();
+    let corner_points = stencils_at(mesh, &corner_queries)?;
+    let mut root_diagonal = vec![0.0; mesh.faces()];
+    for (k, &f) in feature_faces.iter().enumerate() {
+        let p: [Point; 4] =
+            std::array::from_fn(|c| apply_stencil(mesh, &corner_points[4 * k + c]).0);
+        root_diagonal[f] = longer_diagonal(&p);
+    }
+    // The operators of every patch kind on the table path, built once.
+    let mut kinds: Vec<PatchKind> = patches
+        .iter()
+        .zip(&path)
+        .filter(|(_, &p)| p == Path::Table)
+        .map(|(p, _)| p.kind)
+        .collect();
     kinds.sort_by_key(|k| (k.boundary, k.faces, k.sector));
     kinds.dedup();
     let mut operators: HashMap<PatchKind, Operators> = HashMap::new();
@@ -743,44 +858,67 @@ pub fn tessellate_adaptive(
     }
     // Pass 1 (parallel): the adaptive marking of every face, within the polygon budget.
     let polygons = AtomicUsize::new(0);
-    let work: Vec<(Vec<Leaf>, Vec<Marked>)> = patches
+    let mut work: Vec<(Vec<Leaf>, Vec<Marked>)> = patches
         .par_iter()
-        .map(|patch| -> Result<(Vec<Leaf>, Vec<Marked>), RuntimeError> {
-            let ops = operators.get(&patch.kind).ok_or_else(|| {
-                RuntimeError::Unsupported(format!("no operators for {:?}", patch.kind))
-            })?;
-            if ops.size != patch.points.len() {
-                return Err(RuntimeError::Unsupported(format!(
-                    "a patch {:?} has {} control points, its layout {}",
-                    patch.kind,
-                    patch.points.len(),
-                    ops.size
-                )));
-            }
-            let points: Vec<Point> = patch
-                .points
-                .iter()
-                .map(|&v| mesh.positions[v as usize])
-                .collect();
-            let mut face = FaceWork {
-                options,
-                corner: patch.corner,
-                leaves: Vec::new(),
-                marked: Vec::new(),
-                polygons: &polygons,
-            };
-            match ops.regular_patch(&points) {
-                Some(net) => face.regular(&net, 0, 0, 0),
-                None => {
-                    let normal = vertex_normal(table, patch, &points).unwrap_or([0.0; 3]);
-                    face.extraordinary(ops, points, normal);
+        .enumerate()
+        .map(
+            |(f, patch)| -> Result<(Vec<Leaf>, Vec<Marked>), RuntimeError> {
+                match path[f] {
+                    Path::Hole => return Ok((Vec::new(), Vec::new())),
+                    Path::Feature => {
+                        let mut face = FaceWork {
+                            options,
+                            corner: 0,
+                            leaves: Vec::new(),
+                            marked: Vec::new(),
+                            polygons: &polygons,
+                        };
+                        let (level, g) = feature::root(mesh, f);
+                        let frame = [(0, 0), (GRID, 0), (GRID, GRID), (0, GRID)];
+                        face.feature(&level, g, frame, 0, true, root_diagonal[f]);
+                        if face.over_budget() {
+                            return Ok((Vec::new(), Vec::new()));
+                        }
+                        return Ok((face.leaves, face.marked));
+                    }
+                    Path::Table => {}
                 }
-            }
-            if face.over_budget() {
-                return Ok((Vec::new(), Vec::new()));
-            }
-            Ok((face.leaves, face.marked))
-        })
+                let ops = operators.get(&patch.kind).ok_or_else(|| {
+                    RuntimeError::Unsupported(format!("no operators for {:?}", patch.kind))
+                })?;
+                if ops.size != patch.points.len() {
+                    return Err(RuntimeError::Unsupported(format!(
+                        "a patch {:?} has {} control points, its layout {}",
+                        patch.kind,
+                        patch.points.len(),
+                        ops.size
+                    )));
+                }
+                let points: Vec<Point> = patch
+                    .points
+                    .iter()
+                    .map(|&v| mesh.positions[v as usize])
+                    .collect();
+                let mut face = FaceWork {
+                    options,
+                    corner: patch.corner,
+                    leaves: Vec::new(),
+                    marked: Vec::new(),
+                    polygons: &polygons,
+                };
+                match ops.regular_patch(&points) {
+                    Some(net) => face.regular(&net, 0, 0, 0),
+                    None => {
+                        let normal = vertex_normal(table, patch, &points).unwrap_or([0.0; 3]);
+                        face.extraordinary(ops, points, normal);
+                    }
+                }
+                if face.over_budget() {
+                    return Ok((Vec::new(), Vec::new()));
+                }
+                Ok((face.leaves, face.marked))
+            },
+        )
         .collect::<Result<_, _>>()?;
     if polygons.load(Ordering::Relaxed) > options.max_polygons {
         return Err(RuntimeError::OverBudget {
@@ -801,6 +939,48 @@ pub fn tessellate_adaptive(
             limit: format!("{} polygons", options.max_polygons),
             raise: "--max-polygons N raises it, a larger --tolerance needs fewer".to_owned(),
         });
+    }
+    // Pass 1b: the corners of the hull squares, by feature-adaptive limit stencils (one batch),
+    // and those squares' diagonals.
+    let pending: Vec<(usize, usize)> = work
+        .iter()
+        .enumerate()
+        .flat_map(|(f, (_, marked))| {
+            marked
+                .iter()
+                .enumerate()
+                .filter(|(_, m)| m.pending)
+                .map(move |(k, _)| (f, k))
+        })
+        .collect();
+    let queries: Vec<LimitQuery> = pending
+        .iter()
+        .map(|&(f, k)| {
+            let m = &work[f].1[k];
+            LimitQuery {
+                face: f as u32,
+                u: f64::from(m.u) / f64::from(GRID),
+                v: f64::from(m.v) / f64::from(GRID),
+            }
+        })
+        .collect();
+    let stencils = stencils_at(mesh, &queries)?;
+    for (&(f, k), stencil) in pending.iter().zip(&stencils) {
+        let (position, du, dv) = apply_stencil(mesh, stencil);
+        let m = &mut work[f].1[k];
+        m.position = position;
+        m.normal = unit(cross(du, dv));
+        m.pending = false;
+    }
+    for (leaves, marked) in &mut work {
+        for (i, leaf) in leaves.iter_mut().enumerate() {
+            if let Some(corners) = marked.get(4 * i..4 * i + 4) {
+                if leaf.extraordinary && leaf.diagonal == 0.0 {
+                    let p: [Point; 4] = std::array::from_fn(|c| corners[c].position);
+                    leaf.diagonal = longer_diagonal(&p);
+                }
+            }
+        }
     }
     // Pass 2: global ids (section 5), first evaluation wins, in face order.
     let mut ids: HashMap<PointKey, u32> = HashMap::new();
