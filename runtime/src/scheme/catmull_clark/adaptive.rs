@@ -769,6 +769,10 @@ pub(crate) fn submesh(
 
 /// The limit stencils of `queries` on an all-quad mesh, in order.
 pub fn limit_stencils(mesh: &Mesh, queries: &[LimitQuery]) -> Result<Vec<LimitStencil>, MeshError> {
+    // No queried face, no neighbourhood: the submesh of none is not a mesh.
+    if queries.is_empty() {
+        return Ok(Vec::new());
+    }
     let mut out: Vec<LimitStencil> = vec![Vec::new(); queries.len()];
     let mut pending: BTreeMap<usize, Vec<Pending>> = BTreeMap::new();
     for (query, q) in queries.iter().enumerate() {
@@ -920,6 +924,12 @@ mod tests {
     /// `stencilgen`) and adaptive refinement are two independent routes to the same limit:
     /// extraordinary vertices (the octahedron's valence 4 after isolation is regular; the
     /// tetrahedron's 3), boundaries in both modes.
+    #[test]
+    fn no_query_has_no_stencil() {
+        let mesh = grid(4, BoundaryMode::EdgeOnly);
+        assert_eq!(limit_stencils(&mesh, &[]), Ok(Vec::new()));
+    }
+
     #[test]
     fn adaptive_limits_equal_the_table_patches() {
         let n = 5;

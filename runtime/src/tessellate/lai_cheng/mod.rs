@@ -500,17 +500,6 @@ enum Path {
     Feature,
 }
 
-/// [`limit_stencils`] of `queries`, none for none (it needs a face to start from).
-fn stencils_at(
-    mesh: &Mesh,
-    queries: &[LimitQuery],
-) -> Result<Vec<crate::scheme::catmull_clark::adaptive::LimitStencil>, RuntimeError> {
-    if queries.is_empty() {
-        return Ok(Vec::new());
-    }
-    Ok(limit_stencils(mesh, queries)?)
-}
-
 /// Position and the two tangent columns of a limit stencil on `mesh`'s vertices.
 fn apply_stencil(mesh: &Mesh, stencil: &[(u32, [f64; 3])]) -> (Point, Point, Point) {
     let mut out = [[0.0; 3]; 3];
@@ -835,7 +824,7 @@ pub fn tessellate_adaptive(
             })
         })
         .collect();
-    let corner_points = stencils_at(mesh, &corner_queries)?;
+    let corner_points = limit_stencils(mesh, &corner_queries)?;
     let mut root_diagonal = vec![0.0; mesh.faces()];
     for (k, &f) in feature_faces.iter().enumerate() {
         let p: [Point; 4] =
@@ -964,7 +953,7 @@ pub fn tessellate_adaptive(
             }
         })
         .collect();
-    let stencils = stencils_at(mesh, &queries)?;
+    let stencils = limit_stencils(mesh, &queries)?;
     for (&(f, k), stencil) in pending.iter().zip(&stencils) {
         let (position, du, dv) = apply_stencil(mesh, stencil);
         let m = &mut work[f].1[k];
