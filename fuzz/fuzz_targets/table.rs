@@ -1,18 +1,18 @@
 //! The stencil-table reader (`StencilTable::from_bytes`: header, index, checksum, every weight
 //! finite), then a few sections' weights read back. The first byte chooses what the target
 //! mends before reading the rest as a table, so that mutations get past the checks a random
-//! change almost never passes: bit 0 writes the xxh3 checksum of the bytes after the header
-//! into the header, bit 1 writes the length as the declared file size.
+//! change almost never passes: bit 0 writes the checksum (`table_format::checksum`: xxh3 of
+//! every byte but its own, header included since format version 3) into the header, bit 1
+//! writes the length as the declared file size (first, since the checksum covers it).
 
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
 use subtess::StencilTable;
-use table_format::{Precision, HEADER_SIZE};
+use table_format::{Precision, CHECKSUM_OFFSET, HEADER_SIZE};
 
-/// Where the header keeps the declared file size and the checksum (docs/table-format.md).
+/// Where the header keeps the declared file size (docs/table-format.md).
 const FILE_SIZE_AT: usize = 32;
-const CHECKSUM_AT: usize = 40;
 
 fuzz_target!(|data: &[u8]| {
     let [mode, rest @ ..] = data else {
@@ -25,8 +25,8 @@ fuzz_target!(|data: &[u8]| {
             bytes[FILE_SIZE_AT..FILE_SIZE_AT + 8].copy_from_slice(&len.to_le_bytes());
         }
         if mode & 1 != 0 {
-            let sum = xxhash_rust::xxh3::xxh3_64(&bytes[HEADER_SIZE..]);
-            bytes[CHECKSUM_AT..CHECKSUM_AT + 8].copy_from_slice(&sum.to_le_bytes());
+            let sum = table_format::checksum(&bytes);
+            bytes[CHECKSUM_OFFSET..CHECKSUM_OFFSET + 8].copy_from_slice(&sum.to_le_bytes());
         }
     }
     let Ok(table) = StencilTable::from_bytes(&bytes) else {

@@ -5,8 +5,9 @@
 //! interior vertices of some valences and boundary vertices of some face counts, on the primal
 //! and dual grids of some rates `n`, for positions and both first derivatives. `stencilgen`
 //! writes tables with [`encode`]; the runtime reads them with [`Table::parse`], which validates
-//! everything (magic, version, endianness, checksum, every section's bounds, alignment and
-//! shape) before it hands out weights as zero-copy `&[f32]` (or `&[f64]`) slices.
+//! everything (magic, version, endianness, a checksum over every byte but its own, every
+//! section's bounds, alignment and shape) before it hands out weights as zero-copy `&[f32]`
+//! (or `&[f64]`) slices.
 //!
 //! ```
 //! use table_format::{encode, PointSet, Precision, SchemeId, SectionKey, StencilKind, Table, TableMeta};
@@ -25,10 +26,14 @@ use thiserror::Error;
 
 /// The first eight bytes of every table.
 pub const MAGIC: [u8; 8] = *b"SUBTESS\0";
-/// The format version this crate reads and writes.
-pub const VERSION: u32 = 2;
+/// The format version this crate reads and writes. Version 3 extended the checksum over the
+/// header and the section index (version 2 hashed the bytes after the header only, so a
+/// changed boundary-mode flag was read as the other mode); older files are refused.
+pub const VERSION: u32 = 3;
 /// Size of the fixed header.
 pub const HEADER_SIZE: usize = 64;
+/// Where the header keeps the checksum (a u64): the one run of bytes [`checksum`] leaves out.
+pub const CHECKSUM_OFFSET: usize = 40;
 /// Size of one section-index entry.
 pub const ENTRY_SIZE: usize = 40;
 /// Every section starts at a multiple of this.
@@ -49,8 +54,10 @@ pub enum TableError {
         /// The first bytes found.
         found: Vec<u8>,
     },
-    /// A format version this reader does not know.
-    #[error("stencil table format version {found} is not supported (this build reads version {supported}); regenerate the table with this build's `stencilgen tables`")]
+    /// A format version this reader does not know: an older one (1 or 2, whose checksums do
+    /// not cover the header) or a newer one. The message names both versions and the command
+    /// that regenerates the table.
+    #[error("stencil table format version {found} is not supported (this build reads version {supported} only): {}", version_advice(.found, .supported))]
     UnsupportedVersion {
         /// The version in the file.
         found: u32,
@@ -79,8 +86,8 @@ pub enum TableError {
         /// The file size in the header.
         declared: u64,
     },
-    /// The checksum over everything after the header does not match.
-    #[error("the table is corrupt: checksum {computed:#018x} over bytes {HEADER_SIZE}.. does not match the stored {stored:#018x}")]
+    /// The checksum over every byte but its own (header, index, weights) does not match.
+    #[error("the table is corrupt: its checksum over the header, the section index and the weights (every byte but bytes {CHECKSUM_OFFSET}..{}) is {computed:#018x}, not the stored {stored:#018x}", CHECKSUM_OFFSET + 8)]
     Checksum {
         /// The stored checksum.
         stored: u64,
@@ -184,6 +191,31 @@ pub enum TableError {
     /// Sections handed to the writer are inconsistent.
     #[error("cannot encode the table: {0}")]
     Encode(String),
+}
+
+/// What to do about a table of another format version: older ones are regenerated, newer ones
+/// need the build that wrote them (or are regenerated too).
+fn version_advice(found: &u32, supported: &u32) -> &'static str {
+    if found < supported {
+        "the file was written by an older subtess; regenerate it with this build's \
+         `stencilgen tables ... -o FILE` and the options it was made with (docs/table-format.md \
+         lists those of the embedded defaults)"
+    } else {
+        "the file was written by a newer subtess; read it with that build, or regenerate it with \
+         this build's `stencilgen tables ... -o FILE`"
+    }
+}
+
+/// The checksum a table stores at [`CHECKSUM_OFFSET`]: XXH3-64 (seed 0) of every byte of
+/// `bytes` but the checksum's own eight, that is of `bytes[..40]` followed by `bytes[48..]`
+/// (streamed, no copy). Covering the header and index too (since format version 3) means a
+/// changed flag, count or scheme id is refused, not read as another table. `bytes` shorter
+/// than the header are hashed as they are (the reader refuses them before asking).
+pub fn checksum(bytes: &[u8]) -> u64 {
+    let mut hasher = xxhash_rust::xxh3::Xxh3Default::new();
+    hasher.update(&bytes[..bytes.len().min(CHECKSUM_OFFSET)]);
+    hasher.update(bytes.get(CHECKSUM_OFFSET + 8..).unwrap_or(&[]));
+    hasher.digest()
 }
 
 /// The scheme a table belongs to.
@@ -485,8 +517,9 @@ pub fn encode(
         }
     }
     out.resize(file_size as usize, 0);
-    let checksum = xxhash_rust::xxh3::xxh3_64(&out[HEADER_SIZE..]);
-    out[40..48].copy_from_slice(&checksum.to_le_bytes());
+    // Last: the checksum covers every other byte, header and index included.
+    let sum = checksum(&out);
+    out[CHECKSUM_OFFSET..CHECKSUM_OFFSET + 8].copy_from_slice(&sum.to_le_bytes());
     Ok(out)
 }
 
@@ -576,8 +609,10 @@ impl TableIndex {
         let version = u32_at(bytes, 8);
         let count = u32_at(bytes, 20) as u64;
         let index_offset = u64_at(bytes, 24);
-        let stored = u64_at(bytes, 40);
-        let computed = xxhash_rust::xxh3::xxh3_64(&bytes[HEADER_SIZE..]);
+        // Before any other field is interpreted: the checksum covers the header and index
+        // too, so a changed corners flag, count or scheme id is refused here.
+        let stored = u64_at(bytes, CHECKSUM_OFFSET);
+        let computed = checksum(bytes);
         if computed != stored {
             return Err(TableError::Checksum { stored, computed });
         }

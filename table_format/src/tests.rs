@@ -45,8 +45,8 @@ fn parse(bytes: &[u8]) -> Result<(), TableError> {
 
 /// Re-seal a modified file with a correct checksum, to reach the checks behind it.
 fn reseal(bytes: &mut [u8]) {
-    let c = xxhash_rust::xxh3::xxh3_64(&bytes[HEADER_SIZE..]);
-    bytes[40..48].copy_from_slice(&c.to_le_bytes());
+    let c = checksum(bytes);
+    bytes[CHECKSUM_OFFSET..CHECKSUM_OFFSET + 8].copy_from_slice(&c.to_le_bytes());
 }
 
 #[test]
@@ -65,6 +65,14 @@ fn round_trip() {
     );
     // Byte-for-byte deterministic, whatever the order sections are given in.
     assert_eq!(bytes, sample());
+    // Version 3, and the stored checksum is the one over every byte but its own.
+    assert_eq!(table.version, 3);
+    assert_eq!(table.checksum, checksum(&bytes));
+    assert_eq!(u64_at(&bytes, CHECKSUM_OFFSET), table.checksum);
+    // Streamed over the two runs, equal to the one-shot hash of the runs laid end to end
+    // (docs/table-format.md).
+    let runs = [&bytes[..CHECKSUM_OFFSET], &bytes[CHECKSUM_OFFSET + 8..]].concat();
+    assert_eq!(table.checksum, xxhash_rust::xxh3::xxh3_64(&runs));
 }
 
 #[test]
@@ -153,6 +161,111 @@ fn flipped_byte_fails_the_checksum() {
             "byte {at}"
         );
     }
+}
+
+/// Issue 18 (the hole issue 20's fuzzing found): every byte of the file but the checksum's own
+/// is hashed since format version 3. Each byte of the header and the index, and every 7th byte
+/// after (padding and weights), is changed two ways; each change must be an `Err` (never a
+/// panic, never a table read as something else), and `Checksum` for every byte that the header
+/// checks before the checksum (magic, version, endianness mark, header size, file size) do not
+/// catch first.
+#[test]
+fn every_single_byte_change_is_refused() {
+    let b = sample();
+    let index_end = HEADER_SIZE + ENTRY_SIZE * u32_at(&b, 20) as usize;
+    let positions = (0..index_end).chain((index_end..b.len()).step_by(7));
+    let mut checked = 0;
+    for at in positions {
+        for xor in [0x01u8, 0xff] {
+            let mut c = b.clone();
+            c[at] ^= xor;
+            let e = parse(&c).expect_err(&format!("byte {at} ^ {xor:#04x} was read"));
+            let by_field_check = match at {
+                0..=7 => matches!(e, TableError::BadMagic { .. }),
+                8..=11 => matches!(e, TableError::UnsupportedVersion { .. }),
+                12..=15 => matches!(e, TableError::Endianness { .. }),
+                16..=19 => matches!(
+                    e,
+                    TableError::BadField {
+                        field: "header size",
+                        ..
+                    }
+                ),
+                32..=39 => matches!(
+                    e,
+                    TableError::Truncated { .. }
+                        | TableError::TooLarge { .. }
+                        | TableError::BadField {
+                            field: "file size",
+                            ..
+                        }
+                ),
+                _ => matches!(e, TableError::Checksum { .. }),
+            };
+            assert!(by_field_check, "byte {at} ^ {xor:#04x}: {e}");
+            checked += 1;
+        }
+    }
+    // 64 header bytes and 6 entries of 40 bytes, both ways, and the sample after them.
+    assert!(checked > 2 * (64 + 6 * 40), "{checked}");
+}
+
+/// The three changes docs/reliability.md wrote up for version 2, each now refused by the
+/// checksum: the boundary-mode flag (read silently as the other mode), the section count
+/// (sections dropped) and the scheme id (caught only by `Surface::with_table`).
+#[test]
+fn header_fields_are_checksummed() {
+    let b = sample();
+    let mut corners = b.clone();
+    corners[56] = 1;
+    let mut fewer = b.clone();
+    fewer[20..24].copy_from_slice(&2u32.to_le_bytes());
+    let mut scheme = b.clone();
+    scheme[52..56].copy_from_slice(&(SchemeId::SwNonpolyQuad as u32).to_le_bytes());
+    for (what, c) in [("corners", corners), ("count", fewer), ("scheme", scheme)] {
+        let e = parse(&c).expect_err(what);
+        assert!(matches!(e, TableError::Checksum { .. }), "{what}: {e}");
+        assert!(e.to_string().contains("header"), "{what}: {e}");
+    }
+    // Re-sealed, the same changes read as what they say (the checksum is what refuses them).
+    let mut corners = b.clone();
+    corners[56] = 1;
+    reseal(&mut corners);
+    let aligned = AlignedBytes::from_slice(&corners);
+    assert!(
+        Table::parse(aligned.as_bytes())
+            .expect("re-sealed")
+            .meta
+            .corners
+    );
+}
+
+/// A table of an older format version names its version and how to regenerate it; a newer
+/// one says so too.
+#[test]
+fn older_versions_name_themselves_and_the_command() {
+    for old in [1u32, 2] {
+        let mut b = sample();
+        b[8..12].copy_from_slice(&old.to_le_bytes());
+        let e = parse(&b).expect_err("an older version");
+        assert_eq!(
+            e,
+            TableError::UnsupportedVersion {
+                found: old,
+                supported: VERSION
+            }
+        );
+        let message = e.to_string();
+        assert!(
+            message.contains(&format!("version {old} ")) && message.contains("stencilgen tables"),
+            "{message}"
+        );
+        assert!(message.contains("older"), "{message}");
+    }
+    let mut b = sample();
+    b[8..12].copy_from_slice(&(VERSION + 1).to_le_bytes());
+    let message = parse(&b).expect_err("a newer version").to_string();
+    assert!(message.contains("newer"), "{message}");
 }
 
 #[test]

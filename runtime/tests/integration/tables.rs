@@ -145,7 +145,11 @@ fn bad_files_are_clear_errors() {
     let unknown = table_format::VERSION + 1;
     let mut version = good.to_vec();
     version[8..12].copy_from_slice(&unknown.to_le_bytes());
-    let cases: [(&str, Vec<u8>, &str); 4] = [
+    // A version-2 file (checksum over the bytes after the header only): refused naming its
+    // version and the command that regenerates it.
+    let mut old = good.to_vec();
+    old[8..12].copy_from_slice(&2u32.to_le_bytes());
+    let cases: [(&str, Vec<u8>, &str); 6] = [
         (
             "magic.subtess",
             b"PK\x03\x04 not a table".to_vec(),
@@ -155,6 +159,16 @@ fn bad_files_are_clear_errors() {
             "version.subtess",
             version,
             &format!("format version {unknown} is not supported"),
+        ),
+        (
+            "v2.subtess",
+            old.clone(),
+            "format version 2 is not supported",
+        ),
+        (
+            "v2-command.subtess",
+            old,
+            "regenerate it with this build's `stencilgen tables",
         ),
         ("truncated.subtess", good[..1000].to_vec(), "truncated"),
         ("flipped.subtess", flipped, "checksum"),
