@@ -18,7 +18,7 @@ use subtess::eval::exact_eval::{ExactEvaluator, LimitPoint};
 use subtess::eval::limit_point;
 use subtess::io::obj::parse_obj;
 use subtess::mesh::topology::{Mesh, NONE};
-use subtess::scheme::catmull_clark::adaptive::{limit_stencils, LimitQuery};
+use subtess::scheme::catmull_clark::adaptive::{limit_of, limit_stencils, LimitQuery};
 use subtess::scheme::catmull_clark::refine::refine;
 use subtess::Scheme;
 
@@ -181,19 +181,6 @@ fn sharpness_one_is_exactly_one_sharp_step_then_smooth() {
     assert_eq!(checked, 75);
 }
 
-fn apply(stencil: &[(u32, [f64; 3])], mesh: &Mesh) -> [[f64; 3]; 3] {
-    let mut out = [[0.0; 3]; 3];
-    for &(v, w) in stencil {
-        let p = mesh.positions[v as usize];
-        for (k, row) in out.iter_mut().enumerate() {
-            for c in 0..3 {
-                row[c] += w[k] * p[c];
-            }
-        }
-    }
-    out
-}
-
 fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
@@ -275,7 +262,7 @@ fn compare_with_adaptive(
                     .unwrap_or_else(|e| panic!("{name} face {f}.{k} ({u}, {v}): {e}"));
                 let at = query(f, k, a as f64 / b as f64, c as f64 / d as f64);
                 let stencil = limit_stencils(reference, &[at]).expect("reached");
-                let [p, du, dv] = apply(&stencil[0], reference);
+                let [p, du, dv] = limit_of(&stencil[0], reference);
                 let e = (0..3)
                     .map(|c| (got.position[c] - p[c]).abs())
                     .fold(0.0, f64::max);

@@ -767,6 +767,21 @@ pub(crate) fn submesh(
     (sub, vertices, face_of)
 }
 
+/// The limit position, `d/du` and `d/dv` of `stencil` (one of [`limit_stencils`]' answers) on
+/// the positions of the mesh it was computed on.
+pub fn limit_of(stencil: &[(u32, [f64; 3])], mesh: &Mesh) -> [[f64; 3]; 3] {
+    let mut out = [[0.0; 3]; 3];
+    for &(v, w) in stencil {
+        let p = mesh.positions[v as usize];
+        for (k, row) in out.iter_mut().enumerate() {
+            for c in 0..3 {
+                row[c] += w[k] * p[c];
+            }
+        }
+    }
+    out
+}
+
 /// The limit stencils of `queries` on an all-quad mesh, in order.
 pub fn limit_stencils(mesh: &Mesh, queries: &[LimitQuery]) -> Result<Vec<LimitStencil>, MeshError> {
     // No queried face, no neighbourhood: the submesh of none is not a mesh.
@@ -897,19 +912,6 @@ mod tests {
         Mesh::new(positions, &faces, &[], mode).expect("a valid grid")
     }
 
-    fn apply(stencil: &LimitStencil, mesh: &Mesh) -> [[f64; 3]; 3] {
-        let mut out = [[0.0; 3]; 3];
-        for &(v, w) in stencil {
-            let p = mesh.positions[v as usize];
-            for (k, row) in out.iter_mut().enumerate() {
-                for c in 0..3 {
-                    row[c] += w[k] * p[c];
-                }
-            }
-        }
-        out
-    }
-
     fn dual_queries(f: usize, n: usize) -> Vec<LimitQuery> {
         (0..n * n)
             .map(|p| LimitQuery {
@@ -952,7 +954,7 @@ mod tests {
                     dual_positions(&table, &iso.mesh, patch, n as u32).expect("in the table");
                 let stencils = limit_stencils(&iso.mesh, &dual_queries(f, n)).expect("reached");
                 for (p, s) in expected.iter().zip(&stencils) {
-                    let got = apply(s, &iso.mesh)[0];
+                    let got = limit_of(s, &iso.mesh)[0];
                     let d = (0..3).map(|c| (got[c] - p[c]).abs()).fold(0.0, f64::max);
                     assert!(
                         d < 2e-6,
@@ -981,7 +983,7 @@ mod tests {
             let face = (2 * m + i) as u32;
             for t in [0.0, 0.25, 0.5, 0.8] {
                 let q = LimitQuery { face, u: t, v: 0.0 };
-                let [p, du, _] = apply(&limit_stencils(&mesh, &[q]).expect("reached")[0], &mesh);
+                let [p, du, _] = limit_of(&limit_stencils(&mesh, &[q]).expect("reached")[0], &mesh);
                 let (b, db) = bspline(t);
                 let mut curve = [0.0; 3];
                 let mut tangent = [0.0; 3];
@@ -1034,7 +1036,7 @@ mod tests {
             // [0, 1/2]^2 in f's parameters.
             let child = semi.face_halfedges(f).start as u32;
             for (u, v) in [(0.1, 0.2), (0.3, 0.45), (0.25, 0.05)] {
-                let a = apply(
+                let a = limit_of(
                     &limit_stencils(
                         &semi,
                         &[LimitQuery {
@@ -1051,7 +1053,7 @@ mod tests {
                     u: 2.0 * u,
                     v: 2.0 * v,
                 };
-                let b = apply(
+                let b = limit_of(
                     &limit_stencils(&stepped, &[q]).expect("reached")[0],
                     &stepped,
                 )[0];
@@ -1089,13 +1091,13 @@ mod tests {
                 v: v0 + e * (1.0 - 2.0 * v0),
             };
             let stencil = &limit_stencils(mesh, &[q(0.0)]).expect("reached")[0];
-            let at_vertex = apply(stencil, mesh);
+            let at_vertex = limit_of(stencil, mesh);
             let sum: f64 = stencil.iter().map(|(_, w)| w[0]).sum();
             assert!((sum - 1.0).abs() < 1e-12, "face {f}: weights sum to {sum}");
             let mut previous = f64::INFINITY;
             for k in [10, 14, 18, 22] {
                 let e = (0.5f64).powi(k);
-                let near = apply(&limit_stencils(mesh, &[q(e)]).expect("reached")[0], mesh);
+                let near = limit_of(&limit_stencils(mesh, &[q(e)]).expect("reached")[0], mesh);
                 let d = (0..3)
                     .map(|c| (near[0][c] - at_vertex[0][c]).abs())
                     .fold(0.0, f64::max);

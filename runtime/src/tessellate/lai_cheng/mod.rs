@@ -65,7 +65,7 @@ use table_format::{PointSet, SectionKey, StencilKind};
 
 use crate::mesh::topology::{Mesh, NONE};
 use crate::mesh::triangle_mesh::{TriangleMesh, VertexSource};
-use crate::scheme::catmull_clark::adaptive::{limit_stencils, LimitQuery};
+use crate::scheme::catmull_clark::adaptive::{limit_of, limit_stencils, LimitQuery};
 use crate::scheme::patch::{is_smooth_patch, FacePatch, PatchKind};
 use crate::stencil_table::StencilTable;
 use crate::RuntimeError;
@@ -500,20 +500,6 @@ enum Path {
     Feature,
 }
 
-/// Position and the two tangent columns of a limit stencil on `mesh`'s vertices.
-fn apply_stencil(mesh: &Mesh, stencil: &[(u32, [f64; 3])]) -> (Point, Point, Point) {
-    let mut out = [[0.0; 3]; 3];
-    for &(v, w) in stencil {
-        let p = mesh.positions[v as usize];
-        for (k, column) in out.iter_mut().enumerate() {
-            for c in 0..3 {
-                column[c] += w[k] * p[c];
-            }
-        }
-    }
-    (out[0], out[1], out[2])
-}
-
 /// Levels of the extraordinary enclosure ([`ev_enclosure`]).
 const EV_ENCLOSURE_LEVELS: usize = 3;
 
@@ -827,8 +813,7 @@ pub fn tessellate_adaptive(
     let corner_points = limit_stencils(mesh, &corner_queries)?;
     let mut root_diagonal = vec![0.0; mesh.faces()];
     for (k, &f) in feature_faces.iter().enumerate() {
-        let p: [Point; 4] =
-            std::array::from_fn(|c| apply_stencil(mesh, &corner_points[4 * k + c]).0);
+        let p: [Point; 4] = std::array::from_fn(|c| limit_of(&corner_points[4 * k + c], mesh)[0]);
         root_diagonal[f] = longer_diagonal(&p);
     }
     // The operators of every patch kind on the table path, built once.
@@ -955,7 +940,7 @@ pub fn tessellate_adaptive(
         .collect();
     let stencils = limit_stencils(mesh, &queries)?;
     for (&(f, k), stencil) in pending.iter().zip(&stencils) {
-        let (position, du, dv) = apply_stencil(mesh, stencil);
+        let [position, du, dv] = limit_of(stencil, mesh);
         let m = &mut work[f].1[k];
         m.position = position;
         m.normal = unit(cross(du, dv));
