@@ -3,13 +3,15 @@
 //! mends before reading the rest as a table, so that mutations get past the checks a random
 //! change almost never passes: bit 0 writes the checksum (`table_format::checksum`: xxh3 of
 //! every byte but its own, header included since format version 3) into the header, bit 1
-//! writes the length as the declared file size (first, since the checksum covers it).
+//! writes the length as the declared file size (first, since the checksum covers it). A
+//! compact table's grids are expanded too (`StencilTable::weights` on grid keys), for up to
+//! two patches at its rates up to 8.
 
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
 use subtess::StencilTable;
-use table_format::{Precision, CHECKSUM_OFFSET, HEADER_SIZE};
+use table_format::{PointSet, Precision, SectionKey, StencilKind, CHECKSUM_OFFSET, HEADER_SIZE};
 
 /// Where the header keeps the declared file size (docs/table-format.md).
 const FILE_SIZE_AT: usize = 32;
@@ -50,6 +52,37 @@ fuzz_target!(|data: &[u8]| {
                     .expect("an indexed f64 section reads");
                 assert_eq!(weights.len() as u64, expected);
                 assert!(weights.iter().all(|w| w.is_finite()));
+            }
+        }
+    }
+    if !table.is_compact() {
+        return;
+    }
+    let rates: Vec<u32> = index
+        .entries
+        .iter()
+        .filter(|e| e.key.points == PointSet::CurveBasis && e.key.n <= 8)
+        .map(|e| e.key.n)
+        .collect();
+    let patches = index
+        .entries
+        .iter()
+        .filter(|e| e.key.points == PointSet::Subdivision)
+        .take(2);
+    for patch in patches {
+        for &n in &rates {
+            for points in [PointSet::Primal, PointSet::Dual] {
+                let key = SectionKey {
+                    kind: StencilKind::DerivativeU,
+                    points,
+                    n,
+                    ..patch.key
+                };
+                let weights = table.weights(&key).expect("a covered grid expands");
+                assert_eq!(
+                    weights.len() as u64,
+                    points.count(n) * u64::from(patch.width)
+                );
             }
         }
     }

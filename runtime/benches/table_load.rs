@@ -1,36 +1,88 @@
-//! Loading (validating, checksum included) the embedded default table.
+//! Loading (validating, checksum included) the embedded default tables, and expanding a compact
+//! table's grids (what the first plan that needs them pays).
 //!
 //! `cargo bench -p subtess --bench table_load`
 //!
-//! `load default table` is the public call; the table's bytes are a constant, so the same parse
-//! with the bytes behind `black_box` is measured too (the optimizer cannot see through it), and
-//! the two checksums alone: format version 3's (every byte but its own, streamed in two runs)
-//! beside version 2's (the bytes after the 64-byte header, one shot) over the same bytes.
+//! `load default table (SCHEME)` is the public call. `expand every grid` builds a fresh
+//! Catmull–Clark table and asks it for every section of the grid layout (27 patches x 24 rates x
+//! 3 kinds x 2 grids: what the version-3 table stored), the most any sequence of plans can ask;
+//! `expand one patch at rate N` is the three kinds of one valence-5 patch, both grids.
 #![allow(missing_docs)] // criterion_group! generates an undocumented function
-
-use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use subtess::stencil_table::StencilTable;
+use subtess::{BoundaryMode, Scheme};
+use table_format::{PointSet, SectionKey, StencilKind};
+
+/// Every grid section a table of the default coverage answers: `(boundary, faces, sector)`.
+fn patches() -> Vec<(bool, u32, u32)> {
+    let interior = (3..=8).map(|v| (false, v, 0));
+    let boundary = (1..=6).flat_map(|f| (0..f).map(move |s| (true, f, s)));
+    interior.chain(boundary).collect()
+}
+
+fn grids(table: &StencilTable, patches: &[(bool, u32, u32)], rates: &[u32]) -> usize {
+    let mut weights = 0;
+    for &(boundary, faces, sector) in patches {
+        for &n in rates {
+            for kind in [
+                StencilKind::Position,
+                StencilKind::DerivativeU,
+                StencilKind::DerivativeV,
+            ] {
+                for points in [PointSet::Primal, PointSet::Dual] {
+                    let key = SectionKey {
+                        kind,
+                        points,
+                        boundary,
+                        faces,
+                        sector,
+                        n,
+                    };
+                    weights += table.weights(&key).map_or(0, <[f32]>::len);
+                }
+            }
+        }
+    }
+    weights
+}
 
 fn bench(c: &mut Criterion) {
-    // Timing an error would measure nothing (a table the reader refuses fails in nanoseconds).
-    if let Err(e) = StencilTable::default_catmull_clark() {
-        panic!("the embedded default table does not load: {e}");
+    let schemes = [
+        Scheme::CatmullClark,
+        Scheme::Loop,
+        Scheme::Butterfly,
+        Scheme::Sqrt3,
+    ];
+    for scheme in schemes {
+        // Timing an error would measure nothing (a table the reader refuses fails in
+        // nanoseconds).
+        if let Err(e) = scheme.default_table(BoundaryMode::EdgeOnly) {
+            panic!("the embedded {scheme} table does not load: {e}");
+        }
+        c.bench_function(&format!("load default table ({scheme})"), |b| {
+            b.iter(|| {
+                scheme
+                    .default_table(BoundaryMode::EdgeOnly)
+                    .map(|t| t.index().entries.len())
+            })
+        });
     }
-    c.bench_function("load default table", |b| {
-        b.iter(|| StencilTable::default_catmull_clark().map(|t| t.index().entries.len()))
+    let all = patches();
+    let rates: Vec<u32> = (1..=24).collect();
+    let fresh = || StencilTable::default_catmull_clark().expect("loads");
+    assert_eq!(grids(&fresh(), &all, &rates), 14_791_656);
+    let mut group = c.benchmark_group("expand");
+    group.sample_size(10);
+    group.bench_function("expand every grid of the default table", |b| {
+        b.iter(|| grids(&fresh(), &all, &rates))
     });
-    let bytes = tables::default_catmull_clark();
-    c.bench_function("parse default table (black_box bytes)", |b| {
-        b.iter(|| table_format::TableIndex::parse(black_box(bytes)).map(|t| t.entries.len()))
-    });
-    c.bench_function("checksum v3 (all but its own 8 bytes)", |b| {
-        b.iter(|| table_format::checksum(black_box(bytes)))
-    });
-    c.bench_function("checksum v2 range (bytes 64..)", |b| {
-        b.iter(|| xxhash_rust::xxh3::xxh3_64(&black_box(bytes)[table_format::HEADER_SIZE..]))
-    });
+    for n in [8, 24] {
+        group.bench_function(format!("expand one patch at rate {n}"), |b| {
+            b.iter(|| grids(&fresh(), &[(false, 5, 0)], &[n]))
+        });
+    }
+    group.finish();
 }
 
 criterion_group!(benches, bench);

@@ -746,8 +746,14 @@ fn tables_info(file: Option<PathBuf>, scheme: Scheme) -> Result<(), RuntimeError
     out!("precision:  {}", index.meta.precision)?;
     out!("covers:     {}", index.coverage())?;
     out!(
-        "sections:   {} (primal and dual grids; positions, d/du, d/dv)",
-        index.entries.len()
+        "sections:   {} ({})",
+        index.entries.len(),
+        if table.is_compact() {
+            "compact: the regular curve basis per rate; A, the sub-patch matrices and the vertex \
+             masks per patch; the grids are expanded when a plan needs them"
+        } else {
+            "grids; positions, d/du, d/dv"
+        }
     )?;
     out!("weights:    {weights}")?;
     out!(

@@ -27,7 +27,7 @@ use stencilgen::sqrt3_regions::Sqrt3RegionSubstitution;
 use stencilgen::sqrt3_table::{build_sqrt3_table, Sqrt3TableSpec};
 use stencilgen::stencil_set::StencilSetSpec;
 use stencilgen::substitution::Substitution;
-use stencilgen::table::{build_table, TableSpec};
+use stencilgen::table::{build_table, QuadLayout, TableSpec};
 use stencilgen::triangle_patch::TriangleSubstitution;
 use stencilgen::triangle_system::{triangle_stencils, TriangleStencils};
 use stencilgen::triangle_table::{build_triangle_table, TriangleTableSpec};
@@ -118,12 +118,18 @@ enum Command {
         /// Grid rates, as a range or list.
         #[arg(long, default_value = "1..24")]
         n: String,
-        /// Stored precision.
-        #[arg(long, default_value = "f32", value_parser = ["f32", "f64"])]
-        precision: String,
+        /// Stored precision (default: f64 for compact quad tables, which store only f64; f32
+        /// for grids).
+        #[arg(long, value_parser = ["f32", "f64"])]
+        precision: Option<String>,
         /// Generate from exact rationals (slower) instead of the f64 path.
         #[arg(long)]
         exact: bool,
+        /// Quad schemes: store every grid point's stencil (solved on the grid) instead of the
+        /// scaling relation's pieces that the runtime expands (docs/table-format.md). Triangle
+        /// tables always store grids.
+        #[arg(long)]
+        grids: bool,
         /// Output file.
         #[arg(short = 'o', long = "output")]
         output: std::path::PathBuf,
@@ -234,6 +240,7 @@ fn run(cli: Cli) -> Result<(), StencilError> {
             n,
             precision,
             exact,
+            grids,
             output,
         } => {
             let set = StencilSetSpec {
@@ -251,10 +258,16 @@ fn run(cli: Cli) -> Result<(), StencilError> {
                 rates: parse_set("--n", &n, stencilgen::curve_stencils::MAX_RATE)?,
             };
             check_table_size(&set)?;
-            let precision = if precision == "f64" {
-                Precision::F64
+            let layout = if grids {
+                QuadLayout::Grids
             } else {
-                Precision::F32
+                QuadLayout::Compact
+            };
+            let precision_of = |compact: bool| match precision.as_deref() {
+                Some("f64") => Precision::F64,
+                Some(_) => Precision::F32,
+                None if compact => Precision::F64,
+                None => Precision::F32,
             };
             for name in &schemes {
                 let path = if schemes.len() > 1 {
@@ -288,7 +301,7 @@ fn run(cli: Cli) -> Result<(), StencilError> {
                         let spec = ButterflyTableSpec {
                             valences: set.valences.clone(),
                             rates: set.rates.clone(),
-                            precision,
+                            precision: precision_of(false),
                         };
                         write_bytes(&path, &build_butterfly_table(&spec)?, started)?;
                         continue;
@@ -303,7 +316,7 @@ fn run(cli: Cli) -> Result<(), StencilError> {
                         let spec = Sqrt3TableSpec {
                             valences: set.valences.clone(),
                             rates: set.rates.clone(),
-                            precision,
+                            precision: precision_of(false),
                         };
                         write_bytes(&path, &build_sqrt3_table(&spec)?, started)?;
                         continue;
@@ -313,7 +326,7 @@ fn run(cli: Cli) -> Result<(), StencilError> {
                         valences: set.valences.clone(),
                         boundary_faces: set.boundary_faces.clone(),
                         rates: set.rates.clone(),
-                        precision,
+                        precision: precision_of(false),
                     };
                     let bytes = build_triangle_table(&spec)?;
                     write_bytes(&path, &bytes, started)?;
@@ -324,8 +337,9 @@ fn run(cli: Cli) -> Result<(), StencilError> {
                     TableSpec {
                         scheme,
                         set: set.clone(),
-                        precision,
+                        precision: precision_of(layout == QuadLayout::Compact),
                         exact,
+                        layout,
                     },
                     &path,
                 )?;

@@ -159,12 +159,36 @@ fn tables_writes_a_valid_table() {
     let bytes = table_format::AlignedBytes::read(&path).expect("written");
     let table = table_format::Table::parse(bytes.as_bytes()).expect("valid");
     assert_eq!(table.meta.precision, table_format::Precision::F64);
-    assert_eq!(table.entries.len(), 2 * 2 * 3 * 2);
+    // Compact: 2 rates x 2 curve-basis sections, 2 patches x 5 pieces.
+    assert_eq!(table.entries.len(), 2 * 2 + 2 * 5);
     assert_eq!(
         table.coverage(),
         "interior valences 3, 5, no boundary vertices, n = 1..=2"
     );
+    // --grids: every grid, 2 patches x 2 rates x 3 kinds x 2 point sets, f32 by default.
+    let out = Command::new(env!("CARGO_BIN_EXE_stencilgen"))
+        .args([
+            "tables",
+            "--valences",
+            "3,5",
+            "--n",
+            "1..2",
+            "--grids",
+            "-o",
+        ])
+        .arg(&path)
+        .output()
+        .expect("stencilgen runs");
+    assert!(out.status.success());
+    let bytes = table_format::AlignedBytes::read(&path).expect("written");
+    let table = table_format::Table::parse(bytes.as_bytes()).expect("valid");
+    assert_eq!(table.meta.precision, table_format::Precision::F32);
+    assert_eq!(table.entries.len(), 2 * 2 * 3 * 2);
     let _ = std::fs::remove_file(&path);
+    fails_with(
+        "tables --valences 3 --n 1 --precision f32 -o /tmp/x.subtess",
+        "compact tables store f64",
+    );
     fails_with(
         "tables --valences 8..3 -o /tmp/x.subtess",
         "--valences `8..3`",

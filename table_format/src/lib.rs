@@ -26,10 +26,13 @@ use thiserror::Error;
 
 /// The first eight bytes of every table.
 pub const MAGIC: [u8; 8] = *b"SUBTESS\0";
-/// The format version this crate reads and writes. Version 3 extended the checksum over the
-/// header and the section index (version 2 hashed the bytes after the header only, so a
-/// changed boundary-mode flag was read as the other mode); older files are refused.
-pub const VERSION: u32 = 3;
+/// The format version this crate reads and writes. Version 4 added the scaling relation's
+/// pieces as sections ([`PointSet::CurveBasis`], [`PointSet::VertexMask`],
+/// [`PointSet::Subdivision`], [`PointSet::SubPatches`]), from which a reader expands the grid
+/// stencils; version 3 extended the checksum over the header and the section index (version 2
+/// hashed the bytes after the header only, so a changed boundary-mode flag was read as the
+/// other mode). Older files are refused.
+pub const VERSION: u32 = 4;
 /// Size of the fixed header.
 pub const HEADER_SIZE: usize = 64;
 /// Where the header keeps the checksum (a u64): the one run of bytes [`checksum`] leaves out.
@@ -322,17 +325,46 @@ pub enum PointSet {
     /// `((3i+2)/3n, (3j+2)/3n)`: `2(n-j)-1` points in row `j`, the first `2n-1` being the
     /// zigzag along the edge `v = 0`.
     TriangleDual = 3,
+    /// The scaling relation's pieces for tensor-product (quad) schemes, from which a reader
+    /// expands the [`PointSet::Primal`] and [`PointSet::Dual`] stencils (docs/table-format.md,
+    /// "Compact quad tables"). This one: the regular curve basis `phi(t/n - p)` at `t = 0..=n`
+    /// for the four control points `p = -1, 0, 1, 2` of one axis (`n + 1` rows of width 4);
+    /// kind [`StencilKind::Position`] holds the values, [`StencilKind::DerivativeU`] the
+    /// derivatives in `t/n`. Patch fields 0 (not a patch's section).
+    CurveBasis = 4,
+    /// One row at `n = 0`: the patch's stencil at its corner vertex, `(0, 0)`: the limit
+    /// position mask (kind position) or the tangent masks (d/du, d/dv).
+    VertexMask = 5,
+    /// The patch's local subdivision matrix `A` at `n = 0`: `K x K`, row `i` the level-1
+    /// layout point `i` from the level-0 layout points (`P' = A P`).
+    Subdivision = 6,
+    /// The patch's three regular sub-patch matrices `R_0, R_1, R_2` at `n = 0`, stacked:
+    /// `48 x K`, sub-patches `[1/2,1]x[0,1/2]`, `[1/2,1]^2`, `[0,1/2]x[1/2,1]`, each 16 rows
+    /// `(p, q)`, `p, q in -1..=2`, `q` outer.
+    SubPatches = 7,
 }
 
 impl PointSet {
-    /// Number of points at rate `n`; `u64::MAX` where that does not fit (a primal grid at
-    /// `n = u32::MAX`, a rate a file may declare: no table holds it).
+    /// Number of points of a grid at rate `n`; `u64::MAX` where that does not fit (a primal
+    /// grid at `n = u32::MAX`, a rate a file may declare: no table holds it). For the scaling
+    /// relation's pieces, see [`PointSet::rows`].
     pub fn count(self, n: u32) -> u64 {
+        self.rows(n, 0)
+    }
+
+    /// Number of rows of a section of this point set at rate `n` with `width` weights a row:
+    /// the grid's points, `n + 1` curve-basis points, one vertex mask, `K = width` rows of `A`
+    /// or the 48 rows of the sub-patch matrices.
+    pub fn rows(self, n: u32, width: u32) -> u64 {
         let n = u128::from(n);
         let count = match self {
             PointSet::Primal => (n + 1) * (n + 1),
             PointSet::Dual | PointSet::TriangleDual => n * n,
             PointSet::TrianglePrimal => (n + 1) * (n + 2) / 2,
+            PointSet::CurveBasis => n + 1,
+            PointSet::VertexMask => 1,
+            PointSet::Subdivision => u128::from(width),
+            PointSet::SubPatches => 48,
         };
         u64::try_from(count).unwrap_or(u64::MAX)
     }
@@ -340,6 +372,26 @@ impl PointSet {
     /// Whether the point set belongs to triangle patches.
     pub fn is_triangle(self) -> bool {
         matches!(self, PointSet::TrianglePrimal | PointSet::TriangleDual)
+    }
+
+    /// Whether the section holds grid stencils (rather than the scaling relation's pieces).
+    pub fn is_grid(self) -> bool {
+        (self as u8) <= PointSet::TriangleDual as u8
+    }
+
+    fn from_u8(v: u8) -> Option<Self> {
+        [
+            PointSet::Primal,
+            PointSet::Dual,
+            PointSet::TrianglePrimal,
+            PointSet::TriangleDual,
+            PointSet::CurveBasis,
+            PointSet::VertexMask,
+            PointSet::Subdivision,
+            PointSet::SubPatches,
+        ]
+        .into_iter()
+        .find(|p| *p as u8 == v)
     }
 }
 
@@ -373,7 +425,29 @@ impl fmt::Display for SectionKey {
             PointSet::Dual => "dual",
             PointSet::TrianglePrimal => "triangle primal",
             PointSet::TriangleDual => "triangle dual",
+            PointSet::CurveBasis => {
+                return write!(f, "{kind} of the regular curve basis, n = {}", self.n);
+            }
+            PointSet::VertexMask => "vertex mask",
+            PointSet::Subdivision => "subdivision matrix",
+            PointSet::SubPatches => "sub-patch matrices",
         };
+        if !self.points.is_grid() {
+            let what = if self.points == PointSet::VertexMask {
+                format!("{kind} {grid}")
+            } else {
+                grid.to_owned()
+            };
+            return if self.boundary {
+                write!(
+                    f,
+                    "{what} of the boundary vertex with {} faces, sector {}",
+                    self.faces, self.sector
+                )
+            } else {
+                write!(f, "{what} of valence {}", self.faces)
+            };
+        }
         if self.boundary {
             write!(
                 f,
@@ -459,7 +533,7 @@ pub fn encode(
     let mut offset = align_up(index_offset + (ENTRY_SIZE * sorted.len()) as u64);
     let mut entries = Vec::with_capacity(sorted.len());
     for (key, width, weights) in &sorted {
-        let points = key.points.count(key.n);
+        let points = key.points.rows(key.n, *width);
         if weights.len() as u64 != points.saturating_mul(u64::from(*width)) {
             return Err(TableError::Encode(format!(
                 "{key}: {} weights for {points} points x {width}",
@@ -671,18 +745,10 @@ impl TableIndex {
                     })
                 }
             };
-            let points = match e[1] {
-                0 => PointSet::Primal,
-                1 => PointSet::Dual,
-                2 => PointSet::TrianglePrimal,
-                3 => PointSet::TriangleDual,
-                p => {
-                    return Err(TableError::BadField {
-                        field: "section point set",
-                        value: u64::from(p),
-                    })
-                }
-            };
+            let points = PointSet::from_u8(e[1]).ok_or(TableError::BadField {
+                field: "section point set",
+                value: u64::from(e[1]),
+            })?;
             let boundary = match e[2] {
                 0 => false,
                 1 => true,
@@ -735,7 +801,9 @@ impl TableIndex {
             let expected = u64::from(entry.points)
                 .saturating_mul(u64::from(entry.width))
                 .saturating_mul(precision as u64);
-            if entry.length != expected || u64::from(entry.points) != key.points.count(key.n) {
+            if entry.length != expected
+                || u64::from(entry.points) != key.points.rows(key.n, entry.width)
+            {
                 return Err(TableError::WrongShape {
                     index,
                     key,
@@ -853,12 +921,17 @@ impl TableIndex {
         let mut boundary = std::collections::BTreeSet::new();
         let mut rates = std::collections::BTreeSet::new();
         for e in &self.entries {
-            if e.key.boundary {
-                boundary.insert(e.key.faces);
-            } else {
-                valences.insert(e.key.faces);
+            // The curve basis belongs to no patch; the pieces of a patch to no rate.
+            if e.key.points != PointSet::CurveBasis {
+                if e.key.boundary {
+                    boundary.insert(e.key.faces);
+                } else {
+                    valences.insert(e.key.faces);
+                }
             }
-            rates.insert(e.key.n);
+            if e.key.points.is_grid() || e.key.points == PointSet::CurveBasis {
+                rates.insert(e.key.n);
+            }
         }
         let interior = if valences.is_empty() {
             "no interior vertices".to_owned()

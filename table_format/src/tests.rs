@@ -65,8 +65,8 @@ fn round_trip() {
     );
     // Byte-for-byte deterministic, whatever the order sections are given in.
     assert_eq!(bytes, sample());
-    // Version 3, and the stored checksum is the one over every byte but its own.
-    assert_eq!(table.version, 3);
+    // Version 4, and the stored checksum is the one over every byte but its own.
+    assert_eq!(table.version, 4);
     assert_eq!(table.checksum, checksum(&bytes));
     assert_eq!(u64_at(&bytes, CHECKSUM_OFFSET), table.checksum);
     // Streamed over the two runs, equal to the one-shot hash of the runs laid end to end

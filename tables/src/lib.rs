@@ -2,12 +2,12 @@
 //! companion, the Loop table, the butterfly table and the √3 table.
 //!
 //! The default Catmull–Clark table (interior valences 3..=8, boundary vertices with 1..=6 faces
-//! "edge only", n = 1..=24, primal and dual grids, positions and both derivatives, f32) is about
-//! 57 MiB, too large to keep in the repository and in its history. It is generated
-//! deterministically by `stencilgen::table::default_table()` in this crate's build script and
-//! embedded with `include_bytes!`, aligned for zero-copy reads. `stencilgen tables --boundary
-//! -o FILE` writes the same bytes to a file, and a test checks that a fresh generation is
-//! byte-identical to what is embedded.
+//! "edge only", n = 1..=24) is compact (0.29 MB: the scaling relation's pieces, from which the
+//! runtime expands the grids), the triangle tables hold their grids (5–33 MiB). All are generated
+//! deterministically by `stencilgen` in this crate's build script rather than kept in the
+//! repository and its history, and embedded with `include_bytes!`, aligned for zero-copy reads.
+//! `stencilgen tables ... -o FILE` writes the same bytes to a file, and `tests/regenerate.rs`
+//! checks that a fresh generation is identical to what is embedded.
 
 /// `include_bytes!` gives 1-byte alignment; the table format hands out `&[f32]` views, so the
 /// bytes are wrapped in a 64-byte-aligned static.

@@ -204,9 +204,9 @@ impl<'a> PatchPoints<'a> {
         let side = match points {
             PointSet::Primal => n as usize + 1,
             PointSet::Dual => n as usize,
-            PointSet::TrianglePrimal | PointSet::TriangleDual => {
+            _ => {
                 return Err(RuntimeError::Unsupported(format!(
-                    "tolerance rates on triangle grids ({key})"
+                    "tolerance rates on grids other than the quad primal and dual ({key})"
                 )))
             }
         };

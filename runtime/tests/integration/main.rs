@@ -8,6 +8,7 @@ mod bezier;
 mod boundary_tessellation;
 mod butterfly_tessellation;
 mod cli;
+mod compact_tables;
 mod exact_eval;
 mod face_varying;
 mod fuzz_cases;

@@ -121,7 +121,10 @@ fn generated_files_round_trip_through_subtess() {
     let path = temp("small.subtess");
     std::fs::write(&path, small_table()).expect("write");
     let table = StencilTable::read(&path).expect("valid table");
-    assert_eq!(table.index().entries.len(), (2 + 2) * 3 * 3 * 2);
+    // Compact: 4 patches (valences 3, 4; two sectors of the 2-face boundary vertex) x 5 pieces,
+    // 3 rates x 2 curve-basis sections.
+    assert_eq!(table.index().entries.len(), 4 * 5 + 3 * 2);
+    assert!(table.is_compact());
     let info = Command::new(env!("CARGO_BIN_EXE_subtess"))
         .args(["tables", "info"])
         .arg(&path)

@@ -1,10 +1,15 @@
 //! Stencil tables as the runtime uses them: the embedded default, or a file, validated once.
+//! A compact quad table's grids are expanded from the scaling relation's pieces when a plan
+//! first asks for them ([`quad_expansion`]), then kept.
+
+mod quad_expansion;
 
 use std::path::Path;
 
 use table_format::{AlignedBytes, SectionKey, TableIndex};
 
 use crate::RuntimeError;
+use quad_expansion::QuadExpansion;
 
 /// Where a table's bytes live.
 #[derive(Debug)]
@@ -22,6 +27,8 @@ enum Storage {
 pub struct StencilTable {
     storage: Storage,
     index: TableIndex,
+    /// The grids of a compact table, expanded on first use.
+    expansion: Option<QuadExpansion>,
     corners: Option<Box<StencilTable>>,
 }
 
@@ -49,9 +56,22 @@ impl StencilTable {
     }
 
     fn embedded(bytes: &'static [u8]) -> Result<Self, RuntimeError> {
+        Self::validated(Storage::Embedded(bytes))
+    }
+
+    /// A table over bytes whose index is valid (and, for files, whose weights are finite).
+    fn validated(storage: Storage) -> Result<Self, RuntimeError> {
+        let bytes = match &storage {
+            Storage::Embedded(b) => b,
+            Storage::Owned(b) => b.as_bytes(),
+        };
         let index = TableIndex::parse(bytes)?;
+        if matches!(storage, Storage::Owned(_)) {
+            index.check_finite(bytes)?;
+        }
         Ok(StencilTable {
-            storage: Storage::Embedded(bytes),
+            expansion: QuadExpansion::new(&index)?,
+            storage,
             index,
             corners: None,
         })
@@ -78,14 +98,7 @@ impl StencilTable {
     /// Validate a table held in memory (copied once into an aligned buffer), every weight
     /// finite included.
     pub fn from_bytes(bytes: &[u8]) -> Result<Self, RuntimeError> {
-        let bytes = AlignedBytes::from_slice(bytes);
-        let index = TableIndex::parse(bytes.as_bytes())?;
-        index.check_finite(bytes.as_bytes())?;
-        Ok(StencilTable {
-            storage: Storage::Owned(bytes),
-            index,
-            corners: None,
-        })
+        Self::validated(Storage::Owned(AlignedBytes::from_slice(bytes)))
     }
 
     /// Read and validate a table file. The fixed-size header is read and checked first
@@ -110,13 +123,7 @@ impl StencilTable {
         let len = usize::try_from(len)
             .map_err(|_| table_format::TableError::TooLarge { declared: len })?;
         let bytes = AlignedBytes::read_from(head.as_slice().chain(file), len).map_err(io)?;
-        let index = TableIndex::parse(bytes.as_bytes())?;
-        index.check_finite(bytes.as_bytes())?;
-        Ok(StencilTable {
-            storage: Storage::Owned(bytes),
-            index,
-            corners: None,
-        })
+        Self::validated(Storage::Owned(bytes))
     }
 
     /// The raw bytes.
@@ -132,12 +139,31 @@ impl StencilTable {
         &self.index
     }
 
-    /// The f32 weights of one section: `points x K`, point-major (zero-copy).
+    /// Whether the table stores the scaling relation's pieces and expands its grids
+    /// (docs/table-format.md, "Compact quad tables").
+    pub fn is_compact(&self) -> bool {
+        self.expansion.is_some()
+    }
+
+    /// The f32 weights of one section: `points x K`, point-major. Zero-copy for a table that
+    /// stores its grids; for a compact one, expanded on the first request (of the order of a
+    /// millisecond at rate 24) and kept for the table's lifetime.
     pub fn weights(&self, key: &SectionKey) -> Result<&[f32], RuntimeError> {
         if let (Some(corners), true) = (&self.corners, key.boundary && key.faces == 1) {
             return corners.weights(key);
         }
-        Ok(self.index.weights_f32(self.bytes(), key)?)
+        match &self.expansion {
+            Some(expansion) if self.index.entry(key).is_err() => expansion
+                .grid(&self.index, self.bytes(), key)
+                .unwrap_or_else(|| {
+                    Err(table_format::TableError::MissingSection {
+                        key: *key,
+                        coverage: self.index.coverage(),
+                    }
+                    .into())
+                }),
+            _ => Ok(self.index.weights_f32(self.bytes(), key)?),
+        }
     }
 }
 
