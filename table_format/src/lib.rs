@@ -833,6 +833,12 @@ impl TableIndex {
         })
     }
 
+    /// The index entry of `key`, if the table has it (no error built: [`Self::entry`]'s
+    /// message summarizes the whole index).
+    pub fn get(&self, key: &SectionKey) -> Option<&SectionEntry> {
+        self.lookup.get(key).map(|&i| &self.entries[i])
+    }
+
     /// The index entry of `key`, or which sections the table does have.
     pub fn entry(&self, key: &SectionKey) -> Result<&SectionEntry, TableError> {
         self.lookup

@@ -153,7 +153,7 @@ impl StencilTable {
             return corners.weights(key);
         }
         match &self.expansion {
-            Some(expansion) if self.index.entry(key).is_err() => expansion
+            Some(expansion) if self.index.get(key).is_none() => expansion
                 .grid(&self.index, self.bytes(), key)
                 .unwrap_or_else(|| {
                     Err(table_format::TableError::MissingSection {

@@ -94,11 +94,11 @@ impl QuadExpansion {
                         kind: StencilKind::DerivativeU,
                         ..*key
                     };
-                    match (key.kind, index.entry(&derivative)) {
-                        (StencilKind::Position, Err(_)) => {
+                    match (key.kind, index.get(&derivative)) {
+                        (StencilKind::Position, None) => {
                             return Err(incomplete(format!("{key} has no derivative section")))
                         }
-                        (StencilKind::Position, Ok(_)) => rates.push(key.n),
+                        (StencilKind::Position, Some(_)) => rates.push(key.n),
                         _ => {}
                     }
                 }
@@ -120,14 +120,14 @@ impl QuadExpansion {
                             points,
                             ..*key
                         };
-                        match index.entry(&piece) {
-                            Ok(e) if e.width == width => {}
-                            Ok(_) => {
+                        match index.get(&piece) {
+                            Some(e) if e.width == width => {}
+                            Some(_) => {
                                 return Err(incomplete(format!(
                                     "{piece} has another width than {key}"
                                 )))
                             }
-                            Err(_) => return Err(incomplete(format!("{key} has no {piece}"))),
+                            None => return Err(incomplete(format!("{key} has no {piece}"))),
                         }
                     }
                     patches.push((id, width));
