@@ -1,14 +1,30 @@
-//! Loop stencil tables (`docs/table-format.md`, triangle point sets).
+//! Loop stencil tables (`docs/table-format.md`, triangle point sets and "Compact Loop tables").
 //!
-//! Each Loop patch (interior vertex of valence `v`, `v = 6` being the regular patch; each
-//! sector of a boundary vertex with `k` triangles, `k = 3` being the regular boundary) and rate
-//! `n` becomes six sections: positions, d/du and d/dv on the triangle primal grid
-//! `(i/n, j/n)`, `i + j <= n`, and on the `n^2` centroids of the grid's small triangles (the
-//! dual points of section 5.5), in the order [`triangle_dual_points`] gives. Every point's
-//! weights come from the scaling-relation grid system of [`crate::triangle_patch`] (the
-//! centroids live on the grid `1/3n`); the tangent rows at the vertex itself are
-//! [`loop_ev_tangents`]' or [`loop_boundary_tangents`]' masks. The default table is generated from the f64 path, which agrees
-//! with exact arithmetic within 1e-12 (checked by the tests against the exact path).
+//! Two layouts ([`TriangleLayout`]):
+//!
+//! * **Compact** (the default): the pieces of the scaling relation from which every grid
+//!   stencil follows by substitution ([`crate::triangle_patch`]' module docs): per kind, Loop's
+//!   regular basis `psi` (the quartic box spline, or its derivative) on the lattice `k/4`, the
+//!   interpolation data of its quartic pieces ([`LoopRegularBasis::lattice_window`]); a marker
+//!   per rate; per patch, its local subdivision matrix `A`, its three sub-triangle matrices `R_b`
+//!   (12 level-1 points each) and its stencils at the vertex itself (the limit-position mask,
+//!   solved as the fixed point of the patch's system, and the tangent masks of
+//!   [`loop_ev_tangents`] or [`loop_boundary_tangents`]). In f64. The runtime expands the grids
+//!   when a plan asks (`subtess::stencil_table`): `phi(x) = f phi(2x) A` while `u + v <= 1/2`,
+//!   else `f sum_j psi(2x - j) R_b[j]`, `f = 1` for positions and 2 for derivatives, with the
+//!   same operations in the same order as the grid system below, so the two layouts' grids
+//!   are equal (measured: bit for bit; `runtime/tests/integration/compact_tables.rs`).
+//! * **Grids**: each Loop patch (interior vertex of valence `v`, `v = 6` being the regular
+//!   patch; each sector of a boundary vertex with `k` triangles, `k = 3` being the regular
+//!   boundary) and rate `n` becomes six sections: positions, d/du and d/dv on the triangle
+//!   primal grid `(i/n, j/n)`, `i + j <= n`, and on the `n^2` centroids of the grid's small
+//!   triangles (the dual points of section 5.5), in the order [`triangle_dual_points`] gives.
+//!   Every point's weights come from the scaling-relation grid system of
+//!   [`crate::triangle_patch`] (the centroids live on the grid `1/3n`); the tangent rows at the
+//!   vertex itself are [`loop_ev_tangents`]' or [`loop_boundary_tangents`]' masks.
+//!
+//! The default table is compact and generated from the f64 path, which agrees with exact
+//! arithmetic within 1e-12 (checked by the tests against the exact path).
 
 use num_rational::BigRational;
 use rayon::prelude::*;
