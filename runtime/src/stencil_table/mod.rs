@@ -223,8 +223,9 @@ impl StencilTable {
     }
 
     /// The f32 weights of one section: `points x K`, point-major. Zero-copy for a table that
-    /// stores its grids; for a compact one, expanded on the first request (of the order of a
-    /// millisecond at rate 24) and kept for the table's lifetime.
+    /// stores its grids; for a compact one, expanded on the first request (both grids of the
+    /// key's patch, rate and kind: about 0.2 ms for a Catmull–Clark patch at rate 24, 2 ms for
+    /// a Loop one, docs/benchmarks.md) and kept for the table's lifetime.
     pub fn weights(&self, key: &SectionKey) -> Result<&[f32], RuntimeError> {
         if let (Some(corners), true) = (&self.corners, key.boundary && key.faces == 1) {
             return corners.weights(key);
