@@ -4,8 +4,8 @@
 //! change almost never passes: bit 0 writes the checksum (`table_format::checksum`: xxh3 of
 //! every byte but its own, header included since format version 3) into the header, bit 1
 //! writes the length as the declared file size (first, since the checksum covers it). A
-//! compact table's grids are expanded too (`StencilTable::weights` on grid keys), for up to
-//! two patches at its rates up to 8.
+//! compact table's grids (quad or Loop) are expanded too (`StencilTable::weights` on grid
+//! keys), for up to two patches at its rates up to 8.
 
 #![no_main]
 
@@ -58,12 +58,21 @@ fuzz_target!(|data: &[u8]| {
     if !table.is_compact() {
         return;
     }
+    // Quad tables list their rates by curve-basis sections, compact Loop tables by rate
+    // markers.
     let rates: Vec<u32> = index
         .entries
         .iter()
-        .filter(|e| e.key.points == PointSet::CurveBasis && e.key.n <= 8)
+        .filter(|e| {
+            matches!(e.key.points, PointSet::CurveBasis | PointSet::TriangleRate) && e.key.n <= 8
+        })
         .map(|e| e.key.n)
         .collect();
+    let grids = if index.meta.scheme.is_triangle() {
+        [PointSet::TrianglePrimal, PointSet::TriangleDual]
+    } else {
+        [PointSet::Primal, PointSet::Dual]
+    };
     let patches = index
         .entries
         .iter()
@@ -71,7 +80,7 @@ fuzz_target!(|data: &[u8]| {
         .take(2);
     for patch in patches {
         for &n in &rates {
-            for points in [PointSet::Primal, PointSet::Dual] {
+            for points in grids {
                 let key = SectionKey {
                     kind: StencilKind::DerivativeU,
                     points,

@@ -6,7 +6,9 @@
 //! `load default table (SCHEME)` is the public call. `expand every grid` builds a fresh
 //! Catmull–Clark table and asks it for every section of the grid layout (27 patches x 24 rates x
 //! 3 kinds x 2 grids: what the version-3 table stored), the most any sequence of plans can ask;
-//! `expand one patch at rate N` is the three kinds of one valence-5 patch, both grids.
+//! `expand one patch at rate N` is the three kinds of one valence-5 patch, both grids. The
+//! `(loop)` ones do the same with the default Loop table (31 patches: valences 3..=12, boundary
+//! vertices with 1..=6 triangles).
 #![allow(missing_docs)] // criterion_group! generates an undocumented function
 
 use criterion::{criterion_group, criterion_main, Criterion};
@@ -14,14 +16,24 @@ use subtess::stencil_table::StencilTable;
 use subtess::{BoundaryMode, Scheme};
 use table_format::{PointSet, SectionKey, StencilKind};
 
-/// Every grid section a table of the default coverage answers: `(boundary, faces, sector)`.
-fn patches() -> Vec<(bool, u32, u32)> {
-    let interior = (3..=8).map(|v| (false, v, 0));
+/// Every patch of a table of the default coverage, interior valences `3..=max_valence`:
+/// `(boundary, faces, sector)`.
+fn patches(max_valence: u32) -> Vec<(bool, u32, u32)> {
+    let interior = (3..=max_valence).map(|v| (false, v, 0));
     let boundary = (1..=6).flat_map(|f| (0..f).map(move |s| (true, f, s)));
     interior.chain(boundary).collect()
 }
 
-fn grids(table: &StencilTable, patches: &[(bool, u32, u32)], rates: &[u32]) -> usize {
+/// The grid point sets of a quad table, then of a triangle table.
+const QUAD: [PointSet; 2] = [PointSet::Primal, PointSet::Dual];
+const TRIANGLE: [PointSet; 2] = [PointSet::TrianglePrimal, PointSet::TriangleDual];
+
+fn grids(
+    table: &StencilTable,
+    patches: &[(bool, u32, u32)],
+    rates: &[u32],
+    point_sets: [PointSet; 2],
+) -> usize {
     let mut weights = 0;
     for &(boundary, faces, sector) in patches {
         for &n in rates {
@@ -30,7 +42,7 @@ fn grids(table: &StencilTable, patches: &[(bool, u32, u32)], rates: &[u32]) -> u
                 StencilKind::DerivativeU,
                 StencilKind::DerivativeV,
             ] {
-                for points in [PointSet::Primal, PointSet::Dual] {
+                for points in point_sets {
                     let key = SectionKey {
                         kind,
                         points,
@@ -68,18 +80,29 @@ fn bench(c: &mut Criterion) {
             })
         });
     }
-    let all = patches();
     let rates: Vec<u32> = (1..=24).collect();
-    let fresh = || StencilTable::default_catmull_clark().expect("loads");
-    assert_eq!(grids(&fresh(), &all, &rates), 14_791_656);
     let mut group = c.benchmark_group("expand");
     group.sample_size(10);
+    let fresh = || StencilTable::default_catmull_clark().expect("loads");
+    let all = patches(8);
+    assert_eq!(grids(&fresh(), &all, &rates, QUAD), 14_791_656);
     group.bench_function("expand every grid of the default table", |b| {
-        b.iter(|| grids(&fresh(), &all, &rates))
+        b.iter(|| grids(&fresh(), &all, &rates, QUAD))
     });
     for n in [8, 24] {
         group.bench_function(format!("expand one patch at rate {n}"), |b| {
-            b.iter(|| grids(&fresh(), &[(false, 5, 0)], &[n]))
+            b.iter(|| grids(&fresh(), &[(false, 5, 0)], &[n], QUAD))
+        });
+    }
+    let fresh = || StencilTable::default_loop().expect("loads");
+    let all = patches(12);
+    assert_eq!(grids(&fresh(), &all, &rates, TRIANGLE), 8_473_392);
+    group.bench_function("expand every grid of the default table (loop)", |b| {
+        b.iter(|| grids(&fresh(), &all, &rates, TRIANGLE))
+    });
+    for n in [8, 24] {
+        group.bench_function(format!("expand one patch at rate {n} (loop)"), |b| {
+            b.iter(|| grids(&fresh(), &[(false, 5, 0)], &[n], TRIANGLE))
         });
     }
     group.finish();

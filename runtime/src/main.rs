@@ -748,11 +748,17 @@ fn tables_info(file: Option<PathBuf>, scheme: Scheme) -> Result<(), RuntimeError
     out!(
         "sections:   {} ({})",
         index.entries.len(),
-        if table.is_compact() {
-            "compact: the regular curve basis per rate; A, the sub-patch matrices and the vertex \
-             masks per patch; the grids are expanded when a plan needs them"
-        } else {
-            "grids; positions, d/du, d/dv"
+        match (table.is_compact(), index.meta.scheme.is_triangle()) {
+            (true, false) => {
+                "compact: the regular curve basis per rate; A, the sub-patch matrices and the \
+                 vertex masks per patch; the grids are expanded when a plan needs them"
+            }
+            (true, true) => {
+                "compact: the Loop basis on the lattice 1/4 and a marker per rate; A, the \
+                 sub-triangle matrices and the vertex masks per patch; the grids are expanded \
+                 when a plan needs them"
+            }
+            (false, _) => "grids; positions, d/du, d/dv",
         }
     )?;
     out!("weights:    {weights}")?;

@@ -226,8 +226,10 @@ fn boundary_outer_indices(faces: u32, sector: u32) -> Vec<usize> {
 }
 
 /// The twelve level-1 lattice points (unfolded, sector coordinates) of a regular
-/// sub-triangle: the union of its corners' 1-rings, sorted.
-fn sub_triangle_points(corners: [(i64, i64); 3]) -> Vec<(i64, i64)> {
+/// sub-triangle: the union of its corners' 1-rings, sorted. The order of
+/// [`SubTriangle::points`] and so of the rows of a compact Loop table's sub-triangle matrices,
+/// which the runtime recomputes with this function.
+pub fn sub_triangle_points(corners: [(i64, i64); 3]) -> Vec<(i64, i64)> {
     let mut points: Vec<(i64, i64)> = corners
         .iter()
         .flat_map(|&(x, y)| {

@@ -112,6 +112,21 @@ impl LoopRegularBasis {
         sum
     }
 
+    /// The f64 values [`Self::at`] interpolates, `psi(k_1/4, k_2/4)`, on the square window
+    /// `|k_1|, |k_2| <= h` that holds the support, `k_2` outer: `(2h + 1, values)`. What a
+    /// compact Loop table stores ([`table_format::PointSet::LoopBasis`]) so that the runtime
+    /// evaluates `at::<f64>` bit for bit (zero outside the window, as `at` is outside the
+    /// solved box).
+    pub fn lattice_window(&self) -> (u32, Vec<f64>) {
+        let ((l1, h1), (l2, h2)) = self.float.bbox;
+        let h = [l1, h1, l2, h2].iter().map(|v| v.abs()).max().unwrap_or(0);
+        let values = (-h..=h)
+            .flat_map(|k2| (-h..=h).map(move |k1| (k1, k2)))
+            .map(|(k1, k2)| self.float.at(k1, k2))
+            .collect();
+        ((2 * h + 1) as u32, values)
+    }
+
     fn value<S: Scalar>(&self, p: i64, q: i64) -> S {
         if S::EXACT {
             S::from_rational(&self.exact.at(p, q))

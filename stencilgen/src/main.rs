@@ -30,7 +30,7 @@ use stencilgen::substitution::Substitution;
 use stencilgen::table::{build_table, QuadLayout, TableSpec};
 use stencilgen::triangle_patch::TriangleSubstitution;
 use stencilgen::triangle_system::{triangle_stencils, TriangleStencils};
-use stencilgen::triangle_table::{build_triangle_table, TriangleTableSpec};
+use stencilgen::triangle_table::{build_triangle_table, TriangleLayout, TriangleTableSpec};
 use stencilgen::{curve_stencils, excerpt, CurveStencils, Scalar, StencilError};
 use table_format::Precision;
 
@@ -118,16 +118,16 @@ enum Command {
         /// Grid rates, as a range or list.
         #[arg(long, default_value = "1..24")]
         n: String,
-        /// Stored precision (default: f64 for compact quad tables, which store only f64; f32
-        /// for grids).
+        /// Stored precision (default: f64 for compact tables, which store only f64; f32 for
+        /// grids).
         #[arg(long, value_parser = ["f32", "f64"])]
         precision: Option<String>,
         /// Generate from exact rationals (slower) instead of the f64 path.
         #[arg(long)]
         exact: bool,
-        /// Quad schemes: store every grid point's stencil (solved on the grid) instead of the
-        /// scaling relation's pieces that the runtime expands (docs/table-format.md). Triangle
-        /// tables always store grids.
+        /// Quad schemes and Loop: store every grid point's stencil (solved on the grid) instead
+        /// of the scaling relation's pieces that the runtime expands (docs/table-format.md).
+        /// Butterfly and √3 tables always store grids.
         #[arg(long)]
         grids: bool,
         /// Output file.
@@ -326,7 +326,12 @@ fn run(cli: Cli) -> Result<(), StencilError> {
                         valences: set.valences.clone(),
                         boundary_faces: set.boundary_faces.clone(),
                         rates: set.rates.clone(),
-                        precision: precision_of(false),
+                        precision: precision_of(!grids),
+                        layout: if grids {
+                            TriangleLayout::Grids
+                        } else {
+                            TriangleLayout::Compact
+                        },
                     };
                     let bytes = build_triangle_table(&spec)?;
                     write_bytes(&path, &bytes, started)?;

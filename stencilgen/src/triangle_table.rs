@@ -1,15 +1,32 @@
-//! Loop stencil tables (`docs/table-format.md`, triangle point sets).
+//! Loop stencil tables (`docs/table-format.md`, triangle point sets and "Compact Loop tables").
 //!
-//! Each Loop patch (interior vertex of valence `v`, `v = 6` being the regular patch; each
-//! sector of a boundary vertex with `k` triangles, `k = 3` being the regular boundary) and rate
-//! `n` becomes six sections: positions, d/du and d/dv on the triangle primal grid
-//! `(i/n, j/n)`, `i + j <= n`, and on the `n^2` centroids of the grid's small triangles (the
-//! dual points of section 5.5), in the order [`triangle_dual_points`] gives. Every point's
-//! weights come from the scaling-relation grid system of [`crate::triangle_patch`] (the
-//! centroids live on the grid `1/3n`); the tangent rows at the vertex itself are
-//! [`loop_ev_tangents`]' or [`loop_boundary_tangents`]' masks. The default table is generated from the f64 path, which agrees
-//! with exact arithmetic within 1e-12 (checked by the tests against the exact path).
+//! Two layouts ([`TriangleLayout`]):
+//!
+//! * **Compact** (the default): the pieces of the scaling relation from which every grid
+//!   stencil follows by substitution ([`crate::triangle_patch`]' module docs): per kind, Loop's
+//!   regular basis `psi` (the quartic box spline, or its derivative) on the lattice `k/4`, the
+//!   interpolation data of its quartic pieces ([`LoopRegularBasis::lattice_window`]); a marker
+//!   per rate; per patch, its local subdivision matrix `A`, its three sub-triangle matrices `R_b`
+//!   (12 level-1 points each) and its stencils at the vertex itself (the limit-position mask,
+//!   solved as the fixed point of the patch's system, and the tangent masks of
+//!   [`loop_ev_tangents`] or [`loop_boundary_tangents`]). In f64. The runtime expands the grids
+//!   when a plan asks (`subtess::stencil_table`): `phi(x) = f phi(2x) A` while `u + v <= 1/2`,
+//!   else `f sum_j psi(2x - j) R_b[j]`, `f = 1` for positions and 2 for derivatives, with the
+//!   same operations in the same order as the grid system below, so the two layouts' grids
+//!   are equal (measured: bit for bit; `runtime/tests/integration/compact_tables.rs`).
+//! * **Grids**: each Loop patch (interior vertex of valence `v`, `v = 6` being the regular
+//!   patch; each sector of a boundary vertex with `k` triangles, `k = 3` being the regular
+//!   boundary) and rate `n` becomes six sections: positions, d/du and d/dv on the triangle
+//!   primal grid `(i/n, j/n)`, `i + j <= n`, and on the `n^2` centroids of the grid's small
+//!   triangles (the dual points of section 5.5), in the order [`triangle_dual_points`] gives.
+//!   Every point's weights come from the scaling-relation grid system of
+//!   [`crate::triangle_patch`] (the centroids live on the grid `1/3n`); the tangent rows at the
+//!   vertex itself are [`loop_ev_tangents`]' or [`loop_boundary_tangents`]' masks.
+//!
+//! The default table is compact and generated from the f64 path, which agrees with exact
+//! arithmetic within 1e-12 (checked by the tests against the exact path).
 
+use num_rational::BigRational;
 use rayon::prelude::*;
 use schemes::triangle_local::TriangleLocalMatrices;
 use schemes::TriangleScheme;
@@ -37,20 +54,32 @@ pub struct TriangleTableSpec {
     pub boundary_faces: Vec<u32>,
     /// Grid rates.
     pub rates: Vec<u32>,
-    /// Stored precision.
+    /// Stored precision ([`TriangleLayout::Compact`] stores f64 only).
     pub precision: Precision,
+    /// What the sections hold.
+    pub layout: TriangleLayout,
+}
+
+/// What a Loop table stores (module docs). Butterfly and √3 tables always store grids.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TriangleLayout {
+    /// The scaling relation's pieces; the reader expands the grids.
+    Compact,
+    /// Every grid point's stencil.
+    Grids,
 }
 
 impl TriangleTableSpec {
     /// The Loop table `subtess` embeds: interior valences 3..=12, boundary vertices with
-    /// 1..=6 triangles, n = 1..=24, f32.
+    /// 1..=6 triangles, n = 1..=24, compact (f64).
     pub fn default_loop() -> Result<Self, StencilError> {
         Ok(TriangleTableSpec {
             scheme: triangle_scheme("loop")?,
             valences: (3..=12).collect(),
             boundary_faces: (1..=6).collect(),
             rates: (1..=MAX_TRIANGLE_RATE).collect(),
-            precision: Precision::F32,
+            precision: Precision::F64,
+            layout: TriangleLayout::Compact,
         })
     }
 }
@@ -124,6 +153,116 @@ fn patch_sections(
     ])
 }
 
+/// A section of one patch's pieces (`n = 0`): `rows x width` weights.
+fn piece(
+    kind: TableKind,
+    points: PointSet,
+    (boundary, faces, sector): (bool, u32, u32),
+    width: usize,
+    weights: Vec<f64>,
+) -> Section {
+    let key = SectionKey {
+        kind,
+        points,
+        boundary,
+        faces,
+        sector,
+        n: 0,
+    };
+    (key, width as u32, weights)
+}
+
+/// The compact layout's sections (module docs): per kind the Loop basis's rate-4 lattice
+/// values, per rate a marker, per patch `A`, the sub-triangle matrices and the three vertex
+/// masks.
+fn compact_sections(
+    bases: &[LoopRegularBasis],
+    kinds: &[(StencilKind, TableKind)],
+    patches: &[Patch],
+    rates: &[u32],
+) -> Result<Vec<Section>, StencilError> {
+    let mut out = Vec::new();
+    for (basis, &(_, kind)) in bases.iter().zip(kinds) {
+        let (width, values) = basis.lattice_window();
+        let key = SectionKey {
+            kind,
+            points: PointSet::LoopBasis,
+            boundary: false,
+            faces: 0,
+            sector: 0,
+            n: LOOP_BASIS_LATTICE,
+        };
+        out.push((key, width, values));
+    }
+    for &n in rates {
+        let key = SectionKey {
+            kind: TableKind::Position,
+            points: PointSet::TriangleRate,
+            boundary: false,
+            faces: 0,
+            sector: 0,
+            n,
+        };
+        out.push((key, 0, Vec::new()));
+    }
+    let to_f64 = |rows: &[Vec<BigRational>]| -> Vec<f64> {
+        rows.iter().flatten().map(Scalar::to_f64).collect()
+    };
+    for (id, matrices, (du, dv)) in patches {
+        let k = matrices.size();
+        // The limit-position mask: the fixed point phi(0) = phi(0) A of the patch's system,
+        // solved as the grid layout solves it (the same block at every rate).
+        let vertex = patch_stencils_at::<f64>(matrices, &bases[0], &[(0, 0)], 1)?;
+        let position =
+            vertex
+                .stencils
+                .into_iter()
+                .next()
+                .ok_or_else(|| StencilError::Inconsistent {
+                    scheme: matrices.scheme.clone(),
+                    n: 1,
+                    detail: "the patch system has no stencil at the vertex".to_owned(),
+                })?;
+        let sub_triangles: Vec<Vec<BigRational>> = matrices
+            .sub_triangles
+            .iter()
+            .flat_map(|sub| sub.rows.iter().cloned())
+            .collect();
+        out.push(piece(
+            TableKind::Position,
+            PointSet::Subdivision,
+            *id,
+            k,
+            to_f64(&matrices.a),
+        ));
+        out.push(piece(
+            TableKind::Position,
+            PointSet::SubTriangles,
+            *id,
+            k,
+            to_f64(&sub_triangles),
+        ));
+        for (kind, mask) in [
+            (TableKind::Position, position),
+            (TableKind::DerivativeU, du.clone()),
+            (TableKind::DerivativeV, dv.clone()),
+        ] {
+            out.push(piece(kind, PointSet::VertexMask, *id, k, mask));
+        }
+    }
+    Ok(out)
+}
+
+/// The denominator of the lattice the Loop basis's pieces are stored on (its degree).
+const LOOP_BASIS_LATTICE: u32 = 4;
+
+/// One patch: `(boundary, faces, sector)`, the local matrices, the tangent masks at the vertex.
+type Patch = (
+    (bool, u32, u32),
+    TriangleLocalMatrices,
+    (Vec<f64>, Vec<f64>),
+);
+
 /// Generate and encode the table of `spec`.
 pub fn build_triangle_table(spec: &TriangleTableSpec) -> Result<Vec<u8>, StencilError> {
     let scheme_id = SchemeId::from_name(spec.scheme.name)
@@ -142,6 +281,14 @@ pub fn build_triangle_table(spec: &TriangleTableSpec) -> Result<Vec<u8>, Stencil
             max: MAX_TRIANGLE_RATE,
         });
     }
+    if spec.layout == TriangleLayout::Compact && spec.precision != Precision::F64 {
+        return Err(StencilError::UnsupportedScheme {
+            scheme: spec.scheme.name.to_owned(),
+            reason: "compact tables store f64 (their pieces expand to the f32 grids within 1 ulp \
+                     only from f64); write f32 grids with the grid layout"
+                .to_owned(),
+        });
+    }
     let kinds = [
         (StencilKind::Position, TableKind::Position),
         (StencilKind::DerivativeU, TableKind::DerivativeU),
@@ -151,8 +298,7 @@ pub fn build_triangle_table(spec: &TriangleTableSpec) -> Result<Vec<u8>, Stencil
         .iter()
         .map(|&(kind, _)| LoopRegularBasis::new(&spec.scheme, kind))
         .collect::<Result<Vec<_>, _>>()?;
-    // (boundary, faces, sector), the local matrices, the tangent masks at the vertex.
-    let mut patches = Vec::new();
+    let mut patches: Vec<Patch> = Vec::new();
     for &v in &spec.valences {
         let m = TriangleLocalMatrices::new(&spec.scheme, v)?;
         let t = loop_ev_tangents(&m)?;
@@ -164,6 +310,17 @@ pub fn build_triangle_table(spec: &TriangleTableSpec) -> Result<Vec<u8>, Stencil
             let t = loop_boundary_tangents(&m)?;
             patches.push(((true, faces, sector), m, (t.du, t.dv)));
         }
+    }
+    let meta = TableMeta {
+        scheme: scheme_id,
+        precision: spec.precision,
+        corners: false,
+    };
+    if spec.layout == TriangleLayout::Compact {
+        return Ok(encode(
+            meta,
+            &compact_sections(&bases, &kinds, &patches, &spec.rates)?,
+        )?);
     }
     let jobs: Vec<(usize, usize, u32)> = (0..patches.len())
         .flat_map(|p| (0..kinds.len()).map(move |k| (p, k)))
@@ -189,11 +346,6 @@ pub fn build_triangle_table(spec: &TriangleTableSpec) -> Result<Vec<u8>, Stencil
             patch_sections(matrices, &bases[k], key, tangent)
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let meta = TableMeta {
-        scheme: scheme_id,
-        precision: spec.precision,
-        corners: false,
-    };
     let sections: Vec<Section> = sections.into_iter().flatten().collect();
     Ok(encode(meta, &sections)?)
 }

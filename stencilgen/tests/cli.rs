@@ -195,6 +195,63 @@ fn tables_writes_a_valid_table() {
     );
 }
 
+/// `tables --schemes loop` writes a compact table (f64), `--grids` the grids (f32).
+#[test]
+fn tables_writes_compact_and_grid_loop_tables() {
+    let path = std::env::temp_dir().join(format!(
+        "stencilgen-cli-loop-{}.subtess",
+        std::process::id()
+    ));
+    let write = |extra: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_stencilgen"))
+            .args([
+                "tables",
+                "--schemes",
+                "loop",
+                "--valences",
+                "5",
+                "--boundary",
+                "--boundary-faces",
+                "2",
+                "--n",
+                "1..3",
+            ])
+            .args(extra)
+            .arg("-o")
+            .arg(&path)
+            .output()
+            .expect("stencilgen runs");
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let bytes = table_format::AlignedBytes::read(&path).expect("written");
+        let table = table_format::Table::parse(bytes.as_bytes())
+            .expect("valid")
+            .into_index();
+        table
+    };
+    let compact = write(&[]);
+    assert_eq!(compact.meta.precision, table_format::Precision::F64);
+    // 3 basis kinds, 3 rate markers, 3 patches (valence 5, two boundary sectors) x 5 pieces.
+    assert_eq!(compact.entries.len(), 3 + 3 + 3 * 5);
+    assert_eq!(
+        compact.coverage(),
+        "interior valences 5, boundary vertices with 2 faces, n = 1..=3"
+    );
+    let grids = write(&["--grids"]);
+    assert_eq!(grids.meta.precision, table_format::Precision::F32);
+    // 3 patches x 3 rates x 3 kinds x 2 point sets.
+    assert_eq!(grids.entries.len(), 3 * 3 * 3 * 2);
+    assert_eq!(grids.coverage(), compact.coverage());
+    let _ = std::fs::remove_file(&path);
+    fails_with(
+        "tables --schemes loop --valences 5 --n 1 --precision f32 -o /tmp/x.subtess",
+        "compact tables store f64",
+    );
+}
+
 #[test]
 fn triangle_json_lists_the_support_grid() {
     let v = json("triangle --scheme loop --n 2 --json");

@@ -28,8 +28,9 @@ use thiserror::Error;
 pub const MAGIC: [u8; 8] = *b"SUBTESS\0";
 /// The format version this crate reads and writes. Version 4 added the scaling relation's
 /// pieces as sections ([`PointSet::CurveBasis`], [`PointSet::VertexMask`],
-/// [`PointSet::Subdivision`], [`PointSet::SubPatches`]), from which a reader expands the grid
-/// stencils; version 3 extended the checksum over the header and the section index (version 2
+/// [`PointSet::Subdivision`], [`PointSet::SubPatches`]; for Loop [`PointSet::LoopBasis`],
+/// [`PointSet::SubTriangles`], [`PointSet::TriangleRate`]), from which a reader expands the
+/// grid stencils; version 3 extended the checksum over the header and the section index (version 2
 /// hashed the bytes after the header only, so a changed boundary-mode flag was read as the
 /// other mode). Older files are refused.
 pub const VERSION: u32 = 4;
@@ -158,7 +159,7 @@ pub enum TableError {
         expected: u64,
     },
     /// A section's point set is for the other kind of patch (triangle point sets in a quad
-    /// scheme's table or the reverse).
+    /// scheme's table or the reverse; [`PointSet::belongs_to`]).
     #[error("section {key} uses a point set that does not belong to {scheme} patches")]
     WrongPointSet {
         /// The section.
@@ -342,6 +343,22 @@ pub enum PointSet {
     /// `48 x K`, sub-patches `[1/2,1]x[0,1/2]`, `[1/2,1]^2`, `[0,1/2]x[1/2,1]`, each 16 rows
     /// `(p, q)`, `p, q in -1..=2`, `q` outer.
     SubPatches = 7,
+    /// Compact Loop tables (docs/table-format.md, "Compact Loop tables"): the regular basis
+    /// (the quartic box spline `psi`, kind position, or its derivative along `u` or `v`) on the
+    /// degree-4 lattice, `psi(k_1/4, k_2/4)` for `|k_1|, |k_2| <= h`, `k_2` outer: `width = 2h + 1`
+    /// rows of `width` weights, `n = 4` (the lattice's denominator), patch fields 0. Its values
+    /// are the quartic (derivatives: cubic) pieces' interpolation data.
+    LoopBasis = 8,
+    /// A compact Loop table's sub-triangle matrices `R_0, R_1, R_2` of one patch at `n = 0`,
+    /// stacked: `36 x K`, sub-triangles next to `E_0`, the middle one, next to `E_1`
+    /// (`schemes::triangle_local::SUB_TRIANGLES`), each 12 rows, one per level-1 lattice point
+    /// of `schemes::triangle_local::sub_triangle_points` (sorted), the level-0 weights of that
+    /// point.
+    SubTriangles = 9,
+    /// A rate `n` that a compact Loop table covers: no rows (`width` 0), kind position, patch
+    /// fields 0. The expanded grids are the rates listed by these sections, so that the index
+    /// alone says what the table covers.
+    TriangleRate = 10,
 }
 
 impl PointSet {
@@ -353,8 +370,9 @@ impl PointSet {
     }
 
     /// Number of rows of a section of this point set at rate `n` with `width` weights a row:
-    /// the grid's points, `n + 1` curve-basis points, one vertex mask, `K = width` rows of `A`
-    /// or the 48 rows of the sub-patch matrices.
+    /// the grid's points, `n + 1` curve-basis points, one vertex mask, `K = width` rows of `A`,
+    /// the 48 rows of the sub-patch matrices, the 36 of the sub-triangle matrices, a square
+    /// window of the Loop basis (`width` rows) or none for a rate marker.
     pub fn rows(self, n: u32, width: u32) -> u64 {
         let n = u128::from(n);
         let count = match self {
@@ -365,13 +383,42 @@ impl PointSet {
             PointSet::VertexMask => 1,
             PointSet::Subdivision => u128::from(width),
             PointSet::SubPatches => 48,
+            PointSet::LoopBasis => u128::from(width),
+            PointSet::SubTriangles => 36,
+            PointSet::TriangleRate => 0,
         };
         u64::try_from(count).unwrap_or(u64::MAX)
     }
 
-    /// Whether the point set belongs to triangle patches.
+    /// Whether the point set belongs to triangle-scheme tables only.
     pub fn is_triangle(self) -> bool {
-        matches!(self, PointSet::TrianglePrimal | PointSet::TriangleDual)
+        matches!(
+            self,
+            PointSet::TrianglePrimal
+                | PointSet::TriangleDual
+                | PointSet::LoopBasis
+                | PointSet::SubTriangles
+                | PointSet::TriangleRate
+        )
+    }
+
+    /// Whether the point set belongs to quad-scheme tables only. [`PointSet::VertexMask`] and
+    /// [`PointSet::Subdivision`] are neither: both families' compact tables store them.
+    pub fn is_quad(self) -> bool {
+        matches!(
+            self,
+            PointSet::Primal | PointSet::Dual | PointSet::CurveBasis | PointSet::SubPatches
+        )
+    }
+
+    /// Whether the point set may appear in a table of `scheme` (triangle point sets in
+    /// triangle-scheme tables, quad ones in quad-scheme tables, the shared pieces in both).
+    pub fn belongs_to(self, scheme: SchemeId) -> bool {
+        if scheme.is_triangle() {
+            !self.is_quad()
+        } else {
+            !self.is_triangle()
+        }
     }
 
     /// Whether the section holds grid stencils (rather than the scaling relation's pieces).
@@ -389,6 +436,9 @@ impl PointSet {
             PointSet::VertexMask,
             PointSet::Subdivision,
             PointSet::SubPatches,
+            PointSet::LoopBasis,
+            PointSet::SubTriangles,
+            PointSet::TriangleRate,
         ]
         .into_iter()
         .find(|p| *p as u8 == v)
@@ -428,9 +478,14 @@ impl fmt::Display for SectionKey {
             PointSet::CurveBasis => {
                 return write!(f, "{kind} of the regular curve basis, n = {}", self.n);
             }
+            PointSet::LoopBasis => {
+                return write!(f, "{kind} of the Loop basis on the lattice 1/{}", self.n);
+            }
+            PointSet::TriangleRate => return write!(f, "rate marker n = {}", self.n),
             PointSet::VertexMask => "vertex mask",
             PointSet::Subdivision => "subdivision matrix",
             PointSet::SubPatches => "sub-patch matrices",
+            PointSet::SubTriangles => "sub-triangle matrices",
         };
         if !self.points.is_grid() {
             let what = if self.points == PointSet::VertexMask {
@@ -521,7 +576,7 @@ pub fn encode(
     }
     if let Some((key, _, _)) = sorted
         .iter()
-        .find(|(key, _, _)| key.points.is_triangle() != meta.scheme.is_triangle())
+        .find(|(key, _, _)| !key.points.belongs_to(meta.scheme))
     {
         return Err(TableError::WrongPointSet {
             key: *key,
@@ -767,7 +822,7 @@ impl TableIndex {
                 sector: u32_at(e, 8),
                 n: u32_at(e, 12),
             };
-            if points.is_triangle() != scheme.is_triangle() {
+            if !points.belongs_to(scheme) {
                 return Err(TableError::WrongPointSet {
                     key,
                     scheme: scheme.name(),
@@ -927,15 +982,22 @@ impl TableIndex {
         let mut boundary = std::collections::BTreeSet::new();
         let mut rates = std::collections::BTreeSet::new();
         for e in &self.entries {
-            // The curve basis belongs to no patch; the pieces of a patch to no rate.
-            if e.key.points != PointSet::CurveBasis {
+            // The bases and the rate markers belong to no patch; the pieces of a patch to no
+            // rate.
+            let patchless = matches!(
+                e.key.points,
+                PointSet::CurveBasis | PointSet::LoopBasis | PointSet::TriangleRate
+            );
+            if !patchless {
                 if e.key.boundary {
                     boundary.insert(e.key.faces);
                 } else {
                     valences.insert(e.key.faces);
                 }
             }
-            if e.key.points.is_grid() || e.key.points == PointSet::CurveBasis {
+            if e.key.points.is_grid()
+                || matches!(e.key.points, PointSet::CurveBasis | PointSet::TriangleRate)
+            {
                 rates.insert(e.key.n);
             }
         }

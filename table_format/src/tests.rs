@@ -384,6 +384,61 @@ fn triangle_point_sets_count_and_belong_to_triangle_schemes() {
     assert!(matches!(parse(&b), Err(TableError::WrongPointSet { .. })));
 }
 
+/// The compact Loop pieces: the shared ones (vertex masks, `A`) belong to both families, the
+/// Loop basis, the sub-triangle matrices and the rate markers to triangle schemes only; the
+/// rate markers are what the coverage line reads the rates from.
+#[test]
+fn compact_loop_point_sets_belong_to_triangle_schemes() {
+    let loop_ = TableMeta {
+        scheme: SchemeId::Loop,
+        precision: Precision::F64,
+        corners: false,
+    };
+    let cc = TableMeta {
+        scheme: SchemeId::CatmullClark,
+        ..loop_
+    };
+    let basis = key(StencilKind::Position, PointSet::LoopBasis, 0, 4);
+    let subs = key(StencilKind::Position, PointSet::SubTriangles, 6, 0);
+    let a = key(StencilKind::Position, PointSet::Subdivision, 6, 0);
+    let mask = key(StencilKind::Position, PointSet::VertexMask, 6, 0);
+    let rate = |n| key(StencilKind::Position, PointSet::TriangleRate, 0, n);
+    assert_eq!(PointSet::LoopBasis.rows(4, 17), 17);
+    assert_eq!(PointSet::SubTriangles.rows(0, 12), 36);
+    assert_eq!(PointSet::TriangleRate.rows(7, 0), 0);
+    let sections = vec![
+        (basis, 3, vec![0.0; 9]),
+        (subs, 12, vec![0.0; 36 * 12]),
+        (a, 12, vec![0.0; 144]),
+        (mask, 12, vec![0.0; 12]),
+        (rate(1), 0, vec![]),
+        (rate(2), 0, vec![]),
+        (rate(5), 0, vec![]),
+    ];
+    let bytes = encode(loop_, &sections).expect("valid");
+    let aligned = AlignedBytes::from_slice(&bytes);
+    let table = Table::parse(aligned.as_bytes()).expect("valid");
+    assert_eq!(
+        table.coverage(),
+        "interior valences 6, no boundary vertices, n = 1..=2, 5"
+    );
+    assert!(table.weights_f64(&rate(2)).expect("present").is_empty());
+    for loop_only in [
+        PointSet::LoopBasis,
+        PointSet::SubTriangles,
+        PointSet::TriangleRate,
+    ] {
+        let k = key(StencilKind::Position, loop_only, 0, 0);
+        let e = encode(cc, &[(k, 0, vec![])]).expect_err("a Loop piece in a quad table");
+        assert!(
+            matches!(e, TableError::WrongPointSet { .. }),
+            "{loop_only:?}"
+        );
+    }
+    encode(cc, &[(a, 12, vec![0.0; 144]), (mask, 12, vec![0.0; 12])])
+        .expect("the shared pieces belong to quad tables too");
+}
+
 #[test]
 fn sqrt3_is_scheme_five_and_a_triangle_scheme() {
     // docs/table-format.md: scheme id 5 = sqrt3, triangle point sets only.

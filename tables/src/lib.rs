@@ -3,9 +3,10 @@
 //!
 //! The default Catmull–Clark table (interior valences 3..=8, boundary vertices with 1..=6 faces
 //! "edge only", n = 1..=24) is compact (0.29 MB: the scaling relation's pieces, from which the
-//! runtime expands the grids), the triangle tables hold their grids (5–33 MiB). All are generated
-//! deterministically by `stencilgen` in this crate's build script rather than kept in the
-//! repository and its history, and embedded with `include_bytes!`, aligned for zero-copy reads.
+//! runtime expands the grids), and so is the Loop table (0.17 MB); the butterfly and √3 tables
+//! hold their grids (5.3 MiB each). All are generated deterministically by `stencilgen` in this
+//! crate's build script rather than kept in the repository and its history, and embedded with
+//! `include_bytes!`, aligned for zero-copy reads.
 //! `stencilgen tables ... -o FILE` writes the same bytes to a file, and `tests/regenerate.rs`
 //! checks that a fresh generation is identical to what is embedded.
 
@@ -47,9 +48,12 @@ pub fn default_catmull_clark_corners() -> &'static [u8] {
 }
 
 /// The default Loop table's bytes (64-byte aligned): interior valences 3..=12 (6 is the
-/// regular patch), boundary vertices with 1..=6 triangles (every sector), n = 1..=24, triangle
-/// primal and dual grids, positions and both derivatives, f32
-/// (`stencilgen::triangle_table::TriangleTableSpec::default_loop`; 32.6 MiB).
+/// regular patch), boundary vertices with 1..=6 triangles (every sector), n = 1..=24,
+/// positions and both derivatives, compact: the scaling relation's pieces in f64 (the Loop
+/// basis on the lattice `1/4`, the rate markers, per patch `A`, the sub-triangle matrices and
+/// the vertex masks), from which the runtime expands the triangle primal and dual grids
+/// (docs/table-format.md, "Compact Loop tables";
+/// `stencilgen::triangle_table::TriangleTableSpec::default_loop`; 163 KiB, 32.6 MiB as grids).
 pub fn default_loop() -> &'static [u8] {
     &LOOP.0
 }

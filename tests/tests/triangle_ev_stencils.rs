@@ -350,7 +350,7 @@ fn loop_table_sections_are_the_substitution_stencils_at_the_contract_points() {
     // The table's f64 grid system (on 1/3n for the centroids) against exact substitution,
     // point by point in the documented order, interior and boundary patches.
     use stencilgen::triangle_boundary::loop_boundary_tangents;
-    use stencilgen::triangle_table::{build_triangle_table, TriangleTableSpec};
+    use stencilgen::triangle_table::{build_triangle_table, TriangleLayout, TriangleTableSpec};
     use table_format::{AlignedBytes, PointSet, Precision, SectionKey, StencilKind as Kind, Table};
     let loop_ = triangle_scheme("loop").expect("catalogued");
     let rates = [1u32, 2, 5];
@@ -360,6 +360,7 @@ fn loop_table_sections_are_the_substitution_stencils_at_the_contract_points() {
         boundary_faces: vec![2],
         rates: rates.to_vec(),
         precision: Precision::F64,
+        layout: TriangleLayout::Grids,
     };
     let bytes = AlignedBytes::from_slice(&build_triangle_table(&spec).expect("builds"));
     let table = Table::parse(bytes.as_bytes()).expect("valid");

@@ -1,15 +1,92 @@
 //! Stencil tables as the runtime uses them: the embedded default, or a file, validated once.
-//! A compact quad table's grids are expanded from the scaling relation's pieces when a plan
-//! first asks for them ([`quad_expansion`]), then kept.
+//! A compact table's grids are expanded from the scaling relation's pieces when a plan first
+//! asks for them ([`quad_expansion`] for Catmull–Clark, [`triangle_expansion`] for Loop), then
+//! kept.
 
 mod quad_expansion;
+mod triangle_expansion;
 
 use std::path::Path;
+use std::sync::OnceLock;
 
 use table_format::{AlignedBytes, SectionKey, TableIndex};
 
 use crate::RuntimeError;
 use quad_expansion::QuadExpansion;
+use triangle_expansion::TriangleExpansion;
+
+/// One patch of a compact table: which vertex, which sector (its pieces are keyed by these and
+/// `n = 0`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+struct PatchId {
+    boundary: bool,
+    faces: u32,
+    sector: u32,
+}
+
+impl PatchId {
+    /// The patch a section belongs to.
+    fn of(key: &SectionKey) -> Self {
+        PatchId {
+            boundary: key.boundary,
+            faces: key.faces,
+            sector: key.sector,
+        }
+    }
+}
+
+/// The expanded grids of one patch, rate and kind: primal then dual, `points x K` f32,
+/// point-major.
+type Grids = [Box<[f32]>; 2];
+
+/// The grids in `slot`, expanded by `expand` on the first request. Two threads asking at once
+/// may both expand; the first to finish is kept (both computed the same bytes), so no lock is
+/// held while expanding. (`OnceLock::get_or_try_init` would say this, but is not stable.)
+fn expanded_once(
+    slot: &OnceLock<Grids>,
+    expand: impl FnOnce() -> Result<Grids, RuntimeError>,
+) -> Result<&Grids, RuntimeError> {
+    match slot.get() {
+        Some(grids) => Ok(grids),
+        None => {
+            let grids = expand()?;
+            Ok(slot.get_or_init(|| grids))
+        }
+    }
+}
+
+/// The expansion of a compact table, by patch family.
+#[derive(Debug)]
+enum Expansion {
+    /// Catmull–Clark pieces.
+    Quad(QuadExpansion),
+    /// Loop pieces.
+    Triangle(TriangleExpansion),
+}
+
+impl Expansion {
+    /// The expansion of a validated table, `None` if it stores grids only.
+    fn new(index: &TableIndex) -> Result<Option<Self>, RuntimeError> {
+        Ok(if index.meta.scheme.is_triangle() {
+            TriangleExpansion::new(index)?.map(Expansion::Triangle)
+        } else {
+            QuadExpansion::new(index)?.map(Expansion::Quad)
+        })
+    }
+
+    /// The grid of `key`, expanded on first use; `None` if the table cannot expand it.
+    fn grid<'s>(
+        &'s self,
+        index: &TableIndex,
+        bytes: &[u8],
+        key: &SectionKey,
+    ) -> Option<Result<&'s [f32], RuntimeError>> {
+        match self {
+            Expansion::Quad(e) => e.grid(index, bytes, key),
+            Expansion::Triangle(e) => e.grid(index, bytes, key),
+        }
+    }
+}
 
 /// Where a table's bytes live.
 #[derive(Debug)]
@@ -28,7 +105,7 @@ pub struct StencilTable {
     storage: Storage,
     index: TableIndex,
     /// The grids of a compact table, expanded on first use.
-    expansion: Option<QuadExpansion>,
+    expansion: Option<Expansion>,
     corners: Option<Box<StencilTable>>,
 }
 
@@ -70,7 +147,7 @@ impl StencilTable {
             index.check_finite(bytes)?;
         }
         Ok(StencilTable {
-            expansion: QuadExpansion::new(&index)?,
+            expansion: Expansion::new(&index)?,
             storage,
             index,
             corners: None,
@@ -140,14 +217,15 @@ impl StencilTable {
     }
 
     /// Whether the table stores the scaling relation's pieces and expands its grids
-    /// (docs/table-format.md, "Compact quad tables").
+    /// (docs/table-format.md, "Compact quad tables" and "Compact Loop tables").
     pub fn is_compact(&self) -> bool {
         self.expansion.is_some()
     }
 
     /// The f32 weights of one section: `points x K`, point-major. Zero-copy for a table that
-    /// stores its grids; for a compact one, expanded on the first request (of the order of a
-    /// millisecond at rate 24) and kept for the table's lifetime.
+    /// stores its grids; for a compact one, expanded on the first request (both grids of the
+    /// key's patch, rate and kind: about 0.2 ms for a Catmull–Clark patch at rate 24, 2 ms for
+    /// a Loop one, docs/benchmarks.md) and kept for the table's lifetime.
     pub fn weights(&self, key: &SectionKey) -> Result<&[f32], RuntimeError> {
         if let (Some(corners), true) = (&self.corners, key.boundary && key.faces == 1) {
             return corners.weights(key);

@@ -29,18 +29,8 @@ use std::sync::OnceLock;
 
 use table_format::{PointSet, Precision, SectionKey, StencilKind, TableError, TableIndex};
 
+use super::{expanded_once, Grids, PatchId};
 use crate::RuntimeError;
-
-/// One patch of a compact table: which vertex, which sector, how many control points.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
-struct PatchId {
-    boundary: bool,
-    faces: u32,
-    sector: u32,
-}
-
-/// The grids of one patch, rate and kind: primal then dual, `points x K` f32, point-major.
-type Grids = [Box<[f32]>; 2];
 
 /// What a compact table's grids are expanded from, and the grids once a plan asked for them.
 #[derive(Debug)]
@@ -104,11 +94,7 @@ impl QuadExpansion {
                 }
                 PointSet::Subdivision => {
                     let width = index.entry(key)?.width;
-                    let id = PatchId {
-                        boundary: key.boundary,
-                        faces: key.faces,
-                        sector: key.sector,
-                    };
+                    let id = PatchId::of(key);
                     for (kind, points) in [
                         (StencilKind::Position, PointSet::SubPatches),
                         (StencilKind::Position, PointSet::VertexMask),
@@ -158,22 +144,17 @@ impl QuadExpansion {
             PointSet::Dual => false,
             _ => return None,
         };
-        let id = PatchId {
-            boundary: key.boundary,
-            faces: key.faces,
-            sector: key.sector,
-        };
-        let patch = self.patches.binary_search_by_key(&id, |p| p.0).ok()?;
+        let patch = self
+            .patches
+            .binary_search_by_key(&PatchId::of(key), |p| p.0)
+            .ok()?;
         let rate = self.rates.binary_search(&key.n).ok()?;
         let slot = (patch * self.rates.len() + rate) * 3 + key.kind as usize;
-        let grids = match self.grids[slot].get() {
-            Some(g) => g,
-            None => match expand(index, bytes, key, self.patches[patch].1 as usize) {
-                Ok(g) => self.grids[slot].get_or_init(|| g),
-                Err(e) => return Some(Err(e)),
-            },
-        };
-        Some(Ok(&grids[usize::from(!primal)]))
+        let k = self.patches[patch].1 as usize;
+        Some(
+            expanded_once(&self.grids[slot], || expand(index, bytes, key, k))
+                .map(|grids| &*grids[usize::from(!primal)]),
+        )
     }
 }
 

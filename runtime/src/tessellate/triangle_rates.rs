@@ -86,7 +86,8 @@ use crate::tessellate::triangle_dual_grid::{zigzag_cell, TriangleStencils, MAX_T
 use crate::RuntimeError;
 
 /// The rates a table has triangle grids for (position sections on both the primal and the dual
-/// triangle grid, at most [`MAX_TRIANGLE_RATE`]), ascending: the rates a tolerance may select.
+/// triangle grid, or, in a compact Loop table, the rates its markers list, which it expands;
+/// at most [`MAX_TRIANGLE_RATE`]), ascending: the rates a tolerance may select.
 pub fn triangle_table_rates(table: &StencilTable) -> Vec<u32> {
     let on = |points: PointSet| -> BTreeSet<u32> {
         table
@@ -98,10 +99,11 @@ pub fn triangle_table_rates(table: &StencilTable) -> Vec<u32> {
             .filter(|&n| (1..=MAX_TRIANGLE_RATE).contains(&n))
             .collect()
     };
-    on(PointSet::TriangleDual)
+    let stored = on(PointSet::TriangleDual)
         .intersection(&on(PointSet::TrianglePrimal))
         .copied()
-        .collect()
+        .collect::<BTreeSet<u32>>();
+    stored.union(&on(PointSet::TriangleRate)).copied().collect()
 }
 
 /// The rates of the sampling grid `G` (module docs): the two largest of `rates` (one if it has
