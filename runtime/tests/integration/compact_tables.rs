@@ -19,6 +19,30 @@ fn ulps(a: f32, b: f32) -> f64 {
     (f64::from(a) - f64::from(b)).abs() / ulp
 }
 
+/// Every grid section of `grids` against the same section expanded by `compact`, each weight to
+/// 1 ulp of f32; returns the largest difference in ulps and the number of weights compared.
+fn same_grids(compact: &StencilTable, grids: &StencilTable) -> (f64, usize) {
+    assert!(compact.is_compact() && !grids.is_compact());
+    let (mut worst, mut count) = (0.0f64, 0);
+    for entry in &grids.index().entries {
+        let want = grids.weights(&entry.key).expect("grid section");
+        let got = compact.weights(&entry.key).expect("expanded section");
+        assert_eq!(got.len(), want.len(), "{}", entry.key);
+        for (p, (g, w)) in got.iter().zip(want).enumerate() {
+            let d = ulps(*g, *w);
+            assert!(
+                d <= 1.0,
+                "{}: weight {p} (point {}) is {g:e} expanded, {w:e} solved: {d} ulps",
+                entry.key,
+                p / entry.width as usize
+            );
+            worst = worst.max(d);
+        }
+        count += want.len();
+    }
+    (worst, count)
+}
+
 /// The embedded default (compact) against a grid table of the same patches at `rates`, solved
 /// now; returns the largest difference in ulps and the number of weights compared.
 fn compare(corners: bool, rates: Vec<u32>) -> (f64, usize) {
@@ -39,25 +63,7 @@ fn compare(corners: bool, rates: Vec<u32>) -> (f64, usize) {
         StencilTable::default_catmull_clark()
     }
     .expect("embedded table");
-    assert!(compact.is_compact() && !grids.is_compact());
-    let (mut worst, mut count) = (0.0f64, 0);
-    for entry in &grids.index().entries {
-        let want = grids.weights(&entry.key).expect("grid section");
-        let got = compact.weights(&entry.key).expect("expanded section");
-        assert_eq!(got.len(), want.len(), "{}", entry.key);
-        for (p, (g, w)) in got.iter().zip(want).enumerate() {
-            let d = ulps(*g, *w);
-            assert!(
-                d <= 1.0,
-                "{}: weight {p} (point {}) is {g:e} expanded, {w:e} solved: {d} ulps",
-                entry.key,
-                p / entry.width as usize
-            );
-            worst = worst.max(d);
-        }
-        count += want.len();
-    }
-    (worst, count)
+    same_grids(&compact, &grids)
 }
 
 /// Every kind (interior valences 3..=8, boundary vertices with 1..=6 faces, every sector), both
@@ -162,25 +168,7 @@ fn compare_loop(rates: Vec<u32>) -> (f64, usize) {
     let grids = StencilTable::from_bytes(&build_triangle_table(&spec).expect("grid table"))
         .expect("valid grid table");
     let compact = StencilTable::default_loop().expect("embedded table");
-    assert!(compact.is_compact() && !grids.is_compact());
-    let (mut worst, mut count) = (0.0f64, 0);
-    for entry in &grids.index().entries {
-        let want = grids.weights(&entry.key).expect("grid section");
-        let got = compact.weights(&entry.key).expect("expanded section");
-        assert_eq!(got.len(), want.len(), "{}", entry.key);
-        for (p, (g, w)) in got.iter().zip(want).enumerate() {
-            let d = ulps(*g, *w);
-            assert!(
-                d <= 1.0,
-                "{}: weight {p} (point {}) is {g:e} expanded, {w:e} solved: {d} ulps",
-                entry.key,
-                p / entry.width as usize
-            );
-            worst = worst.max(d);
-        }
-        count += want.len();
-    }
-    (worst, count)
+    same_grids(&compact, &grids)
 }
 
 /// Every Loop patch (interior valences 3..=12, boundary vertices with 1..=6 triangles, every
@@ -350,4 +338,34 @@ fn inconsistent_compact_loop_tables_are_refused_at_load() {
         e.to_string().contains("only Loop tables are compact"),
         "{e}"
     );
+}
+
+/// The compact layout is the scaling relation's, not Catmull–Clark's: Schaefer–Warren's
+/// non-polynomial quad scheme (its curve basis solved from its own scaling relation, not a
+/// closed form) expands to the grids solved on the grid, for interior valences 3..=8 (it has no
+/// boundary rules), rates 1..=8.
+#[test]
+fn compact_nonpolynomial_quad_grids_equal_solved_grids() {
+    let scheme = stencilgen::patch_stencils::quad_scheme("sw-nonpoly-quad").expect("catalogued");
+    let set = StencilSetSpec {
+        valences: (3..=8).collect(),
+        boundary_faces: Vec::new(),
+        boundary_mode: schemes::BoundaryMode::EdgeOnly,
+        rates: (1..=8).collect(),
+    };
+    let table = |layout, precision| {
+        let spec = TableSpec {
+            scheme: scheme.clone(),
+            set: set.clone(),
+            precision,
+            exact: false,
+            layout,
+        };
+        StencilTable::from_bytes(&build_table(&spec, &|_, _| {}).expect("table")).expect("valid")
+    };
+    let compact = table(QuadLayout::Compact, Precision::F64);
+    let grids = table(QuadLayout::Grids, Precision::F32);
+    let (worst, count) = same_grids(&compact, &grids);
+    eprintln!("{count} weights, largest difference {worst} ulp");
+    assert!(count > 50_000);
 }
