@@ -72,6 +72,9 @@ pub(super) struct TriangleExpansion {
     points: [Vec<(i64, i64)>; 3],
     /// `(patch * rates + rate) * 3 + kind`.
     grids: Vec<OnceLock<Grids>>,
+    /// The basis at the twelve sub-triangle points of every outer lattice point
+    /// ([`Pieces::basis_at_points`]), which no patch changes: `((rate * 2 + dual) * 3 + kind)`.
+    basis: Vec<OnceLock<Vec<f64>>>,
 }
 
 impl TriangleExpansion {
@@ -200,10 +203,13 @@ impl TriangleExpansion {
         patches.sort_unstable();
         let slots = patches.len() * rates.len() * KINDS.len();
         Ok(Some(TriangleExpansion {
-            rates,
             patches,
             points: SUB_TRIANGLES.map(sub_triangle_points),
             grids: (0..slots).map(|_| OnceLock::new()).collect(),
+            basis: (0..rates.len() * 2 * KINDS.len())
+                .map(|_| OnceLock::new())
+                .collect(),
+            rates,
         }))
     }
 
@@ -227,9 +233,14 @@ impl TriangleExpansion {
         let rate = self.rates.binary_search(&key.n).ok()?;
         let slot = (patch * self.rates.len() + rate) * KINDS.len() + key.kind as usize;
         let k = self.patches[patch].1 as usize;
+        let basis = |dual: usize| &self.basis[(rate * 2 + dual) * KINDS.len() + key.kind as usize];
         Some(
             expanded_once(&self.grids[slot], || {
-                Pieces::read(index, bytes, key, k, &self.points)?.grids(key.kind, key.n)
+                Pieces::read(index, bytes, key, k, &self.points)?.grids(
+                    key.kind,
+                    key.n,
+                    [basis(0), basis(1)],
+                )
             })
             .map(|grids| &*grids[usize::from(!primal)]),
         )
@@ -324,8 +335,14 @@ impl<'a> Pieces<'a> {
         })
     }
 
-    /// Both grids of `kind` at rate `n` (module docs), rounded to f32.
-    fn grids(&self, kind: StencilKind, n: u32) -> Result<Grids, RuntimeError> {
+    /// Both grids of `kind` at rate `n` (module docs), rounded to f32. `basis` caches
+    /// [`Self::basis_at_points`] on the primal lattice `1/n` and the dual one `1/3n`.
+    fn grids(
+        &self,
+        kind: StencilKind,
+        n: u32,
+        basis: [&OnceLock<Vec<f64>>; 2],
+    ) -> Result<Grids, RuntimeError> {
         if !(1..=MAX_COMPACT_TRIANGLE_RATE).contains(&n) {
             return Err(RuntimeError::InvalidParameter {
                 name: "table".to_owned(),
@@ -354,17 +371,24 @@ impl<'a> Pieces<'a> {
         }
         let round = |v: Vec<f64>| -> Box<[f32]> { v.into_iter().map(|w| w as f32).collect() };
         Ok([
-            round(self.lattice(&primal, n, factor)),
-            round(self.lattice(&dual, 3 * n, factor)),
+            round(self.lattice(&primal, n, factor, basis[0])),
+            round(self.lattice(&dual, 3 * n, factor, basis[1])),
         ])
     }
 
     /// The stencils at the points `(i/d, j/d)` of `wanted` (`i, j >= 0`, `i + j <= d`), in
     /// order, `K` each: every point of the lattice they double to is computed once, by
     /// decreasing `i + j`, so that `phi(2x)` is known when `phi(x)` needs it.
-    fn lattice(&self, wanted: &[(i64, i64)], d: i64, factor: f64) -> Vec<f64> {
+    fn lattice(
+        &self,
+        wanted: &[(i64, i64)],
+        d: i64,
+        factor: f64,
+        basis: &OnceLock<Vec<f64>>,
+    ) -> Vec<f64> {
         let k = self.k;
         let side = (d + 1) as usize;
+        let basis = basis.get_or_init(|| self.basis_at_points(d));
         let at = |(i, j): (i64, i64)| j as usize * side + i as usize;
         // The wanted points and the points they double to inside the patch.
         let mut seen = vec![false; side * side];
@@ -403,7 +427,8 @@ impl<'a> Pieces<'a> {
                     }
                 }
             } else {
-                self.regular((2 * p.0, 2 * p.1), d, row);
+                let psi = &basis[at(p) * SUB_POINTS..(at(p) + 1) * SUB_POINTS];
+                self.regular((2 * p.0, 2 * p.1), d, psi, row);
                 for o in row.iter_mut() {
                     *o *= factor;
                 }
@@ -418,19 +443,48 @@ impl<'a> Pieces<'a> {
         out
     }
 
-    /// `sum_j psi(y - j) R_b[j]` at `y = Y / d` (level-1 coordinates) in its sub-triangle `b`.
-    fn regular(&self, y: (i64, i64), d: i64, out: &mut [f64]) {
-        let b = if y.0 >= d {
+    /// The sub-triangle `b` holding `y = Y / d` (level-1 coordinates, `Y_1 + Y_2 > d`).
+    fn sub_triangle(y: (i64, i64), d: i64) -> usize {
+        if y.0 >= d {
             0
         } else if y.1 >= d {
             2
         } else {
             1
-        };
+        }
+    }
+
+    /// `psi(y - j)` for the twelve level-1 points `j` of the sub-triangle holding `y = 2x`, at
+    /// every lattice point `x = (i/d, j/d)` of the patch with `2x` outside it (`2(i + j) > d`),
+    /// twelve values a point at `12 (j (d + 1) + i)`. It depends on the lattice and the kind
+    /// only, not on the patch: computed once per table and shared by every patch's expansion,
+    /// where evaluating the basis for each patch was most of a Loop expansion's time.
+    fn basis_at_points(&self, d: i64) -> Vec<f64> {
+        let side = (d + 1) as usize;
+        let mut out = vec![0.0; side * side * SUB_POINTS];
+        for j in 0..=d {
+            for i in 0..=d - j {
+                if 2 * (i + j) <= d {
+                    continue;
+                }
+                let y = (2 * i, 2 * j);
+                let at = (j as usize * side + i as usize) * SUB_POINTS;
+                let points = &self.points[Self::sub_triangle(y, d)];
+                for (o, &(j1, j2)) in out[at..at + SUB_POINTS].iter_mut().zip(points) {
+                    *o = self.psi(y.0 - d * j1, y.1 - d * j2, d);
+                }
+            }
+        }
+        out
+    }
+
+    /// `sum_j psi(y - j) R_b[j]` at `y = Y / d` (level-1 coordinates) in its sub-triangle `b`,
+    /// given the twelve `psi(y - j)` ([`Self::basis_at_points`]).
+    fn regular(&self, y: (i64, i64), d: i64, psis: &[f64], out: &mut [f64]) {
+        let b = Self::sub_triangle(y, d);
         let k = self.k;
         let rows = &self.sub_triangles[b * SUB_POINTS * k..(b + 1) * SUB_POINTS * k];
-        for (&(j1, j2), r) in self.points[b].iter().zip(rows.chunks_exact(k)) {
-            let psi = self.psi(y.0 - d * j1, y.1 - d * j2, d);
+        for (&psi, r) in psis.iter().zip(rows.chunks_exact(k)) {
             for (o, &e) in out.iter_mut().zip(r) {
                 if e != 0.0 {
                     *o += psi * e;
