@@ -388,7 +388,6 @@ impl<'a> Pieces<'a> {
     ) -> Vec<f64> {
         let k = self.k;
         let side = (d + 1) as usize;
-        let basis = basis.get_or_init(|| self.basis_at_points(d));
         let at = |(i, j): (i64, i64)| j as usize * side + i as usize;
         // The wanted points and the points they double to inside the patch.
         let mut seen = vec![false; side * side];
@@ -405,6 +404,9 @@ impl<'a> Pieces<'a> {
             }
         }
         needed.sort_by_key(|&(i, j)| std::cmp::Reverse(i + j));
+        // `needed` depends on the lattice only, so whichever patch fills the cache fills it
+        // for all.
+        let basis = basis.get_or_init(|| self.basis_at_points(&needed, d));
         // Where each computed point's row is in `values`.
         let mut row_of = vec![0usize; side * side];
         let mut values = vec![0.0f64; needed.len() * k];
@@ -455,24 +457,20 @@ impl<'a> Pieces<'a> {
     }
 
     /// `psi(y - j)` for the twelve level-1 points `j` of the sub-triangle holding `y = 2x`, at
-    /// every lattice point `x = (i/d, j/d)` of the patch with `2x` outside it (`2(i + j) > d`),
-    /// twelve values a point at `12 (j (d + 1) + i)`. It depends on the lattice and the kind
-    /// only, not on the patch: computed once per table and shared by every patch's expansion,
-    /// where evaluating the basis for each patch was most of a Loop expansion's time.
-    fn basis_at_points(&self, d: i64) -> Vec<f64> {
+    /// every lattice point `x = (i/d, j/d)` of `needed` with `2x` outside the patch
+    /// (`2(i + j) > d`), twelve values a point at `12 (j (d + 1) + i)`. It depends on the
+    /// lattice and the kind only, not on the patch: computed once per table and shared by every
+    /// patch's expansion, where evaluating the basis for each patch was most of a Loop
+    /// expansion's time.
+    fn basis_at_points(&self, needed: &[(i64, i64)], d: i64) -> Vec<f64> {
         let side = (d + 1) as usize;
         let mut out = vec![0.0; side * side * SUB_POINTS];
-        for j in 0..=d {
-            for i in 0..=d - j {
-                if 2 * (i + j) <= d {
-                    continue;
-                }
-                let y = (2 * i, 2 * j);
-                let at = (j as usize * side + i as usize) * SUB_POINTS;
-                let points = &self.points[Self::sub_triangle(y, d)];
-                for (o, &(j1, j2)) in out[at..at + SUB_POINTS].iter_mut().zip(points) {
-                    *o = self.psi(y.0 - d * j1, y.1 - d * j2, d);
-                }
+        for &(i, j) in needed.iter().filter(|&&(i, j)| 2 * (i + j) > d) {
+            let y = (2 * i, 2 * j);
+            let at = (j as usize * side + i as usize) * SUB_POINTS;
+            let points = &self.points[Self::sub_triangle(y, d)];
+            for (o, &(j1, j2)) in out[at..at + SUB_POINTS].iter_mut().zip(points) {
+                *o = self.psi(y.0 - d * j1, y.1 - d * j2, d);
             }
         }
         out
