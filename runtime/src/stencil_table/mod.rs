@@ -97,6 +97,15 @@ enum Storage {
     Owned(AlignedBytes),
 }
 
+impl Storage {
+    fn as_bytes(&self) -> &[u8] {
+        match self {
+            Storage::Embedded(b) => b,
+            Storage::Owned(b) => b.as_bytes(),
+        }
+    }
+}
+
 /// A validated stencil table, optionally with a pinned-corner table laid over it: the one-face
 /// boundary sections are then read from that one (every other patch is the same whether a
 /// mesh pins its corners or not).
@@ -138,10 +147,7 @@ impl StencilTable {
 
     /// A table over bytes whose index is valid (and, for files, whose weights are finite).
     fn validated(storage: Storage) -> Result<Self, RuntimeError> {
-        let bytes = match &storage {
-            Storage::Embedded(b) => b,
-            Storage::Owned(b) => b.as_bytes(),
-        };
+        let bytes = storage.as_bytes();
         let index = TableIndex::parse(bytes)?;
         if matches!(storage, Storage::Owned(_)) {
             index.check_finite(bytes)?;
@@ -205,10 +211,7 @@ impl StencilTable {
 
     /// The raw bytes.
     pub fn bytes(&self) -> &[u8] {
-        match &self.storage {
-            Storage::Embedded(b) => b,
-            Storage::Owned(b) => b.as_bytes(),
-        }
+        self.storage.as_bytes()
     }
 
     /// What the table holds.
