@@ -39,6 +39,55 @@ impl PatchId {
 /// point-major.
 type Grids = [Box<[f32]>; 2];
 
+/// The rates and patches a compact table covers, and a slot for the grids of each patch, rate
+/// and kind (position, d/du, d/dv).
+#[derive(Debug)]
+struct GridSlots {
+    /// Ascending.
+    rates: Vec<u32>,
+    /// Ascending, with their control-point counts `K`.
+    patches: Vec<(PatchId, u32)>,
+    /// `(patch * rates + rate) * 3 + kind`.
+    grids: Vec<OnceLock<Grids>>,
+}
+
+/// Where a key's grids go in [`GridSlots`].
+struct Slot<'s> {
+    /// The rate's index among the covered rates.
+    rate: usize,
+    /// The patch's `K`.
+    k: usize,
+    /// Its grids, once expanded.
+    grids: &'s OnceLock<Grids>,
+}
+
+impl GridSlots {
+    fn new(mut rates: Vec<u32>, mut patches: Vec<(PatchId, u32)>) -> Self {
+        rates.sort_unstable();
+        patches.sort_unstable();
+        let slots = patches.len() * rates.len() * 3;
+        GridSlots {
+            rates,
+            patches,
+            grids: (0..slots).map(|_| OnceLock::new()).collect(),
+        }
+    }
+
+    /// The slot of `key`'s patch, rate and kind, `None` if the table does not cover them.
+    fn slot(&self, key: &SectionKey) -> Option<Slot<'_>> {
+        let patch = self
+            .patches
+            .binary_search_by_key(&PatchId::of(key), |p| p.0)
+            .ok()?;
+        let rate = self.rates.binary_search(&key.n).ok()?;
+        Some(Slot {
+            rate,
+            k: self.patches[patch].1 as usize,
+            grids: &self.grids[(patch * self.rates.len() + rate) * 3 + key.kind as usize],
+        })
+    }
+}
+
 /// The grids in `slot`, expanded by `expand` on the first request. Two threads asking at once
 /// may both expand; the first to finish is kept (both computed the same bytes), so no lock is
 /// held while expanding. (`OnceLock::get_or_try_init` would say this, but is not stable.)

@@ -25,22 +25,16 @@
 //! The choice at `max(u, v) = 1/2` follows the grid layout's system (`x` is written through
 //! `2x`, not through the sub-patch), so that the two layouts round the same sums.
 
-use std::sync::OnceLock;
-
 use table_format::{PointSet, Precision, SectionKey, StencilKind, TableError, TableIndex};
 
-use super::{expanded_once, Grids, PatchId};
+use super::{expanded_once, GridSlots, Grids, PatchId};
 use crate::RuntimeError;
 
 /// What a compact table's grids are expanded from, and the grids once a plan asked for them.
 #[derive(Debug)]
 pub(super) struct QuadExpansion {
-    /// Rates with both curve-basis sections, ascending.
-    rates: Vec<u32>,
-    /// Patches with all five pieces, ascending, with their control-point counts.
-    patches: Vec<(PatchId, u32)>,
-    /// `(patch * rates + rate) * 3 + kind`.
-    grids: Vec<OnceLock<Grids>>,
+    /// Rates with both curve-basis sections; patches with all five pieces.
+    slots: GridSlots,
 }
 
 impl QuadExpansion {
@@ -121,13 +115,8 @@ impl QuadExpansion {
                 _ => {}
             }
         }
-        rates.sort_unstable();
-        patches.sort_unstable();
-        let slots = patches.len() * rates.len() * 3;
         Ok(Some(QuadExpansion {
-            rates,
-            patches,
-            grids: (0..slots).map(|_| OnceLock::new()).collect(),
+            slots: GridSlots::new(rates, patches),
         }))
     }
 
@@ -144,15 +133,9 @@ impl QuadExpansion {
             PointSet::Dual => false,
             _ => return None,
         };
-        let patch = self
-            .patches
-            .binary_search_by_key(&PatchId::of(key), |p| p.0)
-            .ok()?;
-        let rate = self.rates.binary_search(&key.n).ok()?;
-        let slot = (patch * self.rates.len() + rate) * 3 + key.kind as usize;
-        let k = self.patches[patch].1 as usize;
+        let slot = self.slots.slot(key)?;
         Some(
-            expanded_once(&self.grids[slot], || expand(index, bytes, key, k))
+            expanded_once(slot.grids, || expand(index, bytes, key, slot.k))
                 .map(|grids| &*grids[usize::from(!primal)]),
         )
     }

@@ -38,7 +38,7 @@ use table_format::{
     PointSet, Precision, SchemeId, SectionKey, StencilKind, TableError, TableIndex,
 };
 
-use super::{expanded_once, Grids, PatchId};
+use super::{expanded_once, GridSlots, Grids, PatchId};
 use crate::RuntimeError;
 
 /// The largest rate a compact Loop table may list: the triangle tessellator's largest
@@ -64,14 +64,10 @@ const KINDS: [StencilKind; 3] = [
 /// them.
 #[derive(Debug)]
 pub(super) struct TriangleExpansion {
-    /// The rates the table lists, ascending.
-    rates: Vec<u32>,
-    /// Patches with all five pieces, ascending, with their control-point counts `K`.
-    patches: Vec<(PatchId, u32)>,
+    /// The rates the table lists; patches with all five pieces.
+    slots: GridSlots,
     /// The level-1 points of each sub-triangle, in the order of its matrix's rows.
     points: [Vec<(i64, i64)>; 3],
-    /// `(patch * rates + rate) * 3 + kind`.
-    grids: Vec<OnceLock<Grids>>,
     /// The basis at the twelve sub-triangle points of every outer lattice point
     /// ([`Pieces::basis_at_points`]), which no patch changes: `((rate * 2 + dual) * 3 + kind)`.
     basis: Vec<OnceLock<Vec<f64>>>,
@@ -199,17 +195,12 @@ impl TriangleExpansion {
         if rates.is_empty() {
             return Err(incomplete("the table lists no rate".to_owned()));
         }
-        rates.sort_unstable();
-        patches.sort_unstable();
-        let slots = patches.len() * rates.len() * KINDS.len();
         Ok(Some(TriangleExpansion {
-            patches,
             points: SUB_TRIANGLES.map(sub_triangle_points),
-            grids: (0..slots).map(|_| OnceLock::new()).collect(),
             basis: (0..rates.len() * 2 * KINDS.len())
                 .map(|_| OnceLock::new())
                 .collect(),
-            rates,
+            slots: GridSlots::new(rates, patches),
         }))
     }
 
@@ -226,17 +217,12 @@ impl TriangleExpansion {
             PointSet::TriangleDual => false,
             _ => return None,
         };
-        let patch = self
-            .patches
-            .binary_search_by_key(&PatchId::of(key), |p| p.0)
-            .ok()?;
-        let rate = self.rates.binary_search(&key.n).ok()?;
-        let slot = (patch * self.rates.len() + rate) * KINDS.len() + key.kind as usize;
-        let k = self.patches[patch].1 as usize;
-        let basis = |dual: usize| &self.basis[(rate * 2 + dual) * KINDS.len() + key.kind as usize];
+        let slot = self.slots.slot(key)?;
+        let basis =
+            |dual: usize| &self.basis[(slot.rate * 2 + dual) * KINDS.len() + key.kind as usize];
         Some(
-            expanded_once(&self.grids[slot], || {
-                Pieces::read(index, bytes, key, k, &self.points)?.grids(
+            expanded_once(slot.grids, || {
+                Pieces::read(index, bytes, key, slot.k, &self.points)?.grids(
                     key.kind,
                     key.n,
                     [basis(0), basis(1)],
