@@ -39,6 +39,63 @@ impl PatchId {
 /// point-major.
 type Grids = [Box<[f32]>; 2];
 
+/// The largest rate a compact table may cover: the tessellators' largest
+/// (`tessellate::dual_grid::MAX_RATE`, `tessellate::triangle_dual_grid::MAX_TRIANGLE_RATE`; a
+/// test checks they agree). The file does not bound a compact table's rates as it bounds a
+/// grid's (a curve basis is `n + 1` rows, a rate marker none), so this caps what one expansion
+/// allocates, `(n + 1)^2 K` weights.
+pub(crate) const MAX_COMPACT_RATE: u32 = 64;
+
+/// The scaling-relation pieces of a validated table (its sections other than grids), `None` if
+/// it has none. They are f64 only: expanded from f32, the grids would not be the grid layout's
+/// to 1 ulp.
+fn compact_pieces(index: &TableIndex) -> Result<Option<Vec<&SectionKey>>, RuntimeError> {
+    let pieces: Vec<&SectionKey> = index
+        .entries
+        .iter()
+        .map(|e| &e.key)
+        .filter(|k| !k.points.is_grid())
+        .collect();
+    if pieces.is_empty() {
+        return Ok(None);
+    }
+    if index.meta.precision != table_format::Precision::F64 {
+        return Err(table_format::TableError::PrecisionMismatch {
+            stored: index.meta.precision,
+            asked: table_format::Precision::F64,
+        }
+        .into());
+    }
+    Ok(Some(pieces))
+}
+
+/// The other pieces of the patch whose subdivision matrix is `a` (`width` = `K` weights a row):
+/// its sub-patch matrices (`sub`) and its three vertex masks, each present and `K` wide; the
+/// error names the piece (`incomplete` words it for the table's scheme).
+fn check_patch_pieces(
+    index: &TableIndex,
+    a: &SectionKey,
+    width: u32,
+    sub: table_format::PointSet,
+    incomplete: impl Fn(String) -> RuntimeError,
+) -> Result<(), RuntimeError> {
+    use table_format::{PointSet, StencilKind};
+    for (kind, points) in [
+        (StencilKind::Position, sub),
+        (StencilKind::Position, PointSet::VertexMask),
+        (StencilKind::DerivativeU, PointSet::VertexMask),
+        (StencilKind::DerivativeV, PointSet::VertexMask),
+    ] {
+        let piece = SectionKey { kind, points, ..*a };
+        match index.get(&piece) {
+            Some(e) if e.width == width => {}
+            Some(_) => return Err(incomplete(format!("{piece} has another width than {a}"))),
+            None => return Err(incomplete(format!("{a} has no {piece}"))),
+        }
+    }
+    Ok(())
+}
+
 /// The rates and patches a compact table covers, and a slot for the grids of each patch, rate
 /// and kind (position, d/du, d/dv).
 #[derive(Debug)]

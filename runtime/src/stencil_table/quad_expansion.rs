@@ -25,9 +25,11 @@
 //! The choice at `max(u, v) = 1/2` follows the grid layout's system (`x` is written through
 //! `2x`, not through the sub-patch), so that the two layouts round the same sums.
 
-use table_format::{PointSet, Precision, SectionKey, StencilKind, TableError, TableIndex};
+use table_format::{PointSet, SectionKey, StencilKind, TableIndex};
 
-use super::{expanded_once, GridSlots, Grids, PatchId};
+use super::{
+    check_patch_pieces, compact_pieces, expanded_once, GridSlots, Grids, PatchId, MAX_COMPACT_RATE,
+};
 use crate::RuntimeError;
 
 /// What a compact table's grids are expanded from, and the grids once a plan asked for them.
@@ -42,22 +44,9 @@ impl QuadExpansion {
     /// piece without the others it needs (a patch's `A` without its sub-patch matrices or vertex
     /// masks, a curve basis without its derivative) or in f32 is an error naming it.
     pub(super) fn new(index: &TableIndex) -> Result<Option<Self>, RuntimeError> {
-        let pieces: Vec<&SectionKey> = index
-            .entries
-            .iter()
-            .map(|e| &e.key)
-            .filter(|k| !k.points.is_grid())
-            .collect();
-        if pieces.is_empty() {
+        let Some(pieces) = compact_pieces(index)? else {
             return Ok(None);
-        }
-        if index.meta.precision != Precision::F64 {
-            return Err(TableError::PrecisionMismatch {
-                stored: index.meta.precision,
-                asked: Precision::F64,
-            }
-            .into());
-        }
+        };
         let incomplete = |what: String| RuntimeError::InvalidParameter {
             name: "table".to_owned(),
             reason: format!(
@@ -74,6 +63,11 @@ impl QuadExpansion {
                     if index.entry(key)?.width != 4 {
                         return Err(incomplete(format!("{key} is not 4 weights a row")));
                     }
+                    if !(1..=MAX_COMPACT_RATE).contains(&key.n) {
+                        return Err(incomplete(format!(
+                            "{key} is not at a rate in 1..={MAX_COMPACT_RATE}"
+                        )));
+                    }
                     let derivative = SectionKey {
                         kind: StencilKind::DerivativeU,
                         ..*key
@@ -88,29 +82,8 @@ impl QuadExpansion {
                 }
                 PointSet::Subdivision => {
                     let width = index.entry(key)?.width;
-                    let id = PatchId::of(key);
-                    for (kind, points) in [
-                        (StencilKind::Position, PointSet::SubPatches),
-                        (StencilKind::Position, PointSet::VertexMask),
-                        (StencilKind::DerivativeU, PointSet::VertexMask),
-                        (StencilKind::DerivativeV, PointSet::VertexMask),
-                    ] {
-                        let piece = SectionKey {
-                            kind,
-                            points,
-                            ..*key
-                        };
-                        match index.get(&piece) {
-                            Some(e) if e.width == width => {}
-                            Some(_) => {
-                                return Err(incomplete(format!(
-                                    "{piece} has another width than {key}"
-                                )))
-                            }
-                            None => return Err(incomplete(format!("{key} has no {piece}"))),
-                        }
-                    }
-                    patches.push((id, width));
+                    check_patch_pieces(index, key, width, PointSet::SubPatches, incomplete)?;
+                    patches.push((PatchId::of(key), width));
                 }
                 _ => {}
             }

@@ -34,18 +34,12 @@
 use std::sync::OnceLock;
 
 use schemes::triangle_local::{sub_triangle_points, SUB_TRIANGLES};
-use table_format::{
-    PointSet, Precision, SchemeId, SectionKey, StencilKind, TableError, TableIndex,
+use table_format::{PointSet, SchemeId, SectionKey, StencilKind, TableIndex};
+
+use super::{
+    check_patch_pieces, compact_pieces, expanded_once, GridSlots, Grids, PatchId, MAX_COMPACT_RATE,
 };
-
-use super::{expanded_once, GridSlots, Grids, PatchId};
 use crate::RuntimeError;
-
-/// The largest rate a compact Loop table may list: the triangle tessellator's largest
-/// (`tessellate::triangle_dual_grid::MAX_TRIANGLE_RATE`; a test checks they agree). The file
-/// does not bound a rate marker's rate as it bounds a grid's, so this caps what one expansion
-/// allocates.
-pub(crate) const MAX_COMPACT_TRIANGLE_RATE: u32 = 64;
 
 /// The denominator of the lattice the basis is stored on: the pieces' degree.
 const LATTICE: i64 = 4;
@@ -78,18 +72,12 @@ impl TriangleExpansion {
     /// scaling-relation pieces. Pieces in a table of another triangle scheme, in f32, a patch
     /// piece without the others it needs or of another width, a basis that is not a centred
     /// square window on the lattice `1/4`, a missing basis kind, a rate marker outside
-    /// `1..=`[`MAX_COMPACT_TRIANGLE_RATE`], a patch of no control points: each an error naming
+    /// `1..=`[`MAX_COMPACT_RATE`], a patch of no control points: each an error naming
     /// the piece.
     pub(super) fn new(index: &TableIndex) -> Result<Option<Self>, RuntimeError> {
-        let pieces: Vec<&SectionKey> = index
-            .entries
-            .iter()
-            .map(|e| &e.key)
-            .filter(|k| !k.points.is_grid())
-            .collect();
-        if pieces.is_empty() {
+        let Some(pieces) = compact_pieces(index)? else {
             return Ok(None);
-        }
+        };
         let incomplete = |what: String| RuntimeError::InvalidParameter {
             name: "table".to_owned(),
             reason: format!(
@@ -103,13 +91,6 @@ impl TriangleExpansion {
                 index.meta.scheme.name(),
                 pieces[0]
             )));
-        }
-        if index.meta.precision != Precision::F64 {
-            return Err(TableError::PrecisionMismatch {
-                stored: index.meta.precision,
-                asked: Precision::F64,
-            }
-            .into());
         }
         let patchless = |key: &SectionKey| !key.boundary && key.faces == 0 && key.sector == 0;
         let mut rates = Vec::new();
@@ -128,11 +109,11 @@ impl TriangleExpansion {
                 PointSet::TriangleRate => {
                     if key.kind != StencilKind::Position
                         || !patchless(key)
-                        || !(1..=MAX_COMPACT_TRIANGLE_RATE).contains(&key.n)
+                        || !(1..=MAX_COMPACT_RATE).contains(&key.n)
                     {
                         return Err(incomplete(format!(
                             "{key} is not a position rate marker in \
-                             1..={MAX_COMPACT_TRIANGLE_RATE} without a patch"
+                             1..={MAX_COMPACT_RATE} without a patch"
                         )));
                     }
                     rates.push(key.n);
@@ -158,28 +139,7 @@ impl TriangleExpansion {
                     if key.kind != StencilKind::Position {
                         return Err(incomplete(format!("{key} is not of kind position")));
                     }
-                    let others = [
-                        (StencilKind::Position, PointSet::SubTriangles),
-                        (StencilKind::Position, PointSet::VertexMask),
-                        (StencilKind::DerivativeU, PointSet::VertexMask),
-                        (StencilKind::DerivativeV, PointSet::VertexMask),
-                    ];
-                    for (kind, points) in others {
-                        let piece = SectionKey {
-                            kind,
-                            points,
-                            ..*key
-                        };
-                        match index.entry(&piece) {
-                            Ok(e) if e.width == width => {}
-                            Ok(_) => {
-                                return Err(incomplete(format!(
-                                    "{piece} has another width than {key}"
-                                )))
-                            }
-                            Err(_) => return Err(incomplete(format!("{key} has no {piece}"))),
-                        }
-                    }
+                    check_patch_pieces(index, key, width, PointSet::SubTriangles, incomplete)?;
                     patches.push((PatchId::of(key), width));
                 }
                 // The format admits no other non-grid point set in a triangle table.
@@ -329,10 +289,10 @@ impl<'a> Pieces<'a> {
         n: u32,
         basis: [&OnceLock<Vec<f64>>; 2],
     ) -> Result<Grids, RuntimeError> {
-        if !(1..=MAX_COMPACT_TRIANGLE_RATE).contains(&n) {
+        if !(1..=MAX_COMPACT_RATE).contains(&n) {
             return Err(RuntimeError::InvalidParameter {
                 name: "table".to_owned(),
-                reason: format!("rate {n} is outside 1..={MAX_COMPACT_TRIANGLE_RATE}"),
+                reason: format!("rate {n} is outside 1..={MAX_COMPACT_RATE}"),
             });
         }
         let factor = if kind == StencilKind::Position {
@@ -533,12 +493,13 @@ impl<'a> Pieces<'a> {
 mod tests {
     use super::*;
 
-    /// The rate cap is the tessellator's largest rate.
+    /// The rate cap is both tessellators' largest rate.
     #[test]
     fn the_rate_cap_is_the_tessellators() {
         assert_eq!(
-            MAX_COMPACT_TRIANGLE_RATE,
+            MAX_COMPACT_RATE,
             crate::tessellate::triangle_dual_grid::MAX_TRIANGLE_RATE
         );
+        assert_eq!(MAX_COMPACT_RATE, crate::tessellate::dual_grid::MAX_RATE);
     }
 }

@@ -87,7 +87,7 @@ fn compact_corner_grids_equal_solved_grids() {
 
 /// A compact table whose pieces do not fit together is refused when it is loaded, naming the
 /// piece, never expanded into a panic: a missing vertex mask, a curve basis that is not four
-/// weights a row, pieces stored in f32. A grid it does not cover is `MissingSection`.
+/// weights a row or beyond rate 64, pieces stored in f32. A grid it does not cover is `MissingSection`.
 #[test]
 fn inconsistent_compact_tables_are_refused_at_load() {
     use table_format::{encode, PointSet, SectionKey, StencilKind, Table, TableMeta};
@@ -147,6 +147,28 @@ fn inconsistent_compact_tables_are_refused_at_load() {
         .collect();
     let e = load(table.meta, &narrow).expect_err("three weights a row");
     assert!(e.to_string().contains("not 4 weights a row"), "{e}");
+
+    // A curve basis at rate 65 would let one grid request allocate (n + 1)^2 K weights for a
+    // rate no tessellator asks for: the rates are capped at the tessellators' 64.
+    let far: Vec<_> = sections
+        .iter()
+        .cloned()
+        .chain(
+            [StencilKind::Position, StencilKind::DerivativeU].map(|kind| {
+                let key = SectionKey {
+                    kind,
+                    points: PointSet::CurveBasis,
+                    boundary: false,
+                    faces: 0,
+                    sector: 0,
+                    n: 65,
+                };
+                (key, 4, vec![0.25; 66 * 4])
+            }),
+        )
+        .collect();
+    let e = load(table.meta, &far).expect_err("rate 65");
+    assert!(e.to_string().contains("1..=64"), "{e}");
 
     let f32_meta = TableMeta {
         precision: Precision::F32,
