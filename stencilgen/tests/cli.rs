@@ -134,30 +134,29 @@ fn stencil_bad_input() {
     }
 }
 
-#[test]
-fn tables_writes_a_valid_table() {
-    let path = std::env::temp_dir().join(format!("stencilgen-cli-{}.subtess", std::process::id()));
-    let out = Command::new(env!("CARGO_BIN_EXE_stencilgen"))
-        .args([
-            "tables",
-            "--valences",
-            "3,5",
-            "--n",
-            "1..2",
-            "--precision",
-            "f64",
-            "-o",
-        ])
-        .arg(&path)
-        .output()
-        .expect("stencilgen runs");
+/// Run `tables ARGS -o FILE` (a temporary file named after `name`), which must succeed, and
+/// read the table it wrote back.
+fn written_table(name: &str, args: &str) -> table_format::TableIndex {
+    let path = std::env::temp_dir().join(format!(
+        "stencilgen-cli-{name}-{}.subtess",
+        std::process::id()
+    ));
+    let out = stencilgen(&format!("tables {args} -o {}", path.display()));
     assert!(
         out.status.success(),
-        "{}",
+        "{args}: {}",
         String::from_utf8_lossy(&out.stderr)
     );
     let bytes = table_format::AlignedBytes::read(&path).expect("written");
-    let table = table_format::Table::parse(bytes.as_bytes()).expect("valid");
+    let _ = std::fs::remove_file(&path);
+    table_format::Table::parse(bytes.as_bytes())
+        .expect("valid")
+        .into_index()
+}
+
+#[test]
+fn tables_writes_a_valid_table() {
+    let table = written_table("quad", "--valences 3,5 --n 1..2 --precision f64");
     assert_eq!(table.meta.precision, table_format::Precision::F64);
     // Compact: 2 rates x 2 curve-basis sections, 2 patches x 5 pieces.
     assert_eq!(table.entries.len(), 2 * 2 + 2 * 5);
@@ -166,25 +165,9 @@ fn tables_writes_a_valid_table() {
         "interior valences 3, 5, no boundary vertices, n = 1..=2"
     );
     // --grids: every grid, 2 patches x 2 rates x 3 kinds x 2 point sets, f32 by default.
-    let out = Command::new(env!("CARGO_BIN_EXE_stencilgen"))
-        .args([
-            "tables",
-            "--valences",
-            "3,5",
-            "--n",
-            "1..2",
-            "--grids",
-            "-o",
-        ])
-        .arg(&path)
-        .output()
-        .expect("stencilgen runs");
-    assert!(out.status.success());
-    let bytes = table_format::AlignedBytes::read(&path).expect("written");
-    let table = table_format::Table::parse(bytes.as_bytes()).expect("valid");
+    let table = written_table("quad", "--valences 3,5 --n 1..2 --grids");
     assert_eq!(table.meta.precision, table_format::Precision::F32);
     assert_eq!(table.entries.len(), 2 * 2 * 3 * 2);
-    let _ = std::fs::remove_file(&path);
     fails_with(
         "tables --valences 3 --n 1 --precision f32 -o /tmp/x.subtess",
         "compact tables store f64",
@@ -198,41 +181,8 @@ fn tables_writes_a_valid_table() {
 /// `tables --schemes loop` writes a compact table (f64), `--grids` the grids (f32).
 #[test]
 fn tables_writes_compact_and_grid_loop_tables() {
-    let path = std::env::temp_dir().join(format!(
-        "stencilgen-cli-loop-{}.subtess",
-        std::process::id()
-    ));
-    let write = |extra: &[&str]| {
-        let out = Command::new(env!("CARGO_BIN_EXE_stencilgen"))
-            .args([
-                "tables",
-                "--schemes",
-                "loop",
-                "--valences",
-                "5",
-                "--boundary",
-                "--boundary-faces",
-                "2",
-                "--n",
-                "1..3",
-            ])
-            .args(extra)
-            .arg("-o")
-            .arg(&path)
-            .output()
-            .expect("stencilgen runs");
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let bytes = table_format::AlignedBytes::read(&path).expect("written");
-        let table = table_format::Table::parse(bytes.as_bytes())
-            .expect("valid")
-            .into_index();
-        table
-    };
-    let compact = write(&[]);
+    let loop_table = "--schemes loop --valences 5 --boundary --boundary-faces 2 --n 1..3";
+    let compact = written_table("loop", loop_table);
     assert_eq!(compact.meta.precision, table_format::Precision::F64);
     // 3 basis kinds, 3 rate markers, 3 patches (valence 5, two boundary sectors) x 5 pieces.
     assert_eq!(compact.entries.len(), 3 + 3 + 3 * 5);
@@ -240,12 +190,11 @@ fn tables_writes_compact_and_grid_loop_tables() {
         compact.coverage(),
         "interior valences 5, boundary vertices with 2 faces, n = 1..=3"
     );
-    let grids = write(&["--grids"]);
+    let grids = written_table("loop", &format!("{loop_table} --grids"));
     assert_eq!(grids.meta.precision, table_format::Precision::F32);
     // 3 patches x 3 rates x 3 kinds x 2 point sets.
     assert_eq!(grids.entries.len(), 3 * 3 * 3 * 2);
     assert_eq!(grids.coverage(), compact.coverage());
-    let _ = std::fs::remove_file(&path);
     fails_with(
         "tables --schemes loop --valences 5 --n 1 --precision f32 -o /tmp/x.subtess",
         "compact tables store f64",
