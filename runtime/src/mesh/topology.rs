@@ -133,16 +133,13 @@ impl Mesh {
                     face.len()
                 )));
             }
-            for (i, &v) in face.iter().enumerate() {
+            for &v in face {
                 if v < 0 || v as usize >= positions.len() {
                     return Err(bad(format!(
                         "vertex index {} is out of range (the mesh has {} vertices)",
                         v + 1,
                         positions.len()
                     )));
-                }
-                if face[..i].contains(&v) {
-                    return Err(bad(format!("vertex {v} appears twice")));
                 }
                 face_vertices.push(v as u32);
                 face_of.push(f as u32);
@@ -167,8 +164,37 @@ impl Mesh {
         };
         let non_manifold = mesh.link_twins()?;
         mesh.split_non_manifold(&non_manifold);
+        mesh.refuse_repeats_in_one_fan(lines)?;
         mesh.sharpen_boundary();
         Ok(mesh)
+    }
+
+    /// A face that repeats a vertex is accepted when splitting the vertex into one copy per
+    /// fan ([`Mesh::copies`]) leaves the face's corners different vertices (the doubled corner
+    /// of `catmark_nonman_quadpole8`, whose degenerate edge is non-manifold). Corners that
+    /// stay one vertex, because the faces around it join them into one fan, would make a
+    /// face pass through one point twice inside a disc: refused, naming the face.
+    fn refuse_repeats_in_one_fan(&self, lines: &[usize]) -> Result<(), MeshError> {
+        let mut seen_in = vec![u32::MAX; self.positions.len()];
+        for f in 0..self.faces() {
+            for &v in self.face(f) {
+                if seen_in[v as usize] == f as u32 {
+                    let v = self.origin(v as usize);
+                    return Err(MeshError::BadFace {
+                        face: f,
+                        line: lines.get(f).copied().unwrap_or(0),
+                        reason: format!(
+                            "vertex {} appears twice, and the faces around it join both \
+                             corners into one fan (a face that repeats a vertex is accepted \
+                             where its corners lie in different fans, as at a doubled corner)",
+                            v + 1
+                        ),
+                    });
+                }
+                seen_in[v as usize] = f as u32;
+            }
+        }
+        Ok(())
     }
 
     /// Make boundary edges infinitely sharp, and one-face boundary corners too in "edge and
@@ -429,9 +455,11 @@ impl Mesh {
         }
         let leaving =
             |v: u32| &outgoing[start[v as usize] as usize..start[v as usize + 1] as usize];
-        // An edge is manifold when exactly two half-edges use it, one each way; any other
-        // use (three faces or more, two the same way) leaves all its half-edges unlinked, to
-        // be split apart with their vertices (`split_non_manifold`).
+        // An edge is manifold when exactly two half-edges of two different faces use it, one
+        // each way; any other use (three faces or more, two the same way, both ways in one
+        // face, or a degenerate edge from a vertex to itself in a face that repeats it) leaves
+        // all its half-edges unlinked, to be split apart with their vertices
+        // (`split_non_manifold`), as OpenSubdiv's Vtr makes each such edge non-manifold.
         let mut non_manifold = Vec::new();
         for h in 0..halfedges {
             let (a, b) = (self.face_vertices[h], self.head(h));
@@ -441,7 +469,9 @@ impl Mesh {
                 .count();
             let mut reverse = leaving(b).iter().filter(|&&g| self.head(g as usize) == a);
             match (same, reverse.next(), reverse.next()) {
-                (1, Some(&t), None) => self.twin[h] = t,
+                (1, Some(&t), None) if a != b && self.face_of[t as usize] != self.face_of[h] => {
+                    self.twin[h] = t
+                }
                 (1, None, None) => {}
                 _ => non_manifold.push(h),
             }
@@ -533,17 +563,24 @@ impl Mesh {
             is_sharpened[v] = true;
         }
         let mut non_manifold_edges: Vec<Vec<(usize, usize)>> = vec![Vec::new(); original];
+        // Ends of an edge that only one face uses, degenerate (from a vertex to itself) or
+        // run both ways in one face: OpenSubdiv gives each such use its own one-face edge, a
+        // boundary edge, which rules out the non-manifold crease at its ends.
+        let mut lone_edge = vec![false; original];
         for &h in non_manifold {
-            let (a, b) = (
-                self.origin(self.face_vertices[h] as usize),
-                self.origin(self.head(h) as usize),
-            );
+            let origin = |g: usize| self.origin(self.face_vertices[g] as usize);
+            let (a, b) = (origin(h), self.origin(self.head(h) as usize));
+            let lone = a == b
+                || self
+                    .face_halfedges(self.face_of[h] as usize)
+                    .any(|g| origin(g) == b && origin(self.next(g)) == a);
             for v in [a, b] {
                 is_sharpened[v] = true;
+                lone_edge[v] |= lone;
                 non_manifold_edges[v].push((a.min(b), a.max(b)));
             }
         }
-        let mut manifold_boundary = vec![false; original];
+        let mut manifold_boundary = lone_edge;
         for h in 0..self.twin.len() {
             if self.twin[h] == NONE && non_manifold.binary_search(&h).is_err() {
                 manifold_boundary[self.origin(self.face_vertices[h] as usize)] = true;
@@ -775,9 +812,52 @@ mod tests {
         let e = Mesh::new(p.clone(), &[vec![0, 1, 9]], &[], BoundaryMode::EdgeOnly)
             .expect_err("out of range");
         assert!(e.to_string().contains("out of range"), "{e}");
-        let e = Mesh::new(p.clone(), &[vec![0, 1, 1, 2]], &[], BoundaryMode::EdgeOnly)
-            .expect_err("repeated");
-        assert!(e.to_string().contains("appears twice"), "{e}");
+    }
+
+    /// A doubled corner (`catmark_nonman_quadpole8`'s quads) is OpenSubdiv's degenerate edge:
+    /// non-manifold, so infinitely sharp, and its vertex pinned; splitting the vertex per fan
+    /// leaves the face with two corners at one position.
+    #[test]
+    fn a_doubled_corner_is_a_degenerate_pinned_edge() {
+        let (p, _) = grid(1);
+        let m = Mesh::new(p, &[vec![0, 1, 1, 2]], &[], BoundaryMode::EdgeOnly).expect("accepted");
+        assert_eq!(m.copies, vec![1]);
+        assert_eq!(m.face(0), &[0, 1, 4, 2]);
+        assert_eq!(m.positions[4], m.positions[1]);
+        assert!(m.twin.iter().all(|&t| t == NONE));
+        assert!(m.edge_sharpness.iter().all(|&s| s == INFINITE));
+        assert_eq!(m.vertex_sharpness[1], INFINITE);
+        assert_eq!(m.vertex_sharpness[4], INFINITE);
+        assert_eq!(m.vertex_sharpness[0], 0.0);
+        assert_eq!(m.boundary_loops(), 1);
+    }
+
+    /// A face that passes twice through a vertex whose other faces join both corners into one
+    /// fan (here a closed, pinched sphere: `(v, 1, 2, v, 3, 4)` with two triangles filling the
+    /// gaps) cannot be split per fan: refused, naming the face and the vertex.
+    #[test]
+    fn corners_of_one_face_in_one_fan_are_refused() {
+        let p = vec![
+            [0.0; 3],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [-1.0, -1.0, 0.0],
+        ];
+        let faces = vec![vec![0, 1, 2, 0, 3, 4], vec![0, 4, 3], vec![0, 2, 1]];
+        let e = Mesh::new(p, &faces, &[11, 12, 13], BoundaryMode::EdgeOnly).expect_err("pinched");
+        assert!(
+            matches!(
+                e,
+                MeshError::BadFace {
+                    face: 0,
+                    line: 11,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        assert!(e.to_string().contains("vertex 1 appears twice"), "{e}");
     }
 
     /// Non-manifold input is split as OpenSubdiv's surfaces split: a non-manifold edge leaves
