@@ -3,31 +3,8 @@
 
 use std::collections::HashSet;
 
+use crate::mesh::watertight::DirectedEdges;
 pub use crate::mesh::VertexSource;
-
-/// Directed edges grouped by tail: the heads of the edges leaving `a` are
-/// `heads[start[a]..start[a + 1]]`, sorted.
-struct DirectedEdges {
-    start: Vec<u32>,
-    heads: Vec<u32>,
-}
-
-impl DirectedEdges {
-    fn leaving(&self, a: u32) -> &[u32] {
-        let a = a as usize;
-        &self.heads[self.start[a] as usize..self.start[a + 1] as usize]
-    }
-
-    fn contains(&self, a: u32, b: u32) -> bool {
-        self.leaving(a).binary_search(&b).is_ok()
-    }
-
-    /// Every edge, by tail, then head.
-    fn edges(&self) -> impl Iterator<Item = (u32, u32)> + '_ {
-        (0..self.start.len() as u32 - 1)
-            .flat_map(move |a| self.leaving(a).iter().map(move |&b| (a, b)))
-    }
-}
 
 /// An indexed triangle mesh: limit positions, unit normals, sources, triangles.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -51,11 +28,16 @@ impl TriangleMesh {
     /// Whether every edge is shared by exactly two triangles that traverse it in opposite
     /// directions (a closed, consistently oriented, edge-manifold surface), in positions: a
     /// vertex split along a texture seam counts as its original ([`TriangleMesh::seam_copies`]).
+    ///
+    /// Exact, and linear but for a sort of the edges outside the faces' grids
+    /// (`mesh::watertight`).
     pub fn is_watertight(&self) -> bool {
-        match self.directed_edges() {
-            Some(d) => d.edges().all(|(a, b)| d.contains(b, a)),
-            None => false,
-        }
+        let of = if self.seam_copies.is_empty() {
+            Vec::new()
+        } else {
+            self.position_vertices()
+        };
+        crate::mesh::watertight::is_closed(&self.triangles, self.positions.len(), &of)
     }
 
     /// The boundary edges (directed edges without an opposite one), or `None` when some directed
@@ -86,37 +68,18 @@ impl TriangleMesh {
     fn directed_edges(&self) -> Option<DirectedEdges> {
         let of = self.position_vertices();
         let n = of.len();
-        if self.triangles.iter().flatten().any(|&i| i as usize >= n) {
+        if self.triangles.iter().flatten().any(|&i| i as usize >= n)
+            || of.iter().any(|&o| o as usize >= n)
+        {
             return None;
         }
-        // Counting sort by tail: linear, where hashing 3 edges per triangle took seconds for
-        // millions of triangles.
-        let mut start = vec![0u32; n + 1];
-        for t in &self.triangles {
-            for &a in t {
-                start[of[a as usize] as usize + 1] += 1;
-            }
-        }
-        for v in 0..n {
-            start[v + 1] += start[v];
-        }
-        let mut fill = start.clone();
-        let mut heads = vec![0u32; start[n] as usize];
-        for t in &self.triangles {
-            for k in 0..3 {
-                let (a, b) = (of[t[k] as usize] as usize, of[t[(k + 1) % 3] as usize]);
-                heads[fill[a] as usize] = b;
-                fill[a] += 1;
-            }
-        }
-        for v in 0..n {
-            let around = &mut heads[start[v] as usize..start[v + 1] as usize];
-            around.sort_unstable();
-            if around.windows(2).any(|w| w[0] == w[1]) {
-                return None;
-            }
-        }
-        Some(DirectedEdges { start, heads })
+        let edges: Vec<(u32, u32)> = self
+            .triangles
+            .iter()
+            .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+            .map(|(a, b)| (of[a as usize], of[b as usize]))
+            .collect();
+        DirectedEdges::new(n, &edges)
     }
 
     /// Euler characteristic `V - E + F` of the triangle mesh.

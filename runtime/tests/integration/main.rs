@@ -31,3 +31,4 @@ mod tables;
 mod tagged_exact_eval;
 mod tessellate;
 mod triangle_rates;
+mod watertight;

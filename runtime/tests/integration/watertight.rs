@@ -1,0 +1,92 @@
+//! `TriangleMesh::is_watertight` pairs the inner edges of the faces' grids by their pattern and
+//! sorts only the rest (`mesh/watertight.rs`). The reference is the general check on every
+//! directed edge, `boundary_edges` (closed: no directed edge used twice, none without its
+//! reverse), on the tessellators' outputs and on those outputs broken in the ways a grid
+//! shortcut could miss.
+
+use proptest::prelude::*;
+use subtess::{Mesh, Rates, Scheme, Surface, TriangleMesh};
+
+/// The general check: every directed edge once, each with its reverse.
+fn closed_by_every_edge(mesh: &TriangleMesh) -> bool {
+    mesh.boundary_edges().is_some_and(|b| b.is_empty())
+}
+
+fn tessellated(file: &str, rates: Rates) -> TriangleMesh {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/data/").to_owned() + file;
+    let mesh = Mesh::read_obj(&path).expect("readable");
+    let surface = Surface::new(&mesh, Scheme::CatmullClark).expect("surface");
+    let mut tessellator = surface.tessellator(&rates).expect("plan");
+    let frame = tessellator.evaluate(&mesh.positions_f32()).expect("frame");
+    frame.to_triangle_mesh()
+}
+
+/// Both checks agree on `mesh`; returns the answer.
+fn agreed(mesh: &TriangleMesh, what: &str) -> bool {
+    let expected = closed_by_every_edge(mesh);
+    assert_eq!(mesh.is_watertight(), expected, "{what}");
+    expected
+}
+
+#[test]
+fn tessellations_are_closed_by_both_checks() {
+    for n in [1, 2, 3, 8] {
+        assert!(agreed(&tessellated("cube.obj", Rates::Uniform(n)), "cube"));
+        // Texture seams: vertices split for their coordinates, welded for the check.
+        assert!(agreed(
+            &tessellated("cube_uv.obj", Rates::Uniform(n)),
+            "cube with uvs"
+        ));
+        assert!(agreed(
+            &tessellated("cube_creased.obj", Rates::Uniform(n)),
+            "creased"
+        ));
+    }
+    let mixed = Rates::PerFace(vec![1, 2, 3, 5, 8, 13]);
+    assert!(agreed(&tessellated("cube.obj", mixed), "mixed rates"));
+    // With boundary: not closed, by both.
+    assert!(!agreed(&tessellated("disc.obj", Rates::Uniform(4)), "disc"));
+}
+
+/// A grid's inner edge used by two more triangles (a fin, closed in itself): four uses of one
+/// edge. The grid pairs its own two; only the check of other triangles against the grids'
+/// inner edges sees the other two.
+#[test]
+fn a_fin_on_a_grid_edge_is_not_closed() {
+    let mut mesh = tessellated("cube.obj", Rates::Uniform(6));
+    // The second triangle of the first face's first quad: [a, c, d]; its diagonal a-c is
+    // inner to the face's grid.
+    let [a, c, _] = mesh.triangles[1];
+    let x = mesh.positions.len() as u32;
+    mesh.positions.push([9.0, 9.0, 9.0]);
+    mesh.triangles.push([a, c, x]);
+    mesh.triangles.push([c, a, x]);
+    assert!(!agreed(&mesh, "fin"));
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// One triangle removed, reversed, duplicated or moved to other vertices: both checks say
+    /// the same.
+    #[test]
+    fn broken_tessellations_agree(rate in 2u32..7, pick in 0usize..10_000, how in 0u8..4) {
+        let mut mesh = tessellated("cube.obj", Rates::Uniform(rate));
+        let t = pick % mesh.triangles.len();
+        match how {
+            0 => {
+                mesh.triangles.remove(t);
+            }
+            1 => mesh.triangles[t].swap(1, 2),
+            2 => {
+                let copy = mesh.triangles[t];
+                mesh.triangles.push(copy);
+            }
+            _ => {
+                let v = mesh.positions.len() as u32;
+                mesh.triangles[t][0] = (mesh.triangles[t][0] + 1) % v;
+            }
+        }
+        agreed(&mesh, "broken");
+    }
+}
