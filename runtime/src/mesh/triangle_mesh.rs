@@ -73,13 +73,12 @@ impl TriangleMesh {
         {
             return None;
         }
-        let edges: Vec<(u32, u32)> = self
-            .triangles
-            .iter()
-            .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
-            .map(|(a, b)| (of[a as usize], of[b as usize]))
-            .collect();
-        DirectedEdges::new(n, &edges)
+        DirectedEdges::new(n, || {
+            self.triangles
+                .iter()
+                .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+                .map(|(a, b)| (of[a as usize], of[b as usize]))
+        })
     }
 
     /// Euler characteristic `V - E + F` of the triangle mesh.

@@ -226,7 +226,7 @@ pub(crate) fn is_closed(triangles: &[[u32; 3]], vertices: usize, of: &[u32]) -> 
             *e = (of[e.0 as usize], of[e.1 as usize]);
         }
     }
-    DirectedEdges::new(vertices, &edges).is_some_and(|d| d.all_paired())
+    DirectedEdges::new(vertices, || edges.iter().copied()).is_some_and(|d| d.all_paired())
 }
 
 /// Up to this many edges leaving a vertex (a tessellation's vertices have about six) are
@@ -243,17 +243,21 @@ pub(crate) struct DirectedEdges {
 impl DirectedEdges {
     /// Group `edges` (between vertices below `vertices`) by tail, by a counting sort: linear,
     /// where hashing took seconds for millions of edges. `None` when an edge is listed twice.
-    pub(crate) fn new(vertices: usize, edges: &[(u32, u32)]) -> Option<DirectedEdges> {
+    /// `edges` is called twice (count, then place), for the same edges each time.
+    pub(crate) fn new<I: Iterator<Item = (u32, u32)>>(
+        vertices: usize,
+        edges: impl Fn() -> I,
+    ) -> Option<DirectedEdges> {
         let mut start = vec![0u32; vertices + 1];
-        for &(a, _) in edges {
+        for (a, _) in edges() {
             start[a as usize + 1] += 1;
         }
         for v in 0..vertices {
             start[v + 1] += start[v];
         }
         let mut fill = start.clone();
-        let mut heads = vec![0u32; edges.len()];
-        for &(a, b) in edges {
+        let mut heads = vec![0u32; start[vertices] as usize];
+        for (a, b) in edges() {
             heads[fill[a as usize] as usize] = b;
             fill[a as usize] += 1;
         }
