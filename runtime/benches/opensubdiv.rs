@@ -1,55 +1,64 @@
-//! subtess side by side with OpenSubdiv 3.7 (through the `opensubdiv-petite` crate), one thread,
-//! in one run: a closed torus of 200 x 100 = 20,000 regular quads, per face the `n x n` dual
-//! points `((2i+1)/2n, (2j+1)/2n)`, position and both derivatives, n = 4, 8, 16.
+//! subtess side by side with OpenSubdiv 3.7 (through the `opensubdiv-petite` crate), in one
+//! run, the per-frame work **from the input control points** on three meshes, at the same
+//! points:
+//!
+//! * a closed torus of 200 x 100 = 20,000 regular quads (generated here; no extraordinary
+//!   vertex: the best case for both), n = 4, 8, 16;
+//! * Crane's Spot refined three times (`../shared/models/crane/spot_control_mesh.obj`, 11,712
+//!   quads, extraordinary vertices far apart: no isolation), n = 4, 8, 16;
+//! * Crane's triangulated Spot (`spot_triangulated.obj`, 5,856 triangles: every face needs
+//!   isolation, two Catmull–Clark steps, 70,272 faces), n = 4, 8 (OpenSubdiv's table at n = 16,
+//!   18 M points, would not fit this machine's memory).
+//!
+//! The Spot meshes are skipped, with a message, when `../shared/models` is absent.
 //!
 //! `scripts/install-opensubdiv-deps.sh && cargo bench -p subtess --features opensubdiv
 //! --bench opensubdiv` (the feature builds OpenSubdiv from C++ source; docs/benchmarks.md).
 //!
-//! Variants, all reported as triangles per second with subtess's triangle count for the points
-//! (`DualGrid::triangle_count`, `2 n^2` per face on this mesh):
+//! The points are subtess's output vertices at uniform rate `n` (their sources: input face,
+//! sub-face of a non-quad, exact `(u, v)`), given to OpenSubdiv as Ptex faces and parameters.
+//! Every variant is reported as triangles per second with subtess's triangle count.
 //!
-//! * subtess: `DualGrid::evaluate` (positions and unit normals from the table's position and
-//!   tangent stencils) and `DualGrid::connect` (all triangles) per frame; plan built once.
-//! * OpenSubdiv `Far::LimitStencilTable`: built once for all points with first derivatives by
-//!   `LimitStencilTableFactory`; per frame its stencils (position, du, dv weights) are applied to
-//!   the control points in one tight loop with f32 accumulation, as
+//! * subtess: `Tessellator::evaluate(&input_points)`, the facade's frame: the isolation's
+//!   refinement map (when isolation took steps), then every output vertex's position and unit
+//!   normal; the plan (and its triangles, which a frame does not rewrite) built once. One
+//!   thread, and two (a two-thread rayon pool installed around the frame).
+//! * OpenSubdiv `Far::LimitStencilTable` at the same points, factorized to the input control
+//!   points (adaptive refinement to level 10 with Gregory end caps, as the parity test builds
+//!   it): built once; per frame its stencils (position, du, dv weights) are applied to the
+//!   input points in one tight loop with f32 accumulation, as
 //!   `LimitStencilTable::UpdateValues`/`UpdateDerivs` do (the crate exposes the table's arrays
-//!   but not those two methods). No triangles.
-//! * OpenSubdiv `Bfr::Surface`, positions only: the crate exposes only
+//!   but not those two methods). No normals, no triangles. One thread (OpenSubdiv's CPU path).
+//! * OpenSubdiv `Bfr::Surface`, positions only, on the all-quad meshes: the crate exposes only
 //!   `Surface::evaluate_position`, which prepares the face's patch points on every call and has
-//!   no derivatives, so this is not the same work; it is shown for reference. Surfaces are
+//!   no derivatives, so this is not the same work; shown for reference. Surfaces are
 //!   initialized once.
 //!
 //! `Far::PatchTable` evaluation is not measured: in opensubdiv-petite 0.3.1 the C shim's
 //! `PatchTable_EvaluateBasis` is a placeholder (uniform weights, zero derivatives) and
 //! `PatchMap_FindPatch` does not return the patch's parameters, so it does not evaluate the
-//! surface (checked at start: its positions are off by about 5e-4 of the size, 2,000 times the
-//! limit stencils' difference to subtess, and its derivatives are zero).
+//! surface (checked on the torus at start: positions off by about 5e-4 of the size, derivatives
+//! zero).
 //!
-//! Before timing, OpenSubdiv's positions at every point (and Bfr's on a sample of faces) are
-//! checked against subtess's to 1e-5 of the torus's size, and the normals from OpenSubdiv's
-//! derivatives against subtess's to 1e-4.
+//! Before timing, OpenSubdiv's positions at every point are checked against subtess's to 1e-5
+//! of the mesh's bounding-box diagonal, the normals from OpenSubdiv's derivatives against
+//! subtess's to 2e-3 rad, and Bfr's positions (every 97th face) to 1e-5.
 #![allow(missing_docs)] // criterion_group! generates an undocumented function
 
+use std::path::Path;
 use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode, Throughput};
-use opensubdiv_petite::bfr::{Surface, SurfaceFactory};
+use opensubdiv_petite::bfr::{Surface as BfrSurface, SurfaceFactory};
 use opensubdiv_petite::far;
 use subtess::mesh::topology::Mesh;
-use subtess::scheme::catmull_clark::isolate::isolate;
-use subtess::stencil_table::StencilTable;
-use subtess::tessellate::dual_grid::DualGrid;
-use subtess::tessellate::GridPlan;
+use subtess::{Rates, Scheme, Surface, VertexSource};
 
 /// Quads around the torus's axis and around its tube.
 const AROUND: usize = 200;
 const TUBE: usize = 100;
 const MAJOR_RADIUS: f64 = 1.0;
 const MINOR_RADIUS: f64 = 0.4;
-/// The torus's extent (outer diameter): the scale of the position tolerance.
-const SIZE: f64 = 2.0 * (MAJOR_RADIUS + MINOR_RADIUS);
-const RATES: [usize; 3] = [4, 8, 16];
 
 /// The torus: vertex `(a, b)` at index `b * AROUND + a`, face `(a, b)` at `b * AROUND + a` with
 /// corners `(a, b), (a+1, b), (a+1, b+1), (a, b+1)`. The tube radius wobbles a little so that no
@@ -79,16 +88,6 @@ fn torus() -> (Vec<[f64; 3]>, Vec<Vec<i64>>) {
         })
         .collect();
     (positions, faces)
-}
-
-/// The dual parameters of one face at rate `n`, row by row (`j` outer), as subtess orders its
-/// output vertices: `(s, t)` arrays.
-fn dual_parameters(n: usize) -> (Vec<f32>, Vec<f32>) {
-    let d = (2 * n) as f32;
-    (0..n)
-        .flat_map(|j| (0..n).map(move |i| (i, j)))
-        .map(|(i, j)| ((2 * i + 1) as f32 / d, (2 * j + 1) as f32 / d))
-        .unzip()
 }
 
 /// OpenSubdiv's limit stencils (position, du, dv) applied to `control`: what
@@ -168,13 +167,284 @@ fn max_difference(a: &[[f32; 3]], b: &[[f32; 3]]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// OpenSubdiv's `Bfr::Surface` positions of one face at the parameters `(s, t)` (crate API).
-fn bfr_face(surface: &Surface, s: &[f32], t: &[f32], control: &[[f32; 3]], out: &mut [[f32; 3]]) {
-    for ((o, &u), &v) in out.iter_mut().zip(s).zip(t) {
-        *o = surface
+/// The diagonal of the points' bounding box: the scale of the position tolerance.
+fn diagonal(points: &[[f32; 3]]) -> f64 {
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for p in points {
+        for x in 0..3 {
+            lo[x] = lo[x].min(f64::from(p[x]));
+            hi[x] = hi[x].max(f64::from(p[x]));
+        }
+    }
+    (0..3).map(|x| (hi[x] - lo[x]).powi(2)).sum::<f64>().sqrt()
+}
+
+/// The largest angle between two lists of unit normals, in radians.
+fn max_angle(a: &[[f32; 3]], b: &[[f32; 3]]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| {
+            let chord = (0..3)
+                .map(|x| f64::from(p[x] - q[x]).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            2.0 * (chord / 2.0).min(1.0).asin()
+        })
+        .fold(0.0, f64::max)
+}
+
+/// One mesh of the comparison.
+struct Case {
+    name: String,
+    mesh: Mesh,
+    rates: &'static [u32],
+}
+
+/// The mesh's input faces in OpenSubdiv's terms: vertices per face, face-vertex indices, and
+/// every face's first Ptex face (a quad is one Ptex face, an `m`-gon `m`, one per corner).
+struct Topology {
+    sizes: Vec<u32>,
+    indices: Vec<u32>,
+    first_ptex: Vec<usize>,
+}
+
+impl Topology {
+    fn new(mesh: &Mesh) -> Self {
+        let faces = mesh.faces();
+        let sizes: Vec<u32> = (0..faces).map(|f| mesh.face(f).len() as u32).collect();
+        let indices = (0..faces).flat_map(|f| mesh.face(f).to_vec()).collect();
+        let mut first_ptex = Vec::with_capacity(faces);
+        let mut next = 0;
+        for &m in &sizes {
+            first_ptex.push(next);
+            next += if m == 4 { 1 } else { m as usize };
+        }
+        Topology {
+            sizes,
+            indices,
+            first_ptex,
+        }
+    }
+
+    /// The Ptex face and parameters of a subtess output vertex.
+    fn ptex(&self, src: &VertexSource) -> (usize, f32, f32) {
+        let f = src.face as usize;
+        let (u, v) = src.uv();
+        let sub = if self.sizes[f] == 4 {
+            0
+        } else {
+            usize::from(src.subface)
+        };
+        (self.first_ptex[f] + sub, u as f32, v as f32)
+    }
+}
+
+/// OpenSubdiv's `Far::LimitStencilTable` at `points` (Ptex face, s, t), consecutive points of
+/// one Ptex face given as one location array.
+fn limit_stencil_table(
+    refiner: &far::TopologyRefiner,
+    points: &[(usize, f32, f32)],
+) -> far::LimitStencilTable {
+    let s: Vec<f32> = points.iter().map(|p| p.1).collect();
+    let t: Vec<f32> = points.iter().map(|p| p.2).collect();
+    let mut locations = Vec::new();
+    let mut start = 0;
+    while start < points.len() {
+        let face = points[start].0;
+        let end = start + points[start..].iter().take_while(|p| p.0 == face).count();
+        locations.push(far::LocationArray {
+            ptex_index: face,
+            s: &s[start..end],
+            t: &t[start..end],
+        });
+        start = end;
+    }
+    let table = far::LimitStencilTable::new(
+        refiner,
+        &locations,
+        None,
+        None,
+        far::LimitStencilTableOptions::default(),
+    )
+    .unwrap_or_else(|e| panic!("limit stencil table: {e}"));
+    assert_eq!(table.len(), points.len(), "a stencil per point");
+    table
+}
+
+/// OpenSubdiv's `Bfr::Surface` positions at `points` (crate API: positions only).
+fn bfr_points(
+    surfaces: &[BfrSurface],
+    points: &[(usize, f32, f32)],
+    control: &[[f32; 3]],
+    out: &mut [[f32; 3]],
+) {
+    for (o, &(f, u, v)) in out.iter_mut().zip(points) {
+        *o = surfaces[f]
             .evaluate_position(u, v, control)
             .unwrap_or_else(|e| panic!("Bfr evaluation: {e:?}"));
     }
+}
+
+fn compare(c: &mut Criterion, two_threads: &rayon::ThreadPool, case: &Case) {
+    let mesh = &case.mesh;
+    let control = mesh.positions_f32();
+    let size = diagonal(&control);
+    let topology = Topology::new(mesh);
+    let all_quads = topology.sizes.iter().all(|&m| m == 4);
+
+    let started = Instant::now();
+    let surface = Surface::new(mesh, Scheme::CatmullClark).unwrap_or_else(|e| panic!("{e}"));
+    eprintln!(
+        "{}: {} input faces, {} isolation steps, {} faces, refinement map {} weights ({:.2} s)",
+        case.name,
+        mesh.faces(),
+        surface.isolation_steps(),
+        surface.faces(),
+        surface.refinement_weights(),
+        started.elapsed().as_secs_f64()
+    );
+
+    // OpenSubdiv: the same vertices and faces, adaptively refined as the parity test does.
+    let descriptor =
+        far::TopologyDescriptor::new(control.len(), &topology.sizes, &topology.indices)
+            .unwrap_or_else(|e| panic!("topology descriptor: {e}"));
+    let mut refiner = far::TopologyRefiner::new(descriptor, far::TopologyRefinerOptions::default())
+        .unwrap_or_else(|e| panic!("topology refiner: {e}"));
+    refiner.refine_adaptive(
+        far::AdaptiveRefinementOptions {
+            isolation_level: 10,
+            ..far::AdaptiveRefinementOptions::default()
+        },
+        &[],
+    );
+    if case.name == "torus" {
+        check_patch_table(&refiner, &control, size);
+    }
+    // Bfr's factory reads its (unrefined) refiner until it is dropped; declared before it, the
+    // refiner outlives it.
+    let bfr_refiner = far::TopologyRefiner::new(descriptor, far::TopologyRefinerOptions::default())
+        .unwrap_or_else(|e| panic!("topology refiner: {e}"));
+    let factory = SurfaceFactory::new(&bfr_refiner, 2, 6)
+        .unwrap_or_else(|e| panic!("Bfr surface factory: {e}"));
+    let surfaces: Vec<BfrSurface> = if all_quads {
+        (0..mesh.faces())
+            .map(|f| {
+                factory
+                    .init_vertex_surface(opensubdiv_petite::Index::from(f))
+                    .unwrap_or_else(|e| panic!("Bfr surface of face {f}: {e:?}"))
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
+
+    for &n in case.rates {
+        let mut tessellator = surface
+            .tessellator(&Rates::Uniform(n))
+            .unwrap_or_else(|e| panic!("{e}"));
+        let triangles = tessellator.triangle_count();
+        let frame = tessellator
+            .evaluate(&control)
+            .unwrap_or_else(|e| panic!("{e}"));
+        let points: Vec<(usize, f32, f32)> =
+            frame.sources().iter().map(|s| topology.ptex(s)).collect();
+        let (ours_p, ours_n) = (frame.positions().to_vec(), frame.normals().to_vec());
+        eprintln!(
+            "{}, n = {n}: {} points, {triangles} triangles, {} of {} faces separable",
+            case.name,
+            points.len(),
+            tessellator.separable_faces(),
+            surface.faces()
+        );
+
+        let started = Instant::now();
+        let limit = limit_stencil_table(&refiner, &points);
+        eprintln!(
+            "{}, n = {n}: OpenSubdiv LimitStencilTable built in {:.2} s ({:.1} weights per \
+             point and quantity)",
+            case.name,
+            started.elapsed().as_secs_f64(),
+            limit.weights().len() as f64 / points.len() as f64
+        );
+        let stencils = LimitStencils::new(&limit);
+        let mut osd_p = vec![[0.0f32; 3]; points.len()];
+        let mut osd_du = osd_p.clone();
+        let mut osd_dv = osd_p.clone();
+        stencils.apply(&control, &mut osd_p, &mut osd_du, &mut osd_dv);
+        let osd_n: Vec<[f32; 3]> = osd_du
+            .iter()
+            .zip(&osd_dv)
+            .map(|(&u, &v)| unit_normal(u, v))
+            .collect();
+        let position_error = max_difference(&osd_p, &ours_p) / size;
+        let normal_error = max_angle(&osd_n, &ours_n);
+        let mut bfr_error = 0.0f64;
+        if all_quads {
+            let sample: Vec<(usize, f32, f32)> = points.iter().copied().step_by(97).collect();
+            let ours: Vec<[f32; 3]> = ours_p.iter().copied().step_by(97).collect();
+            let mut bfr = vec![[0.0f32; 3]; sample.len()];
+            bfr_points(&surfaces, &sample, &control, &mut bfr);
+            bfr_error = max_difference(&bfr, &ours) / size;
+        }
+        eprintln!(
+            "{}, n = {n}: largest differences to subtess: LimitStencilTable positions \
+             {position_error:.1e} of the diagonal, normals {normal_error:.1e} rad; Bfr \
+             positions {bfr_error:.1e}",
+            case.name
+        );
+        assert!(position_error < 1e-5, "LimitStencilTable positions differ");
+        assert!(normal_error < 2e-3, "LimitStencilTable normals differ");
+        assert!(bfr_error < 1e-5, "Bfr positions differ");
+
+        let mut group = c.benchmark_group(format!(
+            "{}, n = {n}, {} points, {triangles} triangles",
+            case.name,
+            points.len()
+        ));
+        group.sample_size(10);
+        group.sampling_mode(SamplingMode::Flat);
+        group.warm_up_time(Duration::from_secs(2));
+        group.measurement_time(Duration::from_secs(5));
+        group.throughput(Throughput::Elements(triangles as u64));
+        group.bench_function("subtess Tessellator::evaluate, 1 thread", |b| {
+            b.iter(|| tessellator.evaluate(&control).map(|f| f.positions().len()))
+        });
+        group.bench_function("subtess Tessellator::evaluate, 2 threads", |b| {
+            b.iter(|| {
+                two_threads.install(|| tessellator.evaluate(&control).map(|f| f.positions().len()))
+            })
+        });
+        group.bench_function("OpenSubdiv LimitStencilTable (P, du, dv), 1 thread", |b| {
+            b.iter(|| stencils.apply(&control, &mut osd_p, &mut osd_du, &mut osd_dv))
+        });
+        if all_quads {
+            group.bench_function(
+                "OpenSubdiv Bfr::Surface (P only, crate API), 1 thread",
+                |b| b.iter(|| bfr_points(&surfaces, &points, &control, &mut osd_p)),
+            );
+        }
+        group.finish();
+    }
+}
+
+/// A mesh from `../shared/models`, refined `steps` times, or `None` (with a message) where the
+/// folder is absent.
+fn shared_mesh(relative: &str, steps: usize) -> Option<Mesh> {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../shared/models")
+        .join(relative);
+    if !path.exists() {
+        eprintln!(
+            "SKIPPED: {} is absent (../shared/models beside the repository)",
+            path.display()
+        );
+        return None;
+    }
+    let mut mesh = Mesh::read_obj(&path).unwrap_or_else(|e| panic!("{e}"));
+    for _ in 0..steps {
+        mesh = subtess::scheme::catmull_clark::refine::refine(&mesh).mesh;
+    }
+    Some(mesh)
 }
 
 fn bench(c: &mut Criterion) {
@@ -182,149 +452,42 @@ fn bench(c: &mut Criterion) {
         .num_threads(1)
         .build_global()
         .unwrap_or_else(|e| panic!("one-thread rayon pool: {e}"));
+    let two_threads = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap_or_else(|e| panic!("two-thread rayon pool: {e}"));
 
     let (positions, faces) = torus();
-    let face_count = faces.len();
-    let control: Vec<[f32; 3]> = positions.iter().map(|p| p.map(|c| c as f32)).collect();
-
-    // subtess: topology, patches (the torus is regular: no refinement step).
-    let table = StencilTable::default_catmull_clark().unwrap_or_else(|e| panic!("{e}"));
-    let mesh = Mesh::new(
-        positions.clone(),
-        &faces,
-        &[],
-        schemes::BoundaryMode::EdgeOnly,
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
-    let (isolated, patches, steps) = isolate(&mesh).unwrap_or_else(|e| panic!("{e}"));
-    assert_eq!(steps, 0, "the torus is all regular quads");
-    assert_eq!(isolated.positions.len(), control.len());
-
-    // OpenSubdiv: the same vertices and faces.
-    let vertices_per_face = vec![4u32; face_count];
-    let face_vertices: Vec<u32> = faces.iter().flatten().map(|&v| v as u32).collect();
-    let descriptor =
-        far::TopologyDescriptor::new(control.len(), &vertices_per_face, &face_vertices)
-            .unwrap_or_else(|e| panic!("topology descriptor: {e}"));
-    let mut refiner = far::TopologyRefiner::new(descriptor, far::TopologyRefinerOptions::default())
-        .unwrap_or_else(|e| panic!("topology refiner: {e}"));
-    refiner.refine_adaptive(far::AdaptiveRefinementOptions::default(), &[]);
-    // Bfr's factory reads its (unrefined) refiner until it is dropped; declared before it, the
-    // refiner outlives it. A quad's ptex face is the face itself: ptex index = face index.
-    let bfr_refiner = far::TopologyRefiner::new(descriptor, far::TopologyRefinerOptions::default())
-        .unwrap_or_else(|e| panic!("topology refiner: {e}"));
-    let factory = SurfaceFactory::new(&bfr_refiner, 2, 6)
-        .unwrap_or_else(|e| panic!("Bfr surface factory: {e}"));
-    let surfaces: Vec<Surface> = (0..face_count)
-        .map(|f| {
-            factory
-                .init_vertex_surface(opensubdiv_petite::Index::from(f))
-                .unwrap_or_else(|e| panic!("Bfr surface of face {f}: {e:?}"))
-        })
-        .collect();
-    check_patch_table(&refiner, &control);
-
-    for n in RATES {
-        let (s, t) = dual_parameters(n);
-        let points = face_count * n * n;
-
-        let grid = DualGrid::new(&table, &isolated, &patches, &vec![n as u32; face_count])
-            .unwrap_or_else(|e| panic!("{e}"));
-        assert_eq!(grid.vertex_count(), points, "closed mesh: dual points only");
-        eprintln!(
-            "n = {n}: subtess plan: {} of {face_count} faces separable (tensor product), \
-             {} triangles",
-            grid.separable_faces(),
-            grid.triangle_count()
-        );
-        let mut positions = vec![[0.0f32; 3]; points];
-        let mut normals = positions.clone();
-        let mut triangles = vec![[0u32; 3]; grid.triangle_count()];
-        grid.evaluate(&control, &mut positions, &mut normals);
-
-        let locations: Vec<far::LocationArray> = (0..face_count)
-            .map(|f| far::LocationArray {
-                ptex_index: f,
-                s: &s,
-                t: &t,
-            })
-            .collect();
-        let started = Instant::now();
-        let limit = far::LimitStencilTable::new(
-            &refiner,
-            &locations,
-            None,
-            None,
-            far::LimitStencilTableOptions::default(),
-        )
-        .unwrap_or_else(|e| panic!("limit stencil table: {e}"));
-        eprintln!(
-            "n = {n}: OpenSubdiv LimitStencilTable for {points} points built in {:.2} s \
-             ({} weights per quantity)",
-            started.elapsed().as_secs_f64(),
-            limit.weights().len()
-        );
-        assert_eq!(limit.len(), points);
-        let stencils = LimitStencils::new(&limit);
-        let mut osd_p = vec![[0.0f32; 3]; points];
-        let mut osd_du = osd_p.clone();
-        let mut osd_dv = osd_p.clone();
-        stencils.apply(&control, &mut osd_p, &mut osd_du, &mut osd_dv);
-
-        let position_error = max_difference(&osd_p, &positions) / SIZE;
-        let osd_normals: Vec<[f32; 3]> = osd_du
-            .iter()
-            .zip(&osd_dv)
-            .map(|(&u, &v)| unit_normal(u, v))
-            .collect();
-        let normal_error = max_difference(&osd_normals, &normals);
-        let mut bfr_p = vec![[0.0f32; 3]; n * n];
-        let mut bfr_error = 0.0f64;
-        for f in (0..face_count).step_by(97) {
-            bfr_face(&surfaces[f], &s, &t, &control, &mut bfr_p);
-            let ours = &positions[f * n * n..(f + 1) * n * n];
-            bfr_error = bfr_error.max(max_difference(&bfr_p, ours) / SIZE);
-        }
-        eprintln!(
-            "n = {n}: largest differences to subtess: LimitStencilTable positions {position_error:.1e} \
-             of the size, normals {normal_error:.1e}; Bfr positions {bfr_error:.1e} of the size"
-        );
-        assert!(position_error < 1e-5, "LimitStencilTable positions differ");
-        assert!(normal_error < 1e-4, "LimitStencilTable normals differ");
-        assert!(bfr_error < 1e-5, "Bfr positions differ");
-
-        let mut group = c.benchmark_group(format!(
-            "torus {face_count} quads, n = {n}, {points} points, 1 thread"
-        ));
-        group.sample_size(10);
-        group.sampling_mode(SamplingMode::Flat);
-        group.warm_up_time(Duration::from_secs(2));
-        group.measurement_time(Duration::from_secs(5));
-        group.throughput(Throughput::Elements(grid.triangle_count() as u64));
-        group.bench_function("subtess dual grid (evaluate + connect)", |b| {
-            b.iter(|| {
-                grid.evaluate(&control, &mut positions, &mut normals);
-                grid.connect(&mut triangles);
-            })
+    let torus = Mesh::new(positions, &faces, &[], schemes::BoundaryMode::EdgeOnly)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let mut cases = vec![Case {
+        name: "torus".to_owned(),
+        mesh: torus,
+        rates: &[4, 8, 16],
+    }];
+    if let Some(mesh) = shared_mesh("crane/spot_control_mesh.obj", 3) {
+        cases.push(Case {
+            name: "Spot refined 3x (no isolation)".to_owned(),
+            mesh,
+            rates: &[4, 8, 16],
         });
-        group.bench_function("OpenSubdiv LimitStencilTable (P, du, dv)", |b| {
-            b.iter(|| stencils.apply(&control, &mut osd_p, &mut osd_du, &mut osd_dv))
+    }
+    if let Some(mesh) = shared_mesh("crane/spot_triangulated.obj", 0) {
+        cases.push(Case {
+            name: "Spot triangulated (isolation)".to_owned(),
+            mesh,
+            rates: &[4, 8],
         });
-        group.bench_function("OpenSubdiv Bfr::Surface (P only, crate API)", |b| {
-            b.iter(|| {
-                for (surface, out) in surfaces.iter().zip(osd_p.chunks_exact_mut(n * n)) {
-                    bfr_face(surface, &s, &t, &control, out);
-                }
-            })
-        });
-        group.finish();
+    }
+    for case in &cases {
+        compare(c, &two_threads, case);
     }
 }
 
 /// The crate's `Far::PatchTable` evaluation (`PatchMap::find_patch` + `evaluate_point`) is not
 /// benchmarked: print how far it is from the limit surface at the face centres (the limit
 /// stencils', which agree with subtess).
-fn check_patch_table(refiner: &far::TopologyRefiner, control: &[[f32; 3]]) {
+fn check_patch_table(refiner: &far::TopologyRefiner, control: &[[f32; 3]], size: f64) {
     let Ok(patches) = far::PatchTable::new(refiner, None) else {
         eprintln!("Far::PatchTable: the crate could not build it");
         return;
@@ -365,7 +528,7 @@ fn check_patch_table(refiner: &far::TopologyRefiner, control: &[[f32; 3]]) {
             eprintln!("Far::PatchTable: evaluate_point failed for face {f}");
             return;
         };
-        worst = worst.max(max_difference(&[result.point], &[*e]) / SIZE);
+        worst = worst.max(max_difference(&[result.point], &[*e]) / size);
         let derivatives = result.du.iter().chain(&result.dv);
         largest_derivative = derivatives.fold(largest_derivative, |m, x| m.max(x.abs()));
     }
