@@ -8,7 +8,7 @@
 /// A point in space.
 pub type Point = [f64; 3];
 
-pub(crate) use crate::mesh::geometry::{cross, norm, sub};
+pub(crate) use crate::mesh::geometry::{cross, dot, norm, sub};
 
 /// A bicubic net, `b[4 j + i]`.
 pub type Net = [Point; 16];
@@ -128,16 +128,19 @@ pub fn flatness_bound(net: &Net) -> f64 {
         sub(net[n], bilinear(i as f64 / 3.0, j as f64 / 3.0))
     });
     let w: Point = std::array::from_fn(|k| (v1[k] - v2[k] + v3[k] - v4[k]) / 4.0);
+    // Squared lengths (`norm` is the square root of `dot`), one square root at the end:
+    // `sqrt` is correctly rounded, hence monotone, so the square root of the largest square
+    // is the largest length to the last bit.
     let mut best: f64 = 0.0;
     for (i, ci) in c.iter().enumerate() {
         for cj in &c[i..] {
             let d = sub(*ci, *cj);
-            let plus = norm([d[0] + w[0], d[1] + w[1], d[2] + w[2]]);
-            let minus = norm([d[0] - w[0], d[1] - w[1], d[2] - w[2]]);
-            best = best.max(plus).max(minus);
+            let plus = [d[0] + w[0], d[1] + w[1], d[2] + w[2]];
+            let minus = [d[0] - w[0], d[1] - w[1], d[2] - w[2]];
+            best = best.max(dot(plus, plus)).max(dot(minus, minus));
         }
     }
-    best
+    best.sqrt()
 }
 
 #[cfg(test)]

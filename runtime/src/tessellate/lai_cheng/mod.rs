@@ -55,7 +55,7 @@ mod feature;
 mod operators;
 mod polygons;
 
-use std::collections::HashMap;
+use std::collections::{HashMap, VecDeque};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
@@ -441,13 +441,33 @@ impl FaceWork<'_> {
 
     /// The patch at an extraordinary vertex with layout `points`: descend with `A` (section
     /// 4.1), the three regular quarters of each level as Bézier squares.
-    fn extraordinary(&mut self, ops: &Operators, mut points: Vec<Point>, vertex_normal: Point) {
+    ///
+    /// The levels `k..=k + EV_ENCLOSURE_LEVELS` that the enclosure of level `k` needs are kept
+    /// in a window and each is made once (the next level's enclosure shares all but one).
+    fn extraordinary(&mut self, ops: &Operators, points: Vec<Point>, vertex_normal: Point) {
         let mut depth = 0;
         let mut root_diagonal = 0.0;
+        let mut window = VecDeque::from([EvLevel::new(ops, points)]);
+        // Without non-negative rules there is no enclosure, only the level itself.
+        let wanted = if ops.nonnegative {
+            EV_ENCLOSURE_LEVELS + 1
+        } else {
+            1
+        };
         loop {
-            let nets: [Net; 3] = std::array::from_fn(|b| ops.sub_patch(b, &points));
+            while window.len() < wanted {
+                if let Some(last) = window.back() {
+                    let next = ops.a.apply(&last.points);
+                    window.push_back(EvLevel::new(ops, next));
+                }
+            }
+            let levels = window.make_contiguous();
+            let Some(level) = levels.first() else {
+                return;
+            };
+            let nets = &level.nets;
             let corner_points = [
-                ops.vertex_position(&points),
+                ops.vertex_position(&level.points),
                 nets[0][3],
                 nets[1][15],
                 nets[2][12],
@@ -457,7 +477,7 @@ impl FaceWork<'_> {
                 root_diagonal = diagonal;
             }
             let bound = if ops.nonnegative {
-                diameter(&points).min(diameter(&ev_enclosure(ops, &nets, &points)))
+                diameter(&level.points).min(diameter(&ev_enclosure(levels)))
             } else {
                 f64::INFINITY
             };
@@ -483,9 +503,27 @@ impl FaceWork<'_> {
             self.regular(&nets[0], half, 0, depth + 1);
             self.regular(&nets[1], half, half, depth + 1);
             self.regular(&nets[2], 0, half, depth + 1);
-            points = ops.a.apply(&points);
+            if let Some(done) = window.pop_front() {
+                if window.is_empty() {
+                    window.push_back(EvLevel::new(ops, ops.a.apply(&done.points)));
+                }
+            }
             depth += 1;
         }
+    }
+}
+
+/// One level `k` of the extraordinary descent: the layout `A^k P` of the square
+/// `[0, 2^-k]^2` at the vertex and the Bézier nets `R_b A^k P` of its three regular quarters.
+struct EvLevel {
+    points: Vec<Point>,
+    nets: [Net; 3],
+}
+
+impl EvLevel {
+    fn new(ops: &Operators, points: Vec<Point>) -> Self {
+        let nets = std::array::from_fn(|b| ops.sub_patch(b, &points));
+        EvLevel { points, nets }
     }
 }
 
@@ -503,33 +541,71 @@ enum Path {
 /// Levels of the extraordinary enclosure ([`ev_enclosure`]).
 const EV_ENCLOSURE_LEVELS: usize = 3;
 
-/// Points whose convex hull contains the surface over the extraordinary square with layout
-/// `points` (`nets`: its three regular quarters, `ops.sub_patch(b, points)`): the Bézier nets
+/// Points whose convex hull contains the surface over the extraordinary square of
+/// `levels[0]` (`levels`: that level and the next [`EV_ENCLOSURE_LEVELS`]): the Bézier nets
 /// of the regular quarters of [`EV_ENCLOSURE_LEVELS`] levels and the layout `A^levels P` of the
 /// innermost square. Each regular quarter lies in the hull of its own Bézier net (Bernstein
 /// polynomials are non-negative and sum to one), the innermost square in the hull of its layout
 /// (`A >= 0`, the extraordinary bound's condition), and the squares tile the extraordinary one.
 /// The hull is inside that of `points` when the quarters' operators are non-negative too, and
 /// shrinks towards the surface piece itself as the levels grow.
-fn ev_enclosure(ops: &Operators, nets: &[Net; 3], points: &[Point]) -> Vec<Point> {
-    let mut out: Vec<Point> = nets.iter().flat_map(|n| n.iter().copied()).collect();
-    let mut layout = ops.a.apply(points);
-    for _ in 1..EV_ENCLOSURE_LEVELS {
-        for b in 0..3 {
-            out.extend_from_slice(&ops.sub_patch(b, &layout));
-        }
-        layout = ops.a.apply(&layout);
+fn ev_enclosure(levels: &[EvLevel]) -> Vec<Point> {
+    let mut out: Vec<Point> = Vec::with_capacity(EV_ENCLOSURE_LEVELS * 48 + 64);
+    for level in levels.iter().take(EV_ENCLOSURE_LEVELS) {
+        out.extend(level.nets.iter().flat_map(|n| n.iter().copied()));
     }
-    out.extend_from_slice(&layout);
+    if let Some(innermost) = levels.get(EV_ENCLOSURE_LEVELS) {
+        out.extend_from_slice(&innermost.points);
+    }
     out
 }
 
-/// The largest distance between two of the points (the diameter of their convex hull).
+/// The largest distance between two of the points (the diameter of their convex hull), to the
+/// last bit the largest `norm(a - b)` over all pairs.
+///
+/// Pairs are visited by decreasing distance `r` from the centroid, and a pair is skipped when
+/// `r_a + r_b` (the triangle inequality's bound on `|a - b|`) is below the best distance found,
+/// with a margin of `1e-12` of the coordinates' and radii's size, far above the rounding of
+/// either side: a skipped pair's computed distance cannot be the largest, so the result is
+/// the full double loop's, and most of the `n^2 / 2` pairs of an enclosure (`ev_enclosure`,
+/// about 170 points clustered near a surface piece) are never computed.
 fn diameter(points: &[Point]) -> f64 {
-    let mut best: f64 = 0.0;
-    for (i, a) in points.iter().enumerate() {
-        for b in &points[i + 1..] {
-            best = best.max(bezier_net::norm(bezier_net::sub(*a, *b)));
+    if points.is_empty() {
+        return 0.0;
+    }
+    let mut centroid = [0.0; 3];
+    let mut scale: f64 = 0.0;
+    for p in points {
+        for c in 0..3 {
+            centroid[c] += p[c];
+            scale = scale.max(p[c].abs());
+        }
+    }
+    let centroid = centroid.map(|c| c / points.len() as f64);
+    let mut by_radius: Vec<(f64, Point)> = points
+        .iter()
+        .map(|&p| (bezier_net::norm(bezier_net::sub(p, centroid)), p))
+        .collect();
+    by_radius.sort_unstable_by(|a, b| b.0.total_cmp(&a.0));
+    let margin = 1e-12 * (scale + 2.0 * by_radius.first().map_or(0.0, |p| p.0));
+    let mut best_squared: f64 = 0.0;
+    let mut best = 0.0;
+    for (i, &(ra, a)) in by_radius.iter().enumerate() {
+        if 2.0 * ra + margin < best {
+            break;
+        }
+        for &(rb, b) in &by_radius[i + 1..] {
+            if ra + rb + margin < best {
+                break;
+            }
+            let d = bezier_net::sub(a, b);
+            // `norm` is the root of this square, and `sqrt` is monotone: the largest
+            // square's root is the largest `norm` exactly.
+            let squared = bezier_net::dot(d, d);
+            if squared > best_squared {
+                best_squared = squared;
+                best = squared.sqrt();
+            }
         }
     }
     best
