@@ -52,6 +52,7 @@
 
 pub mod bezier_net;
 mod feature;
+mod global_ids;
 mod operators;
 mod polygons;
 
@@ -63,7 +64,7 @@ use rayon::prelude::*;
 use serde_json::{json, Value};
 use table_format::{PointSet, SectionKey, StencilKind};
 
-use crate::mesh::topology::{Mesh, NONE};
+use crate::mesh::topology::Mesh;
 use crate::mesh::triangle_mesh::{TriangleMesh, VertexSource};
 use crate::scheme::catmull_clark::adaptive::{limit_of, limit_stencils, LimitQuery};
 use crate::scheme::patch::{is_smooth_patch, FacePatch, PatchKind};
@@ -639,165 +640,6 @@ fn vertex_normal(table: &StencilTable, patch: &FacePatch, points: &[Point]) -> O
     )))
 }
 
-/// The shared key of a point (section 5's global index): a mesh vertex, a point on a mesh
-/// edge (the half-edge with the smaller index of the pair, and the parameter along it), or a
-/// point inside a face.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-enum PointKey {
-    Vertex(u32),
-    Edge(u32, u32),
-    Face(u32, u32, u32),
-}
-
-/// Side `side` of a face (counter-clockwise from corner `side`) and the own parameter `t` along
-/// it of the face point `(u, v)`, if it is on that side's interior.
-fn on_side(u: u32, v: u32) -> Option<(usize, u32)> {
-    match (u, v) {
-        (_, 0) => Some((0, u)),
-        (GRID, _) => Some((1, v)),
-        (_, GRID) => Some((2, GRID - u)),
-        (0, _) => Some((3, GRID - v)),
-        _ => None,
-    }
-}
-
-/// The canonical half-edge of side `side` of face `face`, and whether parameters flip on it.
-fn canonical_edge(mesh: &Mesh, face: usize, side: usize) -> (u32, bool) {
-    let h = mesh.face_halfedges(face).start + side;
-    let t = mesh.twin[h];
-    if t != NONE && (t as usize) < h {
-        (t, true)
-    } else {
-        (h as u32, false)
-    }
-}
-
-fn point_key(mesh: &Mesh, face: usize, u: u32, v: u32) -> PointKey {
-    let corner = match (u, v) {
-        (0, 0) => Some(0),
-        (GRID, 0) => Some(1),
-        (GRID, GRID) => Some(2),
-        (0, GRID) => Some(3),
-        _ => None,
-    };
-    if let Some(k) = corner {
-        return PointKey::Vertex(mesh.face(face)[k]);
-    }
-    match on_side(u, v) {
-        Some((side, t)) => {
-            let (h, flip) = canonical_edge(mesh, face, side);
-            PointKey::Edge(h, if flip { GRID - t } else { t })
-        }
-        None => PointKey::Face(face as u32, u, v),
-    }
-}
-
-/// The values of a sorted list strictly between `lo` and `hi`.
-fn between(sorted: &[u32], lo: u32, hi: u32) -> &[u32] {
-    let a = sorted.partition_point(|&x| x <= lo);
-    let b = sorted.partition_point(|&x| x < hi);
-    &sorted[a..b.max(a)]
-}
-
-/// Every marked point, grouped for the polygon walk: per canonical mesh edge the parameters
-/// along it; per face the interior points on each horizontal (`v` fixed) and vertical line.
-struct MarkedSets {
-    edges: HashMap<u32, Vec<u32>>,
-    lines: Vec<HashMap<(bool, u32), Vec<u32>>>,
-}
-
-impl MarkedSets {
-    /// The marked points strictly inside side `side` of face `face` between own parameters
-    /// `lo` and `hi`, ascending (the walking order of the side).
-    fn on_edge(&self, mesh: &Mesh, face: usize, side: usize, lo: u32, hi: u32) -> Vec<u32> {
-        let (h, flip) = canonical_edge(mesh, face, side);
-        let Some(all) = self.edges.get(&h) else {
-            return Vec::new();
-        };
-        if flip {
-            let mut out: Vec<u32> = between(all, GRID - hi, GRID - lo)
-                .iter()
-                .map(|&t| GRID - t)
-                .collect();
-            out.reverse();
-            out
-        } else {
-            between(all, lo, hi).to_vec()
-        }
-    }
-
-    /// The marked points strictly inside `(lo, hi)` on a face line, ascending.
-    fn on_line(&self, face: usize, horizontal: bool, at: u32, lo: u32, hi: u32) -> &[u32] {
-        match self.lines[face].get(&(horizontal, at)) {
-            Some(all) => between(all, lo, hi),
-            None => &[],
-        }
-    }
-}
-
-/// The ring of face grid points around a leaf: its corners and every marked point on its
-/// sides, counter-clockwise (section 5: "output in order all the marked points between corners
-/// of the base quadrilateral").
-fn leaf_ring(mesh: &Mesh, sets: &MarkedSets, face: usize, leaf: &Leaf) -> Vec<(u32, u32)> {
-    let (u0, v0) = (leaf.u0, leaf.v0);
-    let (u1, v1) = (u0 + leaf.size, v0 + leaf.size);
-    let mut ring = vec![(u0, v0)];
-    if v0 == 0 {
-        ring.extend(sets.on_edge(mesh, face, 0, u0, u1).iter().map(|&t| (t, 0)));
-    } else {
-        ring.extend(
-            sets.on_line(face, true, v0, u0, u1)
-                .iter()
-                .map(|&u| (u, v0)),
-        );
-    }
-    ring.push((u1, v0));
-    if u1 == GRID {
-        ring.extend(
-            sets.on_edge(mesh, face, 1, v0, v1)
-                .iter()
-                .map(|&t| (GRID, t)),
-        );
-    } else {
-        ring.extend(
-            sets.on_line(face, false, u1, v0, v1)
-                .iter()
-                .map(|&v| (u1, v)),
-        );
-    }
-    ring.push((u1, v1));
-    if v1 == GRID {
-        ring.extend(
-            sets.on_edge(mesh, face, 2, GRID - u1, GRID - u0)
-                .iter()
-                .map(|&t| (GRID - t, GRID)),
-        );
-    } else {
-        ring.extend(
-            sets.on_line(face, true, v1, u0, u1)
-                .iter()
-                .rev()
-                .map(|&u| (u, v1)),
-        );
-    }
-    ring.push((u0, v1));
-    if u0 == 0 {
-        ring.extend(
-            sets.on_edge(mesh, face, 3, GRID - v1, GRID - v0)
-                .iter()
-                .map(|&t| (0, GRID - t)),
-        );
-    } else {
-        ring.extend(
-            sets.on_line(face, false, u0, v0, v1)
-                .iter()
-                .rev()
-                .map(|&v| (u0, v)),
-        );
-    }
-    ring
-}
-
 fn check_options(options: &AdaptiveOptions) -> Result<(), RuntimeError> {
     let bad = |name: &str, reason: String| RuntimeError::InvalidParameter {
         name: name.to_owned(),
@@ -1032,48 +874,15 @@ pub fn tessellate_adaptive(
             }
         }
     }
-    // Pass 2: global ids (section 5), first evaluation wins, in face order.
-    let mut ids: HashMap<PointKey, u32> = HashMap::new();
+    // Pass 2 (parallel): global ids (section 5), first evaluation wins, in face order.
     let mut out = AdaptiveMesh::default();
-    let mut sets = MarkedSets {
-        edges: HashMap::new(),
-        lines: vec![HashMap::new(); mesh.faces()],
-    };
-    for (face, (_, marked)) in work.iter().enumerate() {
-        for m in marked {
-            let key = point_key(mesh, face, m.u, m.v);
-            if ids.contains_key(&key) {
-                continue;
-            }
-            ids.insert(key, out.positions.len() as u32);
-            out.positions.push(m.position);
-            out.normals.push(m.normal);
-            let shift = (m.u | m.v | GRID).trailing_zeros();
-            out.sources.push(VertexSource {
-                face: face as u32,
-                u: m.u >> shift,
-                v: m.v >> shift,
-                denominator: GRID >> shift,
-                subface: 0,
-            });
-            match key {
-                PointKey::Vertex(_) => {}
-                PointKey::Edge(h, t) => sets.edges.entry(h).or_default().push(t),
-                PointKey::Face(..) => {
-                    sets.lines[face].entry((true, m.v)).or_default().push(m.u);
-                    sets.lines[face].entry((false, m.u)).or_default().push(m.v);
-                }
-            }
-        }
-    }
-    for list in sets.edges.values_mut() {
-        list.sort_unstable();
-    }
-    for lines in &mut sets.lines {
-        for list in lines.values_mut() {
-            list.sort_unstable();
-        }
-    }
+    let ids = global_ids::assign(
+        mesh,
+        &work,
+        &mut out.positions,
+        &mut out.normals,
+        &mut out.sources,
+    )?;
     // Pass 3 (parallel): the polygons (base quadrilateral replacement) and their triangles.
     let polygons: Vec<Vec<AdaptivePolygon>> = work
         .par_iter()
@@ -1083,22 +892,11 @@ pub fn tessellate_adaptive(
                 leaves
                     .iter()
                     .map(|leaf| {
-                        let ring = leaf_ring(mesh, &sets, face, leaf);
-                        let vertices = ring
-                            .iter()
-                            .map(|&(u, v)| {
-                                ids.get(&point_key(mesh, face, u, v))
-                                    .copied()
-                                    .ok_or_else(|| {
-                                        RuntimeError::Unsupported(format!(
-                                    "internal: face {face} point ({u}, {v}) / {GRID} has no id"
-                                ))
-                                    })
-                            })
-                            .collect::<Result<Vec<u32>, _>>()?;
+                        let ring = ids.leaf_ring(mesh, face, leaf)?;
+                        let vertices: Vec<u32> = ring.iter().map(|&(_, id)| id).collect();
                         let params: Vec<(i64, i64)> = ring
                             .iter()
-                            .map(|&(u, v)| (i64::from(u), i64::from(v)))
+                            .map(|&((u, v), _)| (i64::from(u), i64::from(v)))
                             .collect();
                         let positions: Vec<Point> = vertices
                             .iter()
