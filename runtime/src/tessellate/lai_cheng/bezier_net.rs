@@ -150,17 +150,16 @@ pub fn flatness_bound(net: &Net) -> f64 {
     // point), and a branch-free loop over all 256 of them vectorizes.
     let coordinate = |k: usize| -> [f64; 16] { std::array::from_fn(|n| c[n][k]) };
     let (x, y, z) = (coordinate(0), coordinate(1), coordinate(2));
-    let mut best: f64 = 0.0;
+    // The largest square per `j` (lane-wise maxima), then over `j`.
+    let mut largest = [0.0f64; 16];
     for i in 0..16 {
-        let mut row = [0.0f64; 16];
         for j in 0..16 {
             // `(c_i - c_j) + w`, in this order (the rounding of the unordered pairs' form).
             let d = [x[i] - x[j] + w[0], y[i] - y[j] + w[1], z[i] - z[j] + w[2]];
-            row[j] = dot(d, d);
+            largest[j] = largest[j].max(dot(d, d));
         }
-        best = row.iter().fold(best, |a, &b| a.max(b));
     }
-    best.sqrt()
+    largest.iter().fold(0.0f64, |a, &b| a.max(b)).sqrt()
 }
 
 #[cfg(test)]

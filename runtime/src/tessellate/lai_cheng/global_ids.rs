@@ -341,7 +341,7 @@ impl GlobalIds {
         (id != NONE).then_some(id)
     }
 
-    /// The ring of marked points around a leaf, face grid points and ids: its corners and
+    /// The ring of marked points around a leaf, face grid points and ids, into `ring`: its corners and
     /// every marked point on its sides, counter-clockwise (section 5: "output in order all the
     /// marked points between corners of the base quadrilateral").
     pub(super) fn leaf_ring(
@@ -349,14 +349,15 @@ impl GlobalIds {
         mesh: &Mesh,
         face: usize,
         leaf: &Leaf,
-    ) -> Result<Vec<((u32, u32), u32)>, RuntimeError> {
+        ring: &mut Vec<((u32, u32), u32)>,
+    ) -> Result<(), RuntimeError> {
         let ids = self
             .faces
             .get(face)
             .ok_or_else(|| internal(format!("face {face} has no ids")))?;
         let (u0, v0) = (leaf.u0, leaf.v0);
         let (u1, v1) = (u0 + leaf.size, v0 + leaf.size);
-        let mut ring = Vec::with_capacity(8);
+        ring.clear();
         let corner = |ring: &mut Vec<((u32, u32), u32)>, u: u32, v: u32| {
             let id = self.id(mesh, face, u, v).ok_or_else(|| {
                 internal(format!("face {face} point ({u}, {v}) / {GRID} has no id"))
@@ -364,7 +365,7 @@ impl GlobalIds {
             ring.push(((u, v), id));
             Ok::<(), RuntimeError>(())
         };
-        corner(&mut ring, u0, v0)?;
+        corner(ring, u0, v0)?;
         if v0 == 0 {
             ring.extend(
                 between(&ids.edges[0], u0, u1)
@@ -378,7 +379,7 @@ impl GlobalIds {
                     .map(|&((_, u), id)| ((u, v0), id)),
             );
         }
-        corner(&mut ring, u1, v0)?;
+        corner(ring, u1, v0)?;
         if u1 == GRID {
             ring.extend(
                 between(&ids.edges[1], v0, v1)
@@ -392,7 +393,7 @@ impl GlobalIds {
                     .map(|&((_, v), id)| ((u1, v), id)),
             );
         }
-        corner(&mut ring, u1, v1)?;
+        corner(ring, u1, v1)?;
         if v1 == GRID {
             ring.extend(
                 between(&ids.edges[2], GRID - u1, GRID - u0)
@@ -407,7 +408,7 @@ impl GlobalIds {
                     .map(|&((_, u), id)| ((u, v1), id)),
             );
         }
-        corner(&mut ring, u0, v1)?;
+        corner(ring, u0, v1)?;
         if u0 == 0 {
             ring.extend(
                 between(&ids.edges[3], GRID - v1, GRID - v0)
@@ -422,6 +423,6 @@ impl GlobalIds {
                     .map(|&((_, v), id)| ((u0, v), id)),
             );
         }
-        Ok(ring)
+        Ok(())
     }
 }

@@ -889,19 +889,19 @@ pub fn tessellate_adaptive(
         .enumerate()
         .map(
             |(face, (leaves, _))| -> Result<Vec<AdaptivePolygon>, RuntimeError> {
+                // One set of buffers per face, not per polygon.
+                let mut ring = Vec::new();
+                let mut params = Vec::new();
+                let mut positions = Vec::new();
                 leaves
                     .iter()
                     .map(|leaf| {
-                        let ring = ids.leaf_ring(mesh, face, leaf)?;
+                        ids.leaf_ring(mesh, face, leaf, &mut ring)?;
                         let vertices: Vec<u32> = ring.iter().map(|&(_, id)| id).collect();
-                        let params: Vec<(i64, i64)> = ring
-                            .iter()
-                            .map(|&((u, v), _)| (i64::from(u), i64::from(v)))
-                            .collect();
-                        let positions: Vec<Point> = vertices
-                            .iter()
-                            .map(|&i| out.positions[i as usize])
-                            .collect();
+                        params.clear();
+                        params.extend(ring.iter().map(|&((u, v), _)| (i64::from(u), i64::from(v))));
+                        positions.clear();
+                        positions.extend(vertices.iter().map(|&i| out.positions[i as usize]));
                         let triangles = polygons::triangulate(&params, &positions)
                             .into_iter()
                             .map(|t| t.map(|k| vertices[k]))
@@ -927,7 +927,7 @@ pub fn tessellate_adaptive(
             },
         )
         .collect::<Result<_, _>>()?;
-    out.polygons = polygons.into_iter().flatten().collect();
+    out.polygons = polygons.into_par_iter().flatten().collect();
     let stats = statistics(&out, mesh.faces(), options, started);
     Ok((out, stats))
 }

@@ -41,15 +41,17 @@ pub(crate) fn triangulate(params: &[(i64, i64)], positions: &[Point]) -> Vec<[us
             if area2(params[a], params[b], params[c]) <= 0 {
                 continue;
             }
-            // The ring without `b`, walked in place (no copy per candidate ear).
+            let length = norm(sub(positions[a], positions[c]));
+            if matches!(best, Some((l, _)) if l <= length) {
+                // Not cut whether admissible or not: the earlier ear is at least as short.
+                continue;
+            }
+            // The ring without `b`, walked in place (no copy per candidate ear); only for an
+            // ear that would be cut.
             if collinear(ring.iter().filter(|&&i| i != b).map(|&i| params[i])) {
                 continue;
             }
-            let length = norm(sub(positions[a], positions[c]));
-            match best {
-                Some((l, _)) if l <= length => {}
-                _ => best = Some((length, k)),
-            }
+            best = Some((length, k));
         }
         let Some((_, k)) = best else {
             // Not reachable for a polygon of the documented shape; fan what is left.
