@@ -29,6 +29,7 @@ enum Place {
     Interior,
 }
 
+/// The place of the face grid point `(u, v)` (corners first, then sides, counter-clockwise).
 fn place(u: u32, v: u32) -> Place {
     match (u, v) {
         (0, 0) => Place::Corner(0),
@@ -86,6 +87,8 @@ struct FacePoints {
     sides: [Vec<u32>; 4],
 }
 
+/// A face's distinct marked points (by exact `(u, v)`; the first mark of each is the one whose
+/// evaluation counts) and the canonical parameters of those inside its sides.
 fn face_points(marked: &[Marked], edges: &[SideEdge; 4]) -> FacePoints {
     let mut order: Vec<(u64, u32)> = marked
         .iter()
@@ -119,6 +122,7 @@ fn between<K: Ord + Copy>(sorted: &[(K, u32)], lo: K, hi: K) -> &[(K, u32)] {
     &sorted[a..b.max(a)]
 }
 
+/// The id paired with `key` in a sorted list.
 fn find<K: Ord + Copy>(sorted: &[(K, u32)], key: K) -> Option<u32> {
     sorted
         .binary_search_by(|x| x.0.cmp(&key))
@@ -144,6 +148,7 @@ pub(super) struct GlobalIds {
     faces: Vec<FaceIds>,
 }
 
+/// A broken invariant of the marking (every marked point has an id), as an error, not a panic.
 fn internal(what: String) -> RuntimeError {
     RuntimeError::Unsupported(format!("internal: {what}"))
 }
