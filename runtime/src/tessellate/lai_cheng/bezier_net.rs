@@ -8,7 +8,7 @@
 /// A point in space.
 pub type Point = [f64; 3];
 
-pub(crate) use crate::mesh::geometry::{cross, norm, sub};
+pub(crate) use crate::mesh::geometry::{cross, dot, norm, sub};
 
 /// A bicubic net, `b[4 j + i]`.
 pub type Net = [Point; 16];
@@ -66,11 +66,26 @@ fn halve(p: [Point; 4]) -> ([Point; 4], [Point; 4]) {
 /// section 2), in the order `[0,1/2]^2`, `[1/2,1] x [0,1/2]`, `[1/2,1]^2`, `[0,1/2] x [1/2,1]`.
 /// Exact subdivision of the polynomial (up to f64 rounding).
 pub fn split(net: &Net) -> [Net; 4] {
-    let left = map_lines(net, true, |p| halve(p).0);
-    let right = map_lines(net, true, |p| halve(p).1);
-    let low = |n: &Net| map_lines(n, false, |p| halve(p).0);
-    let high = |n: &Net| map_lines(n, false, |p| halve(p).1);
-    [low(&left), low(&right), high(&right), high(&left)]
+    let (left, right) = halves(net, true);
+    let (low_left, high_left) = halves(&left, false);
+    let (low_right, high_right) = halves(&right, false);
+    [low_left, low_right, high_right, high_left]
+}
+
+/// The two halves of a net at `1/2` along `u` (`along_u`) or `v`: [`halve`] on each of the
+/// four rows or columns, both halves from one de Casteljau pass.
+fn halves(net: &Net, along_u: bool) -> (Net, Net) {
+    let mut low = *net;
+    let mut high = *net;
+    for line in 0..4 {
+        let at = |k: usize| if along_u { 4 * line + k } else { 4 * k + line };
+        let (a, b) = halve(std::array::from_fn(|k| net[at(k)]));
+        for k in 0..4 {
+            low[at(k)] = a[k];
+            high[at(k)] = b[k];
+        }
+    }
+    (low, high)
 }
 
 /// The corners `V_1 = S(0,0)`, `V_2 = S(1,0)`, `V_3 = S(1,1)`, `V_4 = S(0,1)` of the patch
@@ -128,16 +143,23 @@ pub fn flatness_bound(net: &Net) -> f64 {
         sub(net[n], bilinear(i as f64 / 3.0, j as f64 / 3.0))
     });
     let w: Point = std::array::from_fn(|k| (v1[k] - v2[k] + v3[k] - v4[k]) / 4.0);
-    let mut best: f64 = 0.0;
-    for (i, ci) in c.iter().enumerate() {
-        for cj in &c[i..] {
-            let d = sub(*ci, *cj);
-            let plus = norm([d[0] + w[0], d[1] + w[1], d[2] + w[2]]);
-            let minus = norm([d[0] - w[0], d[1] - w[1], d[2] - w[2]]);
-            best = best.max(plus).max(minus);
+    // Squared lengths (`norm` is the square root of `dot`), one square root at the end:
+    // `sqrt` is correctly rounded, hence monotone, so the square root of the largest square
+    // is the largest length to the last bit. Every ordered pair with `+w` covers the
+    // unordered pairs with both signs (`c_j - c_i + w = -(c_i - c_j - w)`, exactly in floating
+    // point), and a branch-free loop over all 256 of them vectorizes.
+    let coordinate = |k: usize| -> [f64; 16] { std::array::from_fn(|n| c[n][k]) };
+    let (x, y, z) = (coordinate(0), coordinate(1), coordinate(2));
+    // The largest square per `j` (lane-wise maxima), then over `j`.
+    let mut largest = [0.0f64; 16];
+    for i in 0..16 {
+        for j in 0..16 {
+            // `(c_i - c_j) + w`, in this order (the rounding of the unordered pairs' form).
+            let d = [x[i] - x[j] + w[0], y[i] - y[j] + w[1], z[i] - z[j] + w[2]];
+            largest[j] = largest[j].max(dot(d, d));
         }
     }
-    best
+    largest.iter().fold(0.0f64, |a, &b| a.max(b)).sqrt()
 }
 
 #[cfg(test)]

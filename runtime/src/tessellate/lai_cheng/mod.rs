@@ -52,10 +52,11 @@
 
 pub mod bezier_net;
 mod feature;
+mod global_ids;
 mod operators;
 mod polygons;
 
-use std::collections::HashMap;
+use std::collections::{HashMap, VecDeque};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
@@ -63,7 +64,7 @@ use rayon::prelude::*;
 use serde_json::{json, Value};
 use table_format::{PointSet, SectionKey, StencilKind};
 
-use crate::mesh::topology::{Mesh, NONE};
+use crate::mesh::topology::Mesh;
 use crate::mesh::triangle_mesh::{TriangleMesh, VertexSource};
 use crate::scheme::catmull_clark::adaptive::{limit_of, limit_stencils, LimitQuery};
 use crate::scheme::patch::{is_smooth_patch, FacePatch, PatchKind};
@@ -441,13 +442,33 @@ impl FaceWork<'_> {
 
     /// The patch at an extraordinary vertex with layout `points`: descend with `A` (section
     /// 4.1), the three regular quarters of each level as Bézier squares.
-    fn extraordinary(&mut self, ops: &Operators, mut points: Vec<Point>, vertex_normal: Point) {
+    ///
+    /// The levels `k..=k + EV_ENCLOSURE_LEVELS` that the enclosure of level `k` needs are kept
+    /// in a window and each is made once (the next level's enclosure shares all but one).
+    fn extraordinary(&mut self, ops: &Operators, points: Vec<Point>, vertex_normal: Point) {
         let mut depth = 0;
         let mut root_diagonal = 0.0;
+        let mut window = VecDeque::from([EvLevel::new(ops, points)]);
+        // Without non-negative rules there is no enclosure, only the level itself.
+        let wanted = if ops.nonnegative {
+            EV_ENCLOSURE_LEVELS + 1
+        } else {
+            1
+        };
         loop {
-            let nets: [Net; 3] = std::array::from_fn(|b| ops.sub_patch(b, &points));
+            while window.len() < wanted {
+                if let Some(last) = window.back() {
+                    let next = ops.a.apply(&last.points);
+                    window.push_back(EvLevel::new(ops, next));
+                }
+            }
+            let levels = window.make_contiguous();
+            let Some(level) = levels.first() else {
+                return;
+            };
+            let nets = &level.nets;
             let corner_points = [
-                ops.vertex_position(&points),
+                ops.vertex_position(&level.points),
                 nets[0][3],
                 nets[1][15],
                 nets[2][12],
@@ -457,7 +478,7 @@ impl FaceWork<'_> {
                 root_diagonal = diagonal;
             }
             let bound = if ops.nonnegative {
-                diameter(&points).min(diameter(&ev_enclosure(ops, &nets, &points)))
+                diameter(&level.points).min(diameter(&ev_enclosure(levels)))
             } else {
                 f64::INFINITY
             };
@@ -483,9 +504,27 @@ impl FaceWork<'_> {
             self.regular(&nets[0], half, 0, depth + 1);
             self.regular(&nets[1], half, half, depth + 1);
             self.regular(&nets[2], 0, half, depth + 1);
-            points = ops.a.apply(&points);
+            if let Some(done) = window.pop_front() {
+                if window.is_empty() {
+                    window.push_back(EvLevel::new(ops, ops.a.apply(&done.points)));
+                }
+            }
             depth += 1;
         }
+    }
+}
+
+/// One level `k` of the extraordinary descent: the layout `A^k P` of the square
+/// `[0, 2^-k]^2` at the vertex and the Bézier nets `R_b A^k P` of its three regular quarters.
+struct EvLevel {
+    points: Vec<Point>,
+    nets: [Net; 3],
+}
+
+impl EvLevel {
+    fn new(ops: &Operators, points: Vec<Point>) -> Self {
+        let nets = std::array::from_fn(|b| ops.sub_patch(b, &points));
+        EvLevel { points, nets }
     }
 }
 
@@ -503,33 +542,71 @@ enum Path {
 /// Levels of the extraordinary enclosure ([`ev_enclosure`]).
 const EV_ENCLOSURE_LEVELS: usize = 3;
 
-/// Points whose convex hull contains the surface over the extraordinary square with layout
-/// `points` (`nets`: its three regular quarters, `ops.sub_patch(b, points)`): the Bézier nets
+/// Points whose convex hull contains the surface over the extraordinary square of
+/// `levels[0]` (`levels`: that level and the next [`EV_ENCLOSURE_LEVELS`]): the Bézier nets
 /// of the regular quarters of [`EV_ENCLOSURE_LEVELS`] levels and the layout `A^levels P` of the
 /// innermost square. Each regular quarter lies in the hull of its own Bézier net (Bernstein
 /// polynomials are non-negative and sum to one), the innermost square in the hull of its layout
 /// (`A >= 0`, the extraordinary bound's condition), and the squares tile the extraordinary one.
 /// The hull is inside that of `points` when the quarters' operators are non-negative too, and
 /// shrinks towards the surface piece itself as the levels grow.
-fn ev_enclosure(ops: &Operators, nets: &[Net; 3], points: &[Point]) -> Vec<Point> {
-    let mut out: Vec<Point> = nets.iter().flat_map(|n| n.iter().copied()).collect();
-    let mut layout = ops.a.apply(points);
-    for _ in 1..EV_ENCLOSURE_LEVELS {
-        for b in 0..3 {
-            out.extend_from_slice(&ops.sub_patch(b, &layout));
-        }
-        layout = ops.a.apply(&layout);
+fn ev_enclosure(levels: &[EvLevel]) -> Vec<Point> {
+    let mut out: Vec<Point> = Vec::with_capacity(EV_ENCLOSURE_LEVELS * 48 + 64);
+    for level in levels.iter().take(EV_ENCLOSURE_LEVELS) {
+        out.extend(level.nets.iter().flat_map(|n| n.iter().copied()));
     }
-    out.extend_from_slice(&layout);
+    if let Some(innermost) = levels.get(EV_ENCLOSURE_LEVELS) {
+        out.extend_from_slice(&innermost.points);
+    }
     out
 }
 
-/// The largest distance between two of the points (the diameter of their convex hull).
+/// The largest distance between two of the points (the diameter of their convex hull), to the
+/// last bit the largest `norm(a - b)` over all pairs.
+///
+/// Pairs are visited by decreasing distance `r` from the centroid, and a pair is skipped when
+/// `r_a + r_b` (the triangle inequality's bound on `|a - b|`) is below the best distance found,
+/// with a margin of `1e-12` of the coordinates' and radii's size, far above the rounding of
+/// either side: a skipped pair's computed distance cannot be the largest, so the result is
+/// the full double loop's, and most of the `n^2 / 2` pairs of an enclosure (`ev_enclosure`,
+/// about 170 points clustered near a surface piece) are never computed.
 fn diameter(points: &[Point]) -> f64 {
-    let mut best: f64 = 0.0;
-    for (i, a) in points.iter().enumerate() {
-        for b in &points[i + 1..] {
-            best = best.max(bezier_net::norm(bezier_net::sub(*a, *b)));
+    if points.is_empty() {
+        return 0.0;
+    }
+    let mut centroid = [0.0; 3];
+    let mut scale: f64 = 0.0;
+    for p in points {
+        for c in 0..3 {
+            centroid[c] += p[c];
+            scale = scale.max(p[c].abs());
+        }
+    }
+    let centroid = centroid.map(|c| c / points.len() as f64);
+    let mut by_radius: Vec<(f64, Point)> = points
+        .iter()
+        .map(|&p| (bezier_net::norm(bezier_net::sub(p, centroid)), p))
+        .collect();
+    by_radius.sort_unstable_by(|a, b| b.0.total_cmp(&a.0));
+    let margin = 1e-12 * (scale + 2.0 * by_radius.first().map_or(0.0, |p| p.0));
+    let mut best_squared: f64 = 0.0;
+    let mut best = 0.0;
+    for (i, &(ra, a)) in by_radius.iter().enumerate() {
+        if 2.0 * ra + margin < best {
+            break;
+        }
+        for &(rb, b) in &by_radius[i + 1..] {
+            if ra + rb + margin < best {
+                break;
+            }
+            let d = bezier_net::sub(a, b);
+            // `norm` is the root of this square, and `sqrt` is monotone: the largest
+            // square's root is the largest `norm` exactly.
+            let squared = bezier_net::dot(d, d);
+            if squared > best_squared {
+                best_squared = squared;
+                best = squared.sqrt();
+            }
         }
     }
     best
@@ -561,165 +638,6 @@ fn vertex_normal(table: &StencilTable, patch: &FacePatch, points: &[Point]) -> O
         tangent(StencilKind::DerivativeU)?,
         tangent(StencilKind::DerivativeV)?,
     )))
-}
-
-/// The shared key of a point (section 5's global index): a mesh vertex, a point on a mesh
-/// edge (the half-edge with the smaller index of the pair, and the parameter along it), or a
-/// point inside a face.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-enum PointKey {
-    Vertex(u32),
-    Edge(u32, u32),
-    Face(u32, u32, u32),
-}
-
-/// Side `side` of a face (counter-clockwise from corner `side`) and the own parameter `t` along
-/// it of the face point `(u, v)`, if it is on that side's interior.
-fn on_side(u: u32, v: u32) -> Option<(usize, u32)> {
-    match (u, v) {
-        (_, 0) => Some((0, u)),
-        (GRID, _) => Some((1, v)),
-        (_, GRID) => Some((2, GRID - u)),
-        (0, _) => Some((3, GRID - v)),
-        _ => None,
-    }
-}
-
-/// The canonical half-edge of side `side` of face `face`, and whether parameters flip on it.
-fn canonical_edge(mesh: &Mesh, face: usize, side: usize) -> (u32, bool) {
-    let h = mesh.face_halfedges(face).start + side;
-    let t = mesh.twin[h];
-    if t != NONE && (t as usize) < h {
-        (t, true)
-    } else {
-        (h as u32, false)
-    }
-}
-
-fn point_key(mesh: &Mesh, face: usize, u: u32, v: u32) -> PointKey {
-    let corner = match (u, v) {
-        (0, 0) => Some(0),
-        (GRID, 0) => Some(1),
-        (GRID, GRID) => Some(2),
-        (0, GRID) => Some(3),
-        _ => None,
-    };
-    if let Some(k) = corner {
-        return PointKey::Vertex(mesh.face(face)[k]);
-    }
-    match on_side(u, v) {
-        Some((side, t)) => {
-            let (h, flip) = canonical_edge(mesh, face, side);
-            PointKey::Edge(h, if flip { GRID - t } else { t })
-        }
-        None => PointKey::Face(face as u32, u, v),
-    }
-}
-
-/// The values of a sorted list strictly between `lo` and `hi`.
-fn between(sorted: &[u32], lo: u32, hi: u32) -> &[u32] {
-    let a = sorted.partition_point(|&x| x <= lo);
-    let b = sorted.partition_point(|&x| x < hi);
-    &sorted[a..b.max(a)]
-}
-
-/// Every marked point, grouped for the polygon walk: per canonical mesh edge the parameters
-/// along it; per face the interior points on each horizontal (`v` fixed) and vertical line.
-struct MarkedSets {
-    edges: HashMap<u32, Vec<u32>>,
-    lines: Vec<HashMap<(bool, u32), Vec<u32>>>,
-}
-
-impl MarkedSets {
-    /// The marked points strictly inside side `side` of face `face` between own parameters
-    /// `lo` and `hi`, ascending (the walking order of the side).
-    fn on_edge(&self, mesh: &Mesh, face: usize, side: usize, lo: u32, hi: u32) -> Vec<u32> {
-        let (h, flip) = canonical_edge(mesh, face, side);
-        let Some(all) = self.edges.get(&h) else {
-            return Vec::new();
-        };
-        if flip {
-            let mut out: Vec<u32> = between(all, GRID - hi, GRID - lo)
-                .iter()
-                .map(|&t| GRID - t)
-                .collect();
-            out.reverse();
-            out
-        } else {
-            between(all, lo, hi).to_vec()
-        }
-    }
-
-    /// The marked points strictly inside `(lo, hi)` on a face line, ascending.
-    fn on_line(&self, face: usize, horizontal: bool, at: u32, lo: u32, hi: u32) -> &[u32] {
-        match self.lines[face].get(&(horizontal, at)) {
-            Some(all) => between(all, lo, hi),
-            None => &[],
-        }
-    }
-}
-
-/// The ring of face grid points around a leaf: its corners and every marked point on its
-/// sides, counter-clockwise (section 5: "output in order all the marked points between corners
-/// of the base quadrilateral").
-fn leaf_ring(mesh: &Mesh, sets: &MarkedSets, face: usize, leaf: &Leaf) -> Vec<(u32, u32)> {
-    let (u0, v0) = (leaf.u0, leaf.v0);
-    let (u1, v1) = (u0 + leaf.size, v0 + leaf.size);
-    let mut ring = vec![(u0, v0)];
-    if v0 == 0 {
-        ring.extend(sets.on_edge(mesh, face, 0, u0, u1).iter().map(|&t| (t, 0)));
-    } else {
-        ring.extend(
-            sets.on_line(face, true, v0, u0, u1)
-                .iter()
-                .map(|&u| (u, v0)),
-        );
-    }
-    ring.push((u1, v0));
-    if u1 == GRID {
-        ring.extend(
-            sets.on_edge(mesh, face, 1, v0, v1)
-                .iter()
-                .map(|&t| (GRID, t)),
-        );
-    } else {
-        ring.extend(
-            sets.on_line(face, false, u1, v0, v1)
-                .iter()
-                .map(|&v| (u1, v)),
-        );
-    }
-    ring.push((u1, v1));
-    if v1 == GRID {
-        ring.extend(
-            sets.on_edge(mesh, face, 2, GRID - u1, GRID - u0)
-                .iter()
-                .map(|&t| (GRID - t, GRID)),
-        );
-    } else {
-        ring.extend(
-            sets.on_line(face, true, v1, u0, u1)
-                .iter()
-                .rev()
-                .map(|&u| (u, v1)),
-        );
-    }
-    ring.push((u0, v1));
-    if u0 == 0 {
-        ring.extend(
-            sets.on_edge(mesh, face, 3, GRID - v1, GRID - v0)
-                .iter()
-                .map(|&t| (0, GRID - t)),
-        );
-    } else {
-        ring.extend(
-            sets.on_line(face, false, u0, v0, v1)
-                .iter()
-                .rev()
-                .map(|&v| (u0, v)),
-        );
-    }
-    ring
 }
 
 fn check_options(options: &AdaptiveOptions) -> Result<(), RuntimeError> {
@@ -956,78 +874,34 @@ pub fn tessellate_adaptive(
             }
         }
     }
-    // Pass 2: global ids (section 5), first evaluation wins, in face order.
-    let mut ids: HashMap<PointKey, u32> = HashMap::new();
+    // Pass 2 (parallel): global ids (section 5), first evaluation wins, in face order.
     let mut out = AdaptiveMesh::default();
-    let mut sets = MarkedSets {
-        edges: HashMap::new(),
-        lines: vec![HashMap::new(); mesh.faces()],
-    };
-    for (face, (_, marked)) in work.iter().enumerate() {
-        for m in marked {
-            let key = point_key(mesh, face, m.u, m.v);
-            if ids.contains_key(&key) {
-                continue;
-            }
-            ids.insert(key, out.positions.len() as u32);
-            out.positions.push(m.position);
-            out.normals.push(m.normal);
-            let shift = (m.u | m.v | GRID).trailing_zeros();
-            out.sources.push(VertexSource {
-                face: face as u32,
-                u: m.u >> shift,
-                v: m.v >> shift,
-                denominator: GRID >> shift,
-                subface: 0,
-            });
-            match key {
-                PointKey::Vertex(_) => {}
-                PointKey::Edge(h, t) => sets.edges.entry(h).or_default().push(t),
-                PointKey::Face(..) => {
-                    sets.lines[face].entry((true, m.v)).or_default().push(m.u);
-                    sets.lines[face].entry((false, m.u)).or_default().push(m.v);
-                }
-            }
-        }
-    }
-    for list in sets.edges.values_mut() {
-        list.sort_unstable();
-    }
-    for lines in &mut sets.lines {
-        for list in lines.values_mut() {
-            list.sort_unstable();
-        }
-    }
+    let ids = global_ids::assign(
+        mesh,
+        &work,
+        &mut out.positions,
+        &mut out.normals,
+        &mut out.sources,
+    )?;
     // Pass 3 (parallel): the polygons (base quadrilateral replacement) and their triangles.
     let polygons: Vec<Vec<AdaptivePolygon>> = work
         .par_iter()
         .enumerate()
         .map(
             |(face, (leaves, _))| -> Result<Vec<AdaptivePolygon>, RuntimeError> {
+                // One set of buffers per face, not per polygon.
+                let mut ring = Vec::new();
+                let mut params = Vec::new();
+                let mut positions = Vec::new();
                 leaves
                     .iter()
                     .map(|leaf| {
-                        let ring = leaf_ring(mesh, &sets, face, leaf);
-                        let vertices = ring
-                            .iter()
-                            .map(|&(u, v)| {
-                                ids.get(&point_key(mesh, face, u, v))
-                                    .copied()
-                                    .ok_or_else(|| {
-                                        RuntimeError::Unsupported(format!(
-                                    "internal: face {face} point ({u}, {v}) / {GRID} has no id"
-                                ))
-                                    })
-                            })
-                            .collect::<Result<Vec<u32>, _>>()?;
-                        let params: Vec<(i64, i64)> = ring
-                            .iter()
-                            .map(|&(u, v)| (i64::from(u), i64::from(v)))
-                            .collect();
-                        let positions: Vec<Point> = vertices
-                            .iter()
-                            .map(|&i| out.positions[i as usize])
-                            .collect();
+                        ids.leaf_ring(mesh, face, leaf, &mut ring)?;
+                        let vertices: Vec<u32> = ring.iter().map(|&(_, id)| id).collect();
+                        params.clear();
+                        params.extend(ring.iter().map(|&((u, v), _)| (i64::from(u), i64::from(v))));
+                        positions.clear();
+                        positions.extend(vertices.iter().map(|&i| out.positions[i as usize]));
                         let triangles = polygons::triangulate(&params, &positions)
                             .into_iter()
                             .map(|t| t.map(|k| vertices[k]))
@@ -1053,7 +927,7 @@ pub fn tessellate_adaptive(
             },
         )
         .collect::<Result<_, _>>()?;
-    out.polygons = polygons.into_iter().flatten().collect();
+    out.polygons = polygons.into_par_iter().flatten().collect();
     let stats = statistics(&out, mesh.faces(), options, started);
     Ok((out, stats))
 }

@@ -14,10 +14,10 @@ fn area2(a: (i64, i64), b: (i64, i64), c: (i64, i64)) -> i64 {
     (b.0 - a.0) * (c.1 - a.1) - (b.1 - a.1) * (c.0 - a.0)
 }
 
-/// Whether all the points are on one line.
-fn collinear(points: &[(i64, i64)]) -> bool {
-    match points {
-        [a, b, rest @ ..] => rest.iter().all(|&c| area2(*a, *b, c) == 0),
+/// Whether all the points are on one line (tested against the line through the first two).
+fn collinear(mut points: impl Iterator<Item = (i64, i64)>) -> bool {
+    match (points.next(), points.next()) {
+        (Some(a), Some(b)) => points.all(|c| area2(a, b, c) == 0),
         _ => true,
     }
 }
@@ -41,19 +41,17 @@ pub(crate) fn triangulate(params: &[(i64, i64)], positions: &[Point]) -> Vec<[us
             if area2(params[a], params[b], params[c]) <= 0 {
                 continue;
             }
-            let rest: Vec<(i64, i64)> = ring
-                .iter()
-                .filter(|&&i| i != b)
-                .map(|&i| params[i])
-                .collect();
-            if collinear(&rest) {
+            let length = norm(sub(positions[a], positions[c]));
+            if matches!(best, Some((l, _)) if l <= length) {
+                // Not cut whether admissible or not: the earlier ear is at least as short.
                 continue;
             }
-            let length = norm(sub(positions[a], positions[c]));
-            match best {
-                Some((l, _)) if l <= length => {}
-                _ => best = Some((length, k)),
+            // The ring without `b`, walked in place (no copy per candidate ear); only for an
+            // ear that would be cut.
+            if collinear(ring.iter().filter(|&&i| i != b).map(|&i| params[i])) {
+                continue;
             }
+            best = Some((length, k));
         }
         let Some((_, k)) = best else {
             // Not reachable for a polygon of the documented shape; fan what is left.

@@ -1,0 +1,433 @@
+//! Globalization (Lai–Cheng section 5): one global id per marked point, and the ring of marked
+//! points around each leaf square.
+//!
+//! A marked point's place is exact: a mesh vertex (a face corner), a mesh edge and the dyadic
+//! parameter along it (inside a face side), or a face and its dyadic `(u, v)`. The ids are
+//! assigned from that structure, face by face in parallel, with no global map: a point
+//! belongs to the first face (in face order) that marks it — a face's own interior points to
+//! it, an edge point to the lower of the edge's two faces that marks it, a vertex to the lowest
+//! face around it — and each face numbers the points it owns in the order it first marked them,
+//! after the points of all lower faces (a prefix sum of the faces' counts). That is the order
+//! of a single pass over the faces that gives every new place the next id ("first evaluation
+//! wins"), so the ids, positions and normals are that pass's, computed in parallel.
+
+use rayon::prelude::*;
+
+use super::{Leaf, Marked, GRID};
+use crate::mesh::topology::{Mesh, NONE};
+use crate::mesh::triangle_mesh::VertexSource;
+use crate::RuntimeError;
+
+/// Where a point of a face's grid lies.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Place {
+    /// Corner `k` (the face's `k`-th vertex).
+    Corner(usize),
+    /// Inside side `side` (counter-clockwise from corner `side`), at parameter `t` along it.
+    Side(usize, u32),
+    /// Inside the face.
+    Interior,
+}
+
+/// The place of the face grid point `(u, v)` (corners first, then sides, counter-clockwise).
+fn place(u: u32, v: u32) -> Place {
+    match (u, v) {
+        (0, 0) => Place::Corner(0),
+        (GRID, 0) => Place::Corner(1),
+        (GRID, GRID) => Place::Corner(2),
+        (0, GRID) => Place::Corner(3),
+        (_, 0) => Place::Side(0, u),
+        (GRID, _) => Place::Side(1, v),
+        (_, GRID) => Place::Side(2, GRID - u),
+        (0, _) => Place::Side(3, GRID - v),
+        _ => Place::Interior,
+    }
+}
+
+/// The mesh edge of a face side: whether the side's parameter flips on the canonical
+/// half-edge (the pair's smaller index), and the other face with its side, if any.
+#[derive(Clone, Copy, Debug)]
+struct SideEdge {
+    flip: bool,
+    twin: Option<(usize, usize)>,
+}
+
+impl SideEdge {
+    fn new(mesh: &Mesh, face: usize, side: usize) -> Self {
+        let h = mesh.face_halfedges(face).start + side;
+        let t = mesh.twin[h];
+        if t == NONE {
+            return SideEdge {
+                flip: false,
+                twin: None,
+            };
+        }
+        let g = mesh.face_of[t as usize] as usize;
+        SideEdge {
+            flip: (t as usize) < h,
+            twin: Some((g, t as usize - mesh.face_halfedges(g).start)),
+        }
+    }
+
+    /// The parameter along the canonical half-edge of the side's own parameter `t`.
+    fn canonical(&self, t: u32) -> u32 {
+        if self.flip {
+            GRID - t
+        } else {
+            t
+        }
+    }
+}
+
+/// One face's marked points, each once, in the order the face first marked them.
+struct FacePoints {
+    /// Index into the face's marked points of each point's first mark.
+    first: Vec<u32>,
+    /// Per side, the canonical parameters of the points the face marked inside it, ascending.
+    sides: [Vec<u32>; 4],
+}
+
+/// A face's distinct marked points (by exact `(u, v)`; the first mark of each is the one whose
+/// evaluation counts) and the canonical parameters of those inside its sides.
+fn face_points(marked: &[Marked], edges: &[SideEdge; 4]) -> FacePoints {
+    let mut order: Vec<(u64, u32)> = marked
+        .iter()
+        .enumerate()
+        .map(|(i, m)| ((u64::from(m.u) << 32) | u64::from(m.v), i as u32))
+        .collect();
+    order.sort_unstable();
+    // Sorted by place, then mark: each run's head is the place's first mark.
+    let mut first: Vec<u32> = order
+        .chunk_by(|a, b| a.0 == b.0)
+        .map(|run| run[0].1)
+        .collect();
+    first.sort_unstable();
+    let mut sides: [Vec<u32>; 4] = Default::default();
+    for &i in &first {
+        let m = &marked[i as usize];
+        if let Place::Side(s, t) = place(m.u, m.v) {
+            sides[s].push(edges[s].canonical(t));
+        }
+    }
+    for list in &mut sides {
+        list.sort_unstable();
+    }
+    FacePoints { first, sides }
+}
+
+/// A sorted list's pairs `(key, id)` with keys strictly between `lo` and `hi`.
+fn between<K: Ord + Copy>(sorted: &[(K, u32)], lo: K, hi: K) -> &[(K, u32)] {
+    let a = sorted.partition_point(|x| x.0 <= lo);
+    let b = sorted.partition_point(|x| x.0 < hi);
+    &sorted[a..b.max(a)]
+}
+
+/// The id paired with `key` in a sorted list.
+fn find<K: Ord + Copy>(sorted: &[(K, u32)], key: K) -> Option<u32> {
+    sorted
+        .binary_search_by(|x| x.0.cmp(&key))
+        .ok()
+        .map(|k| sorted[k].1)
+}
+
+/// The ids of one face's marked points, by place.
+struct FaceIds {
+    /// Interior points by `(v, u)`: the horizontal lines.
+    rows: Vec<((u32, u32), u32)>,
+    /// Interior points by `(u, v)`: the vertical lines.
+    columns: Vec<((u32, u32), u32)>,
+    /// Per side, every point marked inside it by this face or the face across it, by the
+    /// side's own parameter.
+    edges: [Vec<(u32, u32)>; 4],
+}
+
+/// The global ids of a tessellation's marked points.
+pub(super) struct GlobalIds {
+    /// Per mesh vertex its id ([`NONE`] when no face marked it).
+    vertices: Vec<u32>,
+    faces: Vec<FaceIds>,
+}
+
+/// A broken invariant of the marking (every marked point has an id), as an error, not a panic.
+fn internal(what: String) -> RuntimeError {
+    RuntimeError::Unsupported(format!("internal: {what}"))
+}
+
+/// Give every marked point of `work` (per face: leaves and their corners) its id, and append
+/// the points to `positions`, `normals` and `sources` in id order (module documentation).
+pub(super) fn assign(
+    mesh: &Mesh,
+    work: &[(Vec<Leaf>, Vec<Marked>)],
+    positions: &mut Vec<[f64; 3]>,
+    normals: &mut Vec<[f64; 3]>,
+    sources: &mut Vec<VertexSource>,
+) -> Result<GlobalIds, RuntimeError> {
+    let edges: Vec<[SideEdge; 4]> = (0..work.len())
+        .into_par_iter()
+        .map(|f| std::array::from_fn(|s| SideEdge::new(mesh, f, s)))
+        .collect();
+    let points: Vec<FacePoints> = work
+        .par_iter()
+        .zip(&edges)
+        .map(|((_, marked), edges)| face_points(marked, edges))
+        .collect();
+    // The lowest face marking each vertex (every face with leaves marks its four corners).
+    let mut vertex_owner = vec![NONE; mesh.positions.len()];
+    for (f, (_, marked)) in work.iter().enumerate() {
+        if marked.is_empty() {
+            continue;
+        }
+        for &v in mesh.face(f) {
+            if let Some(owner) = vertex_owner.get_mut(v as usize) {
+                if *owner == NONE {
+                    *owner = f as u32;
+                }
+            }
+        }
+    }
+    // Per face, its rank among the points it owns (NONE: owned by a lower face) of each point.
+    let ranks: Vec<Vec<u32>> = (0..work.len())
+        .into_par_iter()
+        .map(|f| {
+            let marked = &work[f].1;
+            let mut next = 0;
+            points[f]
+                .first
+                .iter()
+                .map(|&i| {
+                    let m = &marked[i as usize];
+                    let owned = match place(m.u, m.v) {
+                        Place::Interior => true,
+                        Place::Corner(k) => vertex_owner[mesh.face(f)[k] as usize] == f as u32,
+                        Place::Side(s, t) => match edges[f][s].twin {
+                            Some((g, side)) if g < f => points[g].sides[side]
+                                .binary_search(&edges[f][s].canonical(t))
+                                .is_err(),
+                            _ => true,
+                        },
+                    };
+                    if owned {
+                        next += 1;
+                        next - 1
+                    } else {
+                        NONE
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    let mut base = Vec::with_capacity(work.len());
+    let mut total = positions.len() as u32;
+    for r in &ranks {
+        base.push(total);
+        total += r.iter().filter(|&&x| x != NONE).count() as u32;
+    }
+    let owned: Vec<Vec<(Marked, u32)>> = (0..work.len())
+        .into_par_iter()
+        .map(|f| {
+            points[f]
+                .first
+                .iter()
+                .zip(&ranks[f])
+                .filter(|(_, &r)| r != NONE)
+                .map(|(&i, &r)| (work[f].1[i as usize], base[f] + r))
+                .collect()
+        })
+        .collect();
+    for (f, list) in owned.iter().enumerate() {
+        for (m, _) in list {
+            positions.push(m.position);
+            normals.push(m.normal);
+            let shift = (m.u | m.v | GRID).trailing_zeros();
+            sources.push(VertexSource {
+                face: f as u32,
+                u: m.u >> shift,
+                v: m.v >> shift,
+                denominator: GRID >> shift,
+                subface: 0,
+            });
+        }
+    }
+    let mut vertices = vec![NONE; mesh.positions.len()];
+    for (f, list) in owned.iter().enumerate() {
+        for (m, id) in list {
+            if let Place::Corner(k) = place(m.u, m.v) {
+                vertices[mesh.face(f)[k] as usize] = *id;
+            }
+        }
+    }
+    // Per face and side, the ids of the side points it owns, by canonical parameter.
+    let owned_sides: Vec<[Vec<(u32, u32)>; 4]> = owned
+        .par_iter()
+        .zip(&edges)
+        .map(|(list, edges)| {
+            let mut sides: [Vec<(u32, u32)>; 4] = Default::default();
+            for (m, id) in list {
+                if let Place::Side(s, t) = place(m.u, m.v) {
+                    sides[s].push((edges[s].canonical(t), *id));
+                }
+            }
+            for side in &mut sides {
+                side.sort_unstable();
+            }
+            sides
+        })
+        .collect();
+    // Per face and side, the ids of all the side points it marked, by canonical parameter.
+    let marked_sides: Vec<[Vec<(u32, u32)>; 4]> = (0..work.len())
+        .into_par_iter()
+        .map(|f| -> Result<[Vec<(u32, u32)>; 4], RuntimeError> {
+            let mut sides: [Vec<(u32, u32)>; 4] = Default::default();
+            for (s, list) in sides.iter_mut().enumerate() {
+                for &tc in &points[f].sides[s] {
+                    let own = find(&owned_sides[f][s], tc);
+                    let across = || {
+                        edges[f][s]
+                            .twin
+                            .and_then(|(g, side)| find(&owned_sides[g][side], tc))
+                    };
+                    let id = own.or_else(across).ok_or_else(|| {
+                        internal(format!("face {f} side {s} point {tc} / {GRID} has no id"))
+                    })?;
+                    list.push((tc, id));
+                }
+            }
+            Ok(sides)
+        })
+        .collect::<Result<_, _>>()?;
+    let faces: Vec<FaceIds> = (0..work.len())
+        .into_par_iter()
+        .map(|f| -> Result<FaceIds, RuntimeError> {
+            let marked = &work[f].1;
+            let mut rows = Vec::new();
+            let mut columns = Vec::new();
+            for (&i, &r) in points[f].first.iter().zip(&ranks[f]) {
+                let m = &marked[i as usize];
+                if place(m.u, m.v) == Place::Interior {
+                    rows.push(((m.v, m.u), base[f] + r));
+                    columns.push(((m.u, m.v), base[f] + r));
+                }
+            }
+            rows.sort_unstable();
+            columns.sort_unstable();
+            let edges = std::array::from_fn(|s| {
+                let edge = edges[f][s];
+                let mut all = marked_sides[f][s].clone();
+                if let Some((g, side)) = edge.twin {
+                    all.extend_from_slice(&marked_sides[g][side]);
+                }
+                let mut all: Vec<(u32, u32)> = all
+                    .into_iter()
+                    .map(|(tc, id)| (edge.canonical(tc), id))
+                    .collect();
+                all.sort_unstable();
+                all.dedup_by_key(|x| x.0);
+                all
+            });
+            Ok(FaceIds {
+                rows,
+                columns,
+                edges,
+            })
+        })
+        .collect::<Result<_, _>>()?;
+    Ok(GlobalIds { vertices, faces })
+}
+
+impl GlobalIds {
+    /// The id of the marked point `(u, v)` of face `face`.
+    fn id(&self, mesh: &Mesh, face: usize, u: u32, v: u32) -> Option<u32> {
+        let ids = self.faces.get(face)?;
+        let id = match place(u, v) {
+            Place::Corner(k) => *self.vertices.get(*mesh.face(face).get(k)? as usize)?,
+            Place::Side(s, t) => find(&ids.edges[s], t)?,
+            Place::Interior => find(&ids.rows, (v, u))?,
+        };
+        (id != NONE).then_some(id)
+    }
+
+    /// The ring of marked points around a leaf, face grid points and ids, into `ring`: its corners and
+    /// every marked point on its sides, counter-clockwise (section 5: "output in order all the
+    /// marked points between corners of the base quadrilateral").
+    pub(super) fn leaf_ring(
+        &self,
+        mesh: &Mesh,
+        face: usize,
+        leaf: &Leaf,
+        ring: &mut Vec<((u32, u32), u32)>,
+    ) -> Result<(), RuntimeError> {
+        let ids = self
+            .faces
+            .get(face)
+            .ok_or_else(|| internal(format!("face {face} has no ids")))?;
+        let (u0, v0) = (leaf.u0, leaf.v0);
+        let (u1, v1) = (u0 + leaf.size, v0 + leaf.size);
+        ring.clear();
+        let corner = |ring: &mut Vec<((u32, u32), u32)>, u: u32, v: u32| {
+            let id = self.id(mesh, face, u, v).ok_or_else(|| {
+                internal(format!("face {face} point ({u}, {v}) / {GRID} has no id"))
+            })?;
+            ring.push(((u, v), id));
+            Ok::<(), RuntimeError>(())
+        };
+        corner(ring, u0, v0)?;
+        if v0 == 0 {
+            ring.extend(
+                between(&ids.edges[0], u0, u1)
+                    .iter()
+                    .map(|&(t, id)| ((t, 0), id)),
+            );
+        } else {
+            ring.extend(
+                between(&ids.rows, (v0, u0), (v0, u1))
+                    .iter()
+                    .map(|&((_, u), id)| ((u, v0), id)),
+            );
+        }
+        corner(ring, u1, v0)?;
+        if u1 == GRID {
+            ring.extend(
+                between(&ids.edges[1], v0, v1)
+                    .iter()
+                    .map(|&(t, id)| ((GRID, t), id)),
+            );
+        } else {
+            ring.extend(
+                between(&ids.columns, (u1, v0), (u1, v1))
+                    .iter()
+                    .map(|&((_, v), id)| ((u1, v), id)),
+            );
+        }
+        corner(ring, u1, v1)?;
+        if v1 == GRID {
+            ring.extend(
+                between(&ids.edges[2], GRID - u1, GRID - u0)
+                    .iter()
+                    .map(|&(t, id)| ((GRID - t, GRID), id)),
+            );
+        } else {
+            ring.extend(
+                between(&ids.rows, (v1, u0), (v1, u1))
+                    .iter()
+                    .rev()
+                    .map(|&((_, u), id)| ((u, v1), id)),
+            );
+        }
+        corner(ring, u0, v1)?;
+        if u0 == 0 {
+            ring.extend(
+                between(&ids.edges[3], GRID - v1, GRID - v0)
+                    .iter()
+                    .map(|&(t, id)| ((0, GRID - t), id)),
+            );
+        } else {
+            ring.extend(
+                between(&ids.columns, (u0, v0), (u0, v1))
+                    .iter()
+                    .rev()
+                    .map(|&((_, v), id)| ((u0, v), id)),
+            );
+        }
+        Ok(())
+    }
+}
