@@ -186,6 +186,8 @@ fn bench(c: &mut Criterion) {
     let (positions, faces) = torus();
     let face_count = faces.len();
     let control: Vec<[f32; 3]> = positions.iter().map(|p| p.map(|c| c as f32)).collect();
+    // subtess's plans take f64 control points (`GridPlan::evaluate`): the same f32 values.
+    let control64: Vec<[f64; 3]> = control.iter().map(|p| p.map(f64::from)).collect();
 
     // subtess: topology, patches (the torus is regular: no refinement step).
     let table = StencilTable::default_catmull_clark().unwrap_or_else(|e| panic!("{e}"));
@@ -240,7 +242,7 @@ fn bench(c: &mut Criterion) {
         let mut positions = vec![[0.0f32; 3]; points];
         let mut normals = positions.clone();
         let mut triangles = vec![[0u32; 3]; grid.triangle_count()];
-        grid.evaluate(&control, &mut positions, &mut normals);
+        grid.evaluate(&control64, &mut positions, &mut normals);
 
         let locations: Vec<far::LocationArray> = (0..face_count)
             .map(|f| far::LocationArray {
@@ -303,7 +305,7 @@ fn bench(c: &mut Criterion) {
         group.throughput(Throughput::Elements(grid.triangle_count() as u64));
         group.bench_function("subtess dual grid (evaluate + connect)", |b| {
             b.iter(|| {
-                grid.evaluate(&control, &mut positions, &mut normals);
+                grid.evaluate(&control64, &mut positions, &mut normals);
                 grid.connect(&mut triangles);
             })
         });
