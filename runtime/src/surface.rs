@@ -6,7 +6,9 @@
 //! The per-frame path never refines. Isolation's refinement steps are linear in the control
 //! points, so they are composed once into one sparse map from the input vertices to the isolated
 //! mesh's vertices ([`crate::scheme::stencil::Stencil`]); a frame applies that map (a few dozen
-//! multiply-adds per isolated vertex) and then the table stencils of the plan.
+//! multiply-adds per isolated vertex, in f64) and then the table stencils of the plan (in f32,
+//! on every patch's control points relative to one of them, so that tangents and normals do
+//! not depend on where the mesh sits: docs/reliability.md, *Precision*).
 
 use std::time::Instant;
 
@@ -76,8 +78,9 @@ pub struct Surface {
     input_vertices: usize,
     input_faces: usize,
     boundary_loops: usize,
-    /// Input vertices to isolated vertices; `None` when isolation took no step.
-    refinement: Option<Stencil<f32>>,
+    /// Whether the isolated control points are the input's refined ([`Surface::refinement`]):
+    /// isolation took steps or split vertices.
+    refines: bool,
     /// The texture coordinates' channel (Catmull–Clark), refined as the positions were.
     channel: Option<ChannelIsolation>,
     isolation_seconds: f64,
@@ -111,12 +114,12 @@ impl Surface {
             }
             Scheme::Sqrt3 => Isolated::Triangle(isolate_regions(mesh, RegionScheme::Sqrt3)?),
         };
-        let (steps, refinement) = match &isolated {
-            Isolated::Quad(iso) => (iso.steps, &iso.refinement),
-            Isolated::Triangle(iso) => (iso.steps, &iso.refinement),
+        let steps = match &isolated {
+            Isolated::Quad(iso) => iso.steps,
+            Isolated::Triangle(iso) => iso.steps,
         };
         // Without steps and split vertices the input points are the control points.
-        let refinement = (steps > 0 || !mesh.copies.is_empty()).then(|| refinement.to_f32());
+        let refines = steps > 0 || !mesh.copies.is_empty();
         let channel = match &isolated {
             Isolated::Quad(iso) => ChannelIsolation::new(mesh, iso)?,
             Isolated::Triangle(_) => None,
@@ -128,7 +131,7 @@ impl Surface {
             input_vertices: mesh.input_vertices(),
             input_faces: mesh.faces(),
             boundary_loops: mesh.boundary_loops(),
-            refinement,
+            refines,
             isolation_seconds: started.elapsed().as_secs_f64(),
             isolated,
         })
@@ -188,7 +191,16 @@ impl Surface {
     /// Weights of the map from input to isolated control points (0 when none is needed): the
     /// per-frame cost isolation adds.
     pub fn refinement_weights(&self) -> usize {
-        self.refinement.as_ref().map_or(0, Stencil::entries)
+        self.refinement().map_or(0, Stencil::entries)
+    }
+
+    /// Input vertices to isolated vertices; `None` when isolation took no step.
+    fn refinement(&self) -> Option<&Stencil> {
+        let map = match &self.isolated {
+            Isolated::Quad(iso) => &iso.refinement,
+            Isolated::Triangle(iso) => &iso.refinement,
+        };
+        self.refines.then_some(map)
     }
 
     /// The isolated mesh (at the positions given to [`Surface::new`]).
@@ -215,14 +227,14 @@ impl Surface {
         }
     }
 
-    /// The isolated mesh's control points for input positions `positions` (one per input
-    /// vertex), into `out`; `false` (and `out` untouched) when isolation took no step, so that
-    /// the input itself is the control.
-    fn control_points(&self, positions: &[[f32; 3]], out: &mut Vec<[f32; 3]>) -> bool {
-        match &self.refinement {
+    /// The isolated mesh's control points for input positions `input` (one per input vertex,
+    /// widened to f64: [`GridPlan::evaluate`]), into `out`; `false` (and `out` untouched) when
+    /// isolation took no step, so that the input itself is the control.
+    fn control_points(&self, input: &[[f64; 3]], out: &mut Vec<[f64; 3]>) -> bool {
+        match self.refinement() {
             Some(map) => {
                 out.resize(map.rows(), [0.0; 3]);
-                map.apply_into(positions, out);
+                map.apply_into(input, out);
                 true
             }
             None => false,
@@ -343,6 +355,7 @@ impl Surface {
             grid,
             rates,
             faces_over_tolerance,
+            input: Vec::new(),
             control: Vec::new(),
             positions: vec![[0.0; 3]; vertices],
             normals: vec![[0.0; 3]; vertices],
@@ -384,8 +397,10 @@ pub struct Tessellator<'s> {
     grid: Box<dyn GridPlan + 's>,
     rates: Vec<u32>,
     faces_over_tolerance: Option<usize>,
+    /// The input points of the current frame, in f64.
+    input: Vec<[f64; 3]>,
     /// The isolated control points of the current frame (when isolation took steps).
-    control: Vec<[f32; 3]>,
+    control: Vec<[f64; 3]>,
     positions: Vec<[f32; 3]>,
     normals: Vec<[f32; 3]>,
     triangles: Vec<[u32; 3]>,
@@ -420,10 +435,13 @@ impl<'s> Tessellator<'s> {
                 reason: format!("{:?} is not finite", positions[v]),
             });
         }
-        let control = if self.surface.control_points(positions, &mut self.control) {
+        self.input.clear();
+        self.input
+            .extend(positions.iter().map(|p| p.map(f64::from)));
+        let control = if self.surface.control_points(&self.input, &mut self.control) {
             self.control.as_slice()
         } else {
-            positions
+            self.input.as_slice()
         };
         self.grid
             .evaluate(control, &mut self.positions, &mut self.normals);

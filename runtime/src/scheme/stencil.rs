@@ -195,33 +195,21 @@ impl<W: Weight> Stencil<W> {
 impl Stencil<f64> {
     /// Apply to `[f64; 3]` points (the refined positions of a mesh).
     pub fn apply(&self, points: &[[f64; 3]]) -> Vec<[f64; 3]> {
+        let mut out = vec![[0.0; 3]; self.rows()];
+        self.apply_into(points, &mut out);
+        out
+    }
+
+    /// Apply to `points` into `out` (`rows()` long), in parallel over rows: the per-frame path
+    /// maps a frame's input points, widened to f64, to the isolated control points.
+    ///
+    /// Why f64 per frame: the refined points keep the input's precision. Rounded to f32, each
+    /// would move by up to half an f32 step at its distance from the coordinate origin,
+    /// independently of its neighbours, and the small faces of an isolated neighbourhood would
+    /// turn that into tangent errors that grow with that distance instead of with their size
+    /// (f32 weights would do the same: their sum misses one by about `1e-7`).
+    pub fn apply_into(&self, points: &[[f64; 3]], out: &mut [[f64; 3]]) {
         debug_assert_eq!(points.len(), self.columns);
-        (0..self.rows())
-            .map(|i| {
-                let (js, ws) = self.row(i);
-                js.iter().zip(ws).fold([0.0; 3], |acc, (&j, &w)| {
-                    let p = points[j as usize];
-                    [acc[0] + w * p[0], acc[1] + w * p[1], acc[2] + w * p[2]]
-                })
-            })
-            .collect()
-    }
-
-    /// This map with f32 weights, for the per-frame path.
-    pub fn to_f32(&self) -> Stencil<f32> {
-        Stencil {
-            offsets: self.offsets.clone(),
-            indices: self.indices.clone(),
-            weights: self.weights.iter().map(|&w| w as f32).collect(),
-            columns: self.columns,
-        }
-    }
-}
-
-impl Stencil<f32> {
-    /// Apply to f32 points into `out` (`rows()` long), in parallel over rows; accumulates in
-    /// f32 like the tessellators' own stencils.
-    pub fn apply_into(&self, points: &[[f32; 3]], out: &mut [[f32; 3]]) {
         debug_assert_eq!(out.len(), self.rows());
         out.par_chunks_mut(4096)
             .enumerate()
@@ -229,7 +217,7 @@ impl Stencil<f32> {
                 let first = chunk * 4096;
                 for (i, o) in out.iter_mut().enumerate() {
                     let r = self.offsets[first + i] as usize..self.offsets[first + i + 1] as usize;
-                    let mut acc = [0.0f32; 3];
+                    let mut acc = [0.0f64; 3];
                     for (&j, &w) in self.indices[r.clone()].iter().zip(&self.weights[r]) {
                         let p = points[j as usize];
                         acc = [acc[0] + w * p[0], acc[1] + w * p[1], acc[2] + w * p[2]];

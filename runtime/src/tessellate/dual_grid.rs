@@ -39,8 +39,8 @@ use crate::scheme::patch::{dual_index_in_patch, is_smooth_patch, FacePatch};
 use crate::stencil_table::StencilTable;
 pub use crate::tessellate::kernel::TessellationTime;
 use crate::tessellate::kernel::{
-    cross, evaluate_points, for_each_range, gathered_point, merge_rows, unit, weighted_point,
-    Connectivity, GridPlan, PointPlan, Stencils, MAX_PATCH,
+    cross, evaluate_points, for_each_range, gather_relative, merge_rows, patch_origin, relative,
+    unit, weighted_point, Connectivity, GridPlan, PointPlan, Stencils, MAX_PATCH,
 };
 use crate::RuntimeError;
 
@@ -791,19 +791,24 @@ impl<'t> DualGrid<'t> {
         self.boundary
     }
 
+    /// Every dual point of face `f`, from its control points relative to one of them
+    /// ([`gather_relative`]).
     fn evaluate_face(
         &self,
         f: usize,
-        control: &[[f32; 3]],
+        control: &[[f64; 3]],
         positions: &mut [[f32; 3]],
         normals: &mut [[f32; 3]],
     ) {
         let n = self.rates[f] as usize;
         match &self.faces[f] {
             FaceEval::Separable { grid } => {
-                let g = grid.map(|column| column.map(|v| control[v as usize]));
+                // The face's corner at (0, 0) is the origin.
+                let origin = control[grid[1][1] as usize];
+                let g = grid.map(|column| column.map(|v| relative(control[v as usize], origin)));
                 if let Some(basis) = &self.bases[n] {
-                    evaluate_separable(&g, basis, n, positions, normals);
+                    let origin = origin.map(|c| c as f32);
+                    evaluate_separable(&g, origin, basis, n, positions, normals);
                 }
             }
             FaceEval::Table {
@@ -813,15 +818,14 @@ impl<'t> DualGrid<'t> {
             } => {
                 let points = &self.control[range.start as usize..range.end as usize];
                 let mut local = [[0.0f32; 3]; MAX_PATCH];
-                for (l, &v) in local.iter_mut().zip(points) {
-                    *l = control[v as usize];
-                }
+                let origin = gather_relative(points, control, &mut local);
                 let local = &local[..points.len()];
                 for j in 0..n {
                     for i in 0..n {
                         let (pi, pj) = dual_index_in_patch(*corner as usize, i, j, n);
                         let at = j * n + i;
-                        (positions[at], normals[at]) = weighted_point(stencils, local, pj * n + pi);
+                        (positions[at], normals[at]) =
+                            weighted_point(stencils, local, origin, pj * n + pi);
                     }
                 }
             }
@@ -838,8 +842,16 @@ impl<'t> DualGrid<'t> {
                     du: &w[block..2 * block],
                     dv: &w[2 * block..],
                 };
+                // Any number of control points (the union of the stencils' supports): made
+                // relative once per face, on the heap.
+                let origin = patch_origin(points, control);
+                let local: Vec<[f32; 3]> = points
+                    .iter()
+                    .map(|&v| relative(control[v as usize], origin))
+                    .collect();
+                let origin = origin.map(|c| c as f32);
                 for at in 0..n * n {
-                    (positions[at], normals[at]) = gathered_point(s, points, control, at);
+                    (positions[at], normals[at]) = weighted_point(&s, &local, origin, at);
                 }
             }
         }
@@ -899,7 +911,7 @@ impl GridPlan for DualGrid<'_> {
 
     /// Evaluate every output vertex from the control points `control` (the mesh's vertex
     /// positions): limit positions and unit normals, `vertex_count()` each.
-    fn evaluate(&self, control: &[[f32; 3]], positions: &mut [[f32; 3]], normals: &mut [[f32; 3]]) {
+    fn evaluate(&self, control: &[[f64; 3]], positions: &mut [[f32; 3]], normals: &mut [[f32; 3]]) {
         let dual = self.first[self.rates.len()] as usize;
         let (face_positions, curve_positions) = positions.split_at_mut(dual);
         let (face_normals, curve_normals) = normals.split_at_mut(dual);
@@ -985,9 +997,11 @@ fn connect_strip(strip: &Strip, out: &mut [[u32; 3]]) {
 
 /// The tensor-product evaluation of a regular face: per row `j`, contract the 4 x 4 grid with the
 /// row's weights into four points (and their `v` derivatives), then every point of the row is a
-/// 4-term combination of those.
+/// 4-term combination of those. `g` is relative to `origin` ([`gather_relative`]), where every
+/// position's sum starts.
 fn evaluate_separable(
     g: &[[[f32; 3]; 4]; 4],
+    origin: [f32; 3],
     basis: &SeparableBasis,
     n: usize,
     positions: &mut [[f32; 3]],
@@ -1019,7 +1033,7 @@ fn evaluate_separable(
             .zip(&basis.x_rows)
             .zip(&basis.dx_rows)
         {
-            let mut p = [0.0f32; 3];
+            let mut p = origin;
             let mut du = [0.0f32; 3];
             let mut dv = [0.0f32; 3];
             for a in 0..4 {

@@ -150,11 +150,12 @@ pub(crate) fn merge_rows(
 }
 
 /// Evaluate points planned one by one (`plans[i]` into `positions[i]`, `normals[i]`), in
-/// parallel: each plan's control points are `indices[plan.control]`, vertices of `control`.
+/// parallel: each plan's control points are `indices[plan.control]`, vertices of `control`,
+/// taken relative to the first of them ([`relative`]).
 pub(crate) fn evaluate_points(
     plans: &[PointPlan],
     indices: &[u32],
-    control: &[[f32; 3]],
+    control: &[[f64; 3]],
     positions: &mut [[f32; 3]],
     normals: &mut [[f32; 3]],
 ) {
@@ -167,31 +168,72 @@ pub(crate) fn evaluate_points(
             let k = points.len();
             let (wp, rest) = plan.weights.split_at(k);
             let (wu, wv) = rest.split_at(k);
-            (*p, *q) = gathered_point(
-                Stencils {
-                    position: wp,
-                    du: wu,
-                    dv: wv,
-                },
-                points,
-                control,
-                0,
-            );
+            let s = Stencils {
+                position: wp,
+                du: wu,
+                dv: wv,
+            };
+            // One point per plan: each control point is made relative once either way.
+            let origin = patch_origin(points, control);
+            (*p, *q) = stencil_point(&s, k, 0, origin.map(|c| c as f32), |l| {
+                relative(control[points[l] as usize], origin)
+            });
         });
 }
 
+/// The origin of a patch whose control points are `control[points[l]]`: its first point (zero
+/// for none); see [`gather_relative`].
+#[inline(always)]
+pub(crate) fn patch_origin(points: &[u32], control: &[[f64; 3]]) -> [f64; 3] {
+    points.first().map_or([0.0; 3], |&v| control[v as usize])
+}
+
+/// Control point `p` relative to `origin`, in f32: the difference is taken in f64 and rounded
+/// once, so it carries the f32 precision of the patch's own extent, whatever `origin`'s
+/// distance from the coordinate origin (docs/reliability.md, *Precision*).
+#[inline(always)]
+pub(crate) fn relative(p: [f64; 3], origin: [f64; 3]) -> [f32; 3] {
+    [0, 1, 2].map(|x| (p[x] - origin[x]) as f32)
+}
+
+/// A patch's control points `control[points[l]]` relative to its origin ([`patch_origin`]),
+/// into `local[l]` (as long as `points`); returns the origin rounded to f32: where the
+/// positions' sums start.
+///
+/// Why: a derivative stencil's weights sum to zero, so `sum w_l P_l = sum w_l (P_l - O)` for any
+/// `O`, but in f32 the left side's rounding grows with `|P|`, the distance from the coordinate
+/// origin, while the right side's grows with `|P_l - O|`, the patch's size. Tangents and
+/// normals are therefore computed from relative points only, which makes them independent of
+/// where the mesh sits: a small face far from the origin gets the normals it would get at the
+/// origin. Position stencils sum to one: the position is `O + sum w_l (P_l - O)`, its sum
+/// started at `O` (free, and rounded at the scale of `|O|` as the output itself is).
+#[inline(always)]
+pub(crate) fn gather_relative(
+    points: &[u32],
+    control: &[[f64; 3]],
+    local: &mut [[f32; 3]],
+) -> [f32; 3] {
+    let origin = patch_origin(points, control);
+    for (l, &v) in local.iter_mut().zip(points) {
+        *l = relative(control[v as usize], origin);
+    }
+    origin.map(|c| c as f32)
+}
+
 /// Position and unit normal of row `point` of `s`, a stencil of `k` weights a point, over the
-/// control points `q(0..k)`: the position, and the cross product of the two derivatives.
+/// control points `q(0..k)`, relative to `origin` ([`gather_relative`]): the position `origin +
+/// sum w q`, and the cross product of the two derivatives `sum w_u q`, `sum w_v q`.
 #[inline(always)]
 fn stencil_point(
     s: &Stencils,
     k: usize,
     point: usize,
+    origin: [f32; 3],
     q: impl Fn(usize) -> [f32; 3],
 ) -> ([f32; 3], [f32; 3]) {
     let rows = point * k..(point + 1) * k;
     let (wp, wu, wv) = (&s.position[rows.clone()], &s.du[rows.clone()], &s.dv[rows]);
-    let mut p = [[0.0f32; 3]; 3];
+    let mut p = [origin, [0.0; 3], [0.0; 3]];
     for l in 0..k {
         let q = q(l);
         for x in 0..3 {
@@ -203,25 +245,15 @@ fn stencil_point(
     (p[0], unit(cross(p[1], p[2])))
 }
 
-/// Position and unit normal of row `point` of `s` over the control points `points` (vertices
-/// of `control`), any number of them.
-pub(crate) fn gathered_point(
-    s: Stencils,
-    points: &[u32],
-    control: &[[f32; 3]],
-    point: usize,
-) -> ([f32; 3], [f32; 3]) {
-    stencil_point(&s, points.len(), point, |l| control[points[l] as usize])
-}
-
 /// Position and unit normal of table point `point` (row of the stencils) from the patch's
-/// control points.
+/// control points `local`, relative to `origin` ([`gather_relative`]).
 pub(crate) fn weighted_point(
     s: &Stencils,
-    control: &[[f32; 3]],
+    local: &[[f32; 3]],
+    origin: [f32; 3],
     point: usize,
 ) -> ([f32; 3], [f32; 3]) {
-    stencil_point(s, control.len(), point, |l| control[l])
+    stencil_point(s, local.len(), point, origin, |l| local[l])
 }
 
 /// Running totals of `counts`: item `i` owns `[ends[i-1], ends[i])`.
@@ -337,7 +369,12 @@ pub trait GridPlan: Sync + Send + std::fmt::Debug {
 
     /// Evaluate every output vertex from the control points `control` (the tessellated mesh's
     /// vertex positions): limit positions and unit normals, `vertex_count()` each.
-    fn evaluate(&self, control: &[[f32; 3]], positions: &mut [[f32; 3]], normals: &mut [[f32; 3]]);
+    ///
+    /// The control points are f64 so that the tangents, computed from every patch's points
+    /// relative to one of them, keep the precision of the patch's size wherever the mesh sits
+    /// (an isolated mesh's points rounded to f32 would already have lost it); the outputs are
+    /// f32.
+    fn evaluate(&self, control: &[[f64; 3]], positions: &mut [[f32; 3]], normals: &mut [[f32; 3]]);
 
     /// Write every triangle (`triangle_count()` of them).
     fn connect(&self, triangles: &mut [[u32; 3]]);
@@ -367,8 +404,7 @@ pub trait GridPlan: Sync + Send + std::fmt::Debug {
             seam_copies: self.seam_copies().to_vec(),
         };
         // Every vertex of the mesh is a control point, copies of split vertices included.
-        let control: Vec<[f32; 3]> = mesh.positions.iter().map(|p| p.map(|c| c as f32)).collect();
-        self.evaluate(&control, &mut out.positions, &mut out.normals);
+        self.evaluate(&mesh.positions, &mut out.positions, &mut out.normals);
         self.connect(&mut out.triangles);
         out
     }

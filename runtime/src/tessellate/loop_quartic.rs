@@ -24,10 +24,12 @@
 //! `P_v = sum_a s_a u^a` by Horner's rule: 10 multiply-adds a coordinate for the position and
 //! both derivatives, instead of the stencils' 36.
 //!
-//! Rounding: the coefficients are contracted from the differences `P_l - P_0` (the weights of
-//! every `c_ab` but `c_00` sum to zero, and `c_00`'s to one), so the large absolute position
-//! enters once, as `P_0` added to `c_00`, and the monomial terms carry only the patch's own
-//! extent; the output agrees with the stencils' to f32 rounding of the coordinates.
+//! Rounding: the coefficients are contracted from the differences `P_l - P_0`, taken in f64 by
+//! [`crate::tessellate::kernel::gather_relative`] (the weights of every `c_ab` but `c_00` sum
+//! to zero, and `c_00`'s to one), so the large absolute position enters once, as `P_0` added to
+//! `c_00`, and the monomial terms, hence the tangents and normals, carry only the patch's own
+//! extent wherever it sits; the output agrees with the stencils' to f32 rounding of the
+//! coordinates.
 //!
 //! The dual grid's points lie on rows of constant `v` in the *face's* parameters (`up(i, j)` at
 //! `v = (3j+1)/3n`, `down(i, j)` at `(3j+2)/3n`, the interior primal points at `j/n`), and a
@@ -271,16 +273,21 @@ fn interpolate(values: &[[f64; POINTS]]) -> Option<Coefficients> {
 /// `a + b > 4`).
 type FaceQuartic = [[[f32; 3]; DEGREE + 1]; DEGREE + 1];
 
-/// The face's polynomial from its control points `local` (table order) and the coefficients
-/// `frame` of its patch corner (`frame[l][monomial(a, b)]`): `c_ab = sum_l C[a,b][l] (P_l -
-/// P_0)`, plus `P_0` in `c_00`; control point by control point, all monomials at once (lanes).
-fn contract(frame: &[[f32; MONOMIAL_LANES]; POINTS], local: &[[f32; 3]; POINTS]) -> FaceQuartic {
+/// The face's polynomial from its control points `local = P_l - P_0` (table order, relative
+/// to `origin = P_0`) and the coefficients `frame` of its patch corner (`frame[l][monomial(a,
+/// b)]`): `c_ab = sum_l C[a,b][l] (P_l - P_0)`, plus `P_0` in `c_00`; control point by control
+/// point, all monomials at once (lanes).
+fn contract(
+    frame: &[[f32; MONOMIAL_LANES]; POINTS],
+    local: &[[f32; 3]; POINTS],
+    origin: [f32; 3],
+) -> FaceQuartic {
     let mut sums = [[0.0f32; MONOMIAL_LANES]; 3];
+    // `P_0 - P_0` is zero.
     for (w, p) in frame.iter().zip(local).skip(1) {
         for x in 0..3 {
-            let d = p[x] - local[0][x];
             for m in 0..MONOMIAL_LANES {
-                sums[x][m] += w[m] * d;
+                sums[x][m] += w[m] * p[x];
             }
         }
     }
@@ -293,7 +300,7 @@ fn contract(frame: &[[f32; MONOMIAL_LANES]; POINTS], local: &[[f32; 3]; POINTS])
         }
     }
     for x in 0..3 {
-        c[0][0][x] += local[0][x];
+        c[0][0][x] += origin[x];
     }
     c
 }
@@ -470,16 +477,18 @@ impl RowQuartic {
 /// Rows of constant `v` are `v = k / 3n`: `k = 3j + 1` holds the ups of face row `j`
 /// (`up(i, j)` at `u = (3i+1)/3n`), `3j + 2` its downs (`(3i+2)/3n`; ups and downs interleave
 /// in the output, `up, down, .., up`), `3j` the interior primal points `(i/n, j/n)`, `i >= 1`;
-/// the rows' polynomials are made `LANES` at a time.
+/// the rows' polynomials are made `LANES` at a time. `local` holds the control points relative
+/// to the first, `origin` ([`contract`]).
 pub(crate) fn evaluate_face(
     frame: &[[f32; MONOMIAL_LANES]; POINTS],
     local: &[[f32; 3]; POINTS],
+    origin: [f32; 3],
     n: usize,
     params: &[f32],
     positions: &mut [[f32; 3]],
     normals: &mut [[f32; 3]],
 ) {
-    let c = contract(frame, local);
+    let c = contract(frame, local, origin);
     let interior = n * n;
     let mut k0 = 1;
     while k0 < 3 * n {

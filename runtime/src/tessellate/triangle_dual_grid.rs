@@ -45,8 +45,8 @@ use crate::scheme::triangle::patch::{
 };
 pub use crate::stencil_table::TriangleStencils;
 use crate::tessellate::kernel::{
-    cross, evaluate_points, for_each_range, merge_rows, unit, weighted_point, Connectivity,
-    GridPlan, PointPlan, Stencils, TessellationTime,
+    cross, evaluate_points, for_each_range, gather_relative, merge_rows, unit, weighted_point,
+    Connectivity, GridPlan, PointPlan, Stencils, TessellationTime,
 };
 use crate::tessellate::loop_quartic::{self, QuarticBasis};
 use crate::RuntimeError;
@@ -550,10 +550,12 @@ impl<'t> TriangleDualGrid<'t> {
         self.boundary
     }
 
+    /// Every point of face `f`, from its control points relative to the first of them
+    /// ([`gather_relative`]).
     fn evaluate_face(
         &self,
         f: usize,
-        control: &[[f32; 3]],
+        control: &[[f64; 3]],
         positions: &mut [[f32; 3]],
         normals: &mut [[f32; 3]],
     ) {
@@ -563,16 +565,16 @@ impl<'t> TriangleDualGrid<'t> {
         let map = &maps[plan.corner as usize];
         let points = &self.control[plan.control.start as usize..plan.control.end as usize];
         let mut local = [[0.0f32; 3]; MAX_TRIANGLE_PATCH];
-        for (l, &v) in local.iter_mut().zip(points) {
-            *l = control[v as usize];
-        }
+        let origin = gather_relative(points, control, &mut local);
         if plan.quartic {
             let params = self.params.get(n).filter(|p| p.len() == 3 * n + 1);
             if let (Some(basis), Some(params)) = (self.quartic, params) {
                 let mut net = [[0.0f32; 3]; loop_quartic::POINTS];
                 net.copy_from_slice(&local[..loop_quartic::POINTS]);
                 let frame = &basis.frame[plan.corner as usize % 3];
-                return loop_quartic::evaluate_face(frame, &net, n, params, positions, normals);
+                return loop_quartic::evaluate_face(
+                    frame, &net, origin, n, params, positions, normals,
+                );
             }
         }
         let local = &local[..points.len()];
@@ -581,18 +583,20 @@ impl<'t> TriangleDualGrid<'t> {
         // vectorizes.
         match points.len() {
             LOOP_REGULAR_POINTS => {
-                return fixed_points::<LOOP_REGULAR_POINTS>(plan, map, n, local, positions, normals)
+                return fixed_points::<LOOP_REGULAR_POINTS>(
+                    plan, map, n, local, origin, positions, normals,
+                )
             }
             BUTTERFLY_REGULAR_POINTS => {
                 return fixed_points::<BUTTERFLY_REGULAR_POINTS>(
-                    plan, map, n, local, positions, normals,
+                    plan, map, n, local, origin, positions, normals,
                 )
             }
             _ => {}
         }
         for (at, &row) in map.iter().enumerate() {
             let stencils = if at < n * n { &plan.dual } else { &plan.primal };
-            (positions[at], normals[at]) = weighted_point(stencils, local, row as usize);
+            (positions[at], normals[at]) = weighted_point(stencils, local, origin, row as usize);
         }
     }
 
@@ -667,7 +671,7 @@ impl GridPlan for TriangleDualGrid<'_> {
 
     /// Evaluate every output vertex from the control points `control` (the mesh's vertex
     /// positions): limit positions and unit normals, `vertex_count()` each.
-    fn evaluate(&self, control: &[[f32; 3]], positions: &mut [[f32; 3]], normals: &mut [[f32; 3]]) {
+    fn evaluate(&self, control: &[[f64; 3]], positions: &mut [[f32; 3]], normals: &mut [[f32; 3]]) {
         let extended;
         let control = match &self.phantoms {
             Some(phantoms) => {
@@ -732,12 +736,13 @@ fn is_loop_regular(patch: &TrianglePatch) -> bool {
 const BUTTERFLY_REGULAR_POINTS: usize = 27;
 
 /// Every point of a face whose patch has `N` control points: [`weighted_point`] from the
-/// control points' coordinate columns.
+/// control points' coordinate columns (relative to `origin`).
 fn fixed_points<const N: usize>(
     plan: &FacePlan,
     map: &[u32],
     n: usize,
     local: &[[f32; 3]],
+    origin: [f32; 3],
     positions: &mut [[f32; 3]],
     normals: &mut [[f32; 3]],
 ) {
@@ -749,14 +754,16 @@ fn fixed_points<const N: usize>(
     }
     for (at, &row) in map.iter().enumerate() {
         let stencils = if at < n * n { &plan.dual } else { &plan.primal };
-        (positions[at], normals[at]) = fixed_point::<N>(stencils, &columns, row as usize);
+        (positions[at], normals[at]) = fixed_point::<N>(stencils, &columns, origin, row as usize);
     }
 }
 
-/// [`weighted_point`] for a patch of `N` control points, from their coordinate columns.
+/// [`weighted_point`] for a patch of `N` control points, from their coordinate columns
+/// relative to `origin`.
 fn fixed_point<const N: usize>(
     s: &Stencils,
     columns: &[[f32; N]; 3],
+    origin: [f32; 3],
     point: usize,
 ) -> ([f32; 3], [f32; 3]) {
     let rows = point * N..(point + 1) * N;
@@ -770,10 +777,13 @@ fn fixed_point<const N: usize>(
         weights(&s.du[rows.clone()]),
         weights(&s.dv[rows]),
     );
-    let dot = |w: &[f32; N], x: &[f32; N]| -> f32 { w.iter().zip(x).map(|(a, b)| a * b).sum() };
-    let p = columns.map(|x| dot(&wp, &x));
-    let du = columns.map(|x| dot(&wu, &x));
-    let dv = columns.map(|x| dot(&wv, &x));
+    // `start + w . x`, in order.
+    let dot = |start: f32, w: &[f32; N], x: &[f32; N]| -> f32 {
+        w.iter().zip(x).fold(start, |sum, (a, b)| sum + a * b)
+    };
+    let p = [0, 1, 2].map(|c| dot(origin[c], &wp, &columns[c]));
+    let du = columns.map(|x| dot(0.0, &wu, &x));
+    let dv = columns.map(|x| dot(0.0, &wv, &x));
     (p, unit(cross(du, dv)))
 }
 

@@ -22,6 +22,7 @@ mod opensubdiv_fvar_parity;
 #[cfg(feature = "opensubdiv")]
 mod opensubdiv_parity;
 mod patches;
+mod precision;
 mod rates;
 mod reader_properties;
 mod sharp_features;

@@ -5,43 +5,10 @@
 use std::collections::{HashMap, HashSet};
 
 use proptest::prelude::*;
-use schemes::crease::INFINITE;
 use schemes::BoundaryMode;
 use subtess::{Frame, Mesh, Rates, Scheme, Surface};
 
-/// A cube of side 2 (faces: -z, +z, -y, +x, +y, -x), vertex `i` at the signs of its bits.
-fn cube() -> Mesh {
-    let positions = (0..8)
-        .map(|i| {
-            let s = |b: usize| if i >> b & 1 == 1 { 1.0 } else { -1.0 };
-            [s(0), s(1), s(2)]
-        })
-        .collect();
-    let faces: Vec<Vec<i64>> = vec![
-        vec![0, 2, 3, 1],
-        vec![4, 5, 7, 6],
-        vec![0, 1, 5, 4],
-        vec![1, 3, 7, 5],
-        vec![3, 2, 6, 7],
-        vec![2, 0, 4, 6],
-    ];
-    Mesh::new(positions, &faces, &[], BoundaryMode::EdgeOnly).expect("a cube")
-}
-
-/// The cube with every kind of feature: an infinitely sharp crease loop around the top, a
-/// semi-sharp edge, a dart (one sharp edge ending inside), a semi-sharp corner, and, with
-/// `hole`, face 2 a hole.
-fn featured_cube(hole: bool) -> Mesh {
-    let mut mesh = cube();
-    for (a, b) in [(4, 5), (5, 7), (7, 6), (6, 4)] {
-        mesh.set_edge_sharpness(a, b, INFINITE).expect("an edge");
-    }
-    mesh.set_edge_sharpness(0, 1, 1.5).expect("an edge");
-    mesh.set_edge_sharpness(1, 3, INFINITE).expect("an edge");
-    mesh.set_vertex_sharpness(2, 2.25).expect("a vertex");
-    mesh.holes[2] = hole;
-    mesh
-}
+use crate::common::featured_cube;
 
 /// Every directed edge once (a manifold, consistently oriented output), and its boundary
 /// loops.

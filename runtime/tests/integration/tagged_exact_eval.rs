@@ -22,6 +22,8 @@ use subtess::scheme::catmull_clark::adaptive::{limit_of, limit_stencils, LimitQu
 use subtess::scheme::catmull_clark::refine::refine;
 use subtess::Scheme;
 
+use crate::common::refined_query;
+
 fn q(p: i64, d: i64) -> BigRational {
     BigRational::new(p.into(), d.into())
 }
@@ -347,26 +349,7 @@ fn tagged_shapes_with_other_polygons_agree_on_their_sub_faces() {
         }
         let refined = refine(&mesh).mesh;
         compare_with_adaptive(&name, &mesh, &refined, false, 30, |f, k, u, v| {
-            let first = mesh.face_halfedges(f).start;
-            if mesh.face(f).len() != 4 {
-                return LimitQuery {
-                    face: (first + k) as u32,
-                    u,
-                    v,
-                };
-            }
-            // The quarter holding (u, v) and its own parameters (`refine`'s child numbering).
-            let (c, s, t) = match (u > 0.5, v > 0.5) {
-                (false, false) => (0, 2.0 * u, 2.0 * v),
-                (true, false) => (1, 2.0 * v, 2.0 - 2.0 * u),
-                (true, true) => (2, 2.0 - 2.0 * u, 2.0 - 2.0 * v),
-                (false, true) => (3, 2.0 - 2.0 * v, 2.0 * u),
-            };
-            LimitQuery {
-                face: (first + c) as u32,
-                u: s,
-                v: t,
-            }
+            refined_query(&mesh, f, k, u, v)
         });
         shapes += 1;
     }

@@ -4,11 +4,13 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use schemes::cone_regions::ConeRegions;
+use schemes::crease::INFINITE;
 use schemes::triangle_local::{canonical_triangle_point, TrianglePoint};
 use schemes::{BoundaryMode, TriangleScheme};
 use subtess::io::obj::read_obj;
 use subtess::mesh::topology::Mesh;
 use subtess::mesh::triangle_mesh::{TriangleMesh, VertexSource};
+use subtess::scheme::catmull_clark::adaptive::LimitQuery;
 use subtess::scheme::triangle::cone_chart::ConeChart;
 use subtess::scheme::triangle::isolation::TriangleIsolation;
 use subtess::scheme::triangle::region_patch::RegionScheme;
@@ -99,6 +101,66 @@ pub fn icosahedron() -> Mesh {
             [9, 8, 1],
         ],
     )
+}
+
+/// A cube of side 2 (faces: -z, +z, -y, +x, +y, -x), vertex `i` at the signs of its bits.
+pub fn cube() -> Mesh {
+    let positions = (0..8)
+        .map(|i| {
+            let s = |b: usize| if i >> b & 1 == 1 { 1.0 } else { -1.0 };
+            [s(0), s(1), s(2)]
+        })
+        .collect();
+    let faces: Vec<Vec<i64>> = vec![
+        vec![0, 2, 3, 1],
+        vec![4, 5, 7, 6],
+        vec![0, 1, 5, 4],
+        vec![1, 3, 7, 5],
+        vec![3, 2, 6, 7],
+        vec![2, 0, 4, 6],
+    ];
+    Mesh::new(positions, &faces, &[], BoundaryMode::EdgeOnly).expect("a cube")
+}
+
+/// The cube with every kind of feature: an infinitely sharp crease loop around the top, a
+/// semi-sharp edge, a dart (one sharp edge ending inside), a semi-sharp corner, and, with
+/// `hole`, face 2 a hole.
+pub fn featured_cube(hole: bool) -> Mesh {
+    let mut mesh = cube();
+    for (a, b) in [(4, 5), (5, 7), (7, 6), (6, 4)] {
+        mesh.set_edge_sharpness(a, b, INFINITE).expect("an edge");
+    }
+    mesh.set_edge_sharpness(0, 1, 1.5).expect("an edge");
+    mesh.set_edge_sharpness(1, 3, INFINITE).expect("an edge");
+    mesh.set_vertex_sharpness(2, 2.25).expect("a vertex");
+    mesh.holes[2] = hole;
+    mesh
+}
+
+/// Where the point `(u, v)` of sub-face `k` of face `f` of `mesh` lies on the mesh refined
+/// once by Catmull–Clark (`subtess::scheme::catmull_clark::refine`, whose children are numbered
+/// by the parent's half-edges): sub-face `k` of an n-gon is its child at corner `k`, in the same
+/// parameters; a quad's point lies in the child of its quarter, in that child's parameters.
+pub fn refined_query(mesh: &Mesh, f: usize, k: usize, u: f64, v: f64) -> LimitQuery {
+    let first = mesh.face_halfedges(f).start;
+    if mesh.face(f).len() != 4 {
+        return LimitQuery {
+            face: (first + k) as u32,
+            u,
+            v,
+        };
+    }
+    let (c, s, t) = match (u > 0.5, v > 0.5) {
+        (false, false) => (0, 2.0 * u, 2.0 * v),
+        (true, false) => (1, 2.0 * v, 2.0 - 2.0 * u),
+        (true, true) => (2, 2.0 - 2.0 * u, 2.0 - 2.0 * v),
+        (false, true) => (3, 2.0 - 2.0 * v, 2.0 * u),
+    };
+    LimitQuery {
+        face: (first + c) as u32,
+        u: s,
+        v: t,
+    }
 }
 
 /// A torus of `m x n` lattice cells, each split into two triangles the same way: every vertex
