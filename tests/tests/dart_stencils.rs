@@ -7,7 +7,8 @@
 //!   is one curve for both sides, value and derivative along it);
 //! * on the crease, the sub-patch beside it is the cubic B-spline of the level-1 crease points,
 //!   which are written here by hand from OpenSubdiv's rules (closed form);
-//! * the limit mask at the dart is a fixed point of one subdivision step written by hand.
+//! * the limit mask at the dart is a fixed point of one subdivision step written by hand;
+//! * the tangent masks at the dart span an invariant subspace of the one-ring's step.
 
 use std::collections::HashMap;
 
@@ -252,6 +253,59 @@ fn dart_limit_mask_is_a_fixed_point_of_the_one_ring_rules() {
                 named(nb, 0, l),
                 "valence {v} sector {sector}"
             );
+        }
+    }
+}
+
+/// The f64 tangent masks at the dart (`ev_tangents`) span a left invariant subspace of the
+/// one-ring block `A_1` of `A` (residual below 1e-14 after projecting `x A_1` onto their span),
+/// the subspace of the two largest eigenvalues below 1: the restriction's trace is at most
+/// `2 lambda`, and exactly 1 at valence 4, where `lambda = 1/2` is double.
+#[test]
+fn dart_tangents_span_the_subdominant_invariant_subspace() {
+    use num_traits::ToPrimitive;
+    use stencilgen::ev_tangents::ev_tangents;
+    use stencilgen::extraordinary_patch::LocalMatrices;
+    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+    for v in 3..=8u32 {
+        for sector in 0..v {
+            let m = LocalMatrices::new(&cc(), Neighbourhood::dart(v), sector).expect("valid");
+            let ring = 1 + 2 * v as usize;
+            let t = ev_tangents(&m).expect("tangents");
+            let (du, dv) = (&t.du[..ring], &t.dv[..ring]);
+            assert!(t.du[ring..].iter().chain(&t.dv[ring..]).all(|w| *w == 0.0));
+            let times_a1 = |x: &[f64]| -> Vec<f64> {
+                (0..ring)
+                    .map(|j| {
+                        (0..ring)
+                            .map(|i| x[i] * m.a[i][j].to_f64().expect("finite"))
+                            .sum()
+                    })
+                    .collect()
+            };
+            // An orthonormal basis of the span.
+            let e1: Vec<f64> = du.iter().map(|x| x / dot(du, du).sqrt()).collect();
+            let along = dot(dv, &e1);
+            let w: Vec<f64> = dv.iter().zip(&e1).map(|(x, e)| x - along * e).collect();
+            let e2: Vec<f64> = w.iter().map(|x| x / dot(&w, &w).sqrt()).collect();
+            let mut trace = 0.0;
+            for (k, x) in [&e1, &e2].into_iter().enumerate() {
+                let y = times_a1(x);
+                let (a, b) = (dot(&y, &e1), dot(&y, &e2));
+                trace += [a, b][k];
+                let residual = y
+                    .iter()
+                    .zip(e1.iter().zip(&e2))
+                    .map(|(y, (p, q))| (y - a * p - b * q).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+                assert!(residual < 1e-14, "dart {v} sector {sector}: {residual:e}");
+            }
+            assert!(t.lambda > 0.0 && t.lambda < 1.0, "dart {v}");
+            assert!(trace <= 2.0 * t.lambda + 1e-12, "dart {v} sector {sector}");
+            if v == 4 {
+                assert!((t.lambda - 0.5).abs() < 1e-12 && (trace - 1.0).abs() < 1e-12);
+            }
         }
     }
 }
