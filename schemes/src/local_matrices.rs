@@ -13,6 +13,15 @@
 //! * A boundary vertex with `f` faces has sectors `0..f` and one more half-sector `f` holding
 //!   only its axis `(a, 0)`: the boundary runs along sector 0's `+a` axis and sector `f`'s `+a`
 //!   axis; there is nothing beyond (`canonical` returns `None`).
+//! * A *dart* (Catmull–Clark with infinitely sharp features, DeRose, Kass and Truong 1998
+//!   section 3; OpenSubdiv's `Sdc::Crease::RULE_DART`) is an interior vertex of valence `v`
+//!   whose sectors are glued as an interior vertex's, with exactly one infinitely sharp edge at
+//!   it: sector 0's `+a` axis. The crease runs straight out along that axis, so at every level
+//!   the points `(a, 0)`, `a >= 1`, of sector 0 lie on it ([`on_crease`]) and the neighbourhood
+//!   is self-similar. The rules there ([`refine_point`]): the dart itself takes the smooth vertex
+//!   rule, an edge point on the crease is its edge's midpoint, a vertex on the crease (two sharp
+//!   edges) takes the crease rule `(P_prev + 6 P + P_next) / 8` along it (the scheme's boundary
+//!   curve rule), everything else is smooth.
 //!
 //! The patch of sector `s` is the cell `[0,1]^2` of sector `s`, with `u` along `a` and `v` along
 //! `b` and the vertex at `(0,0)`. Its control points ([`patch_layout`], Stam's layout for
@@ -35,6 +44,18 @@
 //! phantom points `P(a, -1) = 2 P(a, 0) - P(a, 1)` (across sector 0's axis; likewise across the
 //! last axis), which makes the bicubic (or tensor-product) patch reproduce the boundary curve
 //! rules exactly.
+//!
+//! At a dart the points across the crease exist, but a sub-patch with an edge on the crease
+//! does not see them: the surface on each side of an infinitely sharp crease is the one its
+//! own side makes with the crease as its boundary (the crease's points read only the crease,
+//! and the reflected smooth rules are the crease rules), so such a sub-patch takes the same
+//! phantom points from its own side — sub-patch `[1/2,1]x[0,1/2]` of sector 0 reflects across
+//! `b = 0`, sub-patch `[0,1/2]x[1/2,1]` of sector `v - 1` across `a = 0` (OpenSubdiv's `Far`
+//! makes such faces boundary patches of their side). Every other sub-patch's corners are
+//! smooth valence-4 vertices with smooth edges, so it is the plain tensor-product patch of its
+//! 16 points even where they include crease points. The sectors of a dart are all different
+//! patches; sectors `s` and `v - 1 - s` are mirror images (the reflection that fixes the crease
+//! maps `E_i` to `E_{2-i}`), with `u` and `v` exchanged.
 
 use std::collections::HashMap;
 
@@ -71,6 +92,9 @@ pub struct Neighbourhood {
     pub faces: u32,
     /// `None` for an interior vertex; the boundary interpolation mode for a boundary vertex.
     pub boundary: Option<BoundaryMode>,
+    /// An interior vertex with one infinitely sharp edge, sector 0's `+a` axis, the crease
+    /// continuing straight out along it (the module docs). Only with `boundary == None`.
+    pub dart: bool,
 }
 
 impl Neighbourhood {
@@ -79,6 +103,17 @@ impl Neighbourhood {
         Neighbourhood {
             faces: v,
             boundary: None,
+            dart: false,
+        }
+    }
+
+    /// A dart of valence `v`: an interior vertex whose one infinitely sharp edge is sector 0's
+    /// `+a` axis.
+    pub fn dart(v: u32) -> Self {
+        Neighbourhood {
+            faces: v,
+            boundary: None,
+            dart: true,
         }
     }
 
@@ -87,6 +122,7 @@ impl Neighbourhood {
         Neighbourhood {
             faces,
             boundary: Some(mode),
+            dart: false,
         }
     }
 
@@ -100,19 +136,20 @@ impl Neighbourhood {
         self.faces == 1 && self.boundary == Some(BoundaryMode::EdgeAndCorner)
     }
 
-    /// Whether the patch at this vertex is a plain tensor-product patch: valence 4, a boundary
-    /// vertex with two faces, or a pinned corner (phantom points in both directions).
+    /// Whether the patch at this vertex is a plain tensor-product patch: valence 4 (not a
+    /// dart), a boundary vertex with two faces, or a pinned corner (phantom points in both
+    /// directions).
     pub fn is_regular(self) -> bool {
         match self.boundary {
-            None => self.faces == 4,
+            None => self.faces == 4 && !self.dart,
             Some(_) => self.faces == 2 || self.is_corner(),
         }
     }
 
     /// The patches it has: sectors `0..faces` (interior patches are all alike; only sector 0
-    /// is used for them).
+    /// is used for them; a dart's differ by their place relative to the crease).
     pub fn sectors(self) -> u32 {
-        if self.boundary.is_some() {
+        if self.boundary.is_some() || self.dart {
             self.faces
         } else {
             1
@@ -140,6 +177,12 @@ impl Neighbourhood {
             Some(_) if scheme.boundary.is_none() => {
                 Err(unsupported("it has no boundary rules".to_owned()))
             }
+            Some(_) if self.dart => Err(unsupported(
+                "a dart is an interior vertex, not a boundary vertex".to_owned(),
+            )),
+            None if self.dart && scheme.boundary.is_none() => Err(unsupported(
+                "a dart's crease needs boundary (crease) rules, and it has none".to_owned(),
+            )),
             _ if sector >= self.sectors() => Err(unsupported(format!(
                 "sector {sector} does not exist at a vertex with {} patch(es)",
                 self.sectors()
@@ -193,6 +236,12 @@ pub fn canonical(nb: Neighbourhood, s: i64, a: i64, b: i64) -> Option<GridPoint>
     }
 }
 
+/// Whether the canonical point `p` lies on `nb`'s crease: a dart's points `(a, 0)`, `a >= 1`,
+/// of sector 0 (at every level: the crease is self-similar).
+pub fn on_crease(nb: Neighbourhood, p: GridPoint) -> bool {
+    nb.dart && matches!(p, GridPoint::Sector { s: 0, b: 0, .. })
+}
+
 /// The outer points of a patch layout, in the patch sector's coordinates.
 pub const OUTER_POINTS: [(i64, i64); 7] =
     [(2, -1), (2, 0), (2, 1), (2, 2), (1, 2), (0, 2), (-1, 2)];
@@ -223,6 +272,11 @@ fn exists(nb: Neighbourhood, s: i64, a: i64, b: i64) -> GridPoint {
 
 /// The level-0 combination that one subdivision step of `scheme` assigns to the level-1 point
 /// `point` (named in level-1 coordinates, which have the same sector structure).
+///
+/// At a dart (OpenSubdiv's `Sdc` rules for infinitely sharp edges): the dart itself is smooth;
+/// a level-1 point on the crease ([`on_crease`]) with even coordinates is the vertex point of a
+/// crease vertex (two sharp edges), the scheme's boundary curve rule along the crease; with an
+/// odd `a` it is the edge point of a sharp edge, its midpoint.
 pub fn refine_point(scheme: &QuadScheme, nb: Neighbourhood, point: GridPoint) -> Combination {
     let boundary = scheme.boundary;
     let GridPoint::Sector { s, a, b } = point else {
@@ -251,6 +305,7 @@ pub fn refine_point(scheme: &QuadScheme, nb: Neighbourhood, point: GridPoint) ->
             }
         };
     };
+    let crease = on_crease(nb, point);
     let s = i64::from(s);
     let at = |a: i64, b: i64| canonical(nb, s, a, b);
     let quarter = Rational64::new(1, 4);
@@ -271,7 +326,7 @@ pub fn refine_point(scheme: &QuadScheme, nb: Neighbourhood, point: GridPoint) ->
             .iter()
             .map(|&(dx, dy)| at(x + dx, y + dy))
             .collect();
-            if ring.iter().all(Option::is_some) {
+            if ring.iter().all(Option::is_some) && !crease {
                 // A regular interior vertex (every vertex but the centre has valence 4).
                 let (alpha, beta, gamma) = scheme.vertex.weights(4);
                 let mut c = vec![(exists(nb, s, x, y), alpha)];
@@ -279,7 +334,8 @@ pub fn refine_point(scheme: &QuadScheme, nb: Neighbourhood, point: GridPoint) ->
                 c.extend(ring[4..].iter().flatten().map(|&p| (p, gamma)));
                 c
             } else {
-                // A regular boundary vertex on an axis: the boundary curve rule along it.
+                // A regular boundary vertex on an axis, or a vertex on a dart's crease: the
+                // boundary curve rule along the axis.
                 let Some(GridPoint::Sector { s, a: x, .. }) = at(x, y) else {
                     unreachable!("the centre is not refined here")
                 };
@@ -310,12 +366,12 @@ pub fn refine_point(scheme: &QuadScheme, nb: Neighbourhood, point: GridPoint) ->
                     )
                 })
                 .collect();
-            if sides.iter().all(Option::is_some) {
+            if sides.iter().all(Option::is_some) && !crease {
                 let mut c: Combination = ends.iter().map(|&p| (p, scheme.edge_end)).collect();
                 c.extend(sides.iter().flatten().map(|&p| (p, scheme.edge_side)));
                 c
             } else {
-                // A boundary edge: its midpoint.
+                // A boundary edge, or a sharp edge on a dart's crease: its midpoint.
                 ends.iter().map(|&p| (p, half)).collect()
             }
         }
@@ -328,11 +384,17 @@ pub fn refine_point(scheme: &QuadScheme, nb: Neighbourhood, point: GridPoint) ->
     }
 }
 
-/// Point `(a, b)` of sector `s` as a combination of existing points: itself, or a phantom point
-/// extrapolated linearly across the boundary it lies beyond.
+/// Point `(a, b)` of sector `s`, as a net point of one of sector `s`'s sub-patches, as a
+/// combination of existing points: itself, or a phantom point extrapolated linearly across the
+/// boundary, or the dart's crease, that it lies beyond.
 fn with_phantoms(nb: Neighbourhood, s: i64, a: i64, b: i64) -> Combination {
-    if let Some(p) = canonical(nb, s, a, b) {
-        return vec![(p, Rational64::from_integer(1))];
+    // Only the sub-patches beside the crease reach across it: sector 0's with b = -1 (the
+    // crease is its b = 0 axis) and sector v - 1's with a = -1 (its a = 0 axis).
+    let across_crease = nb.dart && ((s == 0 && b < 0) || (s == i64::from(nb.faces) - 1 && a < 0));
+    if !across_crease {
+        if let Some(p) = canonical(nb, s, a, b) {
+            return vec![(p, Rational64::from_integer(1))];
+        }
     }
     // Beyond sector 0's axis (the line b = 0 of sector 0) reflect in b; beyond the last axis
     // (the line a = 0 of sector f - 1) reflect in a. A corner patch has both.
@@ -445,9 +507,14 @@ impl LocalMatrices {
         self.a.len()
     }
 
-    /// A short description for messages: `valence 5`, `boundary, 3 faces, sector 1`.
+    /// A short description for messages: `valence 5`, `dart, valence 4, sector 2`,
+    /// `boundary, 3 faces, sector 1`.
     pub fn describe(&self) -> String {
         match self.neighbourhood.boundary {
+            None if self.neighbourhood.dart => format!(
+                "dart, valence {}, sector {}",
+                self.neighbourhood.faces, self.sector
+            ),
             None => format!("valence {}", self.neighbourhood.faces),
             Some(mode) => format!(
                 "boundary ({mode:?}), {} faces, sector {}",
@@ -519,6 +586,9 @@ mod tests {
         for v in 3..=8 {
             cases.push((cc.clone(), Neighbourhood::interior(v), 0));
             cases.push((sw.clone(), Neighbourhood::interior(v), 0));
+            for s in 0..v {
+                cases.push((cc.clone(), Neighbourhood::dart(v), s));
+            }
         }
         for f in 1..=6 {
             for mode in [BoundaryMode::EdgeOnly, BoundaryMode::EdgeAndCorner] {
@@ -541,6 +611,139 @@ mod tests {
         }
     }
 
+    /// The mirror image of a canonical point of a dart of valence `v`: `(a, b)` of sector `s`
+    /// is `(b, a)` of sector `v - 1 - s` (the reflection that fixes the crease).
+    fn mirrored(nb: Neighbourhood, p: GridPoint) -> GridPoint {
+        match p {
+            GridPoint::Centre => GridPoint::Centre,
+            GridPoint::Sector { s, a, b } => {
+                canonical(nb, i64::from(nb.faces) - 1 - i64::from(s), b, a)
+                    .expect("an interior vertex's points all exist")
+            }
+        }
+    }
+
+    /// Sectors `s` and `v - 1 - s` of a dart are mirror images: `A` and the sub-patch matrices
+    /// of one are those of the other with the points mirrored, sub-patch `[1/2,1]x[0,1/2]`
+    /// exchanged with `[0,1/2]x[1/2,1]` and `(p, q)` with `(q, p)`. This checks the crease's
+    /// rules and which side's phantoms each sub-patch takes.
+    #[test]
+    fn dart_sectors_mirror_each_other() {
+        let cc = QuadScheme::by_name("catmull-clark").expect("catalogued");
+        for v in 3..=6 {
+            let nb = Neighbourhood::dart(v);
+            for s in 0..v {
+                let here = LocalMatrices::new(&cc, nb, s).expect("valid");
+                let there = LocalMatrices::new(&cc, nb, v - 1 - s).expect("valid");
+                let index: HashMap<GridPoint, usize> = there
+                    .layout
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &p)| (p, i))
+                    .collect();
+                let m: Vec<usize> = here
+                    .layout
+                    .iter()
+                    .map(|&p| index[&mirrored(nb, p)])
+                    .collect();
+                for i in 0..here.size() {
+                    for j in 0..here.size() {
+                        assert_eq!(here.a[i][j], there.a[m[i]][m[j]], "v {v} sector {s}");
+                    }
+                }
+                for (b, mirror_b) in [(0, 2), (1, 1), (2, 0)] {
+                    for p in 0..4 {
+                        for q in 0..4 {
+                            for (j, &mj) in m.iter().enumerate() {
+                                assert_eq!(
+                                    here.sub_patches[b][4 * q + p][j],
+                                    there.sub_patches[mirror_b][4 * p + q][mj],
+                                    "v {v} sector {s} sub-patch {b} ({p}, {q})"
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// The dart's rows by hand (OpenSubdiv's `Sdc` rules): at level 1 the dart is the smooth
+    /// vertex point, `(1, 0)` of sector 0 the sharp edge's midpoint `(V + E_1) / 2`, `(2, 0)`
+    /// the crease rule `(V + 6 E_1 + P(2, 0)) / 8`, `(1, 0)` of sector 1 the smooth edge point;
+    /// sector 0's lower sub-patch reflects across the crease, `P(1, -1) = 2 P(1, 0) - P(1, 1)`.
+    #[test]
+    fn dart_rules_by_hand() {
+        let cc = QuadScheme::by_name("catmull-clark").expect("catalogued");
+        let nb = Neighbourhood::dart(5);
+        let m = LocalMatrices::new(&cc, nb, 0).expect("valid");
+        let r = |p: i64, q: i64| BigRational::new(BigInt::from(p), BigInt::from(q));
+        let at = |p: GridPoint| {
+            m.layout
+                .iter()
+                .position(|&x| x == p)
+                .expect("in the layout")
+        };
+        let point = |s: u32, a: i64, b: i64| GridPoint::Sector { s, a, b };
+        let row_of = |p: GridPoint| {
+            let mut row = vec![BigRational::zero(); m.size()];
+            for (x, w) in refine_point(&cc, nb, p) {
+                row[at(x)] += BigRational::new(BigInt::from(*w.numer()), BigInt::from(*w.denom()));
+            }
+            row
+        };
+        let expect = |terms: &[(GridPoint, BigRational)]| {
+            let mut row = vec![BigRational::zero(); m.size()];
+            for (p, w) in terms {
+                row[at(*p)] += w;
+            }
+            row
+        };
+        let v = GridPoint::Centre;
+        // Smooth vertex rule at valence 5: 13/20 V + 3/50 sum E + 1/100 sum F.
+        let mut smooth = vec![(v, r(13, 20))];
+        smooth.extend((0..5).map(|s| (point(s, 1, 0), r(3, 50))));
+        smooth.extend((0..5).map(|s| (point(s, 1, 1), r(1, 100))));
+        assert_eq!(row_of(v), expect(&smooth));
+        assert_eq!(
+            row_of(point(0, 1, 0)),
+            expect(&[(v, r(1, 2)), (point(0, 1, 0), r(1, 2))])
+        );
+        assert_eq!(
+            row_of(point(0, 2, 0)),
+            expect(&[
+                (v, r(1, 8)),
+                (point(0, 1, 0), r(6, 8)),
+                (point(0, 2, 0), r(1, 8))
+            ])
+        );
+        assert_eq!(
+            row_of(point(1, 1, 0)),
+            expect(&[
+                (v, r(3, 8)),
+                (point(1, 1, 0), r(3, 8)),
+                (point(0, 1, 0), r(1, 16)),
+                (point(0, 1, 1), r(1, 16)),
+                (point(1, 1, 1), r(1, 16)),
+                (point(2, 1, 0), r(1, 16)),
+            ])
+        );
+        // Sub-patch 0 (origin (1, 0)), net point (p, q) = (0, -1) + (1, 0): level-1 (1, -1).
+        let phantom = &m.sub_patches[0][1];
+        let (near, far) = (row_of(point(0, 1, 0)), row_of(point(0, 1, 1)));
+        let expected: Vec<BigRational> = near
+            .iter()
+            .zip(&far)
+            .map(|(n, f)| n * r(2, 1) - f)
+            .collect();
+        assert_eq!(phantom, &expected);
+        // Sector 1's neighbourhood reaches across nothing: its (1, -1) is sector 0's (1, 1).
+        let m1 = LocalMatrices::new(&cc, nb, 1).expect("valid");
+        assert!(m1.sub_patches[0][1]
+            .iter()
+            .all(|w| *w >= BigRational::zero()));
+    }
+
     #[test]
     fn unsupported_neighbourhoods_are_errors() {
         let sw = QuadScheme::by_name("sw-nonpoly-quad").expect("catalogued");
@@ -549,6 +752,9 @@ mod tests {
         );
         let cc = QuadScheme::by_name("catmull-clark").expect("catalogued");
         assert!(LocalMatrices::new(&cc, Neighbourhood::interior(2), 0).is_err());
+        assert!(LocalMatrices::new(&cc, Neighbourhood::dart(2), 0).is_err());
+        assert!(LocalMatrices::new(&cc, Neighbourhood::dart(4), 4).is_err());
+        assert!(LocalMatrices::new(&sw, Neighbourhood::dart(4), 0).is_err());
         assert!(
             LocalMatrices::new(&cc, Neighbourhood::boundary(3, BoundaryMode::EdgeOnly), 3).is_err()
         );

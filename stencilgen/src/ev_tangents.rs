@@ -6,7 +6,9 @@
 //! the tangent plane: if `w A_1 = lambda w` for one of the two largest eigenvalues below 1,
 //! then `w . P` is a tangent vector of the limit surface at the vertex. (Interior vertices: the
 //! double eigenvalue of Fourier frequencies 1 and v-1, a "cosine" and a "sine" mode. Boundary
-//! vertices: the boundary curve's tangent, eigenvalue 1/2, and the cross-boundary mode.)
+//! vertices: the boundary curve's tangent, eigenvalue 1/2, and the cross-boundary mode. Darts:
+//! two real eigenvalues, distinct except at valence 4, where 1/2 is double; the reference net
+//! is the interior one, so a dart's masks are tangent directions spanning its tangent plane.)
 //! Which tangent is "d/du" is a choice of normalization; it is fixed on a reference planar net
 //! `V = 0, E_i = (cos t_i, sin t_i), F_i = E_i + E_{i+1}` with `t_i = 2 pi (i-1)/v` (interior)
 //! or `pi (i-1)/max(f, 2)` (boundary, f faces): the `u` mask of sector `s` maps that net to the

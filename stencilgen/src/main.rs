@@ -78,8 +78,13 @@ enum Command {
         /// The vertex at (0, 0) is a boundary vertex with this many faces.
         #[arg(long, value_parser = clap::value_parser!(u32).range(1..=64))]
         boundary: Option<u32>,
-        /// Which of the boundary vertex's patches: 0 has the boundary along u = 0..1, v = 0.
-        #[arg(long, default_value_t = 0, requires = "boundary")]
+        /// The interior vertex of --valence is a dart: one infinitely sharp edge, along sector
+        /// 0's u axis, the crease continuing straight out (Catmull-Clark).
+        #[arg(long, requires = "valence", conflicts_with = "boundary")]
+        dart: bool,
+        /// Which of the boundary vertex's (or dart's) patches: 0 has the boundary (the
+        /// crease) along u = 0..1, v = 0.
+        #[arg(long, default_value_t = 0)]
         sector: u32,
         /// A boundary vertex with one face is a pinned corner (OpenSubdiv "edge and corner").
         #[arg(long, requires = "boundary")]
@@ -355,6 +360,7 @@ fn run(cli: Cli) -> Result<(), StencilError> {
             scheme,
             valence,
             boundary,
+            dart,
             sector,
             corners,
             u,
@@ -363,7 +369,21 @@ fn run(cli: Cli) -> Result<(), StencilError> {
             json,
         } => {
             let (u, v) = (parse_rational(&u)?, parse_rational(&v)?);
+            if sector != 0 && boundary.is_none() && !dart {
+                return Err(StencilError::UnsupportedScheme {
+                    scheme,
+                    reason: "--sector needs --boundary or --dart: an interior vertex's patches \
+                             are all alike"
+                        .to_owned(),
+                });
+            }
             if let Some(triangle) = TriangleScheme::by_name(&scheme) {
+                if dart {
+                    return Err(StencilError::UnsupportedScheme {
+                        scheme,
+                        reason: "darts are implemented for quad schemes only".to_owned(),
+                    });
+                }
                 if corners {
                     return Err(StencilError::UnsupportedScheme {
                         scheme,
@@ -432,6 +452,7 @@ fn run(cli: Cli) -> Result<(), StencilError> {
             };
             let nb = match (valence, boundary) {
                 (_, Some(faces)) => Neighbourhood::boundary(faces, mode),
+                (Some(v), None) if dart => Neighbourhood::dart(v),
                 (Some(v), None) => Neighbourhood::interior(v),
                 (None, None) => unreachable!("clap requires --valence or --boundary"),
             };
@@ -787,6 +808,7 @@ fn stencil_json<S: Scalar>(
         "scheme": scheme.name,
         "valence": nb.faces,
         "boundary": nb.boundary.is_some(),
+        "dart": nb.dart,
         "sector": sector,
         "u": u.to_string(),
         "v": v.to_string(),

@@ -109,6 +109,38 @@ fn stencil_json_follows_the_contract() {
     assert!(v["du"].as_array().expect("f64 tangents").len() == 18);
 }
 
+/// A dart's patches (`--dart --sector S`): at the dart the position is the left eigenvector of
+/// `A` (zero beyond the one-ring), the same in every sector; sector 0's crease point at
+/// `u = 1` is the crease rule's limit `(V + 4 E_1 + (2, 0)) / 6` of a regular crease vertex
+/// (the cubic B-spline of the crease polygon at a knot).
+#[test]
+fn stencil_at_a_dart() {
+    let v = json("stencil --scheme catmull-clark --valence 4 --dart --sector 0 --u 1 --v 0 --json");
+    assert_eq!(v["dart"], true);
+    assert_eq!(v["weights"][0], "1/6");
+    assert_eq!(v["weights"][1], "2/3");
+    // O2 = (2, 0), the crease's next point.
+    assert_eq!(v["order"][10], "O2");
+    assert_eq!(v["weights"][10], "1/6");
+    let at_dart = |sector: u32| {
+        json(&format!(
+            "stencil --scheme catmull-clark --valence 5 --dart --sector {sector} --u 0 --v 0 --json"
+        ))
+    };
+    let (a, b) = (at_dart(0), at_dart(2));
+    assert_eq!(a["weights"], b["weights"]);
+    let beyond_the_ring = &a["weights"].as_array().expect("weights")[11..];
+    assert!(beyond_the_ring.iter().all(|w| w == "0"));
+    fails_with(
+        "stencil --scheme catmull-clark --valence 5 --sector 1 --u 0 --v 0",
+        "--sector needs --boundary or --dart",
+    );
+    fails_with(
+        "stencil --scheme sw-nonpoly-quad --valence 5 --dart --u 0 --v 0",
+        "crease",
+    );
+}
+
 #[test]
 fn stencil_bad_input() {
     let cases: [(&str, &str); 4] = [
