@@ -14,6 +14,9 @@ use stencilgen::regular_patch::StencilKind;
 use stencilgen::substitution::Substitution;
 use subtess_tests::bspline::{q, uniform_bspline, uniform_bspline_derivative};
 
+mod quad_points;
+use quad_points::{add, named};
+
 fn cc() -> QuadScheme {
     QuadScheme::by_name("catmull-clark").expect("catalogued")
 }
@@ -27,29 +30,6 @@ fn neighbourhoods() -> Vec<Neighbourhood> {
     let mut all = vec![Neighbourhood::boundary(1, BoundaryMode::EdgeAndCorner)];
     all.extend((1..=6).map(|f| Neighbourhood::boundary(f, BoundaryMode::EdgeOnly)));
     all
-}
-
-/// Weights of a stencil on named points.
-fn named(
-    nb: Neighbourhood,
-    sector: u32,
-    stencil: &[BigRational],
-) -> HashMap<GridPoint, BigRational> {
-    let layout = stencilgen::extraordinary_patch::patch_layout(nb, sector);
-    layout
-        .into_iter()
-        .zip(stencil)
-        .filter(|(_, w)| !w.is_zero())
-        .map(|(p, w)| (p, w.clone()))
-        .collect()
-}
-
-fn add(map: &mut HashMap<GridPoint, BigRational>, p: GridPoint, w: BigRational) {
-    let e = map.entry(p).or_insert_with(BigRational::zero);
-    *e += w;
-    if e.is_zero() {
-        map.remove(&p);
-    }
 }
 
 /// Position `(a, b)` of sector `s` as existing points, extrapolating linearly across the

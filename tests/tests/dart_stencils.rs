@@ -21,34 +21,15 @@ use stencilgen::regular_patch::StencilKind;
 use stencilgen::substitution::Substitution;
 use subtess_tests::bspline::{q, uniform_bspline, uniform_bspline_derivative};
 
+mod quad_points;
+use quad_points::{add, named};
+
 fn cc() -> QuadScheme {
     QuadScheme::by_name("catmull-clark").expect("catalogued")
 }
 
 fn exact(nb: Neighbourhood, sector: u32, n: u32, kind: StencilKind) -> PatchStencils<BigRational> {
     patch_stencils::<BigRational>(&cc(), nb, sector, n, kind).expect("solvable")
-}
-
-/// Weights of a stencil on named points.
-fn named(
-    nb: Neighbourhood,
-    sector: u32,
-    stencil: &[BigRational],
-) -> HashMap<GridPoint, BigRational> {
-    stencilgen::extraordinary_patch::patch_layout(nb, sector)
-        .into_iter()
-        .zip(stencil)
-        .filter(|(_, w)| !w.is_zero())
-        .map(|(p, w)| (p, w.clone()))
-        .collect()
-}
-
-fn add(map: &mut HashMap<GridPoint, BigRational>, p: GridPoint, w: BigRational) {
-    let e = map.entry(p).or_insert_with(BigRational::zero);
-    *e += w;
-    if e.is_zero() {
-        map.remove(&p);
-    }
 }
 
 /// The grid solve equals plain substitution at every grid point (positions and both
