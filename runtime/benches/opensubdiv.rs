@@ -506,23 +506,8 @@ fn check_patch_table(refiner: &far::TopologyRefiner, control: &[[f32; 3]], size:
         return;
     };
     let faces: Vec<usize> = (0..AROUND * TUBE).step_by(101).collect();
-    let half = [0.5f32];
-    let locations: Vec<far::LocationArray> = faces
-        .iter()
-        .map(|&f| far::LocationArray {
-            ptex_index: f,
-            s: &half,
-            t: &half,
-        })
-        .collect();
-    let limit = far::LimitStencilTable::new(
-        refiner,
-        &locations,
-        None,
-        None,
-        far::LimitStencilTableOptions::default(),
-    )
-    .unwrap_or_else(|e| panic!("limit stencil table: {e}"));
+    let centres: Vec<(usize, f32, f32)> = faces.iter().map(|&f| (f, 0.5, 0.5)).collect();
+    let limit = limit_stencil_table(refiner, &centres);
     let mut expected = vec![[0.0f32; 3]; faces.len()];
     let (mut du, mut dv) = (expected.clone(), expected.clone());
     LimitStencils::new(&limit).apply(control, &mut expected, &mut du, &mut dv);
