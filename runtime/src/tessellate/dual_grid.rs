@@ -35,12 +35,13 @@ use schemes::crease::is_infinite;
 use crate::mesh::topology::{Mesh, NONE};
 use crate::mesh::triangle_mesh::{TriangleMesh, VertexSource};
 use crate::scheme::catmull_clark::adaptive::{limit_stencils, LimitQuery, LimitStencil};
-use crate::scheme::patch::{dual_index_in_patch, is_smooth_patch, FacePatch};
+use crate::scheme::patch::{dual_index_in_patch, FacePatch};
 use crate::stencil_table::StencilTable;
 pub use crate::tessellate::kernel::TessellationTime;
 use crate::tessellate::kernel::{
     cross, evaluate_points, for_each_range, gather_relative, merge_rows, patch_origin, relative,
-    unit, weighted_point, Connectivity, GridPlan, PointPlan, Stencils, MAX_PATCH,
+    table_may_describe, unit, weighted_point, Connectivity, GridPlan, PointPlan, Stencils,
+    MAX_PATCH,
 };
 use crate::RuntimeError;
 
@@ -384,7 +385,7 @@ impl<'t> DualGrid<'t> {
                 grid.faces.push(FaceEval::Hole);
                 continue;
             }
-            let s = if is_smooth_patch(mesh, f) && patch.points.len() <= MAX_PATCH {
+            let s = if table_may_describe(mesh, patch, f) {
                 stencils(table, patch, PointSet::Dual, n).ok()
             } else {
                 None

@@ -9,6 +9,7 @@ use std::sync::OnceLock;
 
 use subtess::io::obj::read_obj;
 use subtess::mesh::topology::Mesh;
+use subtess::scheme::catmull_clark::adaptive::{limit_of, limit_stencils, LimitQuery};
 use subtess::scheme::catmull_clark::isolate::isolate;
 use subtess::scheme::patch::{dual_positions, FacePatch};
 use subtess::stencil_table::StencilTable;
@@ -442,6 +443,100 @@ fn tolerance_rates_equal_the_full_search() {
             let expected = (1..=24u32).find(|&n| full(n) <= t).unwrap_or(24);
             assert_eq!(chosen.rates[f], expected, "face {f} T = {t}");
             assert_eq!(chosen.deviations[f], full(expected), "face {f} T = {t}");
+        }
+    }
+}
+
+/// A closed spindle of quads and triangles: two poles of valence `valence` (beyond the table's
+/// 3..=8 when above 8), fans of triangles around them and a band of quads between.
+fn spindle(valence: usize) -> Mesh {
+    let mut positions = vec![[0.0, 0.0, 1.6], [0.0, 0.0, -1.4]];
+    for (ring, z) in [(0, 0.5), (1, -0.4)] {
+        for i in 0..valence {
+            let t = std::f64::consts::TAU * (i as f64 + 0.3 * ring as f64) / valence as f64;
+            // A bump on every third vertex, so that the poles are not symmetric.
+            let r = 1.0 + 0.15 * f64::from(u8::from(i % 3 == 0));
+            positions.push([r * t.cos(), 0.8 * r * t.sin(), z]);
+        }
+    }
+    let v = valence as i64;
+    let (top, bottom) = (|i: i64| 2 + i % v, |i: i64| 2 + v + i % v);
+    let mut faces = Vec::new();
+    for i in 0..v {
+        faces.push(vec![0, top(i), top(i + 1)]);
+        faces.push(vec![top(i), bottom(i), bottom(i + 1), top(i + 1)]);
+        faces.push(vec![1, bottom(i + 1), bottom(i)]);
+    }
+    Mesh::new(positions, &faces, &[], schemes::BoundaryMode::EdgeOnly).expect("valid spindle")
+}
+
+/// Limit positions at the dual points of rates 23 and 19 of every surface face, from the
+/// feature-adaptive stencils (the tessellator's own evaluation of faces the table does not
+/// describe; the selection reads positions from the same descent carrying positions instead).
+fn adaptive_samples(mesh: &Mesh) -> Vec<[f64; 3]> {
+    let mut queries = Vec::new();
+    for f in (0..mesh.faces()).filter(|&f| !mesh.holes[f]) {
+        for n in [23u32, 19] {
+            let d = f64::from(2 * n);
+            for j in 0..n {
+                for i in 0..n {
+                    queries.push(LimitQuery {
+                        face: f as u32,
+                        u: f64::from(2 * i + 1) / d,
+                        v: f64::from(2 * j + 1) / d,
+                    });
+                }
+            }
+        }
+    }
+    limit_stencils(mesh, &queries)
+        .expect("stencils")
+        .iter()
+        .map(|s| limit_of(s, mesh)[0])
+        .collect()
+}
+
+/// The shipped cube with an infinitely sharp crease around its top, a corner where three
+/// infinitely sharp edges meet, and a hole.
+fn featured_cube() -> Mesh {
+    let mut mesh = cube();
+    for (a, b) in [(4, 5), (5, 6), (6, 7), (7, 4), (0, 1), (0, 3), (0, 4)] {
+        mesh.set_edge_sharpness(a, b, 10.0)
+            .expect("an edge of the cube");
+    }
+    mesh.set_vertex_sharpness(0, 10.0).expect("a vertex");
+    mesh.holes[3] = true;
+    mesh
+}
+
+/// Faces the table does not describe (a valence beyond it, infinitely sharp creases and
+/// corners, the rim of a hole) take rates too, and the output meets the tolerance on the true
+/// surface there, at samples the selection never saw.
+#[test]
+fn tolerance_rates_cover_valences_beyond_the_table_and_sharp_features() {
+    for (name, mesh) in [
+        ("spindle of valence 11", spindle(11)),
+        ("cube with features", featured_cube()),
+    ] {
+        let (isolated, patches, _) = isolate(&mesh).expect("isolates");
+        let samples = adaptive_samples(&isolated);
+        for relative in [1e-2, 3e-3] {
+            let t = relative * diagonal(&mesh);
+            let chosen = tolerance_rates(table(), &isolated, &patches, t).expect("rates");
+            assert!(
+                chosen.unmet.is_empty(),
+                "{name} T = {t}: {:?}",
+                chosen.unmet
+            );
+            assert!(chosen.rates.iter().any(|&n| n > 1), "{name}: curved");
+            let (out, _) =
+                tessellate(table(), &isolated, &patches, &chosen.rates).expect("tessellates");
+            let measured = brute_force_deviation(&samples, &out);
+            assert!(
+                measured <= t,
+                "{name}: T = {t}, measured {measured} with rates {:?}",
+                chosen.rates
+            );
         }
     }
 }
