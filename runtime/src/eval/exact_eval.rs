@@ -199,7 +199,9 @@ pub struct ExactEvaluator {
     /// `levels[0]` is the mesh, `levels[i]` its `i`-th refinement (none for a mesh with sharp
     /// features, which [`feature`] refines locally, point by point).
     levels: Vec<Mesh>,
-    /// Whether the mesh has sharp features ([`Mesh::has_sharp_features`]).
+    /// Whether points take the feature descent ([`feature`]): the mesh has sharp features
+    /// ([`Mesh::has_sharp_features`]) or an interior vertex of valence 2, where no patch of the
+    /// scaling relation exists.
     tagged: bool,
     /// The edge numbering of each refinement step (`levels[i]` -> `levels[i + 1]`).
     edges: Vec<LevelEdges>,
@@ -331,7 +333,9 @@ impl ExactEvaluator {
     pub fn new(mesh: &Mesh) -> Self {
         let mut levels = vec![mesh.clone()];
         let mut edges = Vec::new();
-        let tagged = mesh.has_sharp_features();
+        let valence_two = (0..mesh.positions.len())
+            .any(|v| !mesh.is_boundary_vertex(v) && mesh.fan(v).len() == 2);
+        let tagged = mesh.has_sharp_features() || valence_two;
         while !tagged && levels.len() <= MAX_STEPS {
             let last = &levels[levels.len() - 1];
             if gather_patches(last).is_ok() {

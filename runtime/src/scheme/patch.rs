@@ -66,10 +66,15 @@ pub fn is_irregular(mesh: &Mesh, v: usize) -> bool {
 /// one-face corners "edge and corner" pins). A face next to sharp features is evaluated by
 /// feature-adaptive refinement instead ([`crate::scheme::catmull_clark::adaptive`]); only the
 /// edges at the corners matter, since the children of the others stay outside the face's
-/// refined neighbourhoods.
+/// refined neighbourhoods. So is a face at an interior vertex of valence 2, which has no patch
+/// of the scaling relation (its neighbourhood's layout needs three faces or more: `Neighbourhood`
+/// in `schemes::local_matrices`).
 pub fn is_smooth_patch(mesh: &Mesh, face: usize) -> bool {
     mesh.face(face).iter().all(|&v| {
         let v = v as usize;
+        if !mesh.is_boundary_vertex(v) && mesh.fan(v).len() == 2 {
+            return false;
+        }
         let pinned = mesh.boundary == schemes::BoundaryMode::EdgeAndCorner
             && mesh.is_boundary_vertex(v)
             && mesh.fan(v).len() == 1;

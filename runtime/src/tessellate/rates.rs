@@ -171,10 +171,11 @@ pub struct ToleranceRates {
     pub unmet: Vec<usize>,
 }
 
-/// How one face's limit surface is evaluated: by the table where it describes the face exactly
-/// (the tessellator's own choice, [`is_smooth_patch`] and a patch the table has), otherwise by
-/// feature-adaptive refinement, as the tessellator does for the same faces.
-enum Source<'a> {
+/// One face's limit surface at the table's grid points: from the table where it describes the
+/// face exactly (the tessellator's own choice, [`table_may_describe`], and a patch the table
+/// has), otherwise from feature-adaptive refinement, as the tessellator evaluates the same
+/// faces.
+enum PatchPoints<'a> {
     /// The face's patch: its control points and the table lookups that evaluate it.
     Table {
         table: &'a StencilTable,
@@ -182,16 +183,11 @@ enum Source<'a> {
         control: Vec<[f64; 3]>,
     },
     /// A face the tables do not describe (sharp features nearby, a valence or patch beyond
-    /// the table): its grids from the adaptive limit stencils, computed once per grid.
+    /// the table): its grids from the adaptive refinement, computed once per grid.
     Adaptive {
         face: usize,
         grids: &'a AdaptiveGrids<'a>,
     },
-}
-
-/// One face's limit surface at the table's grid points ([`Source`]).
-struct PatchPoints<'a> {
-    source: Source<'a>,
 }
 
 impl<'a> PatchPoints<'a> {
@@ -206,11 +202,9 @@ impl<'a> PatchPoints<'a> {
         if adaptive.faces.binary_search(&face).is_err() {
             return PatchPoints::new(table, mesh, patch);
         }
-        Ok(PatchPoints {
-            source: Source::Adaptive {
-                face,
-                grids: adaptive,
-            },
+        Ok(PatchPoints::Adaptive {
+            face,
+            grids: adaptive,
         })
     }
 
@@ -237,12 +231,10 @@ impl<'a> PatchPoints<'a> {
                 })
             })
             .collect::<Result<Vec<_>, _>>()?;
-        Ok(PatchPoints {
-            source: Source::Table {
-                table,
-                patch,
-                control,
-            },
+        Ok(PatchPoints::Table {
+            table,
+            patch,
+            control,
         })
     }
 
@@ -258,9 +250,9 @@ impl<'a> PatchPoints<'a> {
                 )))
             }
         };
-        let (table, patch) = match &self.source {
-            Source::Table { table, patch, .. } => (*table, *patch),
-            Source::Adaptive { face, grids } => {
+        let (table, patch) = match self {
+            PatchPoints::Table { table, patch, .. } => (*table, *patch),
+            PatchPoints::Adaptive { face, grids } => {
                 return Ok(Grid::Positions {
                     positions: grids.grid(*face, points, n)?,
                     side,
@@ -294,9 +286,9 @@ impl<'a> PatchPoints<'a> {
     /// The control points of a table face (none for an adaptive one, whose grids hold
     /// positions).
     fn control(&self) -> &[[f64; 3]] {
-        match &self.source {
-            Source::Table { control, .. } => control,
-            Source::Adaptive { .. } => &[],
+        match self {
+            PatchPoints::Table { control, .. } => control,
+            PatchPoints::Adaptive { .. } => &[],
         }
     }
 

@@ -340,9 +340,22 @@ pub(crate) fn vertex_limit(mesh: &Mesh, h: usize) -> Option<VertexLimit> {
             let opposite: Vec<u32> = (0..n)
                 .map(|i| mesh.head(mesh.next(fan[(j + i) % n])))
                 .collect();
+            let nn = i64::try_from(n).ok()?;
+            let face = nn.checked_mul(nn.checked_add(5)?)?;
+            let mut position = vec![(me, nn, nn + 5)];
             if n == 2 {
+                // The mask's derivation (the left fixed vector of the rules on the fan's
+                // rotation-invariant part) holds at valence 2 too: the points approaching the
+                // vertex converge to it (`a_valence_two_limit_is_the_limit_of_the_points_
+                // approaching_it`), not to `V` (OpenSubdiv's `Sdc` mask there, Hbr's, exact
+                // only at the level it is applied). The subdominant eigenvalue is 1/4 and its
+                // face weights vanish; the tangents are the face's own edges.
+                for i in 0..n {
+                    position.push((ring[i], 4, face));
+                    position.push((opposite[i], 1, face));
+                }
                 return Some(with_position(
-                    &[(me, 1, 1)],
+                    &position,
                     vec![
                         (me, [-1.0, -1.0]),
                         (ring[0], [1.0, 0.0]),
@@ -350,9 +363,6 @@ pub(crate) fn vertex_limit(mesh: &Mesh, h: usize) -> Option<VertexLimit> {
                     ],
                 ));
             }
-            let nn = i64::try_from(n).ok()?;
-            let face = nn.checked_mul(nn.checked_add(5)?)?;
-            let mut position = vec![(me, nn, nn + 5)];
             let mut tangents = Vec::with_capacity(2 * n);
             let k = n as f64;
             let theta = 2.0 * std::f64::consts::PI / k;
@@ -1290,6 +1300,52 @@ mod tests {
             ],
             0.5,
         );
+    }
+
+    /// At an interior vertex of valence 2 the smooth limit mask `(4 V + 4 sum E + sum F) / 14`
+    /// is the limit of the points approaching it (OpenSubdiv's `Sdc` mask there, `V` itself,
+    /// is not: 0.61 away at vertex 0 of this pillow, whose sides are about 1). Two quads back to back, every vertex of
+    /// valence 2, not planar; positions only (the normals at such a vertex depend on the face).
+    #[test]
+    fn a_valence_two_limit_is_the_limit_of_the_points_approaching_it() {
+        let positions = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.3],
+            [1.1, 1.0, 0.0],
+            [0.0, 0.9, 0.2],
+        ];
+        let mesh = Mesh::new(
+            positions,
+            &[vec![0, 1, 2, 3], vec![3, 2, 1, 0]],
+            &[],
+            BoundaryMode::EdgeOnly,
+        )
+        .expect("a pillow");
+        for (face, u0, v0) in [(0u32, 0.0, 0.0), (0, 1.0, 1.0), (1, 0.0, 1.0)] {
+            let q = |e: f64| LimitQuery {
+                face,
+                u: u0 + e * (1.0 - 2.0 * u0),
+                v: v0 + e * (1.0 - 2.0 * v0),
+            };
+            let at_vertex = limit_of(
+                &limit_stencils(&mesh, &[q(0.0)]).expect("reached")[0],
+                &mesh,
+            );
+            let mut previous = f64::INFINITY;
+            for k in [10, 14, 18, 22] {
+                let e = (0.5f64).powi(k);
+                let near = limit_of(&limit_stencils(&mesh, &[q(e)]).expect("reached")[0], &mesh);
+                let d = (0..3)
+                    .map(|c| (near[0][c] - at_vertex[0][c]).abs())
+                    .fold(0.0, f64::max);
+                assert!(
+                    d < 2.0 * e.powf(0.75),
+                    "face {face} e 2^-{k}: {d:.2e} from the limit"
+                );
+                assert!(d < previous, "face {face}: not converging");
+                previous = d;
+            }
+        }
     }
 
     /// A crease vertex with three faces on one side (a loop of infinitely sharp edges around
