@@ -196,6 +196,7 @@ impl<'a> PatchPoints<'a> {
             kind: StencilKind::Position,
             points,
             boundary: self.patch.kind.boundary,
+            feature: self.patch.kind.feature,
             faces: self.patch.kind.faces,
             sector: self.patch.kind.sector,
             n,

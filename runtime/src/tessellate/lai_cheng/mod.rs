@@ -620,6 +620,7 @@ fn vertex_normal(table: &StencilTable, patch: &FacePatch, points: &[Point]) -> O
             kind,
             points: PointSet::Primal,
             boundary: patch.kind.boundary,
+            feature: patch.kind.feature,
             faces: patch.kind.faces,
             sector: patch.kind.sector,
             n: 1,
@@ -741,7 +742,7 @@ pub fn tessellate_adaptive(
         .filter(|(_, &p)| p == Path::Table)
         .map(|(p, _)| p.kind)
         .collect();
-    kinds.sort_by_key(|k| (k.boundary, k.faces, k.sector));
+    kinds.sort_by_key(|k| (k.boundary, k.feature, k.faces, k.sector));
     kinds.dedup();
     let mut operators: HashMap<PatchKind, Operators> = HashMap::new();
     for kind in kinds {
