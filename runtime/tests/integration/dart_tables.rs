@@ -92,6 +92,8 @@ fn table_at(
 struct Agreement {
     /// `(valence, sector)` of every dart patch compared.
     kinds: std::collections::BTreeSet<(u32, u32)>,
+    /// Faces that took a dart patch, of all faces.
+    faces: (usize, usize),
     /// Dual points compared.
     points: usize,
     /// Largest position difference, relative to the mesh's size.
@@ -106,13 +108,17 @@ fn compare(name: &str, mesh: &Mesh, rates: &[u32]) -> Agreement {
     let table = StencilTable::default_for(mesh.boundary).expect("embedded table");
     let (mesh, patches, _) = isolate(mesh).unwrap_or_else(|e| panic!("{name}: {e}"));
     let scale = size(&mesh);
-    let mut out = Agreement::default();
+    let mut out = Agreement {
+        faces: (0, patches.len()),
+        ..Agreement::default()
+    };
     for (f, patch) in patches.iter().enumerate() {
         if patch.kind.feature != Feature::Dart {
             assert!(table_dart(&mesh, f).is_none(), "{name}: face {f}");
             continue;
         }
         assert!(!mesh.holes[f]);
+        out.faces.0 += 1;
         out.kinds.insert((patch.kind.faces, patch.kind.sector));
         for &n in rates {
             let nu = n as usize;
@@ -224,7 +230,7 @@ fn dart_patches_equal_adaptive_refinement_on_prisms() {
     assert_eq!(kinds.len(), (3..=8).sum::<usize>());
 }
 
-/// OpenSubdiv's shapes with darts, as given and refined once, rates 1, 2, 4, 7: every face the
+/// OpenSubdiv's shapes with darts, as given and refined once and twice, rates 1, 2, 4, 7: every face the
 /// tables take as a dart patch. As given, `catmark_inf_crease0`'s one dart ends a crease one
 /// edge long at a corner, beside a crease and the boundary, so none of its faces is a dart patch
 /// (they stay adaptive); one step of refinement puts a straight crease vertex beside it, and
@@ -240,12 +246,14 @@ fn dart_patches_equal_adaptive_refinement_on_opensubdiv_shapes() {
         let path = crate::common::models().join("opensubdiv").join(name);
         let obj = read_obj(&path).unwrap_or_else(|e| panic!("{e}"));
         let mesh = Mesh::from_obj(&obj).unwrap_or_else(|e| panic!("{e}")).0;
-        for (level, mesh) in [(0, mesh.clone()), (1, refine(&mesh).mesh)] {
+        let once = refine(&mesh).mesh;
+        let twice = refine(&once).mesh;
+        for (level, mesh) in [(0, mesh), (1, once), (2, twice)] {
             let a = compare(name, &mesh, &[1, 2, 4, 7]);
             eprintln!(
-                "{name}, level {level}: dart patches {:?}, {} dual points: positions within \
-                 {:e} of the size, normals within {:e} rad",
-                a.kinds, a.points, a.position, a.normal
+                "{name}, level {level}: {} of {} faces dart patches {:?}, {} dual points: \
+                 positions within {:e} of the size, normals within {:e} rad",
+                a.faces.0, a.faces.1, a.kinds, a.points, a.position, a.normal
             );
             let expected = !(level == 0 && name == "catmark_inf_crease0.obj");
             assert_eq!(!a.kinds.is_empty(), expected, "{name}, level {level}");

@@ -67,7 +67,7 @@ use table_format::{PointSet, SectionKey, StencilKind};
 use crate::mesh::topology::Mesh;
 use crate::mesh::triangle_mesh::{TriangleMesh, VertexSource};
 use crate::scheme::catmull_clark::adaptive::{limit_of, limit_stencils, LimitQuery};
-use crate::scheme::patch::{is_smooth_patch, FacePatch, PatchKind};
+use crate::scheme::patch::{is_table_patch, FacePatch, PatchKind};
 use crate::stencil_table::StencilTable;
 use crate::RuntimeError;
 use bezier_net::{
@@ -702,12 +702,13 @@ pub fn tessellate_adaptive(
         )));
     }
     // Which faces take which path: a hole has no surface; a face the tables describe (no sharp
-    // feature on its support) its table patch; any other the feature descent.
+    // feature on its support, or a settled dart the dart patches describe) its table patch; any
+    // other the feature descent.
     let path: Vec<Path> = (0..mesh.faces())
         .map(|f| {
             if mesh.holes[f] {
                 Path::Hole
-            } else if is_smooth_patch(mesh, f) {
+            } else if is_table_patch(mesh, f) {
                 Path::Table
             } else {
                 Path::Feature
