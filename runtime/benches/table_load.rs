@@ -47,6 +47,7 @@ fn grids(
                         kind,
                         points,
                         boundary,
+                        feature: table_format::Feature::None,
                         faces,
                         sector,
                         n,

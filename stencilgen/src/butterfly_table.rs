@@ -99,6 +99,7 @@ mod tests {
                                 kind: table_kind,
                                 points: set,
                                 boundary: false,
+                                feature: table_format::Feature::None,
                                 faces: k,
                                 sector: r as u32,
                                 n,

@@ -111,6 +111,11 @@ enum Command {
         /// Interior valences: a range `3..8` (inclusive) or a list `3,5,6`.
         #[arg(long, default_value = "3..8")]
         valences: String,
+        /// Valences of darts (an interior vertex with one infinitely sharp edge; every sector),
+        /// as a range or list, or `none`. Default: the interior valences for a quad scheme with
+        /// crease rules (Catmull–Clark), none for the others.
+        #[arg(long)]
+        darts: Option<String>,
         /// Include boundary vertices (with --boundary-faces faces).
         #[arg(long)]
         boundary: bool,
@@ -239,6 +244,7 @@ fn run(cli: Cli) -> Result<(), StencilError> {
         Command::Tables {
             schemes,
             valences,
+            darts,
             boundary,
             boundary_faces,
             corners,
@@ -248,8 +254,16 @@ fn run(cli: Cli) -> Result<(), StencilError> {
             grids,
             output,
         } => {
-            let set = StencilSetSpec {
-                valences: parse_set("--valences", &valences, MAX_TABLE_VALENCE)?,
+            let valences = parse_set("--valences", &valences, MAX_TABLE_VALENCE)?;
+            // `None`: each scheme's default (below).
+            let darts = match darts.as_deref() {
+                None => None,
+                Some("none") => Some(Vec::new()),
+                Some(d) => Some(parse_set("--darts", d, MAX_TABLE_VALENCE)?),
+            };
+            let mut set = StencilSetSpec {
+                darts: darts.clone().unwrap_or_else(|| valences.clone()),
+                valences,
                 boundary_faces: if boundary {
                     parse_set("--boundary-faces", &boundary_faces, MAX_TABLE_VALENCE)?
                 } else {
@@ -281,6 +295,12 @@ fn run(cli: Cli) -> Result<(), StencilError> {
                     output.clone()
                 };
                 if let Some(triangle) = TriangleScheme::by_name(name) {
+                    if darts.as_ref().is_some_and(|d| !d.is_empty()) {
+                        return Err(StencilError::UnsupportedScheme {
+                            scheme: name.clone(),
+                            reason: "darts are implemented for quad schemes only".to_owned(),
+                        });
+                    }
                     if corners {
                         return Err(StencilError::UnsupportedScheme {
                             scheme: name.clone(),
@@ -343,6 +363,13 @@ fn run(cli: Cli) -> Result<(), StencilError> {
                     continue;
                 }
                 let scheme = quad_scheme(name)?;
+                // A dart's crease takes the scheme's crease (boundary) rules: by default, darts
+                // only where the scheme has them.
+                set.darts = match &darts {
+                    Some(d) => d.clone(),
+                    None if scheme.boundary.is_some() => set.valences.clone(),
+                    None => Vec::new(),
+                };
                 write_table(
                     TableSpec {
                         scheme,
@@ -558,16 +585,22 @@ fn parse_set(flag: &str, text: &str, max: u32) -> Result<Vec<u32>, StencilError>
 }
 
 /// Refuse, before solving anything, a table that would exceed what the format holds
-/// ([`table_format::MAX_FILE_SIZE`], 4 GiB): every patch (valence `v` or boundary face count)
-/// at every rate `n` has `(n + 1)^2` primal and `n^2` dual points, each with at most
+/// ([`table_format::MAX_FILE_SIZE`], 4 GiB): every patch (valence `v` or boundary face count;
+/// a dart of valence `v` counts `v` times, one per sector) at every rate `n` has `(n + 1)^2` primal and `n^2` dual points, each with at most
 /// `2 v + 8` weights (the Catmull–Clark patch; the triangle schemes' are fewer), for the
 /// position and both derivatives, in f64 at most.
 fn check_table_size(set: &StencilSetSpec) -> Result<(), StencilError> {
+    let dart_sectors = set
+        .darts
+        .iter()
+        .flat_map(|&v| std::iter::repeat(v).take(v as usize));
     let bytes: u128 = set
         .valences
         .iter()
-        .chain(&set.boundary_faces)
-        .map(|&v| {
+        .copied()
+        .chain(dart_sectors)
+        .chain(set.boundary_faces.iter().copied())
+        .map(|v| {
             set.rates
                 .iter()
                 .map(|&n| {

@@ -92,6 +92,7 @@ fn region_sections<R: RegionStencilSet>(
                 kind: table_kind,
                 points: set,
                 boundary: false,
+                feature: table_format::Feature::None,
                 faces: regions.valence(),
                 sector: r as u32,
                 n,

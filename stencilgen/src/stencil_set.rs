@@ -14,6 +14,10 @@ use crate::{Scalar, StencilError};
 pub struct StencilSetSpec {
     /// Interior valences (e.g. 3..=8).
     pub valences: Vec<u32>,
+    /// Valences of darts (interior vertices with one infinitely sharp edge,
+    /// [`Neighbourhood::dart`]), every sector of each; empty for none. Only for schemes with
+    /// crease (boundary) rules.
+    pub darts: Vec<u32>,
     /// Boundary face counts (e.g. 1..=6); empty for none.
     pub boundary_faces: Vec<u32>,
     /// The boundary interpolation mode of the boundary entries.
@@ -23,11 +27,12 @@ pub struct StencilSetSpec {
 }
 
 impl StencilSetSpec {
-    /// The default table's contents: interior valences 3..=8, boundary 1..=6 faces
-    /// ("edge only"), n = 1..=24.
+    /// The default table's contents: interior valences 3..=8, darts of valences 3..=8 (every
+    /// sector), boundary 1..=6 faces ("edge only"), n = 1..=24.
     pub fn default_catmull_clark() -> Self {
         StencilSetSpec {
             valences: (3..=8).collect(),
+            darts: (3..=8).collect(),
             boundary_faces: (1..=6).collect(),
             boundary_mode: BoundaryMode::EdgeOnly,
             rates: (1..=24).collect(),
@@ -40,11 +45,17 @@ impl StencilSetSpec {
             .valences
             .iter()
             .map(|&v| (Neighbourhood::interior(v), 0));
+        // Every sector of a dart: sectors `s` and `v - 1 - s` are mirror images, but a mirrored
+        // patch reads its control points in another order, so each is stored as it is read.
+        let darts = self.darts.iter().flat_map(|&v| {
+            let nb = Neighbourhood::dart(v);
+            (0..v).map(move |s| (nb, s))
+        });
         let boundary = self.boundary_faces.iter().flat_map(|&f| {
             let nb = Neighbourhood::boundary(f, self.boundary_mode);
             (0..f).map(move |s| (nb, s))
         });
-        interior.chain(boundary).collect()
+        interior.chain(darts).chain(boundary).collect()
     }
 }
 

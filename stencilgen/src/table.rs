@@ -13,19 +13,20 @@
 //! * **Grids**: each patch stencil grid as two sections, its primal and its dual points, of
 //!   `K` weights per point, solved on the grid (the whole system of `crate::patch_stencils`).
 //!
-//! The default table (what `subtess` embeds) is Catmull–Clark, interior valences 3..=8 and
-//! boundary vertices with 1..=6 faces ("edge only"), n = 1..=24, compact, from the f64 path
+//! The default table (what `subtess` embeds) is Catmull–Clark, interior valences 3..=8, darts of
+//! valences 3..=8 (every sector) and boundary vertices with 1..=6 faces ("edge only"),
+//! n = 1..=24, compact, from the f64 path
 //! (which agrees with exact arithmetic within 1e-12); `--exact` solves in exact rationals
 //! instead.
 
 use num_rational::BigRational;
 use schemes::QuadScheme;
 use table_format::{
-    encode, PointSet, Precision, SchemeId, SectionKey, StencilKind as TableKind, TableMeta,
+    encode, Feature, PointSet, Precision, SchemeId, SectionKey, StencilKind as TableKind, TableMeta,
 };
 
 use crate::ev_tangents::ev_tangents;
-use crate::extraordinary_patch::LocalMatrices;
+use crate::extraordinary_patch::{LocalMatrices, Neighbourhood};
 use crate::patch_stencils::{patch_stencils_with, quad_scheme, regular_curve, PatchStencils};
 use crate::regular_patch::{RegularBasis, StencilKind};
 use crate::stencil_set::{stencil_set_with_progress, StencilSetSpec};
@@ -77,6 +78,7 @@ impl TableSpec {
     pub fn default_corners() -> Result<Self, StencilError> {
         let mut spec = TableSpec::default_catmull_clark()?;
         spec.set.valences = Vec::new();
+        spec.set.darts = Vec::new();
         spec.set.boundary_faces = vec![1];
         spec.set.boundary_mode = schemes::BoundaryMode::EdgeAndCorner;
         Ok(spec)
@@ -127,6 +129,15 @@ pub fn default_corner_table() -> Result<Vec<u8>, StencilError> {
 
 type Section = (SectionKey, u32, Vec<f64>);
 
+/// The section key's sharp feature of a neighbourhood.
+fn feature(nb: Neighbourhood) -> Feature {
+    if nb.dart {
+        Feature::Dart
+    } else {
+        Feature::None
+    }
+}
+
 /// The compact layout's sections (module docs), reporting `progress(done, total)` over rates
 /// and patches.
 fn compact_sections<S: Scalar + Send + Sync>(
@@ -137,11 +148,12 @@ fn compact_sections<S: Scalar + Send + Sync>(
     let patches = spec.set.patches();
     let total = spec.set.rates.len() + patches.len();
     let mut out = Vec::new();
-    let key = |kind, points, boundary, faces, sector, n| SectionKey {
+    let key = |kind, points, nb: Option<Neighbourhood>, sector, n| SectionKey {
         kind,
         points,
-        boundary,
-        faces,
+        boundary: nb.is_some_and(|nb| nb.boundary.is_some()),
+        feature: nb.map_or(Feature::None, feature),
+        faces: nb.map_or(0, |nb| nb.faces),
         sector,
         n,
     };
@@ -152,7 +164,7 @@ fn compact_sections<S: Scalar + Send + Sync>(
                 .flat_map(|t| basis.axis_weights(t, derivative))
                 .map(|w| w.to_f64())
                 .collect();
-            out.push((key(kind, PointSet::CurveBasis, false, 0, 0, n), 4, rows));
+            out.push((key(kind, PointSet::CurveBasis, None, 0, n), 4, rows));
         }
         progress(done + 1, total);
     }
@@ -168,8 +180,7 @@ fn compact_sections<S: Scalar + Send + Sync>(
     for (done, &(nb, sector)) in patches.iter().enumerate() {
         let matrices = LocalMatrices::new(&spec.scheme, nb, sector)?;
         let width = matrices.size() as u32;
-        let boundary = nb.boundary.is_some();
-        let at = |kind, points| key(kind, points, boundary, nb.faces, sector, 0);
+        let at = |kind, points| key(kind, points, Some(nb), sector, 0);
         let position = patch_stencils_with(&spec.scheme, &matrices, &basis, StencilKind::Position)?;
         let limit = position
             .stencils
@@ -266,6 +277,7 @@ fn sections<S: Scalar + Send + Sync>(
                 kind,
                 points,
                 boundary: grid.neighbourhood.boundary.is_some(),
+                feature: feature(grid.neighbourhood),
                 faces: grid.neighbourhood.faces,
                 sector: grid.sector,
                 n: grid.n,

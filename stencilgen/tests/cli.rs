@@ -190,16 +190,29 @@ fn written_table(name: &str, args: &str) -> table_format::TableIndex {
 fn tables_writes_a_valid_table() {
     let table = written_table("quad", "--valences 3,5 --n 1..2 --precision f64");
     assert_eq!(table.meta.precision, table_format::Precision::F64);
-    // Compact: 2 rates x 2 curve-basis sections, 2 patches x 5 pieces.
-    assert_eq!(table.entries.len(), 2 * 2 + 2 * 5);
+    // Compact: 2 rates x 2 curve-basis sections, 2 interior patches and, by default, the darts
+    // of the same valences, every sector (3 + 5), x 5 pieces.
+    assert_eq!(table.entries.len(), 2 * 2 + (2 + 8) * 5);
     assert_eq!(
         table.coverage(),
-        "interior valences 3, 5, no boundary vertices, n = 1..=2"
+        "interior valences 3, 5, darts of valences 3, 5, no boundary vertices, n = 1..=2"
     );
-    // --grids: every grid, 2 patches x 2 rates x 3 kinds x 2 point sets, f32 by default.
+    // --grids: every grid, 10 patches x 2 rates x 3 kinds x 2 point sets, f32 by default.
     let table = written_table("quad", "--valences 3,5 --n 1..2 --grids");
     assert_eq!(table.meta.precision, table_format::Precision::F32);
-    assert_eq!(table.entries.len(), 2 * 2 * 3 * 2);
+    assert_eq!(table.entries.len(), (2 + 8) * 2 * 3 * 2);
+    // --darts chooses the darts' valences, or none.
+    let table = written_table("quad", "--valences 3,5 --darts 4 --n 1");
+    assert_eq!(table.entries.len(), 2 + (2 + 4) * 5);
+    let table = written_table("quad", "--valences 3,5 --darts none --n 1");
+    assert_eq!(table.entries.len(), 2 + 2 * 5);
+    // A scheme without crease rules has no darts unless asked, and then refuses them.
+    let table = written_table("quad", "--schemes sw-nonpoly-quad --valences 3 --n 1");
+    assert_eq!(table.entries.len(), 2 + 5);
+    fails_with(
+        "tables --schemes loop --valences 5 --darts 5 --n 1 -o /tmp/x.subtess",
+        "darts are implemented for quad schemes only",
+    );
     fails_with(
         "tables --valences 3 --n 1 --precision f32 -o /tmp/x.subtess",
         "compact tables store f64",

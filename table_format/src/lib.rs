@@ -10,8 +10,8 @@
 //! (or `&[f64]`) slices.
 //!
 //! ```
-//! use table_format::{encode, PointSet, Precision, SchemeId, SectionKey, StencilKind, Table, TableMeta};
-//! let key = SectionKey { kind: StencilKind::Position, points: PointSet::Dual, boundary: false, faces: 4, sector: 0, n: 1 };
+//! use table_format::{encode, Feature, PointSet, Precision, SchemeId, SectionKey, StencilKind, Table, TableMeta};
+//! let key = SectionKey { kind: StencilKind::Position, points: PointSet::Dual, boundary: false, feature: Feature::None, faces: 4, sector: 0, n: 1 };
 //! let meta = TableMeta { scheme: SchemeId::CatmullClark, precision: Precision::F32, corners: false };
 //! let bytes = encode(meta, &[(key, 16, vec![1.0 / 16.0; 16])]).expect("valid sections");
 //! let aligned = table_format::AlignedBytes::from_slice(&bytes);
@@ -26,14 +26,16 @@ use thiserror::Error;
 
 /// The first eight bytes of every table.
 pub const MAGIC: [u8; 8] = *b"SUBTESS\0";
-/// The format version this crate reads and writes. Version 4 added the scaling relation's
+/// The format version this crate reads and writes. Version 5 turned the index entry's reserved
+/// byte 3 into the patch's sharp feature ([`Feature`]: the dart patches of Catmull–Clark
+/// tables); version 4 added the scaling relation's
 /// pieces as sections ([`PointSet::CurveBasis`], [`PointSet::VertexMask`],
 /// [`PointSet::Subdivision`], [`PointSet::SubPatches`]; for Loop [`PointSet::LoopBasis`],
 /// [`PointSet::SubTriangles`], [`PointSet::TriangleRate`]), from which a reader expands the
 /// grid stencils; version 3 extended the checksum over the header and the section index (version 2
 /// hashed the bytes after the header only, so a changed boundary-mode flag was read as the
 /// other mode). Older files are refused.
-pub const VERSION: u32 = 4;
+pub const VERSION: u32 = 5;
 /// Size of the fixed header.
 pub const HEADER_SIZE: usize = 64;
 /// Where the header keeps the checksum (a u64): the one run of bytes [`checksum`] leaves out.
@@ -445,6 +447,27 @@ impl PointSet {
     }
 }
 
+/// The infinitely sharp feature a patch is made for (index entry byte 3). Sharp features are
+/// stationary: a patch at one refines into itself, so it has exact stencils like a smooth one.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Feature {
+    /// None: a smooth interior vertex or a boundary vertex (with its boundary rules).
+    None = 0,
+    /// A dart: an interior vertex with exactly one infinitely sharp edge, sector 0's `+a` axis
+    /// (`V-E_1`), the crease continuing straight out along it
+    /// (`schemes::local_matrices::Neighbourhood::dart`). Interior keys only.
+    Dart = 1,
+}
+
+impl Feature {
+    /// The feature of byte value `v`, if the format defines it.
+    pub fn from_u8(v: u8) -> Option<Self> {
+        [Feature::None, Feature::Dart]
+            .into_iter()
+            .find(|f| *f as u8 == v)
+    }
+}
+
 /// Identifies one section: one kind of stencil on one grid of one patch.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct SectionKey {
@@ -454,6 +477,9 @@ pub struct SectionKey {
     pub points: PointSet,
     /// Whether the patch's corner vertex is a boundary vertex.
     pub boundary: bool,
+    /// The sharp feature at the patch's corner vertex ([`Feature::Dart`] only with
+    /// `boundary == false`).
+    pub feature: Feature,
     /// The vertex's valence (interior) or number of faces (boundary).
     pub faces: u32,
     /// Which of a boundary vertex's patches (0 for interior vertices); for the butterfly, which
@@ -499,6 +525,12 @@ impl fmt::Display for SectionKey {
                     "{what} of the boundary vertex with {} faces, sector {}",
                     self.faces, self.sector
                 )
+            } else if self.feature == Feature::Dart {
+                write!(
+                    f,
+                    "{what} of the dart of valence {}, sector {}",
+                    self.faces, self.sector
+                )
             } else {
                 write!(f, "{what} of valence {}", self.faces)
             };
@@ -507,6 +539,12 @@ impl fmt::Display for SectionKey {
             write!(
                 f,
                 "{kind} on the {grid} grid, n = {}, boundary vertex with {} faces, sector {}",
+                self.n, self.faces, self.sector
+            )
+        } else if self.feature == Feature::Dart {
+            write!(
+                f,
+                "{kind} on the {grid} grid, n = {}, dart of valence {}, sector {}",
                 self.n, self.faces, self.sector
             )
         } else if self.sector != 0 {
@@ -576,6 +614,14 @@ pub fn encode(
     }
     if let Some((key, _, _)) = sorted
         .iter()
+        .find(|(key, _, _)| key.boundary && key.feature != Feature::None)
+    {
+        return Err(TableError::Encode(format!(
+            "{key}: a boundary vertex has no sharp-feature patch (a dart is interior)"
+        )));
+    }
+    if let Some((key, _, _)) = sorted
+        .iter()
         .find(|(key, _, _)| !key.points.belongs_to(meta.scheme))
     {
         return Err(TableError::WrongPointSet {
@@ -626,7 +672,7 @@ pub fn encode(
             e.key.kind as u8,
             e.key.points as u8,
             u8::from(e.key.boundary),
-            0,
+            e.key.feature as u8,
         ]);
         put_u32(&mut out, e.key.faces);
         put_u32(&mut out, e.key.sector);
@@ -814,10 +860,21 @@ impl TableIndex {
                     })
                 }
             };
+            // A dart is an interior vertex; a boundary vertex's feature is its boundary.
+            let feature = match Feature::from_u8(e[3]) {
+                Some(f) if !(boundary && f != Feature::None) => f,
+                _ => {
+                    return Err(TableError::BadField {
+                        field: "section feature",
+                        value: u64::from(e[3]),
+                    })
+                }
+            };
             let key = SectionKey {
                 kind,
                 points,
                 boundary,
+                feature,
                 faces: u32_at(e, 4),
                 sector: u32_at(e, 8),
                 n: u32_at(e, 12),
@@ -979,6 +1036,7 @@ impl TableIndex {
     /// A one-line summary of what the table covers: valences, boundary face counts, rates.
     pub fn coverage(&self) -> String {
         let mut valences = std::collections::BTreeSet::new();
+        let mut darts = std::collections::BTreeSet::new();
         let mut boundary = std::collections::BTreeSet::new();
         let mut rates = std::collections::BTreeSet::new();
         for e in &self.entries {
@@ -991,6 +1049,8 @@ impl TableIndex {
             if !patchless {
                 if e.key.boundary {
                     boundary.insert(e.key.faces);
+                } else if e.key.feature == Feature::Dart {
+                    darts.insert(e.key.faces);
                 } else {
                     valences.insert(e.key.faces);
                 }
@@ -1011,7 +1071,13 @@ impl TableIndex {
         } else {
             format!("boundary vertices with {} faces", ranges(&boundary))
         };
-        format!("{interior}, {boundary}, n = {}", ranges(&rates))
+        // Darts are named only where a table has them (tables before them read as before).
+        let darts = if darts.is_empty() {
+            String::new()
+        } else {
+            format!(", darts of valences {}", ranges(&darts))
+        };
+        format!("{interior}{darts}, {boundary}, n = {}", ranges(&rates))
     }
 }
 

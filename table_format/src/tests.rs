@@ -9,6 +9,7 @@ fn key(kind: StencilKind, points: PointSet, faces: u32, n: u32) -> SectionKey {
         kind,
         points,
         boundary: false,
+        feature: Feature::None,
         faces,
         sector: 0,
         n,
@@ -65,8 +66,8 @@ fn round_trip() {
     );
     // Byte-for-byte deterministic, whatever the order sections are given in.
     assert_eq!(bytes, sample());
-    // Version 4, and the stored checksum is the one over every byte but its own.
-    assert_eq!(table.version, 4);
+    // Version 5, and the stored checksum is the one over every byte but its own.
+    assert_eq!(table.version, 5);
     assert_eq!(table.checksum, checksum(&bytes));
     assert_eq!(u64_at(&bytes, CHECKSUM_OFFSET), table.checksum);
     // Streamed over the two runs, equal to the one-shot hash of the runs laid end to end
@@ -244,7 +245,8 @@ fn header_fields_are_checksummed() {
 /// one says so too.
 #[test]
 fn older_versions_name_themselves_and_the_command() {
-    for old in [1u32, 2] {
+    // 4: the last version without the feature byte (its byte 3 was reserved, always 0).
+    for old in [1u32, 2, 4] {
         let mut b = sample();
         b[8..12].copy_from_slice(&old.to_le_bytes());
         let e = parse(&b).expect_err("an older version");
@@ -266,6 +268,75 @@ fn older_versions_name_themselves_and_the_command() {
     b[8..12].copy_from_slice(&(VERSION + 1).to_le_bytes());
     let message = parse(&b).expect_err("a newer version").to_string();
     assert!(message.contains("newer"), "{message}");
+}
+
+/// A dart section's key round-trips with its feature in index byte 3 (0 none, 1 dart) and sorts
+/// after the smooth patches of its valence; a feature byte the format does not define, or a
+/// dart on a boundary key, is refused by the reader (behind a valid checksum) and the writer.
+#[test]
+fn dart_keys_round_trip_and_bad_feature_bytes_are_refused() {
+    let meta = TableMeta {
+        scheme: SchemeId::CatmullClark,
+        precision: Precision::F32,
+        corners: false,
+    };
+    let smooth = key(StencilKind::Position, PointSet::Dual, 3, 1);
+    let dart = SectionKey {
+        feature: Feature::Dart,
+        sector: 2,
+        ..smooth
+    };
+    let bytes = encode(
+        meta,
+        &[(dart, 14, vec![0.5; 14]), (smooth, 14, vec![0.25; 14])],
+    )
+    .expect("valid");
+    let aligned = AlignedBytes::from_slice(&bytes);
+    let table = Table::parse(aligned.as_bytes()).expect("valid");
+    assert_eq!(table.weights_f32(&dart).expect("present")[0], 0.5);
+    assert_eq!(table.weights_f32(&smooth).expect("present")[0], 0.25);
+    assert_eq!(
+        table.coverage(),
+        "interior valences 3, darts of valences 3, no boundary vertices, n = 1"
+    );
+    // The second entry is the dart's: byte 3 is 1, the sector 2.
+    let second = HEADER_SIZE + ENTRY_SIZE;
+    assert_eq!(bytes[second + 3], 1);
+    assert_eq!(bytes[second + 8], 2);
+    assert_eq!(bytes[HEADER_SIZE + 3], 0);
+    assert!(
+        dart.to_string().contains("dart of valence 3, sector 2"),
+        "{dart}"
+    );
+
+    let mut b = bytes.clone();
+    b[second + 3] = 2;
+    reseal(&mut b);
+    assert_eq!(
+        parse(&b),
+        Err(TableError::BadField {
+            field: "section feature",
+            value: 2
+        })
+    );
+    let mut b = bytes.clone();
+    b[second + 2] = 1; // boundary, and a dart
+    reseal(&mut b);
+    assert_eq!(
+        parse(&b),
+        Err(TableError::BadField {
+            field: "section feature",
+            value: 1
+        })
+    );
+    let boundary_dart = SectionKey {
+        boundary: true,
+        ..dart
+    };
+    assert!(matches!(
+        encode(meta, &[(boundary_dart, 14, vec![0.5; 14])]),
+        Err(TableError::Encode(_))
+    ));
 }
 
 #[test]

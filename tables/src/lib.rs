@@ -1,8 +1,9 @@
 //! The default stencil tables, embedded: the Catmull–Clark table, its small pinned-corner
 //! companion, the Loop table, the butterfly table and the √3 table.
 //!
-//! The default Catmull–Clark table (interior valences 3..=8, boundary vertices with 1..=6 faces
-//! "edge only", n = 1..=24) is compact (0.29 MB: the scaling relation's pieces, from which the
+//! The default Catmull–Clark table (interior valences 3..=8, darts of valences 3..=8, boundary
+//! vertices with 1..=6 faces "edge only", n = 1..=24) is compact (0.68 MB: the scaling
+//! relation's pieces, from which the
 //! runtime expands the grids), and so is the Loop table (0.17 MB); the butterfly and √3 tables
 //! hold their grids (5.3 MiB each). All are generated deterministically by `stencilgen` in this
 //! crate's build script rather than kept in the repository and its history, and embedded with

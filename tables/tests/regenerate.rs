@@ -64,6 +64,16 @@ fn regenerated_default_table_is_byte_identical() {
         "the embedded default table differs from a fresh generation"
     );
     let table = table_format::Table::parse(embedded).expect("the embedded table is valid");
+    // The darts of valences 3..=8, every sector: 3 + 4 + .. + 8 = 33 patches.
+    let darts = table
+        .entries
+        .iter()
+        .filter(|e| {
+            e.key.feature == table_format::Feature::Dart
+                && e.key.points == table_format::PointSet::Subdivision
+        })
+        .count();
+    assert_eq!(darts, 33);
     println!(
         "default table: {} bytes, {} sections; {}",
         table.size(),

@@ -290,3 +290,117 @@ fn dart_tangents_span_the_subdominant_invariant_subspace() {
         }
     }
 }
+
+/// The dart patches of the default table (`stencilgen::table::default_table()`, the bytes
+/// `subtess` embeds: `tables/tests/regenerate.rs`), read back through the table format: for every
+/// valence 3..=8 and every sector, the stored pieces give by plain substitution,
+/// `phi(x) = psi(2^k x - o_b) R_b A^(k-1)` with `psi` the bicubic B-spline from truncated powers
+/// (`uniform_bspline`, not `stencilgen`'s basis), the position stencils that exact substitution
+/// on freshly built rational matrices gives, at the primal and dual points of rate 4, to 1e-12;
+/// the stored limit mask is the exact one at `(0, 0)`. A wrong feature byte, sector or valence
+/// in the keys, or a corrupted piece, would fail here.
+#[test]
+fn default_table_dart_pieces_give_the_exact_stencils() {
+    use table_format::{Feature, PointSet, SectionKey, StencilKind as Kind, Table};
+    let bytes = stencilgen::table::default_table().expect("the default table");
+    let aligned = table_format::AlignedBytes::from_slice(&bytes);
+    let table = Table::parse(aligned.as_bytes()).expect("valid");
+    let piece = |v: u32, sector: u32, kind: Kind, points: PointSet| -> Vec<f64> {
+        let key = SectionKey {
+            kind,
+            points,
+            boundary: false,
+            feature: Feature::Dart,
+            faces: v,
+            sector,
+            n: 0,
+        };
+        table
+            .weights_f64(&key)
+            .unwrap_or_else(|e| panic!("{key}: {e}"))
+            .to_vec()
+    };
+    let to_f64 = |x: &BigRational| -> f64 {
+        use num_traits::ToPrimitive;
+        x.to_f64().expect("finite")
+    };
+    // psi's 16 weights at t in [0,1]^2, (p, q) in -1..=2, q outer: B_3(t - p + 2) per axis.
+    let psi = |t: [&BigRational; 2]| -> Vec<f64> {
+        let axis = |t: &BigRational| -> Vec<f64> {
+            (-1..=2)
+                .map(|p| to_f64(&uniform_bspline(3, &(t - q(p, 1) + q(2, 1)))))
+                .collect()
+        };
+        let (wu, wv) = (axis(t[0]), axis(t[1]));
+        wv.iter()
+            .flat_map(|b| wu.iter().map(move |a| a * b))
+            .collect()
+    };
+    let mut compared = 0;
+    for v in 3..=8u32 {
+        let k = 2 * v as usize + 8;
+        for sector in 0..v {
+            let a = piece(v, sector, Kind::Position, PointSet::Subdivision);
+            let r = piece(v, sector, Kind::Position, PointSet::SubPatches);
+            let mask = piece(v, sector, Kind::Position, PointSet::VertexMask);
+            assert_eq!((a.len(), r.len(), mask.len()), (k * k, 48 * k, k));
+            let mut exact = Substitution::<BigRational>::new(&cc(), Neighbourhood::dart(v), sector)
+                .expect("substitution");
+            let limit = exact
+                .stencil(&q(0, 1), &q(0, 1), StencilKind::Position)
+                .expect("limit");
+            for (stored, want) in mask.iter().zip(&limit) {
+                assert!(
+                    (stored - to_f64(want)).abs() <= 1e-15,
+                    "dart {v} sector {sector}"
+                );
+            }
+            // Rate 4: primal points (i/4, j/4) and dual points ((2i+1)/8, (2j+1)/8), on 1/8.
+            let points = (0..=8i64)
+                .flat_map(|b| (0..=8i64).map(move |a| (a, b)))
+                .filter(|&(a, b)| (a % 2 == 0 && b % 2 == 0) || (a % 2 == 1 && b % 2 == 1))
+                .filter(|&p| p != (0, 0));
+            for (a_, b_) in points {
+                let (mut x, mut y, mut levels) = (q(a_, 8), q(b_, 8), 0);
+                while x <= q(1, 2) && y <= q(1, 2) {
+                    x *= q(2, 1);
+                    y *= q(2, 1);
+                    levels += 1;
+                }
+                // (x, y) in [0,1]^2 minus [0,1/2]^2: sub-patch b at level 1, local 2x - o_b.
+                let (tx, ty) = (&x * q(2, 1), &y * q(2, 1));
+                let (b, origin) = match (tx >= q(1, 1), ty >= q(1, 1)) {
+                    (true, false) => (0, (1, 0)),
+                    (true, true) => (1, (1, 1)),
+                    _ => (2, (0, 1)),
+                };
+                let t = [&tx - q(origin.0, 1), &ty - q(origin.1, 1)];
+                let w = psi([&t[0], &t[1]]);
+                let mut stencil = vec![0.0; k];
+                for (row, wr) in w.iter().enumerate() {
+                    for (s, rv) in stencil.iter_mut().zip(&r[(16 * b + row) * k..][..k]) {
+                        *s += wr * rv;
+                    }
+                }
+                for _ in 0..levels {
+                    stencil = (0..k)
+                        .map(|j| (0..k).map(|i| stencil[i] * a[i * k + j]).sum())
+                        .collect();
+                }
+                let want = exact
+                    .stencil(&q(a_, 8), &q(b_, 8), StencilKind::Position)
+                    .expect("stencil");
+                for (i, (s, w)) in stencil.iter().zip(&want).enumerate() {
+                    assert!(
+                        (s - to_f64(w)).abs() <= 1e-12,
+                        "dart {v} sector {sector} at ({a_}, {b_})/8, weight {i}: {s} from the \
+                         table, {w} exact"
+                    );
+                }
+                compared += 1;
+            }
+        }
+    }
+    // 33 patches x (24 primal + 16 dual points).
+    assert_eq!(compared, 33 * 40);
+}

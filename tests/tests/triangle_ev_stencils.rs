@@ -400,6 +400,7 @@ fn loop_table_sections_are_the_substitution_stencils_at_the_contract_points() {
                         kind,
                         points: set,
                         boundary,
+                        feature: table_format::Feature::None,
                         faces,
                         sector,
                         n,

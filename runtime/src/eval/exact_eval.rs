@@ -454,11 +454,7 @@ impl ExactEvaluator {
         v: &BigRational,
         level: usize,
     ) -> Result<Derivatives, RuntimeError> {
-        let nb = if patch.kind.boundary {
-            Neighbourhood::boundary(patch.kind.faces, self.levels[0].boundary)
-        } else {
-            Neighbourhood::interior(patch.kind.faces)
-        };
+        let nb = patch.kind.neighbourhood(self.levels[0].boundary);
         let operators = self.operators(nb, patch.kind.sector)?;
         let matrices = &operators.matrices;
         if matrices.size() != points.len() {

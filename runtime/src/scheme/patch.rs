@@ -12,11 +12,18 @@
 //!   cell holding `O_2 = (2,0)` and `O_3 = (2,1)`, below that cell's edge `E_1-O_2` the one with
 //!   `O_1 = (2,-1)`, above its edge `F_1-O_3` the one with `O_4`, `O_5`, then `O_6`, `O_7`.
 //!
+//! A face at a **dart** the tables describe ([`table_dart`]) is a patch of the dart table
+//! (`docs/algorithms/extraordinary-stencils.md`, "Darts"): `V` is the dart, the fan starts at
+//! its sharp edge (`E_1` is that edge's other end, as `Neighbourhood::dart` lays it out), and
+//! the face is sector `s` of the fan, as at a boundary vertex; the outer points are the patch
+//! face's, walked as above.
+//!
 //! Face parameters map to patch parameters by the rotation that brings the chosen corner to
 //! `(0,0)`: corner `k` of the face `(c_0, c_1, c_2, c_3)` gives
 //! `(u', v') = (u, v), (v, 1-u), (1-u, 1-v), (1-v, u)` for `k = 0, 1, 2, 3`.
 
-use table_format::{PointSet, SectionKey, StencilKind};
+use schemes::local_matrices::Neighbourhood;
+use table_format::{Feature, PointSet, SectionKey, StencilKind};
 
 use crate::mesh::topology::{Mesh, NONE};
 use crate::stencil_table::StencilTable;
@@ -27,10 +34,26 @@ use crate::{MeshError, RuntimeError};
 pub struct PatchKind {
     /// Whether the patch vertex is on the boundary.
     pub boundary: bool,
+    /// The sharp feature at the patch vertex: [`Feature::Dart`] for a dart patch (interior).
+    pub feature: Feature,
     /// Its valence (interior) or number of faces (boundary).
     pub faces: u32,
-    /// Which of a boundary vertex's patches (0 for interior).
+    /// Which of a boundary vertex's or a dart's patches (0 for a smooth interior vertex).
     pub sector: u32,
+}
+
+impl PatchKind {
+    /// The neighbourhood whose local subdivision matrices make this patch, for a mesh with
+    /// boundary rule `mode` (quad schemes).
+    pub fn neighbourhood(&self, mode: schemes::BoundaryMode) -> Neighbourhood {
+        if self.boundary {
+            Neighbourhood::boundary(self.faces, mode)
+        } else if self.feature == Feature::Dart {
+            Neighbourhood::dart(self.faces)
+        } else {
+            Neighbourhood::interior(self.faces)
+        }
+    }
 }
 
 /// A face's patch: its kind, its control points (mesh vertices in layout order), and which face
@@ -86,6 +109,97 @@ pub fn is_smooth_patch(mesh: &Mesh, face: usize) -> bool {
     })
 }
 
+/// Whether the limit over face `face` is one the tables describe: a smooth patch
+/// ([`is_smooth_patch`]) or a dart patch ([`table_dart`]).
+pub fn is_table_patch(mesh: &Mesh, face: usize) -> bool {
+    is_smooth_patch(mesh, face) || table_dart(mesh, face).is_some()
+}
+
+/// Whether the edge of half-edge `h` is infinitely sharp.
+fn infinitely_sharp(mesh: &Mesh, h: usize) -> bool {
+    schemes::crease::is_infinite(mesh.edge_sharpness[h])
+}
+
+/// Whether vertex `v` is an interior vertex of valence 4 with no sharp edge and no sharpness
+/// of its own: a regular corner of a smooth patch.
+fn smooth_regular(mesh: &Mesh, v: usize) -> bool {
+    !mesh.is_boundary_vertex(v)
+        && mesh.fan(v).len() == 4
+        && mesh.vertex_sharpness[v] == 0.0
+        && mesh
+            .vertex_edges(v)
+            .iter()
+            .all(|&h| mesh.edge_sharpness[h] == 0.0)
+}
+
+/// The sharp edge of a dart at `v`, as its position in `v`'s fan: `v` is an interior vertex
+/// with no sharpness of its own and exactly one sharp edge, infinitely sharp (a settled dart:
+/// the rules at it are the same at every level).
+fn dart_edge(mesh: &Mesh, v: usize) -> Option<usize> {
+    if mesh.is_boundary_vertex(v) || mesh.vertex_sharpness[v] != 0.0 {
+        return None;
+    }
+    let fan = mesh.fan(v);
+    let mut sharp = fan
+        .iter()
+        .enumerate()
+        .filter(|(_, &h)| mesh.edge_sharpness[h] != 0.0);
+    match (sharp.next(), sharp.next()) {
+        (Some((d, &h)), None) if infinitely_sharp(mesh, h) => Some(d),
+        _ => None,
+    }
+}
+
+/// The dart corner of face `face` and the position of the dart's sharp edge in that corner's
+/// fan, when the face is a patch of the dart table (`Neighbourhood::dart`): a quad with one
+/// corner `V` a settled dart ([`dart_edge`]) and every other corner an interior valence-4
+/// vertex with nothing sharp at it ([`smooth_regular`]), except the sharp edge's other end
+/// `E_1` when it is a corner (the faces on either side of the sharp edge): the table lets the
+/// crease run straight on through it, so `E_1` must be an interior valence-4 vertex without
+/// sharpness whose only sharp edges are the dart's and the opposite one, both infinitely sharp
+/// (a crease vertex, with the crease rule at every level). As for [`is_smooth_patch`], only
+/// the corners matter: the rules of the face's refined neighbourhoods are those of its
+/// corners' edges and vertices. A face the table cannot describe (a semi-sharp edge, a crease
+/// that turns or ends at `E_1`, an irregular or boundary corner beside the dart) is `None` and
+/// refined adaptively.
+pub fn table_dart(mesh: &Mesh, face: usize) -> Option<(usize, usize)> {
+    let corners = mesh.face(face);
+    if corners.len() != 4 {
+        return None;
+    }
+    let corner = (0..4).find(|&k| dart_edge(mesh, corners[k] as usize).is_some())?;
+    let centre = corners[corner] as usize;
+    let fan = mesh.fan(centre);
+    let d = dart_edge(mesh, centre)?;
+    let e1 = mesh.head(fan[d]) as usize;
+    let crease_vertex = || {
+        let e1_fan = mesh.fan(e1);
+        let Some(back) = e1_fan.iter().position(|&h| mesh.head(h) as usize == centre) else {
+            return false;
+        };
+        !mesh.is_boundary_vertex(e1)
+            && e1_fan.len() == 4
+            && mesh.vertex_sharpness[e1] == 0.0
+            && e1_fan.iter().enumerate().all(|(i, &h)| {
+                let on_crease = i == back || i == (back + 2) % 4;
+                if on_crease {
+                    infinitely_sharp(mesh, h)
+                } else {
+                    mesh.edge_sharpness[h] == 0.0
+                }
+            })
+    };
+    let others_fit = (0..4).filter(|&k| k != corner).all(|k| {
+        let v = corners[k] as usize;
+        if v == e1 {
+            crease_vertex()
+        } else {
+            smooth_regular(mesh, v)
+        }
+    });
+    others_fit.then_some((corner, d))
+}
+
 /// The patch of quad face `face`.
 pub fn face_patch(mesh: &Mesh, face: usize) -> Result<FacePatch, MeshError> {
     let not_isolated = |reason: String| MeshError::NotIsolated { face, reason };
@@ -109,9 +223,12 @@ pub fn face_patch(mesh: &Mesh, face: usize) -> Result<FacePatch, MeshError> {
             "{irregular} of its corners are irregular"
         )));
     }
-    // The irregular corner if any, else a boundary corner, else corner 0.
-    let corner = (0..4)
-        .find(|&k| is_irregular(mesh, corners[k] as usize))
+    // A dart the table describes; else the irregular corner if any, else a boundary corner,
+    // else corner 0.
+    let dart = table_dart(mesh, face);
+    let corner = dart
+        .map(|(k, _)| k)
+        .or_else(|| (0..4).find(|&k| is_irregular(mesh, corners[k] as usize)))
         .or_else(|| special.first().copied())
         .unwrap_or(0);
     let h0 = mesh.face_halfedges(face).start + corner;
@@ -135,9 +252,14 @@ pub fn face_patch(mesh: &Mesh, face: usize) -> Result<FacePatch, MeshError> {
         .iter()
         .position(|&h| h == h0)
         .ok_or_else(|| not_isolated("the face is not in its corner's fan".to_owned()))?;
-    // Interior: the fan starts at the patch face. Boundary: at the boundary, the face is sector s.
+    // Interior: the fan starts at the patch face. Boundary: at the boundary, the face is sector
+    // s. Dart: at the sharp edge, the face is sector s.
     let (fan, sector) = if boundary {
         (fan, position)
+    } else if let Some((_, d)) = dart {
+        let mut rotated = fan[d..].to_vec();
+        rotated.extend_from_slice(&fan[..d]);
+        (rotated, (position + fan.len() - d) % fan.len())
     } else {
         let mut rotated = fan[position..].to_vec();
         rotated.extend_from_slice(&fan[..position]);
@@ -221,6 +343,11 @@ pub fn face_patch(mesh: &Mesh, face: usize) -> Result<FacePatch, MeshError> {
     Ok(FacePatch {
         kind: PatchKind {
             boundary,
+            feature: if dart.is_some() {
+                Feature::Dart
+            } else {
+                Feature::None
+            },
             faces,
             sector: sector as u32,
         },
@@ -264,6 +391,7 @@ pub fn dual_positions(
         kind: StencilKind::Position,
         points: PointSet::Dual,
         boundary: patch.kind.boundary,
+        feature: patch.kind.feature,
         faces: patch.kind.faces,
         sector: patch.kind.sector,
         n,

@@ -15,11 +15,12 @@ use crate::RuntimeError;
 use quad_expansion::QuadExpansion;
 use triangle_expansion::TriangleExpansion;
 
-/// One patch of a compact table: which vertex, which sector (its pieces are keyed by these and
+/// One patch of a compact table: which vertex (and sharp feature), which sector (its pieces are keyed by these and
 /// `n = 0`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 struct PatchId {
     boundary: bool,
+    feature: table_format::Feature,
     faces: u32,
     sector: u32,
 }
@@ -29,6 +30,7 @@ impl PatchId {
     fn of(key: &SectionKey) -> Self {
         PatchId {
             boundary: key.boundary,
+            feature: key.feature,
             faces: key.faces,
             sector: key.sector,
         }

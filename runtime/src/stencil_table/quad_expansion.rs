@@ -150,6 +150,7 @@ fn expand(
             kind,
             points: PointSet::CurveBasis,
             boundary: false,
+            feature: table_format::Feature::None,
             faces: 0,
             sector: 0,
             n: key.n,

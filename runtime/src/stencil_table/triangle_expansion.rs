@@ -199,6 +199,7 @@ fn basis_key(kind: StencilKind) -> SectionKey {
         kind,
         points: PointSet::LoopBasis,
         boundary: false,
+        feature: table_format::Feature::None,
         faces: 0,
         sector: 0,
         n: LATTICE as u32,

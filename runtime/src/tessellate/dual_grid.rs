@@ -241,6 +241,7 @@ fn section(patch: &FacePatch, kind: StencilKind, points: PointSet, n: u32) -> Se
         kind,
         points,
         boundary: patch.kind.boundary,
+        feature: patch.kind.feature,
         faces: patch.kind.faces,
         sector: patch.kind.sector,
         n,
@@ -375,10 +376,16 @@ impl<'t> DualGrid<'t> {
             boundary: false,
             seam_copies: Vec::new(),
         };
-        let regular = |p: &FacePatch| !p.kind.boundary && p.kind.faces == 4 && p.corner == 0;
+        // A valence-4 dart is not the regular patch: its crease refines by other rules.
+        let regular = |p: &FacePatch| {
+            !p.kind.boundary
+                && p.kind.feature == table_format::Feature::None
+                && p.kind.faces == 4
+                && p.corner == 0
+        };
         let mut factored = vec![false; MAX_RATE as usize + 1];
-        // Faces the tables describe exactly take their stencils; the others (sharp features
-        // nearby, a valence or patch beyond the table) are refined adaptively below.
+        // Faces the tables describe exactly (smooth patches and settled darts) take their
+        // stencils; the others (other sharp features nearby, a valence or patch beyond the table) are refined adaptively below.
         let mut local_faces = Vec::new();
         for (f, (patch, &n)) in patches.iter().zip(rates).enumerate() {
             if mesh.holes[f] {

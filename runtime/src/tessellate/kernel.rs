@@ -11,18 +11,19 @@ use rayon::prelude::*;
 pub(crate) use crate::mesh::geometry::{cross, normalize as unit};
 use crate::mesh::triangle_mesh::{TriangleMesh, VertexSource};
 use crate::mesh::Mesh;
-use crate::scheme::patch::{is_smooth_patch, FacePatch};
+use crate::scheme::patch::{is_table_patch, FacePatch};
 
 /// The largest patch (control points) the evaluator takes: an interior quad vertex of valence
 /// `v` has `2v + 8`, a boundary vertex with `k` faces `2k + 8`; a triangle patch at most 40.
 pub(crate) const MAX_PATCH: usize = 40;
 
-/// Whether the tessellators evaluate face `face` from its table patch: nothing sharp at its
-/// corners ([`is_smooth_patch`]) and a patch the kernels take (at most [`MAX_PATCH`] points).
+/// Whether the tessellators evaluate face `face` from its table patch: a patch the tables
+/// describe ([`is_table_patch`]: nothing sharp at its corners, or a dart's) and the kernels
+/// take (at most [`MAX_PATCH`] points).
 /// Every other face is evaluated by feature-adaptive refinement, and so is a face whose patch
 /// the table lacks.
 pub(crate) fn table_may_describe(mesh: &Mesh, patch: &FacePatch, face: usize) -> bool {
-    is_smooth_patch(mesh, face) && patch.points.len() <= MAX_PATCH
+    is_table_patch(mesh, face) && patch.points.len() <= MAX_PATCH
 }
 
 /// Timings of one tessellation.

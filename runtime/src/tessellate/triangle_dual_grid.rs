@@ -225,6 +225,7 @@ fn section(patch: &TrianglePatch, kind: StencilKind, points: PointSet, n: u32) -
         kind,
         points,
         boundary: patch.kind.boundary,
+        feature: patch.kind.feature,
         faces: patch.kind.faces,
         sector: patch.kind.sector,
         n,

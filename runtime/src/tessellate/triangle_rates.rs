@@ -157,6 +157,7 @@ impl<'a> Context<'a> {
             kind: StencilKind::Position,
             points,
             boundary: patch.kind.boundary,
+            feature: patch.kind.feature,
             faces: patch.kind.faces,
             sector: patch.kind.sector,
             n,

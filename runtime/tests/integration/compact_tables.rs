@@ -43,9 +43,21 @@ fn same_grids(compact: &StencilTable, grids: &StencilTable) -> (f64, usize) {
     (worst, count)
 }
 
+/// Which of the default table's patches a comparison solves grids for.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Patches {
+    /// Interior valences and boundary vertices, no darts.
+    Smooth,
+    /// The pinned-corner companion.
+    Corners,
+    /// The darts only (every sector of valences 3..=8).
+    Darts,
+}
+
 /// The embedded default (compact) against a grid table of the same patches at `rates`, solved
 /// now; returns the largest difference in ulps and the number of weights compared.
-fn compare(corners: bool, rates: Vec<u32>) -> (f64, usize) {
+fn compare(patches: Patches, rates: Vec<u32>) -> (f64, usize) {
+    let corners = patches == Patches::Corners;
     let mut spec = if corners {
         TableSpec::default_corners()
     } else {
@@ -53,6 +65,14 @@ fn compare(corners: bool, rates: Vec<u32>) -> (f64, usize) {
     }
     .expect("spec");
     spec.set = StencilSetSpec { rates, ..spec.set };
+    match patches {
+        Patches::Smooth => spec.set.darts = Vec::new(),
+        Patches::Darts => {
+            spec.set.valences = Vec::new();
+            spec.set.boundary_faces = Vec::new();
+        }
+        Patches::Corners => {}
+    }
     spec.layout = QuadLayout::Grids;
     spec.precision = Precision::F32;
     let grids = StencilTable::from_bytes(&build_table(&spec, &|_, _| {}).expect("grid table"))
@@ -72,15 +92,26 @@ fn compare(corners: bool, rates: Vec<u32>) -> (f64, usize) {
 /// expansion and the orbit solver substitute in the same order).
 #[test]
 fn compact_grids_equal_solved_grids() {
-    let (worst, count) = compare(false, (1..=24).collect());
+    let (worst, count) = compare(Patches::Smooth, (1..=24).collect());
     eprintln!("{count} weights, largest difference {worst} ulp");
     assert_eq!(count, 14_791_656);
+}
+
+/// Every dart patch of the default table (valences 3..=8, every sector: 33 patches), both
+/// grids, positions and both derivatives, every rate 1..=24. The count is the closed form:
+/// `sum_n ((n+1)^2 + n^2) = 10,424` points a patch and kind, times 3 kinds, times
+/// `sum_v v (2v + 8) = 662` weights a point summed over the sectors: 20,702,064.
+#[test]
+fn compact_dart_grids_equal_solved_grids() {
+    let (worst, count) = compare(Patches::Darts, (1..=24).collect());
+    eprintln!("{count} weights, largest difference {worst} ulp");
+    assert_eq!(count, 20_702_064);
 }
 
 /// The pinned-corner companion, every rate.
 #[test]
 fn compact_corner_grids_equal_solved_grids() {
-    let (worst, count) = compare(true, (1..=24).collect());
+    let (worst, count) = compare(Patches::Corners, (1..=24).collect());
     eprintln!("{count} weights, largest difference {worst} ulp");
     assert!(count > 200_000);
 }
@@ -117,6 +148,7 @@ fn inconsistent_compact_tables_are_refused_at_load() {
         kind: StencilKind::Position,
         points: PointSet::Dual,
         boundary: false,
+        feature: table_format::Feature::None,
         faces: 3,
         sector: 0,
         n,
@@ -159,6 +191,7 @@ fn inconsistent_compact_tables_are_refused_at_load() {
                     kind,
                     points: PointSet::CurveBasis,
                     boundary: false,
+                    feature: table_format::Feature::None,
                     faces: 0,
                     sector: 0,
                     n: 65,
@@ -255,6 +288,7 @@ fn inconsistent_compact_loop_tables_are_refused_at_load() {
         kind: StencilKind::DerivativeV,
         points,
         boundary: true,
+        feature: table_format::Feature::None,
         faces: 2,
         sector: 1,
         n,
@@ -371,6 +405,7 @@ fn compact_nonpolynomial_quad_grids_equal_solved_grids() {
     let scheme = stencilgen::patch_stencils::quad_scheme("sw-nonpoly-quad").expect("catalogued");
     let set = StencilSetSpec {
         valences: (3..=8).collect(),
+        darts: Vec::new(),
         boundary_faces: Vec::new(),
         boundary_mode: schemes::BoundaryMode::EdgeOnly,
         rates: (1..=8).collect(),

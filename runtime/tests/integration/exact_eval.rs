@@ -596,6 +596,7 @@ fn grid_points_agree_with_the_embedded_f32_table() {
                             kind,
                             points,
                             boundary: patch.kind.boundary,
+                            feature: patch.kind.feature,
                             faces: patch.kind.faces,
                             sector: patch.kind.sector,
                             n,

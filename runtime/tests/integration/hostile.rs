@@ -456,6 +456,7 @@ fn tables_with_non_finite_weights_are_refused() {
         kind: StencilKind::Position,
         points: table_format::PointSet::Dual,
         boundary: false,
+        feature: table_format::Feature::None,
         faces: 3,
         sector: 0,
         n: 1,

@@ -605,7 +605,8 @@ fn output_boundary_loops(out: &AdaptiveMesh) -> usize {
 }
 
 /// Lai–Cheng on tagged OpenSubdiv shapes (semi-sharp and infinitely sharp creases, corners,
-/// holes, boundary modes): every dense limit sample within its polygon's bound and the
+/// holes, boundary modes, darts: `catmark_cubes_infsharp`'s faces at its dart take the dart
+/// table patches, checked here against the adaptive limit stencils): every dense limit sample within its polygon's bound and the
 /// tolerance, no leaf over the tolerance, polygons and triangles closed on closed shapes, and
 /// the surface's boundary loops (holes included) and Euler characteristic kept.
 #[test]
@@ -623,6 +624,7 @@ fn tagged_shapes_meet_the_tolerance() {
         "catmark_hole_test2",
         "catmark_single_crease",
         "catmark_edgecorner",
+        "catmark_cubes_infsharp",
     ] {
         let mesh = tagged(name);
         let scale = size(&mesh);

@@ -9,6 +9,7 @@ mod boundary_tessellation;
 mod butterfly_tessellation;
 mod cli;
 mod compact_tables;
+mod dart_tables;
 mod exact_eval;
 mod face_varying;
 mod fuzz_cases;

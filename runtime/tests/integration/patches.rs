@@ -122,6 +122,7 @@ fn pinned_corners_need_a_corner_table() {
     let mut spec = stencilgen::table::TableSpec::default_catmull_clark().expect("spec");
     spec.set = stencilgen::stencil_set::StencilSetSpec {
         valences: vec![4],
+        darts: Vec::new(),
         boundary_faces: vec![1, 2],
         boundary_mode: schemes::BoundaryMode::EdgeAndCorner,
         rates: vec![1, 2, 3, 5, 6, 10, 12, 24],

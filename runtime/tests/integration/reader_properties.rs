@@ -358,6 +358,7 @@ fn table_sections() -> impl Strategy<Value = (TableMeta, Vec<(SectionKey, u32, V
                     kind,
                     points,
                     boundary,
+                    feature: table_format::Feature::None,
                     faces,
                     sector,
                     n,

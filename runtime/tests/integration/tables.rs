@@ -27,6 +27,7 @@ fn key(
         kind,
         points,
         boundary,
+        feature: table_format::Feature::None,
         faces,
         sector,
         n,
@@ -109,6 +110,7 @@ fn small_table() -> Vec<u8> {
     let mut spec = TableSpec::default_catmull_clark().expect("default spec");
     spec.set = StencilSetSpec {
         valences: vec![3, 4],
+        darts: Vec::new(),
         boundary_faces: vec![2],
         boundary_mode: schemes::BoundaryMode::EdgeOnly,
         rates: vec![1, 2, 3],

@@ -251,6 +251,7 @@ fn interior_patch(
     Ok((
         PatchKind {
             boundary: false,
+            feature: table_format::Feature::None,
             faces: valence as u32,
             sector: 0,
         },
@@ -307,6 +308,7 @@ fn phantom_patch(
     Ok((
         PatchKind {
             boundary: false,
+            feature: table_format::Feature::None,
             faces: 6,
             sector: 0,
         },
@@ -370,6 +372,7 @@ fn boundary_patch(mesh: &Mesh, h0: usize, centre: u32) -> Result<(PatchKind, Vec
     Ok((
         PatchKind {
             boundary: true,
+            feature: table_format::Feature::None,
             faces: k as u32,
             sector: s as u32,
         },

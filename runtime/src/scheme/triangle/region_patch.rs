@@ -216,6 +216,7 @@ pub fn gather_region_patches(
                 patches[f] = Some(TrianglePatch {
                     kind: PatchKind {
                         boundary: false,
+                        feature: table_format::Feature::None,
                         faces: k,
                         sector: r as u32,
                     },
@@ -243,6 +244,7 @@ pub fn gather_region_patches(
             Ok(TrianglePatch {
                 kind: PatchKind {
                     boundary: false,
+                    feature: table_format::Feature::None,
                     faces: 6,
                     sector: 0,
                 },

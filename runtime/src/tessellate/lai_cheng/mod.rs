@@ -67,7 +67,7 @@ use table_format::{PointSet, SectionKey, StencilKind};
 use crate::mesh::topology::Mesh;
 use crate::mesh::triangle_mesh::{TriangleMesh, VertexSource};
 use crate::scheme::catmull_clark::adaptive::{limit_of, limit_stencils, LimitQuery};
-use crate::scheme::patch::{is_smooth_patch, FacePatch, PatchKind};
+use crate::scheme::patch::{is_table_patch, FacePatch, PatchKind};
 use crate::stencil_table::StencilTable;
 use crate::RuntimeError;
 use bezier_net::{
@@ -620,6 +620,7 @@ fn vertex_normal(table: &StencilTable, patch: &FacePatch, points: &[Point]) -> O
             kind,
             points: PointSet::Primal,
             boundary: patch.kind.boundary,
+            feature: patch.kind.feature,
             faces: patch.kind.faces,
             sector: patch.kind.sector,
             n: 1,
@@ -701,12 +702,13 @@ pub fn tessellate_adaptive(
         )));
     }
     // Which faces take which path: a hole has no surface; a face the tables describe (no sharp
-    // feature on its support) its table patch; any other the feature descent.
+    // feature on its support, or a settled dart the dart patches describe) its table patch; any
+    // other the feature descent.
     let path: Vec<Path> = (0..mesh.faces())
         .map(|f| {
             if mesh.holes[f] {
                 Path::Hole
-            } else if is_smooth_patch(mesh, f) {
+            } else if is_table_patch(mesh, f) {
                 Path::Table
             } else {
                 Path::Feature
@@ -741,7 +743,7 @@ pub fn tessellate_adaptive(
         .filter(|(_, &p)| p == Path::Table)
         .map(|(p, _)| p.kind)
         .collect();
-    kinds.sort_by_key(|k| (k.boundary, k.faces, k.sector));
+    kinds.sort_by_key(|k| (k.boundary, k.feature, k.faces, k.sector));
     kinds.dedup();
     let mut operators: HashMap<PatchKind, Operators> = HashMap::new();
     for kind in kinds {

@@ -4,7 +4,7 @@
 
 use num_rational::BigRational;
 use num_traits::ToPrimitive;
-use schemes::local_matrices::{LocalMatrices, Neighbourhood};
+use schemes::local_matrices::LocalMatrices;
 use schemes::QuadScheme;
 
 use super::bezier_net::{bspline_to_bezier, Net, Point};
@@ -82,11 +82,7 @@ impl Operators {
     pub(crate) fn new(mesh: &Mesh, kind: PatchKind) -> Result<Self, RuntimeError> {
         let scheme = QuadScheme::by_name("catmull-clark")
             .ok_or_else(|| RuntimeError::Unsupported("catmull-clark is not catalogued".into()))?;
-        let nb = if kind.boundary {
-            Neighbourhood::boundary(kind.faces, mesh.boundary)
-        } else {
-            Neighbourhood::interior(kind.faces)
-        };
+        let nb = kind.neighbourhood(mesh.boundary);
         let exact = LocalMatrices::new(&scheme, nb, kind.sector)
             .map_err(|e| RuntimeError::Unsupported(e.to_string()))?;
         let a = Matrix::from_exact(&exact.a)?;
