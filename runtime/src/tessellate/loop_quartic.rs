@@ -373,6 +373,8 @@ impl RowChunk {
     /// Horner's rule in `u`: `P = sum_a r_a u^a`, `P_u = sum_a (a+1) r_(a+1) u^a`,
     /// `P_v = sum_a s_a u^a`.
     #[inline(always)]
+    // `x` indexes the row coefficients and the three quantities of `out` in step.
+    #[allow(clippy::needless_range_loop)]
     fn point(&self, u: &[f32; LANES], out: &mut Sums) {
         for x in 0..3 {
             let mut q = self.p[DEGREE][x];
@@ -424,12 +426,7 @@ fn row_layout(n: usize, k: usize) -> RowLayout {
         1 => (1, n - j, start, 2),
         2 => (2, n - j - 1, start + 1, 2),
         // Interior points of row j >= 1 follow those of rows 1..j.
-        _ if j >= 1 && j + 1 < n => (
-            3,
-            n - j - 1,
-            n * n + (j - 1) * (n - 1) - (j - 1) * j / 2,
-            1,
-        ),
+        _ if j >= 1 && j + 1 < n => (3, n - j - 1, n * n + (j - 1) * (n - 1) - (j - 1) * j / 2, 1),
         _ => (0, 0, 0, 0),
     };
     RowLayout {
@@ -491,14 +488,16 @@ pub(crate) fn evaluate_face(
                 *u = rows.map(|r| params[r.first + 3 * t.min(r.count.saturating_sub(1))]);
             }
             row_points(&chunk, &u[..m], &mut sums[..m]);
+            // Where point t of every row goes, advanced by the rows' strides.
+            let mut at = rows.map(|r| r.at + r.stride * t0);
             for (t, [p, du, dv]) in (t0..).zip(&sums[..m]) {
                 let normal = unit_cross(*du, *dv);
-                for (k, row) in rows.iter().enumerate() {
-                    if t < row.count {
-                        let o = row.at + row.stride * t;
-                        positions[o] = [p[0][k], p[1][k], p[2][k]];
-                        normals[o] = normal[k];
+                for k in 0..LANES {
+                    if t < rows[k].count {
+                        positions[at[k]] = [p[0][k], p[1][k], p[2][k]];
+                        normals[at[k]] = normal[k];
                     }
+                    at[k] += rows[k].stride;
                 }
             }
         }
