@@ -739,8 +739,12 @@ const LOOP_REGULAR_POINTS: usize = loop_quartic::POINTS;
 
 /// The smallest rate at which a regular Loop face is evaluated as a quartic: below it the
 /// per-face work (contracting the control points into 15 coefficients, the rows' polynomials)
-/// outweighs what the points save (measured on Spot: rate 4, 19 points a face, was about 10%
-/// slower as a quartic, rate 8 faster; break-even estimated at about 25 points).
+/// outweighs what the points save. Against the lane stencils (`tessellate/lane_stencils.rs`)
+/// the quartic costs about the same at rate 8 (289 M against 277 M instructions a frame on
+/// Spot, callgrind) and 17% less at rate 16 (767 M against 919 M), break-even near rate 9
+/// (docs/benchmarks.md); the bound stays at 5, where it was set against the scalar stencils, so
+/// that every rate's output is unchanged (moving it would move rates 5..9 from the quartic's
+/// rounding to the stencils', within `quartic_against_stencils`' bounds).
 pub const MIN_QUARTIC_RATE: u32 = 5;
 
 /// Whether `patch` has the layout of Loop's regular patch (interior, valence 6, twelve points);
