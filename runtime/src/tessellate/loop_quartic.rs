@@ -45,7 +45,8 @@ use num_traits::ToPrimitive;
 use schemes::loop_regular::{RegularDerivative, RegularLoopPatch, REGULAR_NET};
 
 use crate::scheme::triangle::patch::{dual_index, primal_in_patch, primal_index};
-use crate::tessellate::kernel::{cross, unit, Stencils};
+use crate::tessellate::kernel::Stencils;
+use crate::tessellate::lane_stencils::{unit_cross, LANES};
 
 /// Control points of the regular patch.
 pub(crate) const POINTS: usize = 12;
@@ -273,15 +274,15 @@ fn interpolate(values: &[[f64; POINTS]]) -> Option<Coefficients> {
 /// `a + b > 4`).
 type FaceQuartic = [[[f32; 3]; DEGREE + 1]; DEGREE + 1];
 
-/// The face's polynomial from its control points `local = P_l - P_0` (table order, relative
-/// to `origin = P_0`) and the coefficients `frame` of its patch corner (`frame[l][monomial(a,
-/// b)]`): `c_ab = sum_l C[a,b][l] (P_l - P_0)`, plus `P_0` in `c_00`; control point by control
-/// point, all monomials at once (lanes).
-fn contract(
+/// `sum_l C[., .][l] (P_l - P_0)` for every monomial at once (`[coordinate][monomial]`).
+///
+/// Not inlined for the reason of [`row_points`]: inlined into [`contract`], whose result is
+/// read coordinate by coordinate, it was compiled to scalar arithmetic.
+#[inline(never)]
+fn monomial_sums(
     frame: &[[f32; MONOMIAL_LANES]; POINTS],
     local: &[[f32; 3]; POINTS],
-    origin: [f32; 3],
-) -> FaceQuartic {
+) -> [[f32; MONOMIAL_LANES]; 3] {
     let mut sums = [[0.0f32; MONOMIAL_LANES]; 3];
     // `P_0 - P_0` is zero.
     for (w, p) in frame.iter().zip(local).skip(1) {
@@ -291,6 +292,19 @@ fn contract(
             }
         }
     }
+    sums
+}
+
+/// The face's polynomial from its control points `local = P_l - P_0` (table order, relative
+/// to `origin = P_0`) and the coefficients `frame` of its patch corner (`frame[l][monomial(a,
+/// b)]`): `c_ab = sum_l C[a,b][l] (P_l - P_0)`, plus `P_0` in `c_00`; control point by control
+/// point, all monomials at once (lanes).
+fn contract(
+    frame: &[[f32; MONOMIAL_LANES]; POINTS],
+    local: &[[f32; 3]; POINTS],
+    origin: [f32; 3],
+) -> FaceQuartic {
+    let sums = monomial_sums(frame, local);
     let mut c = [[[0.0f32; 3]; DEGREE + 1]; DEGREE + 1];
     for a in 0..=DEGREE {
         for b in 0..=DEGREE - a {
@@ -305,10 +319,6 @@ fn contract(
     c
 }
 
-/// Points evaluated together: rows, and the points along a row, in lanes the compiler keeps
-/// in vector registers (SSE's four f32).
-const LANES: usize = 4;
-
 /// `LANES` rows of constant `v` (one per lane): the quartic in `u`, `r_a(v) = sum_b c_ab v^b`
 /// (`p[a][x]`), and the `v`-derivative's restriction `s_a(v) = sum_b b c_ab v^(b-1)`
 /// (`dv[a][x]`, cubic in `u`: `c_40` has no `v`).
@@ -318,155 +328,125 @@ struct RowChunk {
 }
 
 impl RowChunk {
-    /// The rows at `v[k]`, by Horner's rule in `v`.
-    #[inline(always)]
+    /// The rows at `v[k]`, by Horner's rule in `v` (not inlined, as [`row_points`]).
+    #[inline(never)]
     fn new(c: &FaceQuartic, v: &[f32; LANES]) -> Self {
-        let mut p = [[[0.0f32; LANES]; 3]; DEGREE + 1];
-        let mut dv = [[[0.0f32; LANES]; 3]; DEGREE];
-        for a in 0..=DEGREE {
-            let top = DEGREE - a;
-            for x in 0..3 {
-                let mut r = [c[a][top][x]; LANES];
-                for b in (0..top).rev() {
-                    for k in 0..LANES {
-                        r[k] = r[k] * v[k] + c[a][b][x];
-                    }
-                }
-                p[a][x] = r;
-                if a < DEGREE {
-                    let mut s = [top as f32 * c[a][top][x]; LANES];
-                    for b in (1..top).rev() {
-                        let w = b as f32 * c[a][b][x];
-                        for k in 0..LANES {
-                            s[k] = s[k] * v[k] + w;
-                        }
-                    }
-                    dv[a][x] = s;
-                }
-            }
-        }
-        RowChunk { p, dv }
-    }
-
-    /// Row `lane`'s coefficients: the quartic, its `u`-derivative (`a r_a`), and `s_a`.
-    #[inline(always)]
-    fn row(&self, lane: usize) -> RowQuartic {
-        let mut row = RowQuartic {
-            p: [[0.0; 3]; DEGREE + 1],
-            du: [[0.0; 3]; DEGREE],
-            dv: [[0.0; 3]; DEGREE],
+        let mut chunk = RowChunk {
+            p: [[[0.0f32; LANES]; 3]; DEGREE + 1],
+            dv: [[[0.0f32; LANES]; 3]; DEGREE],
         };
+        // One call per power of `u`, each with its degree in `v` known, so that every Horner
+        // loop is unrolled.
+        chunk.rows::<0, 4>(c, v);
+        chunk.rows::<1, 3>(c, v);
+        chunk.rows::<2, 2>(c, v);
+        chunk.rows::<3, 1>(c, v);
+        chunk.rows::<4, 0>(c, v);
+        chunk
+    }
+
+    /// `r_A(v)` and `s_A(v)`, `TOP = 4 - A` the degree of `r_A` in `v`.
+    #[inline(always)]
+    fn rows<const A: usize, const TOP: usize>(&mut self, c: &FaceQuartic, v: &[f32; LANES]) {
         for x in 0..3 {
-            for a in 0..=DEGREE {
-                row.p[a][x] = self.p[a][x][lane];
+            let mut r = [c[A][TOP][x]; LANES];
+            for b in (0..TOP).rev() {
+                for k in 0..LANES {
+                    r[k] = r[k] * v[k] + c[A][b][x];
+                }
             }
-            for a in 0..DEGREE {
-                row.du[a][x] = (a + 1) as f32 * self.p[a + 1][x][lane];
-                row.dv[a][x] = self.dv[a][x][lane];
+            self.p[A][x] = r;
+            if let Some(dv) = self.dv.get_mut(A) {
+                let mut s = [TOP as f32 * c[A][TOP][x]; LANES];
+                for b in (1..TOP).rev() {
+                    let w = b as f32 * c[A][b][x];
+                    for k in 0..LANES {
+                        s[k] = s[k] * v[k] + w;
+                    }
+                }
+                dv[x] = s;
             }
         }
-        row
     }
-}
 
-/// One row of constant `v`: the quartic in `u` (`p`), its `u`-derivative (`du`, cubic) and the
-/// `v`-derivative's restriction (`dv`, cubic).
-#[derive(Clone, Copy, Debug)]
-struct RowQuartic {
-    p: [[f32; 3]; DEGREE + 1],
-    du: [[f32; 3]; DEGREE],
-    dv: [[f32; 3]; DEGREE],
-}
-
-impl RowQuartic {
-    /// Positions and unit normals at `LANES` parameters `u[k]` along the row, by Horner's rule
-    /// (`P`, `P_u`, `P_v`), the normal `unit(P_u x P_v)`.
+    /// Position, d/du and d/dv of every row at its own parameter `u[k]` (lane `k`), by
+    /// Horner's rule in `u`: `P = sum_a r_a u^a`, `P_u = sum_a (a+1) r_(a+1) u^a`,
+    /// `P_v = sum_a s_a u^a`.
     #[inline(always)]
-    fn points(&self, u: &[f32; LANES]) -> ([[f32; 3]; LANES], [[f32; 3]; LANES]) {
-        let mut p = [[0.0f32; LANES]; 3];
-        let mut du = [[0.0f32; LANES]; 3];
-        let mut dv = [[0.0f32; LANES]; 3];
+    // `x` indexes the row coefficients and the three quantities of `out` in step.
+    #[allow(clippy::needless_range_loop)]
+    fn point(&self, u: &[f32; LANES], out: &mut Sums) {
         for x in 0..3 {
-            let mut q = [self.p[DEGREE][x]; LANES];
+            let mut q = self.p[DEGREE][x];
             for a in (0..DEGREE).rev() {
                 for k in 0..LANES {
-                    q[k] = q[k] * u[k] + self.p[a][x];
+                    q[k] = q[k] * u[k] + self.p[a][x][k];
                 }
             }
-            p[x] = q;
-            let mut q = [self.du[DEGREE - 1][x]; LANES];
-            let mut r = [self.dv[DEGREE - 1][x]; LANES];
+            out[0][x] = q;
+            // The u-derivative's coefficients (a + 1) r_(a+1), made where they are used.
+            let du = |a: usize, k: usize| (a + 1) as f32 * self.p[a + 1][x][k];
+            let mut q: [f32; LANES] = std::array::from_fn(|k| du(DEGREE - 1, k));
+            let mut r = self.dv[DEGREE - 1][x];
             for a in (0..DEGREE - 1).rev() {
                 for k in 0..LANES {
-                    q[k] = q[k] * u[k] + self.du[a][x];
-                    r[k] = r[k] * u[k] + self.dv[a][x];
+                    q[k] = q[k] * u[k] + du(a, k);
+                    r[k] = r[k] * u[k] + self.dv[a][x][k];
                 }
             }
-            du[x] = q;
-            dv[x] = r;
+            out[1][x] = q;
+            out[2][x] = r;
         }
-        // cross(du, dv) and its length, lane by lane ([`cross`], [`unit`]'s operations).
-        let mut m = [[0.0f32; LANES]; 3];
-        let mut squared = [0.0f32; LANES];
-        for k in 0..LANES {
-            m[0][k] = du[1][k] * dv[2][k] - du[2][k] * dv[1][k];
-            m[1][k] = du[2][k] * dv[0][k] - du[0][k] * dv[2][k];
-            m[2][k] = du[0][k] * dv[1][k] - du[1][k] * dv[0][k];
-            squared[k] = m[0][k] * m[0][k] + m[1][k] * m[1][k] + m[2][k] * m[2][k];
-        }
-        let mut positions = [[0.0f32; 3]; LANES];
-        let mut normals = [[0.0f32; 3]; LANES];
-        if squared.iter().all(|s| s.is_normal()) {
-            let mut length = [0.0f32; LANES];
-            for k in 0..LANES {
-                length[k] = squared[k].sqrt();
-            }
-            for k in 0..LANES {
-                for x in 0..3 {
-                    positions[k][x] = p[x][k];
-                    normals[k][x] = m[x][k] / length[k];
-                }
-            }
-        } else {
-            // A degenerate or tiny tangent pair somewhere: unit's careful path, lane by lane.
-            for k in 0..LANES {
-                positions[k] = [p[0][k], p[1][k], p[2][k]];
-                normals[k] = unit(cross(
-                    [du[0][k], du[1][k], du[2][k]],
-                    [dv[0][k], dv[1][k], dv[2][k]],
-                ));
-            }
-        }
-        (positions, normals)
     }
+}
 
-    /// The `count` points `u = params[first + 3t]`, written to `positions[at + stride t]`.
-    #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
-    fn write(
-        &self,
-        params: &[f32],
-        first: usize,
-        count: usize,
-        at: usize,
-        stride: usize,
-        positions: &mut [[f32; 3]],
-        normals: &mut [[f32; 3]],
-    ) {
-        let mut t0 = 0;
-        while t0 < count {
-            let lanes = LANES.min(count - t0);
-            // A short last chunk repeats its last parameter in the unused lanes.
-            let u: [f32; LANES] =
-                std::array::from_fn(|k| params[first + 3 * (t0 + k.min(lanes - 1))]);
-            let (p, q) = self.points(&u);
-            for k in 0..lanes {
-                let o = at + stride * (t0 + k);
-                positions[o] = p[k];
-                normals[o] = q[k];
-            }
-            t0 += LANES;
-        }
+/// Position, d/du and d/dv of `LANES` points: `[quantity][coordinate][lane]`.
+type Sums = [[[f32; LANES]; 3]; 3];
+
+/// Where a row's points go: `count` points `u = params[first + 3t]`, written to
+/// `positions[at + stride t]`.
+#[derive(Clone, Copy, Debug, Default)]
+struct RowLayout {
+    first: usize,
+    count: usize,
+    at: usize,
+    stride: usize,
+}
+
+/// Row `k` of constant `v = k / 3n` of a face at rate `n` ([`evaluate_face`]); `count` 0 for
+/// the rows that hold no point of the face's own.
+fn row_layout(n: usize, k: usize) -> RowLayout {
+    let j = k / 3;
+    if k >= 3 * n || j >= n {
+        return RowLayout::default();
+    }
+    // Face row j starts at dual_index(n, 0, j, false) = j (2n - j).
+    let start = j * (2 * n - j);
+    let (first, count, at, stride) = match k % 3 {
+        1 => (1, n - j, start, 2),
+        2 => (2, n - j - 1, start + 1, 2),
+        // Interior points of row j >= 1 follow those of rows 1..j.
+        _ if j >= 1 && j + 1 < n => (3, n - j - 1, n * n + (j - 1) * (n - 1) - (j - 1) * j / 2, 1),
+        _ => (0, 0, 0, 0),
+    };
+    RowLayout {
+        first,
+        count,
+        at,
+        stride,
+    }
+}
+
+/// The points `t = 0..count` of the rows of `chunk` (one per lane; the `t`-th at `u[t]`).
+///
+/// Why a function of its own, not inlined: where the sums are transposed into points right
+/// after (`[x, y, z]` a point), the compiler's vectorizer groups the arithmetic by coordinate
+/// instead of by lane, shuffling every step; made apart and stored whole, each step is one
+/// vector operation for the four rows.
+#[inline(never)]
+fn row_points(chunk: &RowChunk, u: &[[f32; LANES]], out: &mut [Sums]) {
+    for (out, u) in out.iter_mut().zip(u) {
+        chunk.point(u, out);
     }
 }
 
@@ -476,9 +456,11 @@ impl RowQuartic {
 ///
 /// Rows of constant `v` are `v = k / 3n`: `k = 3j + 1` holds the ups of face row `j`
 /// (`up(i, j)` at `u = (3i+1)/3n`), `3j + 2` its downs (`(3i+2)/3n`; ups and downs interleave
-/// in the output, `up, down, .., up`), `3j` the interior primal points `(i/n, j/n)`, `i >= 1`;
-/// the rows' polynomials are made `LANES` at a time. `local` holds the control points relative
-/// to the first, `origin` ([`contract`]).
+/// in the output, `up, down, .., up`), `3j` the interior primal points `(i/n, j/n)`, `i >= 1`.
+/// The rows' polynomials are made `LANES` at a time (`LANES` consecutive rows, one a lane), and
+/// their points too: the `t`-th point of every row of the chunk together, each lane at its own
+/// `u` (the rows of a chunk differ in length by at most two points, so few lanes idle).
+/// `local` holds the control points relative to the first, `origin` ([`contract`]).
 pub(crate) fn evaluate_face(
     frame: &[[f32; MONOMIAL_LANES]; POINTS],
     local: &[[f32; 3]; POINTS],
@@ -489,37 +471,42 @@ pub(crate) fn evaluate_face(
     normals: &mut [[f32; 3]],
 ) {
     let c = contract(frame, local, origin);
-    let interior = n * n;
+    // The points of a chunk's rows are made BLOCK at a time (buffers small enough to cost
+    // nothing to clear per face).
+    let mut u = [[0.0f32; LANES]; BLOCK];
+    let mut sums = [[[[0.0f32; LANES]; 3]; 3]; BLOCK];
     let mut k0 = 1;
     while k0 < 3 * n {
         let v: [f32; LANES] = std::array::from_fn(|k| params[(k0 + k).min(3 * n)]);
         let chunk = RowChunk::new(&c, &v);
-        for lane in 0..LANES.min(3 * n - k0) {
-            let k = k0 + lane;
-            let j = k / 3;
-            // Face row j starts at dual_index(n, 0, j, false) = j (2n - j).
-            let start = j * (2 * n - j);
-            let (first, count, at, stride) = match k % 3 {
-                1 => (1, n - j, start, 2),
-                2 => (2, n - j - 1, start + 1, 2),
-                // Interior points of row j >= 1 follow those of rows 1..j.
-                _ if j >= 1 && j + 1 < n => (
-                    3,
-                    n - j - 1,
-                    interior + (j - 1) * (n - 1) - (j - 1) * j / 2,
-                    1,
-                ),
-                _ => continue,
-            };
-            if count > 0 {
-                chunk
-                    .row(lane)
-                    .write(params, first, count, at, stride, positions, normals);
+        let rows: [RowLayout; LANES] = std::array::from_fn(|k| row_layout(n, k0 + k));
+        let longest = rows.iter().map(|r| r.count).max().unwrap_or(0);
+        for t0 in (0..longest).step_by(BLOCK) {
+            let m = BLOCK.min(longest - t0);
+            for (t, u) in (t0..).zip(&mut u[..m]) {
+                // A shorter row repeats its last parameter (evaluated, not written).
+                *u = rows.map(|r| params[r.first + 3 * t.min(r.count.saturating_sub(1))]);
+            }
+            row_points(&chunk, &u[..m], &mut sums[..m]);
+            // Where point t of every row goes, advanced by the rows' strides.
+            let mut at = rows.map(|r| r.at + r.stride * t0);
+            for (t, [p, du, dv]) in (t0..).zip(&sums[..m]) {
+                let normal = unit_cross(*du, *dv);
+                for k in 0..LANES {
+                    if t < rows[k].count {
+                        positions[at[k]] = [p[0][k], p[1][k], p[2][k]];
+                        normals[at[k]] = normal[k];
+                    }
+                    at[k] += rows[k].stride;
+                }
             }
         }
         k0 += LANES;
     }
 }
+
+/// Points of every row of a chunk made by one call of [`row_points`].
+const BLOCK: usize = 8;
 
 #[cfg(test)]
 mod tests {

@@ -7,6 +7,7 @@ pub mod bezier;
 pub mod dual_grid;
 mod kernel;
 pub mod lai_cheng;
+mod lane_stencils;
 mod loop_quartic;
 pub mod rates;
 pub mod triangle_dual_grid;

@@ -33,6 +33,7 @@
 //! evaluates all points ([`TriangleDualGrid::evaluate`]) and writes all triangles
 //! ([`TriangleDualGrid::connect`]), both in parallel with rayon over disjoint output slices.
 
+use std::collections::HashMap;
 use std::ops::Range;
 use std::time::Instant;
 
@@ -45,9 +46,10 @@ use crate::scheme::triangle::patch::{
 };
 pub use crate::stencil_table::TriangleStencils;
 use crate::tessellate::kernel::{
-    cross, evaluate_points, for_each_range, gather_relative, merge_rows, unit, weighted_point,
-    Connectivity, GridPlan, PointPlan, Stencils, TessellationTime,
+    evaluate_points, for_each_range, gather_relative, merge_rows, Connectivity, GridPlan,
+    PointPlan, Stencils, TessellationTime,
 };
+use crate::tessellate::lane_stencils::LaneStencils;
 use crate::tessellate::loop_quartic::{self, QuarticBasis};
 use crate::RuntimeError;
 
@@ -59,12 +61,12 @@ const MAX_TRIANGLE_PATCH: usize = 40;
 /// The largest rate the evaluator takes.
 pub const MAX_TRIANGLE_RATE: u32 = 64;
 
-/// How one triangle's points are evaluated: its table stencils on both grids, its control
-/// points, and the map from its own points to the patch's rows.
+/// How one triangle's points are evaluated: its control points, and its table stencils in the
+/// face's own point order ([`LaneStencils`], shared by every face of the same section, corner
+/// and rate).
 #[derive(Clone, Debug)]
-struct FacePlan<'t> {
-    dual: Stencils<'t>,
-    primal: Stencils<'t>,
+struct FacePlan {
+    lanes: u32,
     control: Range<u32>,
     corner: u8,
     /// A regular Loop patch whose rate's stencils the quartic reproduces: evaluated as one
@@ -189,15 +191,16 @@ fn interior_index(n: u32, i: u32, j: u32) -> u32 {
 /// The per-mesh plan of a triangle dual-grid tessellation: build once, then
 /// [`TriangleDualGrid::evaluate`] and [`TriangleDualGrid::connect`] per frame.
 #[derive(Clone, Debug)]
-pub struct TriangleDualGrid<'t> {
+pub struct TriangleDualGrid {
     rates: Vec<u32>,
     /// First output vertex of every triangle (its dual points, then its interior primal
     /// points), and the total after the last.
     first: Vec<u32>,
-    faces: Vec<FacePlan<'t>>,
-    /// By rate, then by patch corner: the patch row of every point of a triangle (the dual
-    /// grid's rows for its dual points, then the primal grid's for its interior points).
-    maps: Vec<Option<[Vec<u32>; 3]>>,
+    /// `first[1..]`, as [`for_each_range`] takes it (kept so that a frame allocates nothing).
+    ends: Vec<usize>,
+    faces: Vec<FacePlan>,
+    /// The faces' stencils in their point order, one per table section, corner and rate.
+    lanes: Vec<LaneStencils>,
     /// By rate: the parameters `k / 3n`, `k = 0..=3n`, of the quartic faces' rows, and whether
     /// the quartic reproduces the rate's regular stencils (`None`: not checked yet).
     params: Vec<Vec<f32>>,
@@ -280,11 +283,11 @@ fn point_map(n: u32, corner: usize) -> Vec<u32> {
     map
 }
 
-impl<'t> TriangleDualGrid<'t> {
+impl TriangleDualGrid {
     /// Plan the tessellation of an isolated triangle mesh (closed or with boundary) with rate
     /// `rates[f]` on triangle `f`.
     pub fn new(
-        table: &'t dyn TriangleStencils,
+        table: &dyn TriangleStencils,
         mesh: &Mesh,
         patches: &[TrianglePatch],
         rates: &[u32],
@@ -311,8 +314,9 @@ impl<'t> TriangleDualGrid<'t> {
         let mut grid = TriangleDualGrid {
             rates: rates.to_vec(),
             first,
+            ends: Vec::new(),
             faces: Vec::with_capacity(patches.len()),
-            maps: vec![None; MAX_TRIANGLE_RATE as usize + 1],
+            lanes: Vec::new(),
             params: vec![Vec::new(); MAX_TRIANGLE_RATE as usize + 1],
             quartic_rates: vec![None; MAX_TRIANGLE_RATE as usize + 1],
             quartic: None,
@@ -325,6 +329,12 @@ impl<'t> TriangleDualGrid<'t> {
             boundary: false,
             phantoms: None,
         };
+        grid.ends = grid.first[1..].iter().map(|&x| x as usize).collect();
+        // By rate, then by patch corner: the patch row of every point of a triangle (the dual
+        // grid's rows for its dual points, then the primal grid's for its interior points).
+        let mut maps: Vec<Option<[Vec<u32>; 3]>> = vec![None; MAX_TRIANGLE_RATE as usize + 1];
+        // The index in `grid.lanes` of every section, corner and patch size met.
+        let mut layouts: HashMap<(SectionKey, u8, usize), u32> = HashMap::new();
         let vertices = mesh.positions.len() as u32;
         if patches
             .iter()
@@ -343,18 +353,41 @@ impl<'t> TriangleDualGrid<'t> {
             // A valence beyond the table's is refused here, by the table naming its coverage.
             let dual = stencils(table, patch, PointSet::TriangleDual, n)?;
             let primal = stencils(table, patch, PointSet::TrianglePrimal, n)?;
-            let maps = &mut grid.maps[n as usize];
-            if maps.is_none() {
-                *maps = Some([0, 1, 2].map(|corner| point_map(n, corner)));
-            }
             let quartic = is_loop_regular(patch)
                 && n >= MIN_QUARTIC_RATE
                 && grid.reproduces(&dual, &primal, n);
+            let k = patch.points.len();
+            let key = (
+                section(patch, StencilKind::Position, PointSet::TriangleDual, n),
+                patch.corner as u8,
+                k,
+            );
+            let lanes = match layouts.get(&key) {
+                Some(&lanes) => lanes,
+                None => {
+                    let map = &maps[n as usize]
+                        .get_or_insert_with(|| [0, 1, 2].map(|corner| point_map(n, corner)))
+                        [patch.corner % 3];
+                    let dual_points = (n * n) as usize;
+                    let lanes = LaneStencils::new(k, map.len(), |t| {
+                        let s = if t < dual_points { &dual } else { &primal };
+                        (s, map[t] as usize)
+                    })
+                    .ok_or_else(|| RuntimeError::LayoutMismatch {
+                        key: key.0,
+                        table: dual.position.len() / dual_points.max(1),
+                        patch: k,
+                    })?;
+                    let index = grid.lanes.len() as u32;
+                    grid.lanes.push(lanes);
+                    layouts.insert(key, index);
+                    index
+                }
+            };
             let start = grid.control.len() as u32;
             grid.control.extend_from_slice(&patch.points);
             grid.faces.push(FacePlan {
-                dual,
-                primal,
+                lanes,
                 control: start..grid.control.len() as u32,
                 corner: patch.corner as u8,
                 quartic,
@@ -408,7 +441,7 @@ impl<'t> TriangleDualGrid<'t> {
     /// the triangle's own indices.
     fn point(
         &mut self,
-        table: &'t dyn TriangleStencils,
+        table: &dyn TriangleStencils,
         patch: &TrianglePatch,
         f: usize,
         (i, j): (u32, u32),
@@ -440,7 +473,7 @@ impl<'t> TriangleDualGrid<'t> {
 
     fn plan_connectivity(
         &mut self,
-        table: &'t dyn TriangleStencils,
+        table: &dyn TriangleStencils,
         mesh: &Mesh,
         patches: &[TrianglePatch],
     ) -> Result<(), RuntimeError> {
@@ -562,8 +595,6 @@ impl<'t> TriangleDualGrid<'t> {
     ) {
         let n = self.rates[f] as usize;
         let plan = &self.faces[f];
-        let Some(maps) = &self.maps[n] else { return };
-        let map = &maps[plan.corner as usize];
         let points = &self.control[plan.control.start as usize..plan.control.end as usize];
         let mut local = [[0.0f32; 3]; MAX_TRIANGLE_PATCH];
         let origin = gather_relative(points, control, &mut local);
@@ -578,26 +609,13 @@ impl<'t> TriangleDualGrid<'t> {
                 );
             }
         }
-        let local = &local[..points.len()];
-        // The regular patches, most of any isolated mesh (Loop's 12 points, the butterfly's 27):
-        // fixed-length dot products over coordinate columns, which the compiler unrolls and
-        // vectorizes.
-        match points.len() {
-            LOOP_REGULAR_POINTS => {
-                return fixed_points::<LOOP_REGULAR_POINTS>(
-                    plan, map, n, local, origin, positions, normals,
-                )
+        // Every other face (the regular patches of the butterfly and √3, Loop's below
+        // MIN_QUARTIC_RATE, the patches at extraordinary vertices): its stencils, `LANES`
+        // points at a time.
+        if let Some(lanes) = self.lanes.get(plan.lanes as usize) {
+            if lanes.control_points() == points.len() {
+                lanes.evaluate(&local[..points.len()], origin, positions, normals);
             }
-            BUTTERFLY_REGULAR_POINTS => {
-                return fixed_points::<BUTTERFLY_REGULAR_POINTS>(
-                    plan, map, n, local, origin, positions, normals,
-                )
-            }
-            _ => {}
-        }
-        for (at, &row) in map.iter().enumerate() {
-            let stencils = if at < n * n { &plan.dual } else { &plan.primal };
-            (positions[at], normals[at]) = weighted_point(stencils, local, origin, row as usize);
         }
     }
 
@@ -629,7 +647,7 @@ impl<'t> TriangleDualGrid<'t> {
     }
 }
 
-impl GridPlan for TriangleDualGrid<'_> {
+impl GridPlan for TriangleDualGrid {
     /// Output vertices per frame.
     fn vertex_count(&self) -> usize {
         self.vertex_count
@@ -684,10 +702,9 @@ impl GridPlan for TriangleDualGrid<'_> {
         let owned = self.first[self.rates.len()] as usize;
         let (face_positions, point_positions) = positions.split_at_mut(owned);
         let (face_normals, point_normals) = normals.split_at_mut(owned);
-        let ends: Vec<usize> = self.first[1..].iter().map(|&x| x as usize).collect();
         rayon::join(
             || {
-                for_each_range(&ends, (face_positions, face_normals), |f, (p, q)| {
+                for_each_range(&self.ends, (face_positions, face_normals), |f, (p, q)| {
                     self.evaluate_face(f, control, p, q)
                 })
             },
@@ -723,69 +740,18 @@ const LOOP_REGULAR_POINTS: usize = loop_quartic::POINTS;
 
 /// The smallest rate at which a regular Loop face is evaluated as a quartic: below it the
 /// per-face work (contracting the control points into 15 coefficients, the rows' polynomials)
-/// outweighs what the points save (measured on Spot: rate 4, 19 points a face, was about 10%
-/// slower as a quartic, rate 8 faster; break-even estimated at about 25 points).
+/// outweighs what the points save. Against the lane stencils (`tessellate/lane_stencils.rs`)
+/// the quartic costs about the same at rate 8 (289 M against 277 M instructions a frame on
+/// Spot, callgrind) and 17% less at rate 16 (767 M against 919 M), break-even near rate 9
+/// (docs/benchmarks.md); the bound stays at 5, where it was set against the scalar stencils, so
+/// that every rate's output is unchanged (moving it would move rates 5..9 from the quartic's
+/// rounding to the stencils', within `quartic_against_stencils`' bounds).
 pub const MIN_QUARTIC_RATE: u32 = 5;
 
 /// Whether `patch` has the layout of Loop's regular patch (interior, valence 6, twelve points);
 /// whether its table section *is* the quartic box spline is checked against the table.
 fn is_loop_regular(patch: &TrianglePatch) -> bool {
     !patch.kind.boundary && patch.kind.faces == 6 && patch.points.len() == LOOP_REGULAR_POINTS
-}
-
-/// Control points of the butterfly's regular patch: the radius-2 ball around the triangle.
-const BUTTERFLY_REGULAR_POINTS: usize = 27;
-
-/// Every point of a face whose patch has `N` control points: [`weighted_point`] from the
-/// control points' coordinate columns (relative to `origin`).
-fn fixed_points<const N: usize>(
-    plan: &FacePlan,
-    map: &[u32],
-    n: usize,
-    local: &[[f32; 3]],
-    origin: [f32; 3],
-    positions: &mut [[f32; 3]],
-    normals: &mut [[f32; 3]],
-) {
-    let mut columns = [[0.0f32; N]; 3];
-    for (l, p) in local.iter().enumerate() {
-        for c in 0..3 {
-            columns[c][l] = p[c];
-        }
-    }
-    for (at, &row) in map.iter().enumerate() {
-        let stencils = if at < n * n { &plan.dual } else { &plan.primal };
-        (positions[at], normals[at]) = fixed_point::<N>(stencils, &columns, origin, row as usize);
-    }
-}
-
-/// [`weighted_point`] for a patch of `N` control points, from their coordinate columns
-/// relative to `origin`.
-fn fixed_point<const N: usize>(
-    s: &Stencils,
-    columns: &[[f32; N]; 3],
-    origin: [f32; 3],
-    point: usize,
-) -> ([f32; 3], [f32; 3]) {
-    let rows = point * N..(point + 1) * N;
-    let weights = |w: &[f32]| -> [f32; N] {
-        let mut out = [0.0; N];
-        out.copy_from_slice(w);
-        out
-    };
-    let (wp, wu, wv) = (
-        weights(&s.position[rows.clone()]),
-        weights(&s.du[rows.clone()]),
-        weights(&s.dv[rows]),
-    );
-    // `start + w . x`, in order.
-    let dot = |start: f32, w: &[f32; N], x: &[f32; N]| -> f32 {
-        w.iter().zip(x).fold(start, |sum, (a, b)| sum + a * b)
-    };
-    let p = [0, 1, 2].map(|c| dot(origin[c], &wp, &columns[c]));
-    let du = columns.map(|x| dot(0.0, &wu, &x));
-    let dv = columns.map(|x| dot(0.0, &wv, &x));
-    (p, unit(cross(du, dv)))
 }
 
 /// Tessellate an isolated triangle mesh (closed or with boundary) with rate `rates[f]` on

@@ -1,0 +1,315 @@
+//! Table stencils regrouped for evaluating [`LANES`] points at once, for the triangle dual
+//! grid's faces ([`crate::tessellate::triangle_dual_grid`]).
+//!
+//! A face's point `t` is, as everywhere in the dual grid, three dot products over the patch's
+//! `K` control points `q_l` (relative to the first, [`crate::tessellate::kernel::gather_relative`]):
+//!
+//! ```text
+//! P(t) = O + sum_l w_l(t) q_l,   P_u(t) = sum_l u_l(t) q_l,   P_v(t) = sum_l v_l(t) q_l,
+//! N(t) = unit(P_u(t) x P_v(t)),
+//! ```
+//!
+//! each sum taken in the order `l = 0..K`. The table stores the weights point by point
+//! (`w_0(t) .. w_{K-1}(t)`), so one point at a time is a chain of `3 K` dependent additions per
+//! coordinate that the compiler may not reorder (float addition is not associative) and so
+//! cannot vectorize. Here the weights of [`LANES`] consecutive output points are interleaved
+//! (`[l][position, d/du, d/dv][lane]`), once per table section, face corner and rate when the
+//! plan is built: a step `l` is then one vector multiply-add per quantity and coordinate for
+//! all the lanes, each lane still summing its own point in the order `l = 0..K`. The result is
+//! bit-identical to the point-by-point sums ([`crate::tessellate::kernel::weighted_point`]),
+//! in about a quarter of the instructions.
+
+use crate::tessellate::kernel::{cross, unit, Stencils};
+
+/// Points evaluated together (SSE's four f32, the baseline x86-64 vector).
+pub(crate) const LANES: usize = 4;
+
+/// One step `l` of a group of points: the weights of control point `l` for position, d/du and
+/// d/dv, one lane per point.
+type LaneWeights = [[f32; LANES]; 3];
+
+/// The stencils of every point of one kind of face (table section, face corner, rate) in the
+/// face's output order, `LANES` points a group.
+#[derive(Clone, Debug)]
+pub(crate) struct LaneStencils {
+    /// Control points of the patch (`K`).
+    k: usize,
+    /// Output points of the face.
+    points: usize,
+    /// `weights[g * k + l]`: group `g`'s weights of control point `l`. The last group's unused
+    /// lanes repeat its last point (evaluated, not written).
+    weights: Vec<LaneWeights>,
+}
+
+impl LaneStencils {
+    /// The stencils of the face's `points` points, point `t` being row `row(t).1` of the
+    /// stencils `row(t).0` (`k` weights a row); `None` if a row is out of range.
+    pub(crate) fn new<'a>(
+        k: usize,
+        points: usize,
+        row: impl Fn(usize) -> (&'a Stencils<'a>, usize),
+    ) -> Option<Self> {
+        let groups = points.div_ceil(LANES);
+        let mut weights = vec![[[0.0f32; LANES]; 3]; groups * k];
+        for g in 0..groups {
+            for lane in 0..LANES {
+                let t = (g * LANES + lane).min(points.checked_sub(1)?);
+                let (s, r) = row(t);
+                let rows = r * k..(r + 1) * k;
+                let (wp, wu, wv) = (
+                    s.position.get(rows.clone())?,
+                    s.du.get(rows.clone())?,
+                    s.dv.get(rows)?,
+                );
+                for l in 0..k {
+                    let w = &mut weights[g * k + l];
+                    w[0][lane] = wp[l];
+                    w[1][lane] = wu[l];
+                    w[2][lane] = wv[l];
+                }
+            }
+        }
+        Some(LaneStencils { k, points, weights })
+    }
+
+    /// Control points of the patch.
+    pub(crate) fn control_points(&self) -> usize {
+        self.k
+    }
+
+    /// Every point of a face from its control points `local` (relative to `origin`, `K` of
+    /// them), into `positions[t]`, `normals[t]`.
+    #[inline(always)]
+    pub(crate) fn evaluate(
+        &self,
+        local: &[[f32; 3]],
+        origin: [f32; 3],
+        positions: &mut [[f32; 3]],
+        normals: &mut [[f32; 3]],
+    ) {
+        // The common patch sizes get their own copies, the control points in registers or
+        // fixed stack slots (Loop's regular 12, the butterfly's and √3's 27); the rest share
+        // one.
+        match self.k {
+            12 => self.evaluate_fixed::<12>(local, origin, positions, normals),
+            27 => self.evaluate_fixed::<27>(local, origin, positions, normals),
+            _ => self.evaluate_any(local, origin, positions, normals),
+        }
+    }
+
+    fn evaluate_fixed<const K: usize>(
+        &self,
+        local: &[[f32; 3]],
+        origin: [f32; 3],
+        positions: &mut [[f32; 3]],
+        normals: &mut [[f32; 3]],
+    ) {
+        let mut q = [[0.0f32; 3]; K];
+        q.copy_from_slice(&local[..K]);
+        let mut sums = [[[[0.0f32; LANES]; 3]; 3]; CHUNK];
+        for (c, weights) in self.weights.chunks(K * CHUNK).enumerate() {
+            chunk_sums_fixed::<K>(weights, &q, origin, &mut sums);
+            self.write(c * CHUNK, &sums[..weights.len() / K], positions, normals);
+        }
+    }
+
+    fn evaluate_any(
+        &self,
+        local: &[[f32; 3]],
+        origin: [f32; 3],
+        positions: &mut [[f32; 3]],
+        normals: &mut [[f32; 3]],
+    ) {
+        let q = &local[..self.k];
+        let mut sums = [[[[0.0f32; LANES]; 3]; 3]; CHUNK];
+        for (c, weights) in self.weights.chunks(self.k * CHUNK).enumerate() {
+            chunk_sums_any(self.k, weights, q, origin, &mut sums);
+            self.write(
+                c * CHUNK,
+                &sums[..weights.len() / self.k],
+                positions,
+                normals,
+            );
+        }
+    }
+
+    /// Groups `first..` from their sums: positions and unit normals.
+    #[inline(always)]
+    fn write(
+        &self,
+        first: usize,
+        sums: &[Sums],
+        positions: &mut [[f32; 3]],
+        normals: &mut [[f32; 3]],
+    ) {
+        for (g, [p, du, dv]) in sums.iter().enumerate() {
+            let normal = unit_cross(*du, *dv);
+            let start = (first + g) * LANES;
+            for lane in 0..LANES.min(self.points - start) {
+                positions[start + lane] = [p[0][lane], p[1][lane], p[2][lane]];
+                normals[start + lane] = normal[lane];
+            }
+        }
+    }
+}
+
+/// One group's sums: `[position, d/du, d/dv][coordinate][lane]`.
+type Sums = [[[f32; LANES]; 3]; 3];
+
+/// Groups whose sums are made by one call of [`chunk_sums_fixed`] or [`chunk_sums_any`].
+const CHUNK: usize = 8;
+
+/// The sums of up to [`CHUNK`] groups (`weights`, `K` steps a group) over the control points
+/// `q`.
+///
+/// Why a function of its own, not inlined: where the sums are transposed into points right
+/// after (`[x, y, z]` a lane), the compiler's vectorizer groups the multiply-adds by coordinate
+/// instead of by lane, shuffling every step (measured: three times the instructions); made
+/// apart and stored whole, every step is one vector multiply-add per quantity and coordinate.
+#[inline(never)]
+fn chunk_sums_fixed<const K: usize>(
+    weights: &[LaneWeights],
+    q: &[[f32; 3]; K],
+    origin: [f32; 3],
+    out: &mut [Sums; CHUNK],
+) {
+    for (out, weights) in out.iter_mut().zip(weights.chunks_exact(K)) {
+        *out = sums(weights, q, origin);
+    }
+}
+
+/// [`chunk_sums_fixed`] for any patch size `k`.
+#[inline(never)]
+fn chunk_sums_any(
+    k: usize,
+    weights: &[LaneWeights],
+    q: &[[f32; 3]],
+    origin: [f32; 3],
+    out: &mut [Sums; CHUNK],
+) {
+    for (out, weights) in out.iter_mut().zip(weights.chunks_exact(k)) {
+        *out = sums(weights, q, origin);
+    }
+}
+
+/// `acc + w q` lane by lane.
+#[inline(always)]
+fn multiply_add(acc: &mut [f32; LANES], w: &[f32; LANES], q: f32) {
+    for lane in 0..LANES {
+        acc[lane] += w[lane] * q;
+    }
+}
+
+/// One group's sums over the control points `q`, the position's started at `origin`, each in
+/// the order of `q`.
+#[inline(always)]
+fn sums(weights: &[LaneWeights], q: &[[f32; 3]], origin: [f32; 3]) -> Sums {
+    let mut p = origin.map(|c| [c; LANES]);
+    let mut du = [[0.0f32; LANES]; 3];
+    let mut dv = [[0.0f32; LANES]; 3];
+    for (w, q) in weights.iter().zip(q) {
+        for x in 0..3 {
+            multiply_add(&mut p[x], &w[0], q[x]);
+            multiply_add(&mut du[x], &w[1], q[x]);
+            multiply_add(&mut dv[x], &w[2], q[x]);
+        }
+    }
+    [p, du, dv]
+}
+
+/// `unit(cross(a, b))` lane by lane, with [`cross`] and [`unit`]'s operations in their order
+/// (bit-identical), the square root and division vectorized where every lane's squared length
+/// is a normal float.
+#[inline(always)]
+pub(crate) fn unit_cross(a: [[f32; LANES]; 3], b: [[f32; LANES]; 3]) -> [[f32; 3]; LANES] {
+    let mut m = [[0.0f32; LANES]; 3];
+    let mut squared = [0.0f32; LANES];
+    for k in 0..LANES {
+        m[0][k] = a[1][k] * b[2][k] - a[2][k] * b[1][k];
+        m[1][k] = a[2][k] * b[0][k] - a[0][k] * b[2][k];
+        m[2][k] = a[0][k] * b[1][k] - a[1][k] * b[0][k];
+        squared[k] = m[0][k] * m[0][k] + m[1][k] * m[1][k] + m[2][k] * m[2][k];
+    }
+    let mut out = [[0.0f32; 3]; LANES];
+    if squared.iter().all(|s| s.is_normal()) {
+        let mut length = [0.0f32; LANES];
+        for k in 0..LANES {
+            length[k] = squared[k].sqrt();
+        }
+        for k in 0..LANES {
+            for x in 0..3 {
+                out[k][x] = m[x][k] / length[k];
+            }
+        }
+    } else {
+        // A degenerate or tiny tangent pair somewhere: unit's careful path, lane by lane.
+        for (k, out) in out.iter_mut().enumerate() {
+            *out = unit(cross(
+                [a[0][k], a[1][k], a[2][k]],
+                [b[0][k], b[1][k], b[2][k]],
+            ));
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tessellate::kernel::weighted_point;
+
+    /// The lanes give the point-by-point sums bit for bit, for every count of points (full and
+    /// short last groups) and patch size (the unrolled ones and others).
+    #[test]
+    fn lanes_are_the_point_by_point_sums_bit_for_bit() {
+        // Deterministic pseudo-random weights and points (a linear congruential sequence).
+        let mut state = 0x2545_f491u32;
+        let mut next = move || {
+            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (state >> 8) as f32 / (1u32 << 24) as f32 - 0.5
+        };
+        for k in [5, 12, 13, 27, 33] {
+            for points in [1, 3, 4, 7, 19] {
+                let block = |next: &mut dyn FnMut() -> f32| -> Vec<f32> {
+                    (0..points * k).map(|_| next()).collect()
+                };
+                let (wp, wu, wv) = (block(&mut next), block(&mut next), block(&mut next));
+                let s = Stencils {
+                    position: &wp,
+                    du: &wu,
+                    dv: &wv,
+                };
+                let local: Vec<[f32; 3]> = (0..k).map(|_| [next(), next(), next()]).collect();
+                let origin = [next() * 100.0, next(), -3.0];
+                // Rows in reverse order, as a rotated face reads them.
+                let lanes =
+                    LaneStencils::new(k, points, |t| (&s, points - 1 - t)).expect("rows in range");
+                let mut positions = vec![[0.0f32; 3]; points];
+                let mut normals = vec![[0.0f32; 3]; points];
+                lanes.evaluate(&local, origin, &mut positions, &mut normals);
+                for t in 0..points {
+                    let (p, n) = weighted_point(&s, &local, origin, points - 1 - t);
+                    assert_eq!(positions[t].map(f32::to_bits), p.map(f32::to_bits));
+                    assert_eq!(normals[t].map(f32::to_bits), n.map(f32::to_bits));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn degenerate_tangents_take_units_path() {
+        let zero = [[0.0f32; LANES]; 3];
+        let mut a = zero;
+        let mut b = zero;
+        a[0] = [1.0, 0.0, 1e-30, 2.0];
+        b[1] = [1.0, 0.0, 1e-30, 3.0];
+        let out = unit_cross(a, b);
+        for k in 0..LANES {
+            let want = unit(cross(
+                [a[0][k], a[1][k], a[2][k]],
+                [b[0][k], b[1][k], b[2][k]],
+            ));
+            assert_eq!(out[k].map(f32::to_bits), want.map(f32::to_bits));
+        }
+    }
+}
