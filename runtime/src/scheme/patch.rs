@@ -43,6 +43,19 @@ pub struct PatchKind {
 }
 
 impl PatchKind {
+    /// The table section of this patch holding `kind` on the grid `points` at rate `n`.
+    pub fn section(&self, kind: StencilKind, points: PointSet, n: u32) -> SectionKey {
+        SectionKey {
+            kind,
+            points,
+            boundary: self.boundary,
+            feature: self.feature,
+            faces: self.faces,
+            sector: self.sector,
+            n,
+        }
+    }
+
     /// The neighbourhood whose local subdivision matrices make this patch, for a mesh with
     /// boundary rule `mode` (quad schemes).
     pub fn neighbourhood(&self, mode: schemes::BoundaryMode) -> Neighbourhood {
@@ -387,15 +400,7 @@ pub fn dual_positions(
     patch: &FacePatch,
     n: u32,
 ) -> Result<Vec<[f64; 3]>, RuntimeError> {
-    let key = SectionKey {
-        kind: StencilKind::Position,
-        points: PointSet::Dual,
-        boundary: patch.kind.boundary,
-        feature: patch.kind.feature,
-        faces: patch.kind.faces,
-        sector: patch.kind.sector,
-        n,
-    };
+    let key = patch.kind.section(StencilKind::Position, PointSet::Dual, n);
     // A one-face boundary vertex is smooth in "edge only" mode and pinned in "edge and corner"
     // mode: its stencils must come from a table made for the mesh's mode.
     let corners = mesh.boundary == schemes::BoundaryMode::EdgeAndCorner;

@@ -237,15 +237,7 @@ pub struct DualGrid<'t> {
 }
 
 fn section(patch: &FacePatch, kind: StencilKind, points: PointSet, n: u32) -> SectionKey {
-    SectionKey {
-        kind,
-        points,
-        boundary: patch.kind.boundary,
-        feature: patch.kind.feature,
-        faces: patch.kind.faces,
-        sector: patch.kind.sector,
-        n,
-    }
+    patch.kind.section(kind, points, n)
 }
 
 fn stencils<'t>(

@@ -83,7 +83,7 @@ use std::sync::{Mutex, OnceLock};
 
 use rayon::prelude::*;
 use schemes::crease::is_infinite;
-use table_format::{PointSet, SectionKey, StencilKind};
+use table_format::{PointSet, StencilKind};
 
 use crate::mesh::topology::{Mesh, NONE};
 use crate::mesh::triangle_grid::TriangleGrid;
@@ -259,15 +259,7 @@ impl<'a> PatchPoints<'a> {
                 })
             }
         };
-        let key = SectionKey {
-            kind: StencilKind::Position,
-            points,
-            boundary: patch.kind.boundary,
-            feature: patch.kind.feature,
-            faces: patch.kind.faces,
-            sector: patch.kind.sector,
-            n,
-        };
+        let key = patch.kind.section(StencilKind::Position, points, n);
         let weights = table.weights(&key)?;
         let k = patch.points.len();
         if weights.len() != side * side * k {
@@ -1016,15 +1008,9 @@ fn adaptive_faces<'a>(
         .par_iter()
         .enumerate()
         .filter(|&(f, patch)| {
-            let key = SectionKey {
-                kind: StencilKind::Position,
-                points: PointSet::Dual,
-                boundary: patch.kind.boundary,
-                feature: patch.kind.feature,
-                faces: patch.kind.faces,
-                sector: patch.kind.sector,
-                n: SELECTION_GRID,
-            };
+            let key = patch
+                .kind
+                .section(StencilKind::Position, PointSet::Dual, SELECTION_GRID);
             let described = table_may_describe(mesh, patch, f) || semi_sharp(mesh, f);
             let from_table = described && table.weights(&key).is_ok();
             !mesh.holes[f] && !from_table

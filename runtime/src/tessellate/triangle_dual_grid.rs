@@ -224,15 +224,7 @@ pub struct TriangleDualGrid {
 }
 
 fn section(patch: &TrianglePatch, kind: StencilKind, points: PointSet, n: u32) -> SectionKey {
-    SectionKey {
-        kind,
-        points,
-        boundary: patch.kind.boundary,
-        feature: patch.kind.feature,
-        faces: patch.kind.faces,
-        sector: patch.kind.sector,
-        n,
-    }
+    patch.kind.section(kind, points, n)
 }
 
 fn stencils<'t>(

@@ -72,7 +72,7 @@
 use std::collections::{BTreeSet, HashMap};
 
 use rayon::prelude::*;
-use table_format::{PointSet, SectionKey, StencilKind};
+use table_format::{PointSet, StencilKind};
 
 use crate::mesh::topology::NONE;
 use crate::mesh::triangle_grid::TriangleGrid;
@@ -153,15 +153,7 @@ impl<'a> Context<'a> {
     /// The position section of triangle `f`'s patch on `points` at rate `n`.
     fn section(&self, f: usize, points: PointSet, n: u32) -> Result<Section<'a>, RuntimeError> {
         let patch = &self.iso.patches[f];
-        let key = SectionKey {
-            kind: StencilKind::Position,
-            points,
-            boundary: patch.kind.boundary,
-            feature: patch.kind.feature,
-            faces: patch.kind.faces,
-            sector: patch.kind.sector,
-            n,
-        };
+        let key = patch.kind.section(StencilKind::Position, points, n);
         let weights = self.table.triangle_weights(&key)?;
         let k = patch.points.len();
         let count = points.count(n) as usize;

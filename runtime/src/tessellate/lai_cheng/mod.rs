@@ -62,7 +62,7 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 use serde_json::{json, Value};
-use table_format::{PointSet, SectionKey, StencilKind};
+use table_format::{PointSet, StencilKind};
 
 use crate::mesh::topology::Mesh;
 use crate::mesh::triangle_mesh::{TriangleMesh, VertexSource};
@@ -616,15 +616,7 @@ fn diameter(points: &[Point]) -> f64 {
 /// `(0,0)` (primal grid, `n = 1`), in patch coordinates (a rotation of the face's).
 fn vertex_normal(table: &StencilTable, patch: &FacePatch, points: &[Point]) -> Option<Point> {
     let tangent = |kind| -> Option<Point> {
-        let key = SectionKey {
-            kind,
-            points: PointSet::Primal,
-            boundary: patch.kind.boundary,
-            feature: patch.kind.feature,
-            faces: patch.kind.faces,
-            sector: patch.kind.sector,
-            n: 1,
-        };
+        let key = patch.kind.section(kind, PointSet::Primal, 1);
         let weights = table.weights(&key).ok()?;
         let row = weights.get(..points.len())?;
         let mut t = [0.0; 3];
