@@ -14,6 +14,7 @@ use table_format::{AlignedBytes, SectionKey, TableIndex};
 
 use crate::RuntimeError;
 use quad_expansion::QuadExpansion;
+pub(crate) use region_expansion::cone_regions;
 use region_expansion::RegionExpansion;
 use triangle_expansion::TriangleExpansion;
 

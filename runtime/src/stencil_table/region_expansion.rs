@@ -33,7 +33,8 @@
 //! solved on each whole grid by the orbit solver, they agree to 1 ulp of f32
 //! (`runtime/tests/integration/compact_tables.rs`).
 
-use std::sync::OnceLock;
+use std::collections::BTreeMap;
+use std::sync::{Arc, Mutex, OnceLock};
 
 use schemes::cone_regions::ConeRegions;
 use schemes::lattice_symmetry::{
@@ -91,13 +92,42 @@ impl RateBasis {
 pub(super) struct RegionExpansion {
     /// The table's scheme.
     scheme: TriangleScheme,
+    /// Its name (`butterfly`, `sqrt3`), the key of the shared region geometry.
+    name: &'static str,
     /// The rates the markers list; the regions with tile rows (patch `sector` = region).
     slots: GridSlots,
     /// Per rate (the slots' order), the basis lookups, made on first use.
     bases: Vec<OnceLock<RateBasis>>,
-    /// The valences with a subdivision matrix, ascending, and their region geometry, built on
-    /// first use.
-    geometry: Vec<(u32, OnceLock<ConeRegions>)>,
+    /// The valences with a subdivision matrix, ascending, and their region geometry, fetched
+    /// on first use ([`cone_regions`], shared with the isolation).
+    geometry: Vec<(u32, OnceLock<Arc<ConeRegions>>)>,
+}
+
+/// The regions of an interior vertex of valence `k` of the region scheme `name` (`butterfly`,
+/// `sqrt3`; [`ConeRegions`]: corners, layouts, tiles, the corner's matrices), built once per
+/// process and shared: the isolation reads their shapes
+/// (`scheme::triangle::region_patch::RegionScheme::cone_regions`), the expansion their tiles.
+/// Building them takes exact rational arithmetic (about 150 M instructions at valence 4),
+/// which a plan would otherwise pay twice.
+pub(crate) fn cone_regions(name: &'static str, k: u32) -> Result<Arc<ConeRegions>, RuntimeError> {
+    type Cache = Mutex<BTreeMap<(&'static str, u32), Arc<ConeRegions>>>;
+    static CACHE: OnceLock<Cache> = OnceLock::new();
+    let cache = CACHE.get_or_init(|| Mutex::new(BTreeMap::new()));
+    // A panic elsewhere while the lock was held leaves complete entries only (each is inserted
+    // whole), so a poisoned lock is still a valid cache.
+    let lock = || cache.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(regions) = lock().get(&(name, k)) {
+        return Ok(Arc::clone(regions));
+    }
+    let scheme = TriangleScheme::by_name(name)
+        .ok_or_else(|| RuntimeError::Unsupported(format!("{name} is not catalogued")))?;
+    // `ConeRegions::new` reads the dilation (2 or 3) from the scheme's rules. Built without the
+    // lock held; two threads asking at once both build, and the first is kept.
+    let built = Arc::new(
+        ConeRegions::new(&scheme, k)
+            .map_err(|e| RuntimeError::Unsupported(format!("{name} at valence {k}: {e}")))?,
+    );
+    Ok(Arc::clone(lock().entry((name, k)).or_insert(built)))
 }
 
 /// The error of a compact region table missing or misshaping a piece.
@@ -147,7 +177,7 @@ impl RegionExpansion {
         let Some(pieces) = compact_pieces(index)? else {
             return Ok(None);
         };
-        let scheme = match index.meta.scheme {
+        let name = match index.meta.scheme {
             SchemeId::Butterfly => "butterfly",
             SchemeId::Sqrt3 => "sqrt3",
             other => {
@@ -157,8 +187,8 @@ impl RegionExpansion {
                 )))
             }
         };
-        let scheme = TriangleScheme::by_name(scheme)
-            .ok_or_else(|| incomplete(format!("{scheme} is not catalogued")))?;
+        let scheme = TriangleScheme::by_name(name)
+            .ok_or_else(|| incomplete(format!("{name} is not catalogued")))?;
         let patchless = |key: &SectionKey| !key.boundary && key.faces == 0 && key.sector == 0;
         let (mut rates, mut patches, mut valences) = (Vec::new(), Vec::new(), Vec::new());
         for key in pieces {
@@ -258,6 +288,7 @@ impl RegionExpansion {
         let slots = GridSlots::new(rates, patches);
         Ok(Some(RegionExpansion {
             scheme,
+            name,
             bases: (0..slots.rates.len()).map(|_| OnceLock::new()).collect(),
             slots,
             geometry: valences,
@@ -288,10 +319,8 @@ impl RegionExpansion {
                 let regions = match geometry.get() {
                     Some(regions) => regions,
                     None => {
-                        let built = ConeRegions::new(&self.scheme, key.faces).map_err(|e| {
-                            incomplete(format!("the regions of valence {}: {e}", key.faces))
-                        })?;
-                        geometry.get_or_init(|| built)
+                        let shared = cone_regions(self.name, key.faces)?;
+                        geometry.get_or_init(|| shared)
                     }
                 };
                 let basis = self.bases[slot.rate].get_or_init(|| self.rate_basis(key.n));
@@ -344,12 +373,14 @@ struct Pieces<'a> {
     regions: &'a ConeRegions,
     /// Which region.
     r: usize,
-    /// `A` (`K x K`, the corner's width), region 0 only (empty otherwise).
-    a: &'a [f64],
+    /// The nonzero entries `(i, A[i][c])` of each column `c` of `A` (`K x K`, the corner's
+    /// width), `i` ascending; region 0 only (empty otherwise).
+    a_columns: Vec<Vec<(usize, f64)>>,
     /// The mask at `V` for this kind, region 0 only.
     vertex: &'a [f64],
-    /// The region's tile rows, one per regular point.
-    rows: &'a [f64],
+    /// The nonzero entries `(c, R[u][c])` of the region's tile row of each regular point `u`,
+    /// `c` ascending (about 60% of the rows' entries are zero).
+    rows: Vec<Vec<(usize, f64)>>,
     /// `psi` on the wedge and `psi_1` on the quarter.
     psi: &'a [f64],
     psi_1: &'a [f64],
@@ -422,14 +453,35 @@ impl<'a> Pieces<'a> {
                 count(&basis.quarter)
             )));
         }
+        // The zero entries are skipped as `stencilgen`'s evaluation skips them, so sparse rows
+        // give the same sums in the same order.
+        let sparse = |row: &[f64]| -> Vec<(usize, f64)> {
+            row.iter()
+                .copied()
+                .enumerate()
+                .filter(|&(_, x)| x != 0.0)
+                .collect()
+        };
+        let a_columns = if a.is_empty() {
+            Vec::new()
+        } else {
+            (0..k)
+                .map(|c| {
+                    (0..k)
+                        .map(|i| (i, a[i * k + c]))
+                        .filter(|&(_, x)| x != 0.0)
+                        .collect()
+                })
+                .collect()
+        };
         Ok(Pieces {
             kind: key.kind,
             k,
             regions,
             r,
-            a,
+            a_columns,
             vertex,
-            rows,
+            rows: rows.chunks_exact(k).map(sparse).collect(),
             psi,
             psi_1,
             basis,
@@ -488,15 +540,17 @@ impl<'a> Pieces<'a> {
         let mut row = self.tile(x)?;
         // phi(x) = phi(λx) A, `steps` times; times λ per step for a derivative.
         let lambda = l as f64;
-        let k = self.k;
         for _ in 0..steps {
-            row = (0..k)
-                .map(|c| {
-                    let sum = row
+            row = self
+                .a_columns
+                .iter()
+                .map(|column| {
+                    // Over the rows i ascending where both factors are nonzero, as
+                    // `stencilgen` sums them.
+                    let sum = column
                         .iter()
-                        .zip(self.a.chunks_exact(k))
-                        .filter(|(w, ai)| **w != 0.0 && ai[c] != 0.0)
-                        .fold(0.0, |acc, (w, ai)| acc + w * ai[c]);
+                        .filter(|&&(i, _)| row[i] != 0.0)
+                        .fold(0.0, |acc, &(i, a)| acc + row[i] * a);
                     if self.kind == StencilKind::Position {
                         sum
                     } else {
@@ -526,8 +580,7 @@ impl<'a> Pieces<'a> {
             StencilKind::DerivativeU => Some(e1),
             StencilKind::DerivativeV => Some(e2),
         };
-        let k = self.k;
-        let mut out = vec![0.0f64; k];
+        let mut out = vec![0.0f64; self.k];
         for &u in &region.tiles[tile].points {
             let Some(&(j1, j2)) = region.regular_points.get(u) else {
                 continue;
@@ -551,10 +604,8 @@ impl<'a> Pieces<'a> {
             if w == 0.0 {
                 continue;
             }
-            for (o, &rw) in out.iter_mut().zip(&self.rows[u * k..(u + 1) * k]) {
-                if rw != 0.0 {
-                    *o += w * rw;
-                }
+            for &(c, rw) in &self.rows[u] {
+                out[c] += w * rw;
             }
         }
         Ok(out)
