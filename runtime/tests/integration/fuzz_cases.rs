@@ -2,7 +2,7 @@
 //! as a named regression test (`fuzz_case_NN`, in the order found; docs/reliability.md lists
 //! them with their causes). Binary inputs are in `runtime/tests/fuzz_cases/`; for the table
 //! target they are the bytes the reader got (the target's first byte applied: checksum and
-//! declared size mended), found as format version 2 and moved to versions 3 and 4 (the version
+//! declared size mended), found as format version 2 and moved to versions 3, 4 and 5 (the version
 //! field and the checksum, which since version 3 covers the header, rewritten; nothing else) so
 //! that they still reach the code they broke.
 
