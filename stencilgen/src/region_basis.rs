@@ -42,7 +42,6 @@ use schemes::lattice_symmetry::{
 };
 use schemes::LatticeMask;
 
-use crate::cone_regions::RegionBasis;
 use crate::regular_patch::StencilKind;
 use crate::triangle_system::TriangleStencils;
 use crate::StencilError;
@@ -242,8 +241,9 @@ impl CanonicalBasis {
 
     /// The basis everywhere on the grid, from the canonical values by the lattice's symmetries
     /// (`psi(x) = psi(w(x))`, `psi_1(x) = ±psi_1(q(x))`, `psi_2(y) = psi_1(rho^-1 y)`): what a
-    /// reader of the table evaluates, as a [`RegionBasis`] for [`crate::cone_regions`].
-    pub fn region_basis(&self, mask: &LatticeMask) -> RegionBasis<f64> {
+    /// reader of the table evaluates; `psi`, `psi_1`, `psi_2` in [`StencilKind`] order, the
+    /// kinds of a `crate::cone_regions::RegionBasis`.
+    pub fn spread(&self, mask: &LatticeMask) -> [TriangleStencils<f64>; 3] {
         let hull = mask.hull();
         let wedge: HashMap<(i64, i64), f64> = wedge_points(&hull, mask.dilation, self.d)
             .into_iter()
@@ -279,14 +279,11 @@ impl CanonicalBasis {
                 .collect(),
             residual: 0.0,
         };
-        RegionBasis {
-            n: self.d,
-            kinds: [
-                Some(grid(StencilKind::Position, &psi)),
-                Some(grid(StencilKind::DerivativeU, &psi_1)),
-                Some(grid(StencilKind::DerivativeV, &|k| psi_1(rotate_back(k)))),
-            ],
-        }
+        [
+            grid(StencilKind::Position, &psi),
+            grid(StencilKind::DerivativeU, &psi_1),
+            grid(StencilKind::DerivativeV, &|k| psi_1(rotate_back(k))),
+        ]
     }
 }
 
@@ -311,7 +308,7 @@ mod tests {
             for d in rates {
                 let basis = CanonicalBasis::new(&mask, d)
                     .expect("settles")
-                    .region_basis(&mask);
+                    .spread(&mask);
                 for (slot, kind) in [
                     StencilKind::Position,
                     StencilKind::DerivativeU,
@@ -322,7 +319,7 @@ mod tests {
                 {
                     let want =
                         family_regular_basis_kind::<f64>(family, &scheme, d, kind).expect("solves");
-                    let got = basis.kinds[slot].as_ref().expect("every kind");
+                    let got = &basis[slot];
                     assert_eq!(got.bbox, want.bbox);
                     let worst = got
                         .values

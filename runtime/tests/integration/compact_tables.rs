@@ -485,7 +485,7 @@ fn compact_region_grids_equal_solved_grids_at_every_rate() {
 
 /// Every rate 1..=24 of the embedded region tables, every region, kind and grid point, against
 /// `stencilgen`'s own evaluation of the regions (`ConeRegionStencils::stencil` in f64) with the
-/// table's basis spread by the lattice's symmetries (`CanonicalBasis::region_basis`): the
+/// table's basis spread by the lattice's symmetries (`CanonicalBasis::spread`): the
 /// runtime's expansion is that evaluation, rounded once, at every rate (0 ulp expected); with
 /// [`compact_region_grids_equal_solved_grids`] (the basis itself against the orbit solves at
 /// rates 1..=8, and `stencilgen::region_basis`'s test at the rates 3..=15) this covers every
@@ -532,7 +532,10 @@ fn compact_region_grids_are_the_region_evaluation_at_every_rate() {
                     .expect("psi_1")
                     .to_vec(),
             };
-            let basis = canonical.region_basis(&mask);
+            let basis = stencilgen::cone_regions::RegionBasis {
+                n: 3 * n,
+                kinds: canonical.spread(&mask).map(Some),
+            };
             for regions in &valences {
                 let k = regions.regions.valence;
                 let count_regions = if k == 6 {
