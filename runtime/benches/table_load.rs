@@ -8,7 +8,11 @@
 //! 3 kinds x 2 grids: what the version-3 table stored), the most any sequence of plans can ask;
 //! `expand one patch at rate N` is the three kinds of one valence-5 patch, both grids. The
 //! `(loop)` ones do the same with the default Loop table (31 patches: valences 3..=12, boundary
-//! vertices with 1..=6 triangles).
+//! vertices with 1..=6 triangles). The `(butterfly)` and `(sqrt3)` ones expand the default
+//! region tables (46 regions: the nine of valences 3, 4, 5, 7, 8 and region 0 of valence 6;
+//! the 28,518,480 weights of the version-4 grid layout at n = 1..=24); their one-patch rows
+//! are the nine regions of valence 5 (a plan reads all of a valence's regions), both grids,
+//! three kinds.
 #![allow(missing_docs)] // criterion_group! generates an undocumented function
 
 use criterion::{criterion_group, criterion_main, Criterion};
@@ -105,6 +109,22 @@ fn bench(c: &mut Criterion) {
         group.bench_function(format!("expand one patch at rate {n} (loop)"), |b| {
             b.iter(|| grids(&fresh(), &[(false, 5, 0)], &[n], TRIANGLE))
         });
+    }
+    for scheme in [Scheme::Butterfly, Scheme::Sqrt3] {
+        let fresh = || scheme.default_table(BoundaryMode::EdgeOnly).expect("loads");
+        let regions = |k: u32| (0..if k == 6 { 1 } else { 9 }).map(move |r| (false, k, r));
+        let all: Vec<(bool, u32, u32)> = (3..=8).flat_map(regions).collect();
+        assert_eq!(grids(&fresh(), &all, &rates, TRIANGLE), 28_518_480);
+        group.bench_function(
+            format!("expand every grid of the default table ({scheme})"),
+            |b| b.iter(|| grids(&fresh(), &all, &rates, TRIANGLE)),
+        );
+        let five: Vec<(bool, u32, u32)> = regions(5).collect();
+        for n in [8, 24] {
+            group.bench_function(format!("expand one valence at rate {n} ({scheme})"), |b| {
+                b.iter(|| grids(&fresh(), &five, &[n], TRIANGLE))
+            });
+        }
     }
     group.finish();
 }

@@ -748,12 +748,17 @@ fn tables_info(file: Option<PathBuf>, scheme: Scheme) -> Result<(), RuntimeError
     out!(
         "sections:   {} ({})",
         index.entries.len(),
-        match (table.is_compact(), index.meta.scheme.is_triangle()) {
-            (true, false) => {
+        match (table.is_compact(), index.meta.scheme) {
+            (true, table_format::SchemeId::Butterfly | table_format::SchemeId::Sqrt3) => {
+                "compact: the regular basis on 1/3n and a marker per rate; A and the vertex \
+                 masks per valence, the tile rows per region; the grids are expanded when a \
+                 plan needs them"
+            }
+            (true, scheme) if !scheme.is_triangle() => {
                 "compact: the regular curve basis per rate; A, the sub-patch matrices and the \
                  vertex masks per patch; the grids are expanded when a plan needs them"
             }
-            (true, true) => {
+            (true, _) => {
                 "compact: the Loop basis on the lattice 1/4 and a marker per rate; A, the \
                  sub-triangle matrices and the vertex masks per patch; the grids are expanded \
                  when a plan needs them"

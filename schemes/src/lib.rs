@@ -21,6 +21,7 @@ pub mod cone_local;
 pub mod cone_regions;
 pub mod crease;
 pub mod curve;
+pub mod lattice_symmetry;
 pub mod local_matrices;
 pub mod loop_regular;
 pub mod quad;

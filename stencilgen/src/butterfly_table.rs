@@ -1,6 +1,10 @@
-//! Butterfly stencil tables (`docs/table-format.md`, triangle point sets).
+//! Butterfly stencil tables (`docs/table-format.md`, "Compact region tables" and the triangle
+//! point sets).
 //!
-//! Every region `r` of an interior vertex of valence `K` ([`schemes::butterfly_regions`]: the nine
+//! The default layout is compact ([`crate::region_table`]: per rate the regular basis by its
+//! canonical values, per valence `A`, the masks at `V` and each region's tile rows; the runtime
+//! expands the grids). In the grid layout (`--grids`, the reference the compact one is tested
+//! against) every region `r` of an interior vertex of valence `K` ([`schemes::butterfly_regions`]: the nine
 //! triangles of a sector whose surface the vertex shapes) and rate `n` becomes six sections, keyed
 //! `faces = K`, `sector = r`: positions, d/du and d/dv on the triangle primal grid `(i/n, j/n)`,
 //! `i + j <= n`, and on the `n^2` centroids of its small triangles
@@ -20,22 +24,26 @@ use schemes::TriangleScheme;
 use table_format::{Precision, SchemeId};
 
 use crate::butterfly_regions::{ButterflyBasis, ButterflyRegionStencils};
-use crate::region_table::{build_region_table, RegionTableSpec, KINDS};
+use crate::region_table::{
+    build_compact_region_table, build_region_table, RegionLayout, RegionTableSpec, KINDS,
+};
 use crate::triangle_patch::triangle_scheme;
+use crate::triangle_system::MAX_TRIANGLE_RATE;
 use crate::StencilError;
 
 /// What to put in a butterfly table.
 pub type ButterflyTableSpec = RegionTableSpec;
 
 impl RegionTableSpec {
-    /// The butterfly table `subtess` embeds: valences 3..=8, n = 1..=8, f32 (5.3 MiB; the
-    /// rates up to 24 make a 109.2 MiB table, written by `stencilgen tables` in about 14 CPU
-    /// minutes).
+    /// The butterfly table `subtess` embeds: valences 3..=8, n = 1..=24, compact, f64
+    /// (3.2 MiB; the grid layout of the same rates is 109.2 MiB, and its orbit solves take
+    /// about 14 CPU minutes).
     pub fn default_butterfly() -> Self {
         RegionTableSpec {
             valences: (3..=8).collect(),
-            rates: (1..=8).collect(),
-            precision: Precision::F32,
+            rates: (1..=MAX_TRIANGLE_RATE).collect(),
+            precision: Precision::F64,
+            layout: RegionLayout::Compact,
         }
     }
 }
@@ -49,6 +57,14 @@ pub fn default_butterfly_table() -> Result<Vec<u8>, StencilError> {
 /// Generate and encode the butterfly table of `spec`.
 pub fn build_butterfly_table(spec: &ButterflyTableSpec) -> Result<Vec<u8>, StencilError> {
     let scheme: TriangleScheme = triangle_scheme("butterfly")?;
+    if spec.layout == RegionLayout::Compact {
+        return build_compact_region_table(
+            SchemeId::Butterfly,
+            spec,
+            &scheme.regular_mask(),
+            |k| Ok(ButterflyRegionStencils::<f64>::new(&scheme, k)?.compact_pieces()),
+        );
+    }
     let kinds = KINDS.map(|(k, _)| k);
     build_region_table(
         SchemeId::Butterfly,
@@ -75,6 +91,7 @@ mod tests {
             valences: vec![3, 4],
             rates: vec![1, 2],
             precision: Precision::F64,
+            layout: RegionLayout::Grids,
         };
         let bytes = AlignedBytes::from_slice(&build_butterfly_table(&spec).expect("builds"));
         let table = Table::parse(bytes.as_bytes()).expect("parses");

@@ -315,6 +315,30 @@ impl<S: Scalar> ConeRegionStencils<S> {
     }
 }
 
+impl ConeRegionStencils<f64> {
+    /// What a compact region table stores of this valence
+    /// ([`crate::region_table::build_compact_region_table`]): the corner's width, every
+    /// region's width, and `A`, the masks at `V` (limit, d/du, d/dv) and every region's tile
+    /// rows (one per regular point, in [`ConeRegion::regular_points`] order), row-major, as
+    /// [`Self::stencil`] uses them.
+    pub fn compact_pieces(&self) -> (usize, Vec<usize>, crate::region_table::ValencePieces) {
+        let flat = |m: &Vec<Vec<f64>>| m.iter().flatten().copied().collect::<Vec<f64>>();
+        (
+            self.a.len(),
+            self.regions.regions.iter().map(ConeRegion::size).collect(),
+            (
+                flat(&self.a),
+                [
+                    self.limit.clone(),
+                    self.vertex_tangents[0].clone(),
+                    self.vertex_tangents[1].clone(),
+                ],
+                self.rows.iter().map(flat).collect(),
+            ),
+        )
+    }
+}
+
 impl RegionStencilSet for ConeRegionStencils<f64> {
     type Basis = RegionBasis<f64>;
 

@@ -44,6 +44,7 @@ pub mod orbit_block;
 pub mod orbits;
 pub mod patch_stencils;
 pub mod rational;
+pub mod region_basis;
 pub mod region_table;
 pub mod regular_patch;
 pub mod scalar;

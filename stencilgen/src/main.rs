@@ -21,6 +21,7 @@ use stencilgen::butterfly_table::{build_butterfly_table, ButterflyTableSpec};
 use stencilgen::extraordinary_patch::{canonical, Neighbourhood, OUTER_POINTS};
 use stencilgen::patch_stencils::{curve_scheme, quad_scheme};
 use stencilgen::rational::parse_rational;
+use stencilgen::region_table::RegionLayout;
 use stencilgen::regular_patch::StencilKind;
 use stencilgen::sqrt3_patch::Sqrt3Substitution;
 use stencilgen::sqrt3_regions::Sqrt3RegionSubstitution;
@@ -135,9 +136,9 @@ enum Command {
         /// Generate from exact rationals (slower) instead of the f64 path.
         #[arg(long)]
         exact: bool,
-        /// Quad schemes and Loop: store every grid point's stencil (solved on the grid) instead
-        /// of the scaling relation's pieces that the runtime expands (docs/table-format.md).
-        /// Butterfly and √3 tables always store grids.
+        /// Store every grid point's stencil (solved on the grid) instead of the scaling
+        /// relation's pieces that the runtime expands (docs/table-format.md): the reference
+        /// the compact tables are tested against.
         #[arg(long)]
         grids: bool,
         /// Output file.
@@ -282,6 +283,11 @@ fn run(cli: Cli) -> Result<(), StencilError> {
             } else {
                 QuadLayout::Compact
             };
+            let region_layout = if grids {
+                RegionLayout::Grids
+            } else {
+                RegionLayout::Compact
+            };
             let precision_of = |compact: bool| match precision.as_deref() {
                 Some("f64") => Precision::F64,
                 Some(_) => Precision::F32,
@@ -326,7 +332,8 @@ fn run(cli: Cli) -> Result<(), StencilError> {
                         let spec = ButterflyTableSpec {
                             valences: set.valences.clone(),
                             rates: set.rates.clone(),
-                            precision: precision_of(false),
+                            precision: precision_of(!grids),
+                            layout: region_layout,
                         };
                         write_bytes(&path, &build_butterfly_table(&spec)?, started)?;
                         continue;
@@ -341,7 +348,8 @@ fn run(cli: Cli) -> Result<(), StencilError> {
                         let spec = Sqrt3TableSpec {
                             valences: set.valences.clone(),
                             rates: set.rates.clone(),
-                            precision: precision_of(false),
+                            precision: precision_of(!grids),
+                            layout: region_layout,
                         };
                         write_bytes(&path, &build_sqrt3_table(&spec)?, started)?;
                         continue;

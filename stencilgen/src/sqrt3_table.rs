@@ -1,6 +1,8 @@
-//! √3 stencil tables (`docs/table-format.md`, triangle point sets; scheme id 5).
+//! √3 stencil tables (`docs/table-format.md`, "Compact region tables" and the triangle point
+//! sets; scheme id 5).
 //!
-//! Every region `r` of an interior vertex of valence `K` ([`schemes::sqrt3_regions`]: the nine
+//! The default layout is compact, as the butterfly's ([`crate::region_table`]). In the grid
+//! layout (`--grids`) every region `r` of an interior vertex of valence `K` ([`schemes::sqrt3_regions`]: the nine
 //! triangles of a sector whose surface the vertex shapes) and rate `n` becomes six sections, keyed
 //! `faces = K`, `sector = r`: positions, d/du and d/dv on the triangle primal grid `(i/n, j/n)`,
 //! `i + j <= n`, and on the `n^2` centroids of its small triangles
@@ -16,30 +18,34 @@
 //! [`crate::sqrt3_patch::sqrt3_regular_basis_kind`]: exactly and rounded, which at these rates, all
 //! multiples of 3, beats the f64 solve), the regions' matrices in f64 (`alpha_K` is irrational at
 //! `K = 5, 7, 8`), so f64 throughout; a test compares a small table with the exact path. `tables/`
-//! embeds [`default_sqrt3_table`] (n = 1..=8); `stencilgen tables --schemes sqrt3` writes any
-//! range (time and size in docs/table-format.md).
+//! embeds [`default_sqrt3_table`] (compact, n = 1..=24); `stencilgen tables --schemes sqrt3`
+//! writes any range (time and size in docs/table-format.md).
 //!
 //! The sections are built by the builder both region schemes share, [`crate::region_table`].
 
 use schemes::TriangleScheme;
 use table_format::{Precision, SchemeId};
 
-use crate::region_table::{build_region_table, RegionTableSpec, KINDS};
+use crate::region_table::{
+    build_compact_region_table, build_region_table, RegionLayout, RegionTableSpec, KINDS,
+};
 use crate::sqrt3_regions::{Sqrt3Basis, Sqrt3RegionStencils};
 use crate::triangle_patch::triangle_scheme;
+use crate::triangle_system::MAX_TRIANGLE_RATE;
 use crate::StencilError;
 
 /// What to put in a √3 table.
 pub type Sqrt3TableSpec = RegionTableSpec;
 
 impl RegionTableSpec {
-    /// The table `subtess` embeds (`tables::default_sqrt3`): valences 3..=8, n = 1..=8, f32
-    /// (the butterfly's embedded shape).
+    /// The table `subtess` embeds (`tables::default_sqrt3`): valences 3..=8, n = 1..=24,
+    /// compact, f64 (the butterfly's embedded shape; 2.6 MiB).
     pub fn default_sqrt3() -> Self {
         RegionTableSpec {
             valences: (3..=8).collect(),
-            rates: (1..=8).collect(),
-            precision: Precision::F32,
+            rates: (1..=MAX_TRIANGLE_RATE).collect(),
+            precision: Precision::F64,
+            layout: RegionLayout::Compact,
         }
     }
 }
@@ -53,6 +59,11 @@ pub fn default_sqrt3_table() -> Result<Vec<u8>, StencilError> {
 /// Generate and encode the √3 table of `spec`.
 pub fn build_sqrt3_table(spec: &Sqrt3TableSpec) -> Result<Vec<u8>, StencilError> {
     let scheme: TriangleScheme = triangle_scheme("sqrt3")?;
+    if spec.layout == RegionLayout::Compact {
+        return build_compact_region_table(SchemeId::Sqrt3, spec, &scheme.regular_mask(), |k| {
+            Ok(Sqrt3RegionStencils::<f64>::new(&scheme, k)?.compact_pieces())
+        });
+    }
     let kinds = KINDS.map(|(k, _)| k);
     build_region_table(
         SchemeId::Sqrt3,
@@ -80,6 +91,7 @@ mod tests {
             valences: vec![3, 4, 6],
             rates: vec![1, 2],
             precision: Precision::F64,
+            layout: RegionLayout::Grids,
         };
         let bytes = AlignedBytes::from_slice(&build_sqrt3_table(&spec).expect("builds"));
         let table = Table::parse(bytes.as_bytes()).expect("parses");

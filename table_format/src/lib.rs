@@ -28,7 +28,9 @@ use thiserror::Error;
 pub const MAGIC: [u8; 8] = *b"SUBTESS\0";
 /// The format version this crate reads and writes. Version 5 turned the index entry's reserved
 /// byte 3 into the patch's sharp feature ([`Feature`]: the dart patches of Catmull–Clark
-/// tables); version 4 added the scaling relation's
+/// tables) and added the compact region tables' pieces ([`PointSet::RegionBasis`],
+/// [`PointSet::RegionRows`]; the butterfly's and √3's grids are expanded from them as Loop's
+/// are). Version 4 added the scaling relation's
 /// pieces as sections ([`PointSet::CurveBasis`], [`PointSet::VertexMask`],
 /// [`PointSet::Subdivision`], [`PointSet::SubPatches`]; for Loop [`PointSet::LoopBasis`],
 /// [`PointSet::SubTriangles`], [`PointSet::TriangleRate`]), from which a reader expands the
@@ -361,6 +363,17 @@ pub enum PointSet {
     /// fields 0. The expanded grids are the rates listed by these sections, so that the index
     /// alone says what the table covers.
     TriangleRate = 10,
+    /// Compact region tables (butterfly, √3; docs/table-format.md, "Compact region tables"):
+    /// the regular basis on the grid `1/3n` of rate `n` (the key's `n`), by its canonical
+    /// values (`schemes::lattice_symmetry`): kind position, `psi` at the wedge points; kind
+    /// d/du, `psi_1` at the quarter points; one row of `width` values, patch fields 0. The
+    /// reader knows the points' count from the scheme's support and checks it.
+    RegionBasis = 11,
+    /// A compact region table's tile rows of one region (`faces` the valence, `sector` the
+    /// region): `n` rows (the key's `n` is the row count: the region's regular points, in
+    /// `schemes::cone_regions::ConeRegion::regular_points` order) of `width` weights (the
+    /// region's layout), the level-0 weights of each regular point.
+    RegionRows = 12,
 }
 
 impl PointSet {
@@ -374,7 +387,8 @@ impl PointSet {
     /// Number of rows of a section of this point set at rate `n` with `width` weights a row:
     /// the grid's points, `n + 1` curve-basis points, one vertex mask, `K = width` rows of `A`,
     /// the 48 rows of the sub-patch matrices, the 36 of the sub-triangle matrices, a square
-    /// window of the Loop basis (`width` rows) or none for a rate marker.
+    /// window of the Loop basis (`width` rows), none for a rate marker, one row of a region
+    /// basis, `n` tile rows of a region.
     pub fn rows(self, n: u32, width: u32) -> u64 {
         let n = u128::from(n);
         let count = match self {
@@ -388,6 +402,8 @@ impl PointSet {
             PointSet::LoopBasis => u128::from(width),
             PointSet::SubTriangles => 36,
             PointSet::TriangleRate => 0,
+            PointSet::RegionBasis => 1,
+            PointSet::RegionRows => n,
         };
         u64::try_from(count).unwrap_or(u64::MAX)
     }
@@ -401,6 +417,8 @@ impl PointSet {
                 | PointSet::LoopBasis
                 | PointSet::SubTriangles
                 | PointSet::TriangleRate
+                | PointSet::RegionBasis
+                | PointSet::RegionRows
         )
     }
 
@@ -441,6 +459,8 @@ impl PointSet {
             PointSet::LoopBasis,
             PointSet::SubTriangles,
             PointSet::TriangleRate,
+            PointSet::RegionBasis,
+            PointSet::RegionRows,
         ]
         .into_iter()
         .find(|p| *p as u8 == v)
@@ -508,6 +528,20 @@ impl fmt::Display for SectionKey {
                 return write!(f, "{kind} of the Loop basis on the lattice 1/{}", self.n);
             }
             PointSet::TriangleRate => return write!(f, "rate marker n = {}", self.n),
+            PointSet::RegionBasis => {
+                return write!(
+                    f,
+                    "{kind} of the regular basis on the grid 1/{}",
+                    u64::from(self.n) * 3
+                );
+            }
+            PointSet::RegionRows => {
+                return write!(
+                    f,
+                    "tile rows of region {} of valence {}",
+                    self.sector, self.faces
+                );
+            }
             PointSet::VertexMask => "vertex mask",
             PointSet::Subdivision => "subdivision matrix",
             PointSet::SubPatches => "sub-patch matrices",
@@ -1044,7 +1078,10 @@ impl TableIndex {
             // rate.
             let patchless = matches!(
                 e.key.points,
-                PointSet::CurveBasis | PointSet::LoopBasis | PointSet::TriangleRate
+                PointSet::CurveBasis
+                    | PointSet::LoopBasis
+                    | PointSet::TriangleRate
+                    | PointSet::RegionBasis
             );
             if !patchless {
                 if e.key.boundary {

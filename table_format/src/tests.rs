@@ -580,3 +580,52 @@ fn non_finite_weights_are_found_behind_a_valid_checksum() {
     let index = TableIndex::parse(sample.as_bytes()).expect("valid");
     index.check_finite(sample.as_bytes()).expect("all finite");
 }
+
+/// The compact region pieces (format version 5): a region basis is one row of any width, the
+/// tile rows of a region have as many rows as the key's `n` says; both belong to triangle
+/// schemes only, and a region basis names no patch (the coverage line lists the region rows'
+/// valence, not a valence 0).
+#[test]
+fn compact_region_point_sets_have_their_shapes() {
+    let butterfly = TableMeta {
+        scheme: SchemeId::Butterfly,
+        precision: Precision::F64,
+        corners: false,
+    };
+    assert_eq!(PointSet::RegionBasis.rows(24, 10_476), 1);
+    assert_eq!(PointSet::RegionRows.rows(31, 27), 31);
+    let basis = key(StencilKind::DerivativeU, PointSet::RegionBasis, 0, 3);
+    let rows = SectionKey {
+        sector: 4,
+        ..key(StencilKind::Position, PointSet::RegionRows, 5, 7)
+    };
+    let rate = key(StencilKind::Position, PointSet::TriangleRate, 0, 3);
+    let bytes = encode(
+        butterfly,
+        &[
+            (basis, 5, vec![0.5; 5]),
+            (rows, 3, vec![0.25; 21]),
+            (rate, 0, vec![]),
+        ],
+    )
+    .expect("valid");
+    let aligned = AlignedBytes::from_slice(&bytes);
+    let table = Table::parse(aligned.as_bytes()).expect("valid");
+    assert_eq!(table.weights_f64(&rows).expect("present").len(), 21);
+    assert_eq!(
+        table.coverage(),
+        "interior valences 5, no boundary vertices, n = 3"
+    );
+    // A wrong row count is a wrong shape.
+    let e = encode(butterfly, &[(rows, 3, vec![0.25; 18])]).expect_err("6 rows, not 7");
+    assert!(matches!(e, TableError::Encode(_)), "{e}");
+    let cc = TableMeta {
+        scheme: SchemeId::CatmullClark,
+        ..butterfly
+    };
+    for piece in [basis, rows] {
+        let e =
+            encode(cc, &[(piece, 1, vec![0.0; 7])]).expect_err("a region piece in a quad table");
+        assert!(matches!(e, TableError::WrongPointSet { .. }), "{piece}");
+    }
+}

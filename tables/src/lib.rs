@@ -3,9 +3,9 @@
 //!
 //! The default Catmull–Clark table (interior valences 3..=8, darts of valences 3..=8, boundary
 //! vertices with 1..=6 faces "edge only", n = 1..=24) is compact (0.68 MB: the scaling
-//! relation's pieces, from which the
-//! runtime expands the grids), and so is the Loop table (0.17 MB); the butterfly and √3 tables
-//! hold their grids (5.3 MiB each). All are generated deterministically by `stencilgen` in this
+//! relation's pieces, from which the runtime expands the grids), and so are the Loop table
+//! (0.17 MB) and the butterfly and √3 tables (n = 1..=24: 3.4 MB and 2.7 MB, the regular basis
+//! per rate and the region matrices). All are generated deterministically by `stencilgen` in this
 //! crate's build script rather than kept in the repository and its history, and embedded with
 //! `include_bytes!`, aligned for zero-copy reads.
 //! `stencilgen tables ... -o FILE` writes the same bytes to a file, and `tests/regenerate.rs`
@@ -60,19 +60,19 @@ pub fn default_loop() -> &'static [u8] {
 }
 
 /// The default butterfly table's bytes (64-byte aligned): the nine regions of interior vertices
-/// of valence 3..=8 (region 0 only at valence 6, the regular patch), n = 1..=8, triangle primal
-/// and dual grids, positions and both derivatives, f32
-/// (`stencilgen::butterfly_table::ButterflyTableSpec::default_butterfly`; 5.3 MiB). Rates up
-/// to 24 need a table written by `stencilgen tables --schemes butterfly`.
+/// of valence 3..=8 (region 0 only at valence 6, the regular patch), n = 1..=24, positions and
+/// both derivatives, compact: per rate the regular basis on `1/3n` by its canonical values, per
+/// valence `A` and the masks at `V`, per region its tile rows, in f64, from which the runtime
+/// expands the triangle primal and dual grids (docs/table-format.md, "Compact region tables";
+/// `stencilgen::butterfly_table::ButterflyTableSpec::default_butterfly`; 3.2 MiB).
 pub fn default_butterfly() -> &'static [u8] {
     &BUTTERFLY.0
 }
 
 /// The default √3 table's bytes (64-byte aligned): the nine regions of interior vertices of
 /// valence 3..=8 (region 0 only at valence 6, the regular patch) of two √3 steps taken as one
-/// ternary step, n = 1..=8, triangle primal and dual grids, positions and both derivatives, f32
-/// (`stencilgen::sqrt3_table::default_sqrt3_table`; 5.3 MiB). Rates up to 24 need a
-/// table written by `stencilgen tables --schemes sqrt3`.
+/// ternary step, n = 1..=24, positions and both derivatives, compact as the butterfly's
+/// (`stencilgen::sqrt3_table::default_sqrt3_table`; 2.6 MiB).
 pub fn default_sqrt3() -> &'static [u8] {
     &SQRT3.0
 }

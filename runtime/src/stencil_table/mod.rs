@@ -1,9 +1,10 @@
 //! Stencil tables as the runtime uses them: the embedded default, or a file, validated once.
 //! A compact table's grids are expanded from the scaling relation's pieces when a plan first
-//! asks for them ([`quad_expansion`] for Catmull–Clark, [`triangle_expansion`] for Loop), then
-//! kept.
+//! asks for them ([`quad_expansion`] for Catmull–Clark, [`triangle_expansion`] for Loop,
+//! [`region_expansion`] for the butterfly and √3), then kept.
 
 mod quad_expansion;
+mod region_expansion;
 mod triangle_expansion;
 
 use std::path::Path;
@@ -13,6 +14,8 @@ use table_format::{AlignedBytes, SectionKey, TableIndex};
 
 use crate::RuntimeError;
 use quad_expansion::QuadExpansion;
+pub(crate) use region_expansion::cone_regions;
+use region_expansion::RegionExpansion;
 use triangle_expansion::TriangleExpansion;
 
 /// One patch of a compact table: which vertex (and sharp feature), which sector (its pieces are keyed by these and
@@ -170,16 +173,23 @@ enum Expansion {
     Quad(QuadExpansion),
     /// Loop pieces.
     Triangle(TriangleExpansion),
+    /// Butterfly and √3 pieces.
+    Region(RegionExpansion),
 }
 
 impl Expansion {
     /// The expansion of a validated table, `None` if it stores grids only.
     fn new(index: &TableIndex) -> Result<Option<Self>, RuntimeError> {
-        Ok(if index.meta.scheme.is_triangle() {
-            TriangleExpansion::new(index)?.map(Expansion::Triangle)
-        } else {
-            QuadExpansion::new(index)?.map(Expansion::Quad)
-        })
+        use table_format::SchemeId;
+        Ok(
+            if matches!(index.meta.scheme, SchemeId::Butterfly | SchemeId::Sqrt3) {
+                RegionExpansion::new(index)?.map(Expansion::Region)
+            } else if index.meta.scheme.is_triangle() {
+                TriangleExpansion::new(index)?.map(Expansion::Triangle)
+            } else {
+                QuadExpansion::new(index)?.map(Expansion::Quad)
+            },
+        )
     }
 
     /// The grid of `key`, expanded on first use; `None` if the table cannot expand it.
@@ -192,6 +202,7 @@ impl Expansion {
         match self {
             Expansion::Quad(e) => e.grid(index, bytes, key),
             Expansion::Triangle(e) => e.grid(index, bytes, key),
+            Expansion::Region(e) => e.grid(index, bytes, key),
         }
     }
 }

@@ -845,11 +845,13 @@ mod tests {
             triangle_table_rates(&loop_table),
             (1..=24).collect::<Vec<_>>()
         );
-        let butterfly = StencilTable::default_butterfly().expect("table");
-        assert_eq!(
-            triangle_table_rates(&butterfly),
-            (1..=8).collect::<Vec<_>>()
-        );
+        // The compact region tables list their rates by markers, as the Loop table does.
+        for region in [
+            StencilTable::default_butterfly().expect("table"),
+            StencilTable::default_sqrt3().expect("table"),
+        ] {
+            assert_eq!(triangle_table_rates(&region), (1..=24).collect::<Vec<_>>());
+        }
         let quads = StencilTable::default_catmull_clark().expect("table");
         assert!(triangle_table_rates(&quads).is_empty());
         assert_eq!(triangle_sampling_rates(&[1, 2, 3, 24, 23]), vec![24, 23]);

@@ -507,6 +507,30 @@ fn loop_scheme_tessellates_triangles() {
     }
 }
 
+/// `subtess tessellate MESH --scheme SCHEME --rate N --stats` for every `N` in 1..=24 (the
+/// embedded table's rates): each reports a watertight output of `3N^2 - 3N + 3` triangles per
+/// isolated triangle (genus 0: `V = T/2 + 2`); rate 25 is refused by name.
+fn every_rate_is_watertight(mesh: &std::path::Path, out_path: &std::path::Path, scheme: &str) {
+    for n in 1..=24u64 {
+        let stats = json(&succeeds(&format!(
+            "tessellate {} -o {} --scheme {scheme} --rate {n} --stats",
+            mesh.display(),
+            out_path.display()
+        )));
+        assert_eq!(stats["watertight"], true, "{scheme} at rate {n}");
+        let faces = stats["faces"].as_u64().expect("faces");
+        let triangles = faces * (3 * n * n - 3 * n + 3);
+        assert_eq!(stats["triangles"], triangles, "{scheme} at rate {n}");
+        assert_eq!(stats["vertices"], triangles / 2 + 2, "{scheme} at rate {n}");
+    }
+    let err = fails(&format!(
+        "tessellate {} -o {} --scheme {scheme} --rate 25",
+        mesh.display(),
+        out_path.display()
+    ));
+    assert!(err.contains("25"), "{err}");
+}
+
 #[test]
 fn butterfly_scheme_tessellates_closed_triangle_meshes() {
     let mesh = temp("octahedron-b.obj");
@@ -535,13 +559,8 @@ fn butterfly_scheme_tessellates_closed_triangle_meshes() {
     ));
     assert_eq!(json(&bench)["triangles"], 8 * 64 * 21);
     assert!(json(&bench)["isolation_seconds"].as_f64().is_some());
-    // The embedded table stops at n = 8; the error names the missing section.
-    let err = fails(&format!(
-        "tessellate {} -o {} --scheme butterfly --rate 9",
-        mesh.display(),
-        out_path.display()
-    ));
-    assert!(err.contains("n = 9"), "{err}");
+    // Issue 18: the embedded (compact) table covers every rate 1..=24, each one watertight.
+    every_rate_is_watertight(&mesh, &out_path, "butterfly");
     // A mesh with a boundary: the butterfly's boundary rules are not implemented.
     let open = temp("open-triangle.obj");
     std::fs::write(&open, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").expect("written");
@@ -581,13 +600,8 @@ fn sqrt3_scheme_tessellates_closed_triangle_meshes() {
         mesh.display()
     ));
     assert_eq!(json(&bench)["triangles"], 8 * 81 * 9);
-    // The embedded table stops at n = 8; the error names the missing section.
-    let err = fails(&format!(
-        "tessellate {} -o {} --scheme sqrt3 --rate 9",
-        mesh.display(),
-        out_path.display()
-    ));
-    assert!(err.contains("n = 9"), "{err}");
+    // Issue 18: the embedded (compact) table covers every rate 1..=24, each one watertight.
+    every_rate_is_watertight(&mesh, &out_path, "sqrt3");
     // A mesh with a boundary: √3's boundary rules are not implemented.
     let open = temp("open-triangle-s.obj");
     std::fs::write(&open, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").expect("written");

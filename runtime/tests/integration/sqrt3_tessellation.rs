@@ -235,3 +235,30 @@ fn spot_tessellates_to_a_closed_manifold_at_mixed_rates() {
     let table = StencilTable::default_sqrt3().expect("embedded table");
     check_spot_at_mixed_rates(RegionScheme::Sqrt3, &table, 2);
 }
+
+/// Issue 18: the embedded (compact) table covers every rate 1..=24. On the octahedron (every
+/// vertex of valence 4) the surface meets the limit positions of twice-refined vertices at
+/// rate 9, and at rates 9, 12, 16 and 24 (those the grid table before format version 5 lacked;
+/// `cli::every_rate_is_watertight` runs every rate 1..=24) the tessellation is a watertight
+/// oriented manifold of the input's Euler characteristic (`check_topology`).
+#[test]
+fn the_embedded_table_covers_the_new_rates_watertight() {
+    let table = StencilTable::default_sqrt3().expect("embedded sqrt3 table");
+    let iso = isolate_regions(&octahedron(), RegionScheme::Sqrt3).expect("isolates");
+    let levels = levels_of(&iso.mesh, 2);
+    check_against_limit_positions("octahedron at rate 9", &table, &iso, &levels, 9);
+    for rate in [9, 12, 16, 24] {
+        let grid = TriangleDualGrid::new(
+            &table,
+            &iso.mesh,
+            &iso.patches,
+            &vec![rate; iso.mesh.faces()],
+        )
+        .unwrap_or_else(|e| panic!("rate {rate}: {e}"));
+        check_topology(
+            &iso.mesh,
+            &grid.tessellate(&iso.mesh),
+            &format!("octahedron at rate {rate}"),
+        );
+    }
+}

@@ -205,11 +205,11 @@ fn unmet_faces_are_reported_and_bad_input_refused() {
     let butterfly = isolate_regions(&octahedron(), RegionScheme::Butterfly).expect("isolates");
     assert_eq!(
         triangle_table_rates(butterfly_table()),
-        (1..=8).collect::<Vec<_>>()
+        (1..=24).collect::<Vec<_>>()
     );
-    let e = triangle_tolerance_rates_among(butterfly_table(), &butterfly, 0.1, &[9])
-        .expect_err("the butterfly table stops at 8");
-    assert!(e.to_string().contains("1..=8"), "{e}");
+    let e = triangle_tolerance_rates_among(butterfly_table(), &butterfly, 0.1, &[25])
+        .expect_err("the butterfly table stops at 24");
+    assert!(e.to_string().contains("1..=24"), "{e}");
     // A quad table has no triangle grids.
     let quads = StencilTable::default_catmull_clark().expect("table");
     assert!(triangle_tolerance_rates(&quads, &iso, 0.1).is_err());

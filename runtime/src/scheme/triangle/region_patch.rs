@@ -21,11 +21,11 @@
 //! at patch `(0,0)`: the patch's `corner` is the face corner that is the region's first.
 
 use std::collections::{BTreeMap, BTreeSet};
+use std::sync::Arc;
 
 use rayon::prelude::*;
 use schemes::cone_regions::ConeRegions;
 use schemes::triangle_local::{canonical_triangle_point, TrianglePoint};
-use schemes::TriangleScheme;
 
 use crate::mesh::topology::{Mesh, NONE};
 use crate::mesh::triangle_topology::neighbours;
@@ -53,19 +53,22 @@ impl RegionScheme {
         }
     }
 
+    /// The regions of an interior vertex of valence `k` ([`ConeRegions`]), built once per
+    /// process and shared with a compact table's expansion
+    /// ([`crate::stencil_table::cone_regions`]).
+    pub(crate) fn cone_regions(self, k: u32) -> Result<Arc<ConeRegions>, RuntimeError> {
+        crate::stencil_table::cone_regions(self.name(), k)
+    }
+
     /// The regions of an interior vertex of valence `k`: every region's corners and layout.
     fn shapes(self, k: u32) -> Result<Vec<RegionShape>, RuntimeError> {
-        let name = self.name();
-        let scheme = TriangleScheme::by_name(name)
-            .ok_or_else(|| RuntimeError::Unsupported(format!("{name} is not catalogued")))?;
-        // `ConeRegions::new` reads the dilation (2 or 3) from the scheme's rules.
-        Ok(ConeRegions::new(&scheme, k)
-            .map_err(|e| RuntimeError::Unsupported(format!("{name} at valence {k}: {e}")))?
+        Ok(self
+            .cone_regions(k)?
             .regions
-            .into_iter()
+            .iter()
             .map(|r| RegionShape {
                 corners: r.triangle.corners(),
-                layout: r.layout,
+                layout: r.layout.clone(),
             })
             .collect())
     }
