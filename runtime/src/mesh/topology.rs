@@ -13,7 +13,7 @@
 //! "edge and corner" mode so is a boundary vertex with one face, as OpenSubdiv makes them
 //! before the first refinement (`schemes::crease`).
 
-use schemes::crease::INFINITE;
+use schemes::crease::{is_infinite, INFINITE};
 use schemes::{BoundaryMode, CreaseMethod};
 
 use crate::mesh::face_varying::FaceVarying;
@@ -21,6 +21,18 @@ use crate::MeshError;
 
 /// "No half-edge": the twin of a boundary half-edge.
 pub const NONE: u32 = u32::MAX;
+
+/// What separates two consecutive faces around a vertex where the tessellators sample the
+/// surface ([`Mesh::cut`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Cut {
+    /// Nothing: the surface is smooth across the edge.
+    None,
+    /// An infinitely sharp edge (or a face-varying seam): one surface, two sectors.
+    Sector,
+    /// The boundary or a hole: separate sheets of surface.
+    Sheet,
+}
 
 /// A validated polygon mesh.
 #[derive(Clone, Debug, PartialEq)]
@@ -428,6 +440,26 @@ impl Mesh {
             valence[v as usize] += 1;
         }
         valence
+    }
+
+    /// What the tessellators' sampling separates across the edge of half-edge `h`: the
+    /// boundary and a hole's side part separate sheets of surface, an infinitely sharp edge
+    /// (or a face-varying seam, `seam`) two sectors of one sheet, each sampled as a limit curve
+    /// that both sides' strips meet. Around a vertex, the edge of fan face `i` lies between it
+    /// and fan face `i - 1`, so this is the cut before fan face `i` (the boundary before the
+    /// first face of an open fan, whose first half-edge has no twin).
+    pub(crate) fn cut(&self, h: usize, seam: bool) -> Cut {
+        let t = self.twin[h];
+        if t == NONE
+            || self.holes[self.face_of[h] as usize]
+            || self.holes[self.face_of[t as usize] as usize]
+        {
+            Cut::Sheet
+        } else if is_infinite(self.edge_sharpness[h]) || seam {
+            Cut::Sector
+        } else {
+            Cut::None
+        }
     }
 
     /// Whether vertex `v` is on the boundary.

@@ -30,9 +30,7 @@ use std::time::Instant;
 
 use table_format::{PointSet, SectionKey, StencilKind};
 
-use schemes::crease::is_infinite;
-
-use crate::mesh::topology::{Mesh, NONE};
+use crate::mesh::topology::{Cut, Mesh, NONE};
 use crate::mesh::triangle_mesh::{TriangleMesh, VertexSource};
 use crate::scheme::catmull_clark::adaptive::{limit_stencils, LimitQuery, LimitStencil};
 use crate::scheme::patch::{dual_index_in_patch, FacePatch};
@@ -40,8 +38,8 @@ use crate::stencil_table::StencilTable;
 pub use crate::tessellate::kernel::TessellationTime;
 use crate::tessellate::kernel::{
     cross, evaluate_points, for_each_range, gather_relative, merge_rows, patch_origin, relative,
-    table_may_describe, unit, weighted_point, Connectivity, GridPlan, PointPlan, Stencils,
-    MAX_PATCH,
+    table_may_describe, unit, unless_absent, weighted_point, Connectivity, GridPlan, PointPlan,
+    Stencils, MAX_PATCH,
 };
 use crate::RuntimeError;
 
@@ -161,17 +159,6 @@ enum FaceEval<'t> {
     Local { control: Range<u32>, weights: usize },
     /// A hole: no points, no triangles.
     Hole,
-}
-
-/// What separates two consecutive faces around a vertex.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Cut {
-    /// Nothing: the surface is smooth across the edge.
-    None,
-    /// An infinitely sharp edge: one surface, two sectors.
-    Sector,
-    /// The boundary or a hole: separate sheets of surface.
-    Sheet,
 }
 
 /// A row of output vertices `start + t * step`, `t = 0..len`, at parameters
@@ -385,7 +372,7 @@ impl<'t> DualGrid<'t> {
                 continue;
             }
             let s = if table_may_describe(mesh, patch, f) {
-                stencils(table, patch, PointSet::Dual, n).ok()
+                unless_absent(stencils(table, patch, PointSet::Dual, n))?
             } else {
                 None
             };
@@ -584,8 +571,6 @@ impl<'t> DualGrid<'t> {
         // An infinitely sharp edge between two surface faces is tessellated like a boundary
         // on both sides: the crease curve is sampled, and shared by the two sides' strips. A
         // seam is sampled too, each side with its own copies of the points.
-        let sharp =
-            |h: usize| mesh.twin[h] != NONE && (is_infinite(mesh.edge_sharpness[h]) || seam(h));
         // Around every vertex, the fan is cut by the boundary and holes (separate surface
         // sheets, each with its own limit point) and by sharp edges (sectors of one sheet,
         // sharing its limit point). A smooth interior vertex makes one closed polygon of
@@ -596,21 +581,8 @@ impl<'t> DualGrid<'t> {
         for v in 0..mesh.positions.len() {
             let fan = mesh.fan(v);
             let n = fan.len();
-            let open = mesh.is_boundary_vertex(v);
             // The cut before fan face i, across the edge of fan[i].
-            let cut = |i: usize| {
-                if i == 0 && open {
-                    return Cut::Sheet;
-                }
-                let before = mesh.face_of[fan[(i + n - 1) % n]] as usize;
-                if hole(before) || hole(mesh.face_of[fan[i]] as usize) {
-                    Cut::Sheet
-                } else if sharp(fan[i]) {
-                    Cut::Sector
-                } else {
-                    Cut::None
-                }
-            };
+            let cut = |i: usize| mesh.cut(fan[i], seam(fan[i]));
             let start = (0..n)
                 .find(|&i| cut(i) == Cut::Sheet)
                 .or_else(|| (0..n).find(|&i| cut(i) == Cut::Sector));
@@ -695,10 +667,10 @@ impl<'t> DualGrid<'t> {
             }
             let side = h - mesh.face_halfedges(f).start;
             let row = self.row(f, side);
-            let across_surface = t != NONE && !hole(mesh.face_of[t as usize] as usize);
-            if !across_surface || sharp(h) {
+            let cut = mesh.cut(h, seam(h));
+            if cut != Cut::None {
                 let (tail, head) = (limit_at[h], limit_at[mesh.next(h)]);
-                if across_surface && (t as usize) < h {
+                if cut == Cut::Sector && (t as usize) < h {
                     let (mut first, segments) = curve_of[t as usize];
                     if seam(h) {
                         // This side's copies, in the other side's order: its point s lies at

@@ -12,6 +12,8 @@ pub(crate) use crate::mesh::geometry::{cross, normalize as unit};
 use crate::mesh::triangle_mesh::{TriangleMesh, VertexSource};
 use crate::mesh::Mesh;
 use crate::scheme::patch::{is_table_patch, FacePatch};
+use crate::RuntimeError;
+use table_format::TableError;
 
 /// The largest patch (control points) the evaluator takes: an interior quad vertex of valence
 /// `v` has `2v + 8`, a boundary vertex with `k` faces `2k + 8`; a triangle patch at most 40.
@@ -24,6 +26,18 @@ pub(crate) const MAX_PATCH: usize = 40;
 /// the table lacks.
 pub(crate) fn table_may_describe(mesh: &Mesh, patch: &FacePatch, face: usize) -> bool {
     is_table_patch(mesh, face) && patch.points.len() <= MAX_PATCH
+}
+
+/// A table lookup for a face the table may describe, where a section the table does not have
+/// is `None` (the face is then refined adaptively, like one beyond the table) and any other
+/// failure, a malformed user table for one, is the error it is: a table that cannot be read is
+/// refused, not silently bypassed.
+pub(crate) fn unless_absent<T>(lookup: Result<T, RuntimeError>) -> Result<Option<T>, RuntimeError> {
+    match lookup {
+        Ok(found) => Ok(Some(found)),
+        Err(RuntimeError::Table(TableError::MissingSection { .. })) => Ok(None),
+        Err(e) => Err(e),
+    }
 }
 
 /// Timings of one tessellation.

@@ -85,13 +85,13 @@ use rayon::prelude::*;
 use schemes::crease::is_infinite;
 use table_format::{PointSet, StencilKind};
 
-use crate::mesh::topology::{Mesh, NONE};
+use crate::mesh::topology::{Cut, Mesh};
 use crate::mesh::triangle_grid::TriangleGrid;
 use crate::mesh::triangle_mesh::TriangleMesh;
 use crate::scheme::catmull_clark::adaptive::{limit_points, LimitQuery};
 use crate::scheme::patch::{dual_index_in_patch, FacePatch};
 use crate::stencil_table::StencilTable;
-use crate::tessellate::kernel::table_may_describe;
+use crate::tessellate::kernel::{table_may_describe, unless_absent};
 use crate::RuntimeError;
 
 /// The largest rate selected: the largest of the default table (`n = 1..=24`).
@@ -711,7 +711,7 @@ impl FaceLocal {
         let mut beyond = Vec::with_capacity(4);
         for side in 0..4 {
             let t = mesh.twin[first + side];
-            beyond.push(if cuts(mesh, first + side) {
+            beyond.push(if mesh.cut(first + side, false) != Cut::None {
                 let mut curve = Vec::with_capacity(m + 1);
                 own.extend(
                     &primal,
@@ -1004,20 +1004,22 @@ fn adaptive_faces<'a>(
     patches: &[FacePatch],
 ) -> Result<AdaptiveGrids<'a>, RuntimeError> {
     check_faces(mesh, patches)?;
-    let faces = patches
+    let faces: Vec<Option<usize>> = patches
         .par_iter()
         .enumerate()
-        .filter(|&(f, patch)| {
+        .map(|(f, patch)| {
             let key = patch
                 .kind
                 .section(StencilKind::Position, PointSet::Dual, SELECTION_GRID);
             let described = table_may_describe(mesh, patch, f) || semi_sharp(mesh, f);
-            let from_table = described && table.weights(&key).is_ok();
-            !mesh.holes[f] && !from_table
+            let from_table = described && unless_absent(table.weights(&key))?.is_some();
+            Ok((!mesh.holes[f] && !from_table).then_some(f))
         })
-        .map(|(f, _)| f)
-        .collect();
-    Ok(AdaptiveGrids::new(mesh, faces))
+        .collect::<Result<_, RuntimeError>>()?;
+    Ok(AdaptiveGrids::new(
+        mesh,
+        faces.into_iter().flatten().collect(),
+    ))
 }
 
 /// Whether a corner of face `f` has a semi-sharp edge or vertex (finite, non-zero sharpness).
@@ -1033,28 +1035,16 @@ fn semi_sharp(mesh: &Mesh, f: usize) -> bool {
     })
 }
 
-/// Whether the tessellator cuts the surface along the edge of half-edge `h` (dual_grid.rs): the
-/// boundary, an edge of a hole or an infinitely sharp edge, each sampled as a limit curve that
-/// both sides' strips meet.
-fn cuts(mesh: &Mesh, h: usize) -> bool {
-    let t = mesh.twin[h];
-    t == NONE
-        || mesh.holes[mesh.face_of[h] as usize]
-        || mesh.holes[mesh.face_of[t as usize] as usize]
-        || is_infinite(mesh.edge_sharpness[h])
-}
-
 /// The faces around the corner at half-edge `h` whose corner points make its vertex polygon in
 /// the tessellator (dual_grid.rs), as their half-edges at the vertex in fan order, and whether
-/// the polygon closes on itself: the whole fan of a vertex no cut reaches ([`cuts`]); otherwise
+/// the polygon closes on itself: the whole fan of a vertex no cut reaches ([`Mesh::cut`]); otherwise
 /// the sector between the cuts before and after `h`'s face, which the vertex's limit point
 /// closes.
 fn sector(mesh: &Mesh, h: usize) -> (Vec<usize>, bool) {
     let v = mesh.face_vertices[h] as usize;
     let fan = mesh.fan(v);
     let n = fan.len();
-    // The cut before fan face i is across the edge of fan[i] (the boundary before the first).
-    let cut = |i: usize| (i == 0 && mesh.is_boundary_vertex(v)) || cuts(mesh, fan[i]);
+    let cut = |i: usize| mesh.cut(fan[i], false) != Cut::None;
     let Some(me) = fan.iter().position(|&e| e == h) else {
         return (vec![h], false);
     };

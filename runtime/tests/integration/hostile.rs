@@ -470,3 +470,62 @@ fn tables_with_non_finite_weights_are_refused() {
     std::fs::remove_file(&path).ok();
     assert!(stderr.contains("not finite"), "{stderr}");
 }
+
+/// A user table whose section does not fit the face's patch (13 weights per point where the
+/// valence-3 patch has 14 control points) used to be bypassed: the faces went to the adaptive
+/// refinement as if the table lacked the section, and the run succeeded on other stencils
+/// than the ones asked for. Only an absent section sends a face there now.
+#[test]
+fn a_table_section_that_does_not_fit_its_patch_is_refused_not_bypassed() {
+    use table_format::{encode, Precision, SchemeId, SectionKey, StencilKind, TableMeta};
+    let meta = TableMeta {
+        scheme: SchemeId::CatmullClark,
+        precision: Precision::F32,
+        corners: false,
+    };
+    let (n, width) = (2, 13);
+    let points = table_format::PointSet::Dual.count(n) as usize;
+    let sections: Vec<_> = [
+        StencilKind::Position,
+        StencilKind::DerivativeU,
+        StencilKind::DerivativeV,
+    ]
+    .into_iter()
+    .map(|kind| {
+        let key = SectionKey {
+            kind,
+            points: table_format::PointSet::Dual,
+            boundary: false,
+            feature: table_format::Feature::None,
+            faces: 3,
+            sector: 0,
+            n,
+        };
+        (
+            key,
+            width,
+            vec![1.0 / f64::from(width); points * width as usize],
+        )
+    })
+    .collect();
+    let bytes = encode(meta, &sections).expect("written");
+    let table = temp("narrow.subtess");
+    std::fs::write(&table, bytes).expect("temp file");
+    let out = temp("narrow.obj");
+    let stderr = refused(&[
+        "tessellate",
+        data("cube.obj").to_str().expect("a UTF-8 path"),
+        "-o",
+        out.to_str().expect("a UTF-8 path"),
+        "--table",
+        table.to_str().expect("a UTF-8 path"),
+        "--rate",
+        "2",
+    ]);
+    std::fs::remove_file(&table).ok();
+    std::fs::remove_file(&out).ok();
+    assert!(
+        stderr.contains("13 weights per point") && stderr.contains("14 control points"),
+        "{stderr}"
+    );
+}
