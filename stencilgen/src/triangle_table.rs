@@ -60,7 +60,8 @@ pub struct TriangleTableSpec {
     pub layout: TriangleLayout,
 }
 
-/// What a Loop table stores (module docs). Butterfly and √3 tables always store grids.
+/// What a Loop table stores (module docs). Butterfly and √3 tables choose between the same two
+/// with [`crate::region_table::RegionLayout`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TriangleLayout {
     /// The scaling relation's pieces; the reader expands the grids.
