@@ -17,8 +17,8 @@
 //! pinned-corner companion), `loop`, `butterfly` and `sqrt3`. The build script generates, and
 //! the crate embeds and exposes a function for, only the tables of the enabled features, so a
 //! program that needs only Catmull–Clark links 0.7 MB of tables instead of 7.0 MB and its build
-//! skips the triangle tables' generation (docs/benchmarks.md, "Table sizes"). `subtess`
-//! forwards the same four features.
+//! skips the triangle tables' generation, about 21 s (docs/benchmarks.md, "Per-scheme cargo
+//! features"). `subtess` forwards the same four features.
 
 /// `include_bytes!` gives 1-byte alignment; the table format hands out `&[f32]` views, so the
 /// bytes are wrapped in a 64-byte-aligned static.
