@@ -132,6 +132,13 @@ pub enum RuntimeError {
         /// Whether the mesh pins corners.
         mesh_corners: bool,
     },
+    /// A scheme's default table was asked for, but this build does not embed it: `subtess` was
+    /// built without the scheme's cargo feature ([`crate::Scheme::cargo_feature`]).
+    #[error("the {scheme} table is not embedded in this build: enable subtess's cargo feature `{}`, or give a table file (the CLI's --table FILE)", scheme.cargo_feature())]
+    NotEmbedded {
+        /// The scheme whose table is missing.
+        scheme: crate::Scheme,
+    },
     /// Something the runtime does not do yet, said plainly.
     #[error("not supported yet: {0}")]
     Unsupported(String),

@@ -10,40 +10,62 @@
 //! `include_bytes!`, aligned for zero-copy reads.
 //! `stencilgen tables ... -o FILE` writes the same bytes to a file, and `tests/regenerate.rs`
 //! checks that a fresh generation is identical to what is embedded.
+//!
+//! # Cargo features
+//!
+//! One per scheme, all four on by default: `catmull-clark` (the Catmull–Clark table and its
+//! pinned-corner companion), `loop`, `butterfly` and `sqrt3`. The build script generates, and
+//! the crate embeds and exposes a function for, only the tables of the enabled features, so a
+//! program that needs only Catmull–Clark links 0.7 MB of tables instead of 7.0 MB and its build
+//! skips the triangle tables' generation, about 21 s (docs/benchmarks.md, "Per-scheme cargo
+//! features"). `subtess` forwards the same four features.
 
 /// `include_bytes!` gives 1-byte alignment; the table format hands out `&[f32]` views, so the
 /// bytes are wrapped in a 64-byte-aligned static.
+#[cfg(any(
+    feature = "catmull-clark",
+    feature = "loop",
+    feature = "butterfly",
+    feature = "sqrt3"
+))]
 #[repr(C, align(64))]
 struct Aligned<T: ?Sized>(T);
 
+#[cfg(feature = "catmull-clark")]
 static CATMULL_CLARK: &Aligned<[u8]> = &Aligned(*include_bytes!(concat!(
     env!("OUT_DIR"),
     "/catmull-clark.subtess"
 )));
 
+#[cfg(feature = "catmull-clark")]
 static CATMULL_CLARK_CORNERS: &Aligned<[u8]> = &Aligned(*include_bytes!(concat!(
     env!("OUT_DIR"),
     "/catmull-clark-corners.subtess"
 )));
 
+#[cfg(feature = "loop")]
 static LOOP: &Aligned<[u8]> = &Aligned(*include_bytes!(concat!(env!("OUT_DIR"), "/loop.subtess")));
 
+#[cfg(feature = "butterfly")]
 static BUTTERFLY: &Aligned<[u8]> = &Aligned(*include_bytes!(concat!(
     env!("OUT_DIR"),
     "/butterfly.subtess"
 )));
 
+#[cfg(feature = "sqrt3")]
 static SQRT3: &Aligned<[u8]> =
     &Aligned(*include_bytes!(concat!(env!("OUT_DIR"), "/sqrt3.subtess")));
 
-/// The default Catmull–Clark table's bytes (64-byte aligned).
+/// The default Catmull–Clark table's bytes (64-byte aligned). Feature `catmull-clark`.
+#[cfg(feature = "catmull-clark")]
 pub fn default_catmull_clark() -> &'static [u8] {
     &CATMULL_CLARK.0
 }
 
 /// The pinned-corner companion table's bytes (64-byte aligned): the one-face boundary vertex in
 /// "edge and corner" mode, n = 1..=24 (`stencilgen::table::TableSpec::default_corners`). Laid
-/// over the default table for meshes with `interpolateboundary 1`.
+/// over the default table for meshes with `interpolateboundary 1`. Feature `catmull-clark`.
+#[cfg(feature = "catmull-clark")]
 pub fn default_catmull_clark_corners() -> &'static [u8] {
     &CATMULL_CLARK_CORNERS.0
 }
@@ -55,6 +77,8 @@ pub fn default_catmull_clark_corners() -> &'static [u8] {
 /// the vertex masks), from which the runtime expands the triangle primal and dual grids
 /// (docs/table-format.md, "Compact Loop tables";
 /// `stencilgen::triangle_table::TriangleTableSpec::default_loop`; 163 KiB, 32.6 MiB as grids).
+/// Feature `loop`.
+#[cfg(feature = "loop")]
 pub fn default_loop() -> &'static [u8] {
     &LOOP.0
 }
@@ -64,7 +88,9 @@ pub fn default_loop() -> &'static [u8] {
 /// both derivatives, compact: per rate the regular basis on `1/3n` by its canonical values, per
 /// valence `A` and the masks at `V`, per region its tile rows, in f64, from which the runtime
 /// expands the triangle primal and dual grids (docs/table-format.md, "Compact region tables";
-/// `stencilgen::butterfly_table::ButterflyTableSpec::default_butterfly`; 3.2 MiB).
+/// `stencilgen::butterfly_table::ButterflyTableSpec::default_butterfly`; 3.2 MiB). Feature
+/// `butterfly`.
+#[cfg(feature = "butterfly")]
 pub fn default_butterfly() -> &'static [u8] {
     &BUTTERFLY.0
 }
@@ -72,22 +98,31 @@ pub fn default_butterfly() -> &'static [u8] {
 /// The default √3 table's bytes (64-byte aligned): the nine regions of interior vertices of
 /// valence 3..=8 (region 0 only at valence 6, the regular patch) of two √3 steps taken as one
 /// ternary step, n = 1..=24, positions and both derivatives, compact as the butterfly's
-/// (`stencilgen::sqrt3_table::default_sqrt3_table`; 2.6 MiB).
+/// (`stencilgen::sqrt3_table::default_sqrt3_table`; 2.6 MiB). Feature `sqrt3`.
+#[cfg(feature = "sqrt3")]
 pub fn default_sqrt3() -> &'static [u8] {
     &SQRT3.0
 }
 
 #[cfg(test)]
 mod tests {
-    /// Every embedded table.
-    fn all() -> [&'static [u8]; 5] {
-        [
+    /// Every embedded table (those of the enabled features), pushed feature by feature: nothing
+    /// without any feature, one push with only `loop`, `butterfly` or `sqrt3`.
+    #[allow(unused_mut, clippy::vec_init_then_push)]
+    fn all() -> Vec<&'static [u8]> {
+        let mut all = Vec::new();
+        #[cfg(feature = "catmull-clark")]
+        all.extend([
             super::default_catmull_clark(),
             super::default_catmull_clark_corners(),
-            super::default_loop(),
-            super::default_butterfly(),
-            super::default_sqrt3(),
-        ]
+        ]);
+        #[cfg(feature = "loop")]
+        all.push(super::default_loop());
+        #[cfg(feature = "butterfly")]
+        all.push(super::default_butterfly());
+        #[cfg(feature = "sqrt3")]
+        all.push(super::default_sqrt3());
+        all
     }
 
     #[test]

@@ -47,6 +47,23 @@ impl Scheme {
         self.table_scheme().name()
     }
 
+    /// The cargo feature of `subtess` that embeds the scheme's default table: the catalogue
+    /// name ([`Scheme::name`]).
+    pub fn cargo_feature(self) -> &'static str {
+        self.name()
+    }
+
+    /// Whether this build embeds the scheme's default table (its cargo feature is enabled);
+    /// without it [`Scheme::default_table`] returns [`RuntimeError::NotEmbedded`].
+    pub fn is_embedded(self) -> bool {
+        match self {
+            Scheme::CatmullClark => cfg!(feature = "catmull-clark"),
+            Scheme::Loop => cfg!(feature = "loop"),
+            Scheme::Butterfly => cfg!(feature = "butterfly"),
+            Scheme::Sqrt3 => cfg!(feature = "sqrt3"),
+        }
+    }
+
     /// Whether the scheme subdivides triangles (the triangle dual grid tessellates it).
     pub fn is_triangle(self) -> bool {
         self != Scheme::CatmullClark
@@ -63,7 +80,8 @@ impl Scheme {
     }
 
     /// The embedded default table for a mesh with boundary rule `boundary` (Catmull–Clark has
-    /// a pinned-corner companion for "edge and corner").
+    /// a pinned-corner companion for "edge and corner"); [`RuntimeError::NotEmbedded`] when
+    /// this build does not embed it ([`Scheme::is_embedded`]).
     pub fn default_table(
         self,
         boundary: schemes::BoundaryMode,
@@ -133,5 +151,59 @@ impl FromStr for Scheme {
             name: format!("scheme `{name}`"),
             reason: "not a scheme; catmull-clark, loop, butterfly or sqrt3".to_owned(),
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every scheme's cargo feature is declared in this crate's manifest, forwards to the
+    /// tables crate's feature of the same name, and is among the defaults.
+    #[test]
+    fn every_scheme_has_its_cargo_feature() {
+        let manifest = include_str!("../../Cargo.toml");
+        let default = manifest
+            .lines()
+            .find(|line| line.starts_with("default = ["))
+            .expect("a default feature list");
+        for scheme in Scheme::ALL {
+            let feature = scheme.cargo_feature();
+            let forward = format!("\n{feature} = [\"subtess-tables/{feature}\"]\n");
+            assert!(manifest.contains(&forward), "no feature line {forward:?}");
+            assert!(default.contains(&format!("\"{feature}\"")), "{default}");
+        }
+    }
+
+    /// A scheme's default table loads exactly when its feature is on (true of any feature
+    /// set; all four by default); otherwise the error names the scheme and the feature.
+    #[test]
+    fn default_tables_follow_the_features() {
+        for scheme in Scheme::ALL {
+            match scheme.default_table(schemes::BoundaryMode::EdgeAndCorner) {
+                Ok(table) => {
+                    assert!(scheme.is_embedded(), "{scheme}");
+                    assert_eq!(table.index().meta.scheme, scheme.table_scheme());
+                }
+                Err(RuntimeError::NotEmbedded { scheme: missing }) => {
+                    assert!(!scheme.is_embedded(), "{scheme}");
+                    assert_eq!(missing, scheme);
+                }
+                Err(e) => panic!("{scheme}: {e}"),
+            }
+        }
+    }
+
+    /// The message a build without a scheme's table gives (the CLI prints it as is).
+    #[test]
+    fn a_missing_table_names_its_feature() {
+        let message = |scheme| RuntimeError::NotEmbedded { scheme }.to_string();
+        assert_eq!(
+            message(Scheme::Loop),
+            "the loop table is not embedded in this build: enable subtess's cargo feature \
+             `loop`, or give a table file (the CLI's --table FILE)"
+        );
+        assert!(message(Scheme::CatmullClark).contains("cargo feature `catmull-clark`"));
+        assert!(message(Scheme::Sqrt3).starts_with("the sqrt3 table is not embedded"));
     }
 }

@@ -237,27 +237,50 @@ pub struct StencilTable {
     corners: Option<Box<StencilTable>>,
 }
 
+/// The bytes of an embedded table, `tables::$function()`, when `subtess`'s cargo feature
+/// `$feature` embeds it; else [`RuntimeError::NotEmbedded`] naming the scheme (whose
+/// [`crate::Scheme::cargo_feature`] is `$feature`).
+macro_rules! embedded_bytes {
+    ($feature:literal, $scheme:ident, $function:ident) => {{
+        #[cfg(feature = $feature)]
+        let bytes: Result<&'static [u8], RuntimeError> = Ok(tables::$function());
+        #[cfg(not(feature = $feature))]
+        let bytes: Result<&'static [u8], RuntimeError> = Err(RuntimeError::NotEmbedded {
+            scheme: crate::Scheme::$scheme,
+        });
+        bytes
+    }};
+}
+
 impl StencilTable {
-    /// The embedded default Catmull–Clark table (validated: its checksum is verified too).
+    /// The embedded default Catmull–Clark table (validated: its checksum is verified too);
+    /// [`RuntimeError::NotEmbedded`] without the cargo feature `catmull-clark`.
     pub fn default_catmull_clark() -> Result<Self, RuntimeError> {
-        Self::embedded(tables::default_catmull_clark())
+        Self::embedded(embedded_bytes!(
+            "catmull-clark",
+            CatmullClark,
+            default_catmull_clark
+        )?)
     }
 
-    /// The embedded default Loop table (Warren's weights; validated, checksum included).
+    /// The embedded default Loop table (Warren's weights; validated, checksum included);
+    /// [`RuntimeError::NotEmbedded`] without the cargo feature `loop`.
     pub fn default_loop() -> Result<Self, RuntimeError> {
-        Self::embedded(tables::default_loop())
+        Self::embedded(embedded_bytes!("loop", Loop, default_loop)?)
     }
 
     /// The embedded default butterfly table (the modified butterfly's regions around interior
-    /// vertices of valence 3..=8; validated, checksum included).
+    /// vertices of valence 3..=8; validated, checksum included); [`RuntimeError::NotEmbedded`]
+    /// without the cargo feature `butterfly`.
     pub fn default_butterfly() -> Result<Self, RuntimeError> {
-        Self::embedded(tables::default_butterfly())
+        Self::embedded(embedded_bytes!("butterfly", Butterfly, default_butterfly)?)
     }
 
     /// The embedded default √3 table (the regions of two √3 steps taken as one ternary step,
-    /// around interior vertices of valence 3..=8; validated, checksum included).
+    /// around interior vertices of valence 3..=8; validated, checksum included);
+    /// [`RuntimeError::NotEmbedded`] without the cargo feature `sqrt3`.
     pub fn default_sqrt3() -> Result<Self, RuntimeError> {
-        Self::embedded(tables::default_sqrt3())
+        Self::embedded(embedded_bytes!("sqrt3", Sqrt3, default_sqrt3)?)
     }
 
     fn embedded(bytes: &'static [u8]) -> Result<Self, RuntimeError> {
@@ -281,12 +304,15 @@ impl StencilTable {
 
     /// The embedded default table for a mesh's boundary rule: for "edge and corner" meshes, the
     /// default table with the embedded pinned-corner table laid over it.
+    /// [`RuntimeError::NotEmbedded`] without the cargo feature `catmull-clark`.
     pub fn default_for(mode: schemes::BoundaryMode) -> Result<Self, RuntimeError> {
         let mut table = Self::default_catmull_clark()?;
         if mode == schemes::BoundaryMode::EdgeAndCorner {
-            table.corners = Some(Box::new(Self::embedded(
-                tables::default_catmull_clark_corners(),
-            )?));
+            table.corners = Some(Box::new(Self::embedded(embedded_bytes!(
+                "catmull-clark",
+                CatmullClark,
+                default_catmull_clark_corners
+            )?)?));
         }
         Ok(table)
     }
