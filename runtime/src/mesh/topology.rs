@@ -462,6 +462,23 @@ impl Mesh {
         }
     }
 
+    /// Whether vertex `v` is the tip of a cone: pinned (infinitely sharp: a `corner` tag, a
+    /// non-manifold vertex's copy), with at least three faces around it and no [`Mesh::cut`]
+    /// (boundary, hole, infinitely sharp edge) reaching it. Its limit point is the vertex
+    /// itself, where the surface has no tangent plane (a normal there is a choice: those of
+    /// points approaching it converge like `e^0.07`, docs/results.md). The corner points of the
+    /// faces around would cut the tip off by a distance of the order of the sampling step, not
+    /// its square as at a smooth vertex, so the tessellators close the fan around the limit
+    /// point, as a wheel. A pinned vertex of two faces has no polygon to close (the strips across
+    /// its two edges meet).
+    pub fn is_cone_tip(&self, v: usize) -> bool {
+        if !is_infinite(self.vertex_sharpness[v]) {
+            return false;
+        }
+        let fan = self.fan(v);
+        fan.len() >= 3 && fan.iter().all(|&h| self.cut(h, false) == Cut::None)
+    }
+
     /// Whether vertex `v` is on the boundary.
     pub fn is_boundary_vertex(&self, v: usize) -> bool {
         let h = self.vertex_halfedge[v];
@@ -775,6 +792,34 @@ pub fn split_fans(faces: &mut [Vec<i64>], origin: &mut Vec<u32>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A cone's tip: pinned, three faces or more, no cut around it. A sharp edge, a hole or the
+    /// boundary at the vertex, or a vertex sharpness short of infinite, makes it none.
+    #[test]
+    fn a_cone_tip_is_a_pinned_vertex_no_cut_reaches() {
+        let octahedron = crate::mesh::test_meshes::octahedron;
+        let mut m = octahedron();
+        assert!(!m.is_cone_tip(4));
+        m.set_vertex_sharpness(4, 9.5).expect("a vertex");
+        assert!(!m.is_cone_tip(4), "semi-sharp: smooth in the limit");
+        m.set_vertex_sharpness(4, INFINITE).expect("a vertex");
+        assert!(m.is_cone_tip(4));
+        assert!(!m.is_cone_tip(0), "not pinned");
+        let mut creased = m.clone();
+        creased.set_edge_sharpness(4, 0, INFINITE).expect("an edge");
+        assert!(!creased.is_cone_tip(4), "a sharp edge cuts the fan");
+        let mut holed = m.clone();
+        holed.holes[0] = true;
+        assert!(!holed.is_cone_tip(4), "a hole cuts the fan");
+        // The 2 x 2 grid without its last face: its middle vertex has three faces and the
+        // boundary.
+        let (p, mut f) = grid(2);
+        f.pop();
+        let mut open = Mesh::new(p, &f, &[], BoundaryMode::EdgeOnly).expect("an L of quads");
+        open.set_vertex_sharpness(4, INFINITE).expect("a vertex");
+        assert_eq!(open.fan(4).len(), 3);
+        assert!(!open.is_cone_tip(4), "the boundary cuts the fan");
+    }
 
     fn grid(n: i64) -> (Vec<[f64; 3]>, Vec<Vec<i64>>) {
         let positions = (0..=n)

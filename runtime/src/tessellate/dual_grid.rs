@@ -586,7 +586,10 @@ impl<'t> DualGrid<'t> {
             let start = (0..n)
                 .find(|&i| cut(i) == Cut::Sheet)
                 .or_else(|| (0..n).find(|&i| cut(i) == Cut::Sector));
-            let Some(start) = start else {
+            // A pinned vertex no cut reaches is a cone's tip: a wheel of corner points around
+            // its limit point, the one sector of a fan that closes on itself.
+            let wheel = start.is_none() && mesh.is_cone_tip(v);
+            let Some(start) = start.or(wheel.then_some(0)) else {
                 for &h in &fan {
                     let f = mesh.face_of[h] as usize;
                     let corner = self.corner_point(f, h - mesh.face_halfedges(f).start);
@@ -608,6 +611,9 @@ impl<'t> DualGrid<'t> {
                 let c = if k == n { Cut::Sheet } else { cut(i) };
                 if k == 0 || c != Cut::None {
                     if !polygon.is_empty() {
+                        if wheel {
+                            polygon.push(polygon[0]);
+                        }
                         self.connectivity.polygons.push(limit);
                         self.connectivity.polygons.append(&mut polygon);
                         self.connectivity

@@ -47,7 +47,8 @@
 //! the same refinement ([`limit_points`]), so `S_f` is the true surface there. `L_{f,n}` follows
 //! the tessellator's cuts: an infinitely sharp edge or a hole's side is a limit curve both
 //! sides' strips meet, as a boundary is, and a vertex the cuts reach closes each sector's
-//! polygon with its limit point. Hole faces take the smallest rate and no samples. One
+//! polygon with its limit point, as a pinned vertex that no cut reaches closes its whole fan (a
+//! cone's tip). Hole faces take the smallest rate and no samples. One
 //! heuristic remains: a face next to a semi-sharp feature whose patch the table has is measured
 //! on that patch, the surface without the feature (its exact limit needs as many levels of
 //! refinement as the sharpness everywhere on the face: 100 s of selection on `catmark_bishop`
@@ -1037,9 +1038,10 @@ fn semi_sharp(mesh: &Mesh, f: usize) -> bool {
 
 /// The faces around the corner at half-edge `h` whose corner points make its vertex polygon in
 /// the tessellator (dual_grid.rs), as their half-edges at the vertex in fan order, and whether
-/// the polygon closes on itself: the whole fan of a vertex no cut reaches ([`Mesh::cut`]); otherwise
-/// the sector between the cuts before and after `h`'s face, which the vertex's limit point
-/// closes.
+/// the polygon closes on itself: the whole fan of a smooth vertex no cut reaches ([`Mesh::cut`]);
+/// around a cone's tip ([`Mesh::is_cone_tip`]), the whole fan with its first face again, a wheel
+/// around the limit point; otherwise the sector between the cuts before and after `h`'s face,
+/// which the vertex's limit point closes.
 fn sector(mesh: &Mesh, h: usize) -> (Vec<usize>, bool) {
     let v = mesh.face_vertices[h] as usize;
     let fan = mesh.fan(v);
@@ -1049,6 +1051,12 @@ fn sector(mesh: &Mesh, h: usize) -> (Vec<usize>, bool) {
         return (vec![h], false);
     };
     if !(0..n).any(cut) {
+        if mesh.is_cone_tip(v) {
+            // The wheel around the limit point.
+            let mut wheel = fan;
+            wheel.push(wheel[0]);
+            return (wheel, false);
+        }
         return (fan, true);
     }
     let start = (0..n)

@@ -35,7 +35,10 @@
 //!   `(1, 1)` at the face centre; `Far::PtexIndices`, `Vtr::QuadRefinement`). Points with no
 //!   patch (holes) are counted, not evaluated. OpenSubdiv's normal is `du x dv` normalized;
 //!   where its two tangents are (nearly) parallel (`|du x dv| < 1e-2 |du| |dv|`) the normal is
-//!   not compared and the point is counted (see *smooth corners* below).
+//!   not compared and the point is counted (see *smooth corners* below); nor at a cone's tip
+//!   (`Mesh::is_cone_tip`: a pinned vertex on smooth edges, where the surface has no tangent
+//!   plane and the normals of points approaching it converge like `e^0.07`, so that each side's
+//!   normal there is a choice; its position is compared).
 //! * **Cross-check: `Bfr::Surface`** positions (approximation levels 10/10; control points
 //!   relative to the face's first vertex) in Bfr's own parameterization (a quad's `(u, v)`; an
 //!   n-gon's sub-face `k` is the tile `(k mod U, k div U)` of side 1 with `U = 2` for 3 and 4
@@ -289,6 +292,29 @@ struct Ours {
     positions: Vec<[f32; 3]>,
     normals: Vec<[f32; 3]>,
     sources: Vec<subtess::VertexSource>,
+    /// Whether each point is a cone's tip (`Mesh::is_cone_tip`), where neither side's normal
+    /// is the surface's: it has no tangent plane there.
+    cone_tips: Vec<bool>,
+}
+
+/// Whether `src` lies on a vertex of its face that is a cone's tip: a quad's four corners, an
+/// n-gon's sub-face `k` at `(0, 0)`, its corner `k`.
+fn at_cone_tip(mesh: &subtess::Mesh, src: &subtess::VertexSource) -> bool {
+    let face = mesh.face(src.face as usize);
+    let (u, v) = (src.u, src.v);
+    let d = src.denominator;
+    let corner = if face.len() == 4 {
+        match (u, v) {
+            (0, 0) => Some(0),
+            (x, 0) if x == d => Some(1),
+            (x, y) if x == d && y == d => Some(2),
+            (0, y) if y == d => Some(3),
+            _ => None,
+        }
+    } else {
+        ((u, v) == (0, 0)).then_some(usize::from(src.subface))
+    };
+    corner.is_some_and(|c| mesh.is_cone_tip(face[c] as usize))
 }
 
 fn subtess_side(path: &Path, shape: &Shape) -> Result<Ours, String> {
@@ -333,6 +359,11 @@ fn subtess_side(path: &Path, shape: &Shape) -> Result<Ours, String> {
     Ok(Ours {
         positions: frame.positions().to_vec(),
         normals: frame.normals().to_vec(),
+        cone_tips: frame
+            .sources()
+            .iter()
+            .map(|src| at_cone_tip(&mesh, src))
+            .collect(),
         sources: frame.sources().to_vec(),
     })
 }
@@ -762,6 +793,8 @@ struct Row {
     no_patch: usize,
     /// Points where OpenSubdiv's tangents are (nearly) parallel: normal not compared.
     osd_parallel: usize,
+    /// Points at cone tips (no tangent plane): normal not compared.
+    cone_tips: usize,
     /// Points where subtess's normal is zero but OpenSubdiv's is not.
     ours_zero: usize,
     /// Where the worst position and normal are: `face/sub (u, v)`.
@@ -799,6 +832,12 @@ impl Row {
             notes.push(format!(
                 "{} pts OSD tangents parallel (normal skipped)",
                 self.osd_parallel
+            ));
+        }
+        if self.cone_tips > 0 {
+            notes.push(format!(
+                "{} pts at cone tips (normal undefined, skipped)",
+                self.cone_tips
             ));
         }
         if let Some(e) = &self.bfr_error {
@@ -920,6 +959,10 @@ fn compare(path: &Path) -> Row {
             row.position = row.position.max(e);
             row.worst_position_at = at(src);
             worst_position = Some(i);
+        }
+        if ours.cone_tips[i] {
+            row.cone_tips += 1;
+            continue;
         }
         let n = cross(du, dv);
         if norm(n) < PARALLEL_TANGENTS * norm(du) * norm(dv) || norm(n) == 0.0 {
