@@ -58,6 +58,39 @@ fn every_feature_tessellates_closed_and_a_hole_opens_one_loop() {
     }
 }
 
+/// A pinned vertex on smooth edges is a cone's tip: an output vertex at the vertex itself (the
+/// corner rule's limit), whose fan the tessellator closes as a wheel, and whose normal, though
+/// the surface has no tangent plane there, is the cone's axis: at a cube's corner, by the
+/// cube's symmetry about its diagonal, the diagonal (before, one face's corner normal:
+/// `(-1, -1, 5)/sqrt(27)` at rate 1, 1.23 rad off it). Every rate, a closed manifold.
+#[test]
+fn a_cone_tip_is_an_output_vertex_with_the_cones_axis_as_normal() {
+    let mut mesh = crate::common::cube();
+    let tip = 7;
+    mesh.set_vertex_sharpness(tip, schemes::crease::INFINITE)
+        .expect("a vertex");
+    let corner = mesh.positions[tip];
+    let axis = corner.map(|c| c / 3f64.sqrt());
+    let surface = Surface::new(&mesh, Scheme::CatmullClark).expect("a surface");
+    for n in [1, 2, 5, 8] {
+        let mut tessellator = surface.tessellator(&Rates::Uniform(n)).expect("a plan");
+        let frame = tessellator
+            .evaluate(&mesh.positions_f32())
+            .expect("a frame");
+        assert_eq!(manifold_boundary_loops(&frame), 0, "rate {n}");
+        let at_tip: Vec<usize> = (0..frame.positions().len())
+            .filter(|&i| {
+                let p = frame.positions()[i];
+                (0..3).all(|c| (f64::from(p[c]) - corner[c]).abs() < 1e-6)
+            })
+            .collect();
+        assert_eq!(at_tip.len(), 1, "rate {n}: one output vertex at the tip");
+        let normal = frame.normals()[at_tip[0]];
+        let cos: f64 = (0..3).map(|c| f64::from(normal[c]) * axis[c]).sum();
+        assert!(cos > 1.0 - 1e-6, "rate {n}: normal {normal:?}, cos {cos}");
+    }
+}
+
 /// An infinitely sharp crease separates the surface: the top face, ringed by the crease
 /// loop, depends on its own four vertices only, all at z = 1, so its whole tessellation lies in
 /// that plane; moving every other vertex leaves it in place, and nothing rises above it.

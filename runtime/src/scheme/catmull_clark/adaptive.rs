@@ -228,6 +228,45 @@ fn with_position(position: &[(u32, i64, i64)], tangents: Vec<(u32, [f64; 2])>) -
     }
 }
 
+/// The fan of vertex `v` rotated to start at its half-edge `h`: the edge neighbours `E_i` and the
+/// faces' opposite vertices `F_i`, in fan order (`None` if `h` does not leave `v`).
+fn fan_rings(mesh: &Mesh, v: usize, h: usize) -> Option<(Vec<u32>, Vec<u32>)> {
+    let fan = mesh.fan(v);
+    let n = fan.len();
+    let j = fan.iter().position(|&e| e == h)?;
+    let ring = (0..n).map(|i| mesh.head(fan[(j + i) % n])).collect();
+    let opposite = (0..n)
+        .map(|i| mesh.head(mesh.next(fan[(j + i) % n])))
+        .collect();
+    Some((ring, opposite))
+}
+
+/// OpenSubdiv's smooth tangent masks at an interior vertex of valence `n` (`Sdc`'s Catmull–Clark
+/// limit tangents, after Halstead et al.): `t_1 = sum_i 4 cos(i theta) E_i + (cos(i theta) +
+/// cos((i + 1) theta)) / (4 lambda - 1) F_i`, `theta = 2 pi / n`, `lambda` the subdominant
+/// eigenvalue, and `t_2` the same turned back by one edge, so that `t_1 x t_2` follows the
+/// face's orientation; `(vertex, [t_1, t_2])` terms over `ring` (`E_i`) and `opposite` (`F_i`).
+fn smooth_tangents(ring: &[u32], opposite: &[u32]) -> Vec<(u32, [f64; 2])> {
+    let n = ring.len();
+    let k = n as f64;
+    let theta = 2.0 * std::f64::consts::PI / k;
+    let lambda = 5.0 / 16.0
+        + (theta.cos() + (theta / 2.0).cos() * (2.0 * (9.0 + theta.cos())).sqrt()) / 16.0;
+    let face_scale = 1.0 / (4.0 * lambda - 1.0);
+    let tangent = |i: usize| {
+        let (c0, c1) = ((i as f64 * theta).cos(), ((i + 1) as f64 * theta).cos());
+        (4.0 * c0, face_scale * (c0 + c1))
+    };
+    let mut tangents = Vec::with_capacity(2 * n);
+    for i in 0..n {
+        let (e1, f1) = tangent(i);
+        let (e2, f2) = tangent((i + n - 1) % n);
+        tangents.push((ring[i], [e1, e2]));
+        tangents.push((opposite[i], [f1, f2]));
+    }
+    tangents
+}
+
 /// The limit position and tangents at vertex `v`, the corner of face `g` at half-edge `h`, by
 /// OpenSubdiv's limit masks, where they are exact: a settled crease vertex (the sector of `g`
 /// between its two sharp edges) or a corner. `None` elsewhere (smooth vertices are reached by
@@ -242,6 +281,17 @@ pub(crate) fn vertex_limit(mesh: &Mesh, h: usize) -> Option<VertexLimit> {
     let rule = CreaseRule::of(mesh.vertex_sharpness[v], &sharpness);
     let me = v as u32;
     match rule {
+        CreaseRule::Corner if mesh.is_cone_tip(v) => {
+            // A cone's tip has no tangent plane, so its normal is a choice: the smooth masks'
+            // tangents (rotation-invariant combinations of the ring), whose normal is the same
+            // from every face and, by symmetry, the cone's axis where it has one (the diagonal
+            // at a cube's corner), rather than one face's corner normal.
+            let (ring, opposite) = fan_rings(mesh, v, h)?;
+            Some(with_position(
+                &[(me, 1, 1)],
+                smooth_tangents(&ring, &opposite),
+            ))
+        }
         CreaseRule::Corner => {
             // Tangents along the face's own edges at v: the normal of its corner.
             let (out, into) = (mesh.head(h), mesh.face_vertices[mesh.prev(h)]);
@@ -336,10 +386,7 @@ pub(crate) fn vertex_limit(mesh: &Mesh, h: usize) -> Option<VertexLimit> {
             let fan = mesh.fan(v);
             let n = fan.len();
             let j = fan.iter().position(|&e| e == h)?;
-            let ring: Vec<u32> = (0..n).map(|i| mesh.head(fan[(j + i) % n])).collect();
-            let opposite: Vec<u32> = (0..n)
-                .map(|i| mesh.head(mesh.next(fan[(j + i) % n])))
-                .collect();
+            let (ring, opposite) = fan_rings(mesh, v, h)?;
             let nn = i64::try_from(n).ok()?;
             let face = nn.checked_mul(nn.checked_add(5)?)?;
             let mut position = vec![(me, nn, nn + 5)];
@@ -363,26 +410,11 @@ pub(crate) fn vertex_limit(mesh: &Mesh, h: usize) -> Option<VertexLimit> {
                     ],
                 ));
             }
-            let mut tangents = Vec::with_capacity(2 * n);
-            let k = n as f64;
-            let theta = 2.0 * std::f64::consts::PI / k;
-            let lambda = 5.0 / 16.0
-                + (theta.cos() + (theta / 2.0).cos() * (2.0 * (9.0 + theta.cos())).sqrt()) / 16.0;
-            let face_scale = 1.0 / (4.0 * lambda - 1.0);
-            let tangent = |i: usize| {
-                let (c0, c1) = ((i as f64 * theta).cos(), ((i + 1) as f64 * theta).cos());
-                (4.0 * c0, face_scale * (c0 + c1))
-            };
             for i in 0..n {
-                let (e1, f1) = tangent(i);
-                // The second tangent is the first turned by one edge.
-                let (e2, f2) = tangent((i + n - 1) % n);
                 position.push((ring[i], 4, face));
                 position.push((opposite[i], 1, face));
-                tangents.push((ring[i], [e1, e2]));
-                tangents.push((opposite[i], [f1, f2]));
             }
-            let limit = with_position(&position, tangents);
+            let limit = with_position(&position, smooth_tangents(&ring, &opposite));
             if rule == CreaseRule::Dart {
                 let sharp = (0..n).find(|&i| is_infinite(mesh.edge_sharpness[fan[(j + i) % n]]))?;
                 let shape = Stationary::Dart { n, sharp };
