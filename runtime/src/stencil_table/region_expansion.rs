@@ -222,6 +222,20 @@ pub(super) struct RegionExpansion {
     geometry: Vec<(u32, OnceLock<Arc<ConeRegions>>)>,
     /// Per patch (the slots' order), its sparse tile rows (and `A`), read on first use.
     rows: Vec<OnceLock<SparseRows>>,
+    /// The expansion's working buffers, kept between grids (a thread that finds them taken
+    /// makes its own).
+    buffers: Mutex<Option<Box<Buffers>>>,
+}
+
+/// The working buffers of an expansion: 20 KiB, allocated and zeroed once per table rather
+/// than per grid.
+#[derive(Debug)]
+struct Buffers {
+    /// A stencil's weights per control point, and the corner's next ones.
+    row: Width,
+    scratch: Width,
+    /// The stencil rounded, per kind.
+    rounded: [[f32; MAX_REGION_WIDTH]; 3],
 }
 
 /// The regions of an interior vertex of valence `k` of the region scheme `name` (`butterfly`,
@@ -414,6 +428,7 @@ impl RegionExpansion {
             name,
             bases: (0..slots.rates.len()).map(|_| OnceLock::new()).collect(),
             rows: (0..slots.patches.len()).map(|_| OnceLock::new()).collect(),
+            buffers: Mutex::new(None),
             slots,
             geometry: valences,
         }))
@@ -472,7 +487,7 @@ impl RegionExpansion {
                     &self.rows[slot.patch],
                     basis,
                 )?
-                .grids(key.n)?;
+                .grids(key.n, &self.buffers)?;
                 let mut asked = None;
                 for (grids, kind) in [position, du, dv].into_iter().zip(KINDS) {
                     if kind == key.kind {
@@ -651,7 +666,11 @@ impl<'a> Region<'a> {
     }
 
     /// Both grids of the three kinds at rate `n` (module docs), rounded to f32.
-    fn grids(&self, n: u32) -> Result<[Grids; 3], RuntimeError> {
+    fn grids(
+        &self,
+        n: u32,
+        pool: &Mutex<Option<Box<Buffers>>>,
+    ) -> Result<[Grids; 3], RuntimeError> {
         if !(1..=MAX_COMPACT_RATE).contains(&n) {
             return Err(incomplete(format!(
                 "rate {n} is outside 1..={MAX_COMPACT_RATE}"
@@ -659,14 +678,32 @@ impl<'a> Region<'a> {
         }
         let n = i64::from(n);
         let k = self.k;
-        // Per control point, its weight of the three kinds.
-        let mut row: Box<Width> = Box::new([[0.0; 4]; MAX_REGION_WIDTH]);
-        let mut scratch: Box<Width> = Box::new([[0.0; 4]; MAX_REGION_WIDTH]);
+        // A panic while the lock was held leaves buffers whose contents are never read
+        // before being written.
+        let lock = || pool.lock().unwrap_or_else(|e| e.into_inner());
+        let taken = lock().take();
+        let mut buffers = taken.unwrap_or_else(|| {
+            Box::new(Buffers {
+                row: [[0.0; 4]; MAX_REGION_WIDTH],
+                scratch: [[0.0; 4]; MAX_REGION_WIDTH],
+                rounded: [[0.0; MAX_REGION_WIDTH]; 3],
+            })
+        });
+        let Buffers {
+            row,
+            scratch,
+            rounded,
+        } = &mut *buffers;
         let mut hint = 0;
+        // Point `p`'s stencils appended to each kind's grid.
         let mut eval = |p: (i64, i64), grids: &mut [Vec<f32>; 3]| -> Result<(), RuntimeError> {
-            self.stencil(p, &mut row, &mut scratch, &mut hint)?;
-            for (kind, grid) in grids.iter_mut().enumerate() {
-                grid.extend(row[..k].iter().map(|w| w[kind] as f32));
+            self.stencil(p, row, scratch, &mut hint)?;
+            let [r0, r1, r2] = rounded;
+            for (((w, a), b), c) in row[..k].iter().zip(&mut *r0).zip(&mut *r1).zip(&mut *r2) {
+                (*a, *b, *c) = (w[0] as f32, w[1] as f32, w[2] as f32);
+            }
+            for (grid, r) in grids.iter_mut().zip(&*rounded) {
+                grid.extend_from_slice(&r[..k]);
             }
             Ok(())
         };
@@ -689,6 +726,7 @@ impl<'a> Region<'a> {
                 }
             }
         }
+        *lock() = Some(buffers);
         let [p0, p1, p2] = primal.map(Vec::into_boxed_slice);
         let [d0, d1, d2] = dual.map(Vec::into_boxed_slice);
         Ok([[p0, d0], [p1, d1], [p2, d2]])
@@ -885,7 +923,10 @@ mod tests {
                 let stored = |v: &[f64]| v.iter().filter(|&&w| w != 0.0).count();
                 assert!(stored(psi) > 0 && stored(psi_1) > 0, "{name} at rate {n}");
                 assert!(nonzero[0] >= stored(psi), "{name} at rate {n}");
-                assert!(nonzero[1].min(nonzero[2]) >= stored(psi_1), "{name} at rate {n}");
+                assert!(
+                    nonzero[1].min(nonzero[2]) >= stored(psi_1),
+                    "{name} at rate {n}"
+                );
             }
         }
     }
