@@ -32,6 +32,13 @@
 //! from the same basis; they are rounded once to f32. Against the grid layout, whose basis is
 //! solved on each whole grid by the orbit solver, they agree to 1 ulp of f32
 //! (`runtime/tests/integration/compact_tables.rs`).
+//!
+//! A plan reads a region's three kinds at a rate together, so they are expanded together: one
+//! tile search and one basis lookup (`[psi, psi_1, psi_2]` from the basis spread once per rate
+//! on its support box) per tile point, one pass over its sparse row updating the three sums.
+//! Each kind's sums are still its own operations in its order: where a kind's weight is zero
+//! (`stencilgen` skips the point) the pass adds zero products, which leaves sums that start at
+//! `+0` unchanged bit for bit.
 
 use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex, OnceLock};
@@ -99,7 +106,8 @@ impl RateBasis {
                 y = rotate(y);
             }
         }
-        let images: [fn((i64, i64)) -> (i64, i64); 4] = [
+        type Map = fn((i64, i64)) -> (i64, i64);
+        let images: [Map; 4] = [
             |q| q,
             reflect,
             |q| (-q.0, -q.1),
