@@ -875,11 +875,12 @@ mod tests {
     /// and 24.
     #[test]
     fn the_spread_basis_is_the_canonical_lookups() {
-        for (name, bytes) in [
-            ("butterfly", tables::default_butterfly()),
-            ("sqrt3", tables::default_sqrt3()),
+        for (name, table) in [
+            ("butterfly", super::super::StencilTable::default_butterfly()),
+            ("sqrt3", super::super::StencilTable::default_sqrt3()),
         ] {
-            let index = TableIndex::parse(bytes).expect("embedded table");
+            let table = table.expect("embedded table");
+            let (bytes, index) = (table.bytes(), table.index());
             let scheme = TriangleScheme::by_name(name).expect("catalogued");
             let mask = scheme.regular_mask();
             let hull = mask.hull();
