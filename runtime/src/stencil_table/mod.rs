@@ -116,8 +116,9 @@ fn check_patch_pieces(
 struct GridSlots {
     /// Ascending.
     rates: Vec<u32>,
-    /// Per rate `n` up to the largest, its index in `rates` (`u32::MAX`: not covered): a plan
-    /// asks for a grid per face, so the lookup is one load, not a search.
+    /// Per rate `n` up to the largest, its index in `rates` (`u32::MAX`: not covered): one
+    /// load, not a search. At most [`MAX_COMPACT_RATE`] + 1 entries: every expansion refuses
+    /// a rate above it before making its slots.
     rate_index: Vec<u32>,
     /// Ascending, with their control-point counts `K`.
     patches: Vec<(PatchId, u32)>,
