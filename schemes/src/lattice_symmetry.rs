@@ -22,27 +22,32 @@
 //! change or a permutation of values, exact in any arithmetic.
 
 /// `rho`: the rotation by 60 degrees (`e_1 -> e_2`).
+#[inline]
 pub fn rotate(x: (i64, i64)) -> (i64, i64) {
     (-x.1, x.0 + x.1)
 }
 
 /// `rho^-1`: the rotation by -60 degrees (`e_2 -> e_1`).
+#[inline]
 pub fn rotate_back(x: (i64, i64)) -> (i64, i64) {
     (x.0 + x.1, -x.0)
 }
 
 /// `sigma`: the reflection in the `e_1` axis.
+#[inline]
 pub fn reflect(x: (i64, i64)) -> (i64, i64) {
     (x.0 + x.1, -x.1)
 }
 
 /// Whether `x` is in the wedge `W` (`0 <= x_2 <= x_1`).
+#[inline]
 pub fn in_wedge(x: (i64, i64)) -> bool {
     0 <= x.1 && x.1 <= x.0
 }
 
 /// Whether `x` is in the quarter `Q` (`x_2 > 0` and `2 x_1 + x_2 >= 0`, or `x_2 = 0` and
 /// `x_1 >= 0`).
+#[inline]
 pub fn in_quarter(x: (i64, i64)) -> bool {
     (x.1 > 0 && 2 * x.0 + x.1 >= 0) || (x.1 == 0 && x.0 >= 0)
 }
@@ -112,29 +117,61 @@ pub fn in_open_support(hull: &[(i64, i64)], dilation: u32, d: u32, k: (i64, i64)
     })
 }
 
-/// The numerators `k` of the grid `(1/d) Z^2` strictly inside the support and in the region
-/// `keep`, `k_2` outer, `k_1` inner, both ascending: the order a compact table stores values in.
+/// The numerators `k_1` of the row `k_2` of the grid `(1/d) Z^2` strictly inside the support
+/// ([`in_open_support`]), as the run `(first, last)`, `None` if there are none: each edge's
+/// test is linear in `k_1` along the row, `A k_1 + B > 0`, a bound on `k_1` (none and no point
+/// at all where `A = 0` and `B <= 0`).
+fn open_support_row(hull: &[(i64, i64)], dilation: u32, d: u32, k2: i64) -> Option<(i64, i64)> {
+    let (n, s) = (i64::from(d), i64::from(dilation) - 1);
+    let (mut first, mut last) = (i64::MIN, i64::MAX);
+    for e in 0..hull.len() {
+        let (a, b) = (hull[e], hull[(e + 1) % hull.len()]);
+        let (p, q) = (n * (b.0 - a.0), n * (b.1 - a.1));
+        // p (s k_2 - n a_2) - q (s k_1 - n a_1) > 0.
+        let (slope, rest) = (-q * s, p * (s * k2 - n * a.1) + q * n * a.0);
+        match slope.signum() {
+            // k_1 > -B/A.
+            1 => first = first.max((-rest).div_euclid(slope) + 1),
+            // k_1 < B/|A|.
+            -1 => last = last.min(-(-rest).div_euclid(-slope) - 1),
+            _ if rest <= 0 => return None,
+            _ => {}
+        }
+    }
+    (first <= last).then_some((first, last))
+}
+
+/// The numerators `k` of the grid `(1/d) Z^2` strictly inside the support whose `k_1` is at
+/// least `start(k_2)` (the wedge, the quarter: `None` for a row without such points), `k_2`
+/// outer, `k_1` inner, both ascending: the order a compact table stores values in.
 fn canonical(
     hull: &[(i64, i64)],
     dilation: u32,
     d: u32,
-    keep: fn((i64, i64)) -> bool,
+    start: fn(i64) -> Option<i64>,
 ) -> Vec<(i64, i64)> {
-    let ((l1, h1), (l2, h2)) = support_box(hull, dilation, d);
-    (l2..=h2)
-        .flat_map(|k2| (l1..=h1).map(move |k1| (k1, k2)))
-        .filter(|&k| keep(k) && in_open_support(hull, dilation, d, k))
-        .collect()
+    let ((_, _), (l2, h2)) = support_box(hull, dilation, d);
+    let mut points = Vec::new();
+    for k2 in l2..=h2 {
+        if let (Some(from), Some((first, last))) =
+            (start(k2), open_support_row(hull, dilation, d, k2))
+        {
+            points.extend((first.max(from)..=last).map(|k1| (k1, k2)));
+        }
+    }
+    points
 }
 
 /// The wedge points of the grid `1/d` inside the support, in storage order (`psi`).
 pub fn wedge_points(hull: &[(i64, i64)], dilation: u32, d: u32) -> Vec<(i64, i64)> {
-    canonical(hull, dilation, d, in_wedge)
+    // W: 0 <= k_2 <= k_1.
+    canonical(hull, dilation, d, |k2| (k2 >= 0).then_some(k2))
 }
 
 /// The quarter points of the grid `1/d` inside the support, in storage order (`psi_1`).
 pub fn quarter_points(hull: &[(i64, i64)], dilation: u32, d: u32) -> Vec<(i64, i64)> {
-    canonical(hull, dilation, d, in_quarter)
+    // Q: 2 k_1 + k_2 >= 0 where k_2 > 0, k_1 >= 0 where k_2 = 0.
+    canonical(hull, dilation, d, |k2| (k2 >= 0).then_some(-(k2 / 2)))
 }
 
 #[cfg(test)]
@@ -143,6 +180,37 @@ mod tests {
 
     /// Every point of a box has an image in `W` and in `Q`, reached by a symmetry (the image
     /// has the same hexagonal norm), and the images of a point's orbit agree.
+    /// The row runs of [`canonical`] are the filter over the whole support box, for both
+    /// region schemes' hulls at every grid `1/3n` of the tables' rates and the odd grids
+    /// between.
+    #[test]
+    fn canonical_points_are_the_box_filtered() {
+        for name in ["butterfly", "sqrt3"] {
+            let mask = crate::TriangleScheme::by_name(name)
+                .expect("catalogued")
+                .regular_mask();
+            let hull = mask.hull();
+            for d in 1..=72 {
+                let ((l1, h1), (l2, h2)) = support_box(&hull, mask.dilation, d);
+                let all: Vec<(i64, i64)> = (l2..=h2)
+                    .flat_map(|k2| (l1..=h1).map(move |k1| (k1, k2)))
+                    .filter(|&k| in_open_support(&hull, mask.dilation, d, k))
+                    .collect();
+                for (keep, fast) in [
+                    (
+                        in_wedge as fn((i64, i64)) -> bool,
+                        wedge_points(&hull, mask.dilation, d),
+                    ),
+                    (in_quarter, quarter_points(&hull, mask.dilation, d)),
+                ] {
+                    let want: Vec<_> = all.iter().copied().filter(|&k| keep(k)).collect();
+                    assert!(!want.is_empty(), "{name} at 1/{d}");
+                    assert_eq!(fast, want, "{name} at 1/{d}");
+                }
+            }
+        }
+    }
+
     #[test]
     fn every_point_has_its_canonical_images() {
         // The hexagonal norm squared: |x_1 e_1 + x_2 e_2|^2 = x_1^2 + x_1 x_2 + x_2^2.

@@ -29,6 +29,15 @@ struct PatchId {
 }
 
 impl PatchId {
+    /// The id as one integer, ordered as the ids are (the fields' order: `boundary`,
+    /// `feature`, `faces`, `sector`).
+    fn packed(self) -> u128 {
+        (u128::from(self.boundary) << 72)
+            | (u128::from(self.feature as u8) << 64)
+            | (u128::from(self.faces) << 32)
+            | u128::from(self.sector)
+    }
+
     /// The patch a section belongs to.
     fn of(key: &SectionKey) -> Self {
         PatchId {
@@ -107,14 +116,22 @@ fn check_patch_pieces(
 struct GridSlots {
     /// Ascending.
     rates: Vec<u32>,
+    /// Per rate `n` up to the largest, its index in `rates` (`u32::MAX`: not covered): one
+    /// load, not a search. At most [`MAX_COMPACT_RATE`] + 1 entries: every expansion refuses
+    /// a rate above it before making its slots.
+    rate_index: Vec<u32>,
     /// Ascending, with their control-point counts `K`.
     patches: Vec<(PatchId, u32)>,
+    /// The patches' ids packed into one integer each ([`PatchId::packed`]), ascending too.
+    packed: Vec<u128>,
     /// `(patch * rates + rate) * 3 + kind`.
     grids: Vec<OnceLock<Grids>>,
 }
 
 /// Where a key's grids go in [`GridSlots`].
 struct Slot<'s> {
+    /// The patch's index among the covered patches.
+    patch: usize,
     /// The rate's index among the covered rates.
     rate: usize,
     /// The patch's `K`.
@@ -128,8 +145,14 @@ impl GridSlots {
         rates.sort_unstable();
         patches.sort_unstable();
         let slots = patches.len() * rates.len() * 3;
+        let mut rate_index = vec![u32::MAX; rates.last().map_or(0, |&n| n as usize + 1)];
+        for (i, &n) in rates.iter().enumerate() {
+            rate_index[n as usize] = i as u32;
+        }
         GridSlots {
+            packed: patches.iter().map(|p| p.0.packed()).collect(),
             rates,
+            rate_index,
             patches,
             grids: (0..slots).map(|_| OnceLock::new()).collect(),
         }
@@ -137,12 +160,13 @@ impl GridSlots {
 
     /// The slot of `key`'s patch, rate and kind, `None` if the table does not cover them.
     fn slot(&self, key: &SectionKey) -> Option<Slot<'_>> {
-        let patch = self
-            .patches
-            .binary_search_by_key(&PatchId::of(key), |p| p.0)
-            .ok()?;
-        let rate = self.rates.binary_search(&key.n).ok()?;
+        let patch = self.packed.binary_search(&PatchId::of(key).packed()).ok()?;
+        let rate = match self.rate_index.get(key.n as usize) {
+            Some(&i) if i != u32::MAX => i as usize,
+            _ => return None,
+        };
         Some(Slot {
+            patch,
             rate,
             k: self.patches[patch].1 as usize,
             grids: &self.grids[(patch * self.rates.len() + rate) * 3 + key.kind as usize],
@@ -234,6 +258,9 @@ pub struct StencilTable {
     index: TableIndex,
     /// The grids of a compact table, expanded on first use.
     expansion: Option<Expansion>,
+    /// Whether the index holds any grid section (a compact table usually holds none: then a
+    /// grid request goes to the expansion without a lookup in the index first).
+    stores_grids: bool,
     corners: Option<Box<StencilTable>>,
 }
 
@@ -296,6 +323,7 @@ impl StencilTable {
         }
         Ok(StencilTable {
             expansion: Expansion::new(&index)?,
+            stores_grids: index.entries.iter().any(|e| e.key.points.is_grid()),
             storage,
             index,
             corners: None,
@@ -379,15 +407,20 @@ impl StencilTable {
             return corners.weights(key);
         }
         match &self.expansion {
-            Some(expansion) if self.index.get(key).is_none() => expansion
-                .grid(&self.index, self.bytes(), key)
-                .unwrap_or_else(|| {
-                    Err(table_format::TableError::MissingSection {
-                        key: *key,
-                        coverage: self.index.coverage(),
-                    }
-                    .into())
-                }),
+            Some(expansion)
+                if (key.points.is_grid() && !self.stores_grids)
+                    || self.index.get(key).is_none() =>
+            {
+                expansion
+                    .grid(&self.index, self.bytes(), key)
+                    .unwrap_or_else(|| {
+                        Err(table_format::TableError::MissingSection {
+                            key: *key,
+                            coverage: self.index.coverage(),
+                        }
+                        .into())
+                    })
+            }
             _ => Ok(self.index.weights_f32(self.bytes(), key)?),
         }
     }

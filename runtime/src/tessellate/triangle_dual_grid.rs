@@ -342,21 +342,29 @@ impl TriangleDualGrid {
                     patch.kind.faces
                 )));
             }
-            // A valence beyond the table's is refused here, by the table naming its coverage.
-            let dual = stencils(table, patch, PointSet::TriangleDual, n)?;
-            let primal = stencils(table, patch, PointSet::TrianglePrimal, n)?;
-            let quartic = is_loop_regular(patch)
-                && n >= MIN_QUARTIC_RATE
-                && grid.reproduces(&dual, &primal, n);
             let k = patch.points.len();
             let key = (
                 section(patch, StencilKind::Position, PointSet::TriangleDual, n),
                 patch.corner as u8,
                 k,
             );
-            let lanes = match layouts.get(&key) {
-                Some(&lanes) => lanes,
+            let (lanes, quartic) = match layouts.get(&key) {
+                // The section, corner and size of an earlier face: its stencils were read and
+                // checked then, and whether the quartic reproduces them is known for the rate.
+                Some(&lanes) => (
+                    lanes,
+                    is_loop_regular(patch)
+                        && n >= MIN_QUARTIC_RATE
+                        && grid.quartic_rates[n as usize] == Some(true),
+                ),
                 None => {
+                    // A valence beyond the table's is refused here, by the table naming its
+                    // coverage.
+                    let dual = stencils(table, patch, PointSet::TriangleDual, n)?;
+                    let primal = stencils(table, patch, PointSet::TrianglePrimal, n)?;
+                    let quartic = is_loop_regular(patch)
+                        && n >= MIN_QUARTIC_RATE
+                        && grid.reproduces(&dual, &primal, n);
                     let map = &maps[n as usize]
                         .get_or_insert_with(|| [0, 1, 2].map(|corner| point_map(n, corner)))
                         [patch.corner % 3];
@@ -373,7 +381,7 @@ impl TriangleDualGrid {
                     let index = grid.lanes.len() as u32;
                     grid.lanes.push(lanes);
                     layouts.insert(key, index);
-                    index
+                    (index, quartic)
                 }
             };
             let start = grid.control.len() as u32;
