@@ -321,6 +321,12 @@ struct TessellateArgs {
     /// (docs/reliability.md: 200 million, about 16 GB, by default).
     #[arg(long, default_value_t = subtess::DEFAULT_MAX_TRIANGLES, value_parser = clap::value_parser!(u64).range(1..))]
     max_triangles: u64,
+    /// Adaptive: the deepest midpoint subdivision of a face's square (1..=24). A square still
+    /// over the tolerance there is kept with its bound, counted in `--stats`'
+    /// `leaves_over_tolerance`, and warned about (cone tips need about log T / log 0.654
+    /// levels: docs/lai-cheng.md).
+    #[arg(long, default_value_t = AdaptiveOptions::default().max_depth, value_parser = clap::value_parser!(u32).range(1..=i64::from(subtess::tessellate::lai_cheng::MAX_DEPTH)))]
+    max_depth: u32,
     /// Adaptive: fail when meeting the tolerance needs more than N polygons (docs/reliability.md:
     /// 20 million, about 15 GB, by default).
     #[arg(long, default_value_t = subtess::tessellate::lai_cheng::DEFAULT_MAX_POLYGONS as u64, value_parser = clap::value_parser!(u64).range(1..))]
@@ -564,9 +570,16 @@ fn adaptive_command(args: &TessellateArgs, surface: &Surface) -> Result<(), Runt
         relative: args.relative,
         triangulate: args.triangulate,
         max_polygons: usize::try_from(args.max_polygons).unwrap_or(usize::MAX),
+        max_depth: args.max_depth,
         ..AdaptiveOptions::default()
     };
     let (adaptive, stats) = surface.tessellate_adaptive(&options)?;
+    if stats.leaves_over_tolerance > 0 {
+        eprintln!(
+            "warning: {} squares do not meet the tolerance {tolerance} at depth {} (--max-depth);              they are kept with their bounds",
+            stats.leaves_over_tolerance, args.max_depth
+        );
+    }
     if MeshFormat::from_path(&args.output)? == MeshFormat::Obj && !args.triangulate {
         write_obj_polygons(&adaptive, &args.output)?;
     } else {

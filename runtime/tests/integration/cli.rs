@@ -393,6 +393,40 @@ fn adaptive_method_from_the_command_line() {
     let _ = std::fs::remove_file(obj);
 }
 
+/// `--max-depth`: the pinned corner of `cube_creased.obj` is a cone's tip, where the bound
+/// shrinks by 0.654 a level (docs/lai-cheng.md): `T = 1e-3` needs more than the default 16
+/// levels there, so squares stay over it, and stderr says how many; at 18 none does. Beyond
+/// the parameter grid's 24 levels, or 0, is a usage error.
+#[test]
+fn adaptive_max_depth_and_the_squares_left_over() {
+    let ply = temp("cone.ply");
+    let base = format!(
+        "tessellate data/cube_creased.obj -o {} --method adaptive --tolerance 1e-3 --stats",
+        ply.display()
+    );
+    let out = succeeds(&base);
+    let over = json(&out)["leaves_over_tolerance"]
+        .as_u64()
+        .expect("a count");
+    assert!(over > 0, "the cone's tip at depth 16");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains(&format!(
+            "warning: {over} squares do not meet the tolerance 0.001 at depth 16"
+        )),
+        "{stderr}"
+    );
+    let out = succeeds(&format!("{base} --max-depth 18"));
+    assert_eq!(json(&out)["leaves_over_tolerance"], 0);
+    assert_eq!(json(&out)["max_depth"], 18);
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("warning"));
+    for depth in [0, 25] {
+        let stderr = fails(&format!("{base} --max-depth {depth}"));
+        assert!(stderr.contains("--max-depth"), "{stderr}");
+    }
+    let _ = std::fs::remove_file(ply);
+}
+
 /// A regular octahedron (every vertex valence 4: one Loop step isolates it).
 const OCTAHEDRON: &str = "v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\n\
 f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n";
