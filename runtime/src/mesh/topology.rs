@@ -302,25 +302,48 @@ impl Mesh {
         interior_sharp || sharp_vertex || self.holes.iter().any(|&h| h)
     }
 
-    /// OpenSubdiv's "no boundary interpolation" (`interpolateboundary 0`): every face at a
-    /// boundary vertex with a boundary edge that is not infinitely sharp by a tag becomes a
-    /// hole (`sharp_boundary`: the edges so tagged, as sorted vertex pairs).
+    /// OpenSubdiv's "no boundary interpolation" (`interpolateboundary 0`): every face at an
+    /// input vertex with a boundary edge that is not infinitely sharp by a tag becomes a hole
+    /// (`sharp_boundary`: the edges so tagged, as sorted input vertex pairs).
+    ///
+    /// The test is on the input's topology, as `Far::TopologyRefinerFactory` makes it before
+    /// any sharpening: an edge is on the boundary when one face uses it, and a vertex with
+    /// such an edge loses every face around it, all its copies' ([`Mesh::copies`]) included.
+    /// A doubled corner's degenerate edge (from a vertex to itself) is such an edge, as many
+    /// faces as double the vertex (`catmark_nonman_quadpole8` under mode 0 has no surface).
+    /// The edges a non-manifold split leaves with one face each on the split mesh (an edge
+    /// of three or more faces) are not boundary edges there, and a non-manifold vertex with a
+    /// true boundary edge loses its closed fans too (`catmark_val2_nonman` under
+    /// `interpolateboundary 0` has no surface at all in OpenSubdiv).
     pub fn exclude_boundary_faces(&mut self, sharp_boundary: &[(usize, usize)]) {
         let mut sharp_boundary = sharp_boundary.to_vec();
         sharp_boundary.sort_unstable();
-        for v in 0..self.positions.len() {
-            if !self.is_boundary_vertex(v) {
-                continue;
+        let mut edges: Vec<(usize, usize)> = (0..self.faces())
+            .flat_map(|f| {
+                let corners = self.face(f);
+                (0..corners.len()).map(move |k| (corners[k], corners[(k + 1) % corners.len()]))
+            })
+            .map(|(a, b)| (self.origin(a as usize), self.origin(b as usize)))
+            .map(|(a, b)| (a.min(b), a.max(b)))
+            .collect();
+        edges.sort_unstable();
+        let mut excluded = vec![false; self.input_vertices()];
+        for run in edges.chunk_by(|x, y| x == y) {
+            let edge = run[0];
+            // Vtr gives each degenerate edge of a face its own edge, whatever the faces.
+            let one_face = run.len() == 1 || edge.0 == edge.1;
+            if one_face && sharp_boundary.binary_search(&edge).is_err() {
+                excluded[edge.0] = true;
+                excluded[edge.1] = true;
             }
-            let edges = self.vertex_edges(v);
-            let untagged = edges.iter().any(|&h| {
-                let (a, b) = (v, self.opposite(h, v) as usize);
-                self.twin[h] == NONE && sharp_boundary.binary_search(&(a.min(b), a.max(b))).is_err()
-            });
-            if untagged {
-                for h in self.fan(v) {
-                    self.holes[self.face_of[h] as usize] = true;
-                }
+        }
+        for f in 0..self.faces() {
+            if self
+                .face(f)
+                .iter()
+                .any(|&v| excluded[self.origin(v as usize)])
+            {
+                self.holes[f] = true;
             }
         }
     }
@@ -792,6 +815,63 @@ pub fn split_fans(faces: &mut [Vec<i64>], origin: &mut Vec<u32>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `interpolateboundary 0` on a non-manifold edge: a pillow (two quads back to back) with
+    /// two flaps on its edge 1-2, so that the edge has four faces and vertices 1 and 2 have the
+    /// flaps' boundary edges. OpenSubdiv (`Far::TopologyRefinerFactory`) takes every face at a
+    /// vertex with an untagged boundary edge out, the pillow's included (the shape
+    /// `catmark_val2_nonman` under mode 0 has no patch in OpenSubdiv). Splitting the vertices
+    /// first left the pillow's closed fans, and a surface OpenSubdiv does not have. With the
+    /// flaps' boundary edges tagged infinitely sharp, no face goes (the split's own boundary
+    /// edges took every face before).
+    #[test]
+    fn no_boundary_interpolation_decides_on_the_input_edges() {
+        let positions = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [2.0, 0.0, 0.5],
+            [2.0, 1.0, 0.5],
+            [2.0, 0.0, -0.5],
+            [2.0, 1.0, -0.5],
+        ];
+        let faces = [
+            vec![0, 1, 2, 3],
+            vec![3, 2, 1, 0],
+            vec![1, 4, 5, 2],
+            vec![2, 7, 6, 1],
+        ];
+        let mesh = Mesh::new(positions, &faces, &[], BoundaryMode::EdgeOnly).expect("a mesh");
+        assert!(!mesh.copies.is_empty(), "edge 1-2 is non-manifold");
+        let mut none = mesh.clone();
+        none.exclude_boundary_faces(&[]);
+        assert_eq!(none.holes, vec![true; 4]);
+        let mut tagged = mesh.clone();
+        tagged.exclude_boundary_faces(&[(1, 4), (4, 5), (2, 5), (1, 6), (6, 7), (2, 7)]);
+        assert_eq!(tagged.holes, vec![false; 4]);
+    }
+
+    /// `interpolateboundary 0` at doubled corners (`catmark_nonman_quadpole8`'s pole, made
+    /// small): a ring of quads `r_i r_i+1 h h` around `h` inside a strip whose outer ring is the
+    /// boundary. Every inner vertex `r_i` is interior, so only `h`'s degenerate edges can take
+    /// the pole's faces out: Vtr gives each its own edge of one face, a boundary edge, and
+    /// OpenSubdiv has no patch there (measured on the shape under mode 0).
+    #[test]
+    fn no_boundary_interpolation_takes_the_faces_at_a_doubled_corner() {
+        let ring = |r: f64, z: f64| [[r, 0.0, z], [0.0, r, z], [-r, 0.0, z], [0.0, -r, z]];
+        let mut positions: Vec<[f64; 3]> = ring(2.0, 0.0).into_iter().collect();
+        positions.extend(ring(1.0, 0.2));
+        positions.push([0.0, 0.0, 0.5]);
+        let (outer, inner, hub) = (|i: i64| i % 4, |i: i64| 4 + i % 4, 8);
+        let mut faces: Vec<Vec<i64>> = (0..4)
+            .map(|i| vec![outer(i), outer(i + 1), inner(i + 1), inner(i)])
+            .collect();
+        faces.extend((0..4).map(|i| vec![inner(i), inner(i + 1), hub, hub]));
+        let mut mesh = Mesh::new(positions, &faces, &[], BoundaryMode::EdgeOnly).expect("a pole");
+        mesh.exclude_boundary_faces(&[]);
+        assert_eq!(mesh.holes, vec![true; 8]);
+    }
 
     /// A cone's tip: pinned, three faces or more, no cut around it. A sharp edge, a hole or the
     /// boundary at the vertex, or a vertex sharpness short of infinite, makes it none.
