@@ -22,6 +22,8 @@ mod models;
 mod opensubdiv_fvar_parity;
 #[cfg(feature = "opensubdiv")]
 mod opensubdiv_parity;
+#[cfg(feature = "opensubdiv")]
+mod opensubdiv_random_tags;
 mod patches;
 mod precision;
 mod rates;

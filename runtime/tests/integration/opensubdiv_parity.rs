@@ -775,7 +775,7 @@ fn angle(a: [f64; 3], b: [f64; 3]) -> f64 {
 
 /// One shape's comparison.
 #[derive(Default)]
-struct Row {
+pub(super) struct Row {
     name: String,
     vertices: usize,
     points: usize,
@@ -863,7 +863,7 @@ fn at(src: &subtess::VertexSource) -> String {
     )
 }
 
-fn compare(path: &Path) -> Row {
+pub(super) fn compare(path: &Path) -> Row {
     let name = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
@@ -1053,7 +1053,7 @@ fn cell(x: Option<f64>) -> String {
 
 /// The columns of one row: shape, V, points, pos (Far), normal (Far), pos (Bfr), Far vs Bfr,
 /// verdict, notes.
-fn columns(r: &Row) -> [String; 9] {
+pub(super) fn columns(r: &Row) -> [String; 9] {
     let compared = r.refused.is_none();
     let value = |x: f64| cell(compared.then_some(x));
     [
