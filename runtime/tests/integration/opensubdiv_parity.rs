@@ -70,7 +70,7 @@ use std::path::{Path, PathBuf};
 use opensubdiv_petite::bfr::{Surface as BfrSurface, SurfaceFactory};
 use opensubdiv_petite::far;
 
-const FAITHFUL_POSITION: f64 = 1e-5;
+pub(super) const FAITHFUL_POSITION: f64 = 1e-5;
 const FAITHFUL_NORMAL: f64 = 2e-3;
 /// `|du x dv| / (|du| |dv|)` below this: OpenSubdiv's normal is not compared.
 const PARALLEL_TANGENTS: f64 = 1e-2;
@@ -780,7 +780,7 @@ pub(super) struct Row {
     vertices: usize,
     points: usize,
     /// Largest position difference over the bounding-box diagonal (Far).
-    position: f64,
+    pub(super) position: f64,
     /// Largest normal angle, radians (Far).
     normal: f64,
     /// Largest position difference over the diagonal (Bfr), if any point was evaluated.
@@ -790,7 +790,7 @@ pub(super) struct Row {
     /// Why Bfr could not be used, if it could not.
     bfr_error: Option<String>,
     /// Points with no OpenSubdiv patch.
-    no_patch: usize,
+    pub(super) no_patch: usize,
     /// Points where OpenSubdiv's tangents are (nearly) parallel: normal not compared.
     osd_parallel: usize,
     /// Points at cone tips (no tangent plane): normal not compared.
@@ -800,7 +800,7 @@ pub(super) struct Row {
     /// Where the worst position and normal are: `face/sub (u, v)`.
     worst_position_at: String,
     worst_normal_at: String,
-    refused: Option<String>,
+    pub(super) refused: Option<String>,
     /// Seconds spent in subtess, Far and Bfr.
     seconds: [f64; 3],
 }
