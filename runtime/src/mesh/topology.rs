@@ -486,7 +486,7 @@ impl Mesh {
     }
 
     /// Whether vertex `v` is the tip of a cone: pinned (infinitely sharp: a `corner` tag, a
-    /// non-manifold vertex's copy), with at least three faces around it and no [`Mesh::cut`]
+    /// non-manifold vertex's copy), with at least three faces around it and no `Mesh::cut`
     /// (boundary, hole, infinitely sharp edge) reaching it. Its limit point is the vertex
     /// itself, where the surface has no tangent plane (a normal there is a choice: those of
     /// points approaching it converge like `e^0.07`, docs/results.md). The corner points of the

@@ -165,8 +165,8 @@ fn dart_edge(mesh: &Mesh, v: usize) -> Option<usize> {
 
 /// The dart corner of face `face` and the position of the dart's sharp edge in that corner's
 /// fan, when the face is a patch of the dart table (`Neighbourhood::dart`): a quad with one
-/// corner `V` a settled dart ([`dart_edge`]) and every other corner an interior valence-4
-/// vertex with nothing sharp at it ([`smooth_regular`]), except the sharp edge's other end
+/// corner `V` a settled dart (`dart_edge`) and every other corner an interior valence-4
+/// vertex with nothing sharp at it (`smooth_regular`), except the sharp edge's other end
 /// `E_1` when it is a corner (the faces on either side of the sharp edge): the table lets the
 /// crease run straight on through it, so `E_1` must be an interior valence-4 vertex without
 /// sharpness whose only sharp edges are the dart's and the opposite one, both infinitely sharp

@@ -1,7 +1,7 @@
 //! Stencil tables as the runtime uses them: the embedded default, or a file, validated once.
 //! A compact table's grids are expanded from the scaling relation's pieces when a plan first
-//! asks for them ([`quad_expansion`] for Catmull–Clark, [`triangle_expansion`] for Loop,
-//! [`region_expansion`] for the butterfly and √3), then kept.
+//! asks for them (`quad_expansion` for Catmull–Clark, `triangle_expansion` for Loop,
+//! `region_expansion` for the butterfly and √3), then kept.
 
 mod quad_expansion;
 mod region_expansion;
