@@ -25,6 +25,7 @@
 //! B-spline weights of the two directions (checked when the plan is built), so a point costs 12
 //! multiply-adds per coordinate for position, d/du and d/dv together instead of 48.
 
+use std::collections::HashMap;
 use std::ops::Range;
 use std::time::Instant;
 
@@ -37,11 +38,13 @@ use crate::scheme::patch::{dual_index_in_patch, FacePatch};
 use crate::stencil_table::StencilTable;
 pub use crate::tessellate::kernel::TessellationTime;
 use crate::tessellate::kernel::{
-    cross, evaluate_points, for_each_range, gather_relative, merge_rows, patch_origin, relative,
-    table_may_describe, unit, unless_absent, weighted_point, Connectivity, GridPlan, PointPlan,
-    Stencils, MAX_PATCH,
+    evaluate_points, for_each_range, gather_relative, merge_rows, patch_origin, relative,
+    table_may_describe, unless_absent, weighted_point, Connectivity, GridPlan, PointPlan, Stencils,
+    MAX_PATCH,
 };
+use crate::tessellate::lane_stencils::{unit_cross_x4, LaneStencils, LANES};
 use crate::RuntimeError;
+use wide::f32x4;
 
 /// The largest rate of the tables the evaluator takes.
 pub const MAX_RATE: u32 = 64;
@@ -55,9 +58,10 @@ struct SeparableBasis {
     dx: [Vec<f32>; 4],
     y: [Vec<f32>; 4],
     dy: [Vec<f32>; 4],
-    /// `x` and `dx` transposed: the four weights of point `i` together.
-    x_rows: Vec<[f32; 4]>,
-    dx_rows: Vec<[f32; 4]>,
+    /// `x` and `dx` by groups of [`LANES`] points: `x_lanes[g][a][lane]` is `x[a][g * LANES +
+    /// lane]`; the last group's unused lanes repeat the last point (evaluated, not written).
+    x_lanes: Vec<[f32x4; 4]>,
+    dx_lanes: Vec<[f32x4; 4]>,
 }
 
 /// Grid coordinates `(a, b)` (each in -1..=2) of the regular patch's layout entries
@@ -82,6 +86,32 @@ const REGULAR_LAYOUT: [(i32, i32); 16] = [
 ];
 
 impl SeparableBasis {
+    /// The factors `x`, `dx` (along `u`) and `y`, `dy` (along `v`), `n` values each.
+    fn from_factors(
+        x: [Vec<f32>; 4],
+        dx: [Vec<f32>; 4],
+        y: [Vec<f32>; 4],
+        dy: [Vec<f32>; 4],
+    ) -> Self {
+        let n = x[0].len();
+        let lanes = |f: &[Vec<f32>; 4]| {
+            (0..n.div_ceil(LANES))
+                .map(|g| {
+                    f.each_ref()
+                        .map(|w| f32x4::new(std::array::from_fn(|l| w[(g * LANES + l).min(n - 1)])))
+                })
+                .collect()
+        };
+        SeparableBasis {
+            x_lanes: lanes(&x),
+            dx_lanes: lanes(&dx),
+            x,
+            dx,
+            y,
+            dy,
+        }
+    }
+
     /// Factor the regular patch's stencils at rate `n`: the marginals of a tensor product are
     /// its factors (the other direction's weights sum to one, and its derivative's to zero), and
     /// the factorization is accepted only if it reproduces every weight to 1e-6.
@@ -109,20 +139,12 @@ impl SeparableBasis {
             }
             out
         };
-        let (x, dx) = (column(s.position, true), column(s.du, true));
-        let rows = |f: &[Vec<f32>; 4]| {
-            (0..n)
-                .map(|i| [f[0][i], f[1][i], f[2][i], f[3][i]])
-                .collect()
-        };
-        let basis = SeparableBasis {
-            x_rows: rows(&x),
-            dx_rows: rows(&dx),
-            x,
-            dx,
-            y: column(s.position, false),
-            dy: column(s.dv, false),
-        };
+        let basis = SeparableBasis::from_factors(
+            column(s.position, true),
+            column(s.du, true),
+            column(s.position, false),
+            column(s.dv, false),
+        );
         let check = |w: &[f32], fx: &[Vec<f32>; 4], fy: &[Vec<f32>; 4]| {
             (0..n * n).all(|p| {
                 let (i, j) = (p % n, p / n);
@@ -141,17 +163,14 @@ impl SeparableBasis {
 
 /// How one face's dual points are evaluated.
 #[derive(Clone, Debug)]
-enum FaceEval<'t> {
+enum FaceEval {
     /// A regular interior face: the 4 x 4 control grid (`grid[a][b]`, columns along `u`) and the
     /// separable factors of its rate.
     Separable { grid: [[u32; 4]; 4] },
-    /// Any other patch: its table stencils, its control points, and the face corner at the
-    /// patch's `(0,0)`.
-    Table {
-        stencils: Stencils<'t>,
-        control: Range<u32>,
-        corner: u8,
-    },
+    /// Any other patch: its table stencils in the face's point order, [`LANES`] points at a
+    /// time (`DualGrid::lanes[lanes]`, shared by every face of the same section, corner and
+    /// patch size), and its control points.
+    Table { lanes: u32, control: Range<u32> },
     /// A face the tables do not describe (sharp features, a valence beyond the table's):
     /// stencils from feature-adaptive refinement ([`crate::scheme::catmull_clark::adaptive`]),
     /// in the face's own parameters, `control.len()` weights a point in three blocks (position,
@@ -198,13 +217,15 @@ enum Strip {
 /// The per-mesh plan of a dual-grid tessellation: build once, then [`DualGrid::evaluate`] and
 /// [`DualGrid::connect`] per frame.
 #[derive(Clone, Debug)]
-pub struct DualGrid<'t> {
+pub struct DualGrid {
     rates: Vec<u32>,
     /// First dual vertex of every face, and the total after the last.
     first: Vec<u32>,
-    faces: Vec<FaceEval<'t>>,
+    faces: Vec<FaceEval>,
     /// Separable factors by rate (index `n`).
     bases: Vec<Option<SeparableBasis>>,
+    /// The table faces' stencils in lanes, one per section, corner and patch size met.
+    lanes: Vec<LaneStencils>,
     /// Control points of the table-evaluated patches, concatenated.
     control: Vec<u32>,
     /// Boundary-curve points (vertex limit points first, then edges' interior points).
@@ -278,11 +299,11 @@ fn strip_triangle_count(a: u32, b: u32) -> usize {
     (a + b - 2) as usize
 }
 
-impl<'t> DualGrid<'t> {
+impl DualGrid {
     /// Plan the tessellation of an isolated mesh (closed or with boundary) with rate `rates[f]`
     /// on face `f` (any rates the table holds, not only powers of two).
     pub fn new(
-        table: &'t StencilTable,
+        table: &StencilTable,
         mesh: &Mesh,
         patches: &[FacePatch],
         rates: &[u32],
@@ -299,7 +320,7 @@ impl<'t> DualGrid<'t> {
     /// vertex: same stencils, so the same position bits, but each with a source on its own side
     /// ([`GridPlan::seam_copies`]).
     pub fn with_channel(
-        table: &'t StencilTable,
+        table: &StencilTable,
         mesh: &Mesh,
         patches: &[FacePatch],
         rates: &[u32],
@@ -345,6 +366,7 @@ impl<'t> DualGrid<'t> {
             first,
             faces: Vec::with_capacity(patches.len()),
             bases: vec![None; MAX_RATE as usize + 1],
+            lanes: Vec::new(),
             control: Vec::new(),
             boundary_points: Vec::new(),
             local_weights: Vec::new(),
@@ -363,6 +385,8 @@ impl<'t> DualGrid<'t> {
                 && p.corner == 0
         };
         let mut factored = vec![false; MAX_RATE as usize + 1];
+        // The index in `grid.lanes` of every section, corner and patch size met.
+        let mut layouts: HashMap<(SectionKey, u8, usize), u32> = HashMap::new();
         // Faces the tables describe exactly (smooth patches and settled darts) take their
         // stencils; the others (other sharp features nearby, a valence or patch beyond the table) are refined adaptively below.
         let mut local_faces = Vec::new();
@@ -395,12 +419,37 @@ impl<'t> DualGrid<'t> {
                 }
                 grid.faces.push(FaceEval::Separable { grid: cells });
             } else {
+                let k = patch.points.len();
+                let key = (
+                    section(patch, StencilKind::Position, PointSet::Dual, n),
+                    patch.corner as u8,
+                    k,
+                );
+                let lanes = match layouts.get(&key) {
+                    Some(&lanes) => lanes,
+                    None => {
+                        let n = n as usize;
+                        let corner = patch.corner;
+                        let lanes = LaneStencils::new(k, n * n, |t| {
+                            let (pi, pj) = dual_index_in_patch(corner, t % n, t / n, n);
+                            (&s, pj * n + pi)
+                        })
+                        .ok_or_else(|| RuntimeError::LayoutMismatch {
+                            key: key.0,
+                            table: s.position.len() / (n * n).max(1),
+                            patch: k,
+                        })?;
+                        let index = grid.lanes.len() as u32;
+                        grid.lanes.push(lanes);
+                        layouts.insert(key, index);
+                        index
+                    }
+                };
                 let start = grid.control.len() as u32;
                 grid.control.extend_from_slice(&patch.points);
                 grid.faces.push(FaceEval::Table {
-                    stencils: s,
+                    lanes,
                     control: start..grid.control.len() as u32,
-                    corner: patch.corner as u8,
                 });
             }
         }
@@ -446,7 +495,7 @@ impl<'t> DualGrid<'t> {
     /// face's own indices.
     fn boundary_point(
         &mut self,
-        table: &'t StencilTable,
+        table: &StencilTable,
         patch: &FacePatch,
         f: usize,
         n: u32,
@@ -553,7 +602,7 @@ impl<'t> DualGrid<'t> {
 
     fn plan_connectivity(
         &mut self,
-        table: &'t StencilTable,
+        table: &StencilTable,
         mesh: &Mesh,
         patches: &[FacePatch],
         channel: Option<&[u32]>,
@@ -790,20 +839,15 @@ impl<'t> DualGrid<'t> {
                 }
             }
             FaceEval::Table {
-                stencils,
+                lanes,
                 control: range,
-                corner,
             } => {
                 let points = &self.control[range.start as usize..range.end as usize];
                 let mut local = [[0.0f32; 3]; MAX_PATCH];
                 let origin = gather_relative(points, control, &mut local);
-                let local = &local[..points.len()];
-                for j in 0..n {
-                    for i in 0..n {
-                        let (pi, pj) = dual_index_in_patch(*corner as usize, i, j, n);
-                        let at = j * n + i;
-                        (positions[at], normals[at]) =
-                            weighted_point(stencils, local, origin, pj * n + pi);
+                if let Some(lanes) = self.lanes.get(*lanes as usize) {
+                    if lanes.control_points() == points.len() {
+                        lanes.evaluate(&local[..points.len()], origin, positions, normals);
                     }
                 }
             }
@@ -853,7 +897,7 @@ impl<'t> DualGrid<'t> {
     }
 }
 
-impl GridPlan for DualGrid<'_> {
+impl GridPlan for DualGrid {
     /// Output vertices per frame.
     fn vertex_count(&self) -> usize {
         self.vertex_count
@@ -977,6 +1021,13 @@ fn connect_strip(strip: &Strip, out: &mut [[u32; 3]]) {
 /// row's weights into four points (and their `v` derivatives), then every point of the row is a
 /// 4-term combination of those. `g` is relative to `origin` ([`gather_relative`]), where every
 /// position's sum starts.
+///
+/// Both steps run in vectors of [`LANES`]: the contraction with the grid's four columns `a` in
+/// the lanes, the row's points [`LANES`] at a time. Every lane makes its sums in the order of the
+/// scalar formulas (`r[a] = sum_b y_b g[a][b]`, then `P = O + sum_a x_a r[a]`,
+/// `P_u = sum_a x'_a r[a]`, `P_v = sum_a x_a s[a]`, each over `b, a = 0..4` from zero or `O`),
+/// so the output is bit-identical to one point at a time
+/// (`separable_lanes_are_the_scalar_sums_bit_for_bit`).
 fn evaluate_separable(
     g: &[[[f32; 3]; 4]; 4],
     origin: [f32; 3],
@@ -985,44 +1036,54 @@ fn evaluate_separable(
     positions: &mut [[f32; 3]],
     normals: &mut [[f32; 3]],
 ) {
+    // gt[b][c]: coordinate c of the grid's row b, the columns a in the lanes.
+    let gt: [[f32x4; 3]; 4] = std::array::from_fn(|b| {
+        std::array::from_fn(|c| f32x4::new([g[0][b][c], g[1][b][c], g[2][b][c], g[3][b][c]]))
+    });
+    let origin = origin.map(f32x4::splat);
     for j in 0..n {
-        let y = [basis.y[0][j], basis.y[1][j], basis.y[2][j], basis.y[3][j]];
-        let dy = [
-            basis.dy[0][j],
-            basis.dy[1][j],
-            basis.dy[2][j],
-            basis.dy[3][j],
-        ];
-        // r[a] = sum_b y_b g[a][b]; s[a] = sum_b dy_b g[a][b].
-        let mut r = [[0.0f32; 3]; 4];
-        let mut s = [[0.0f32; 3]; 4];
-        for a in 0..4 {
-            for b in 0..4 {
-                for c in 0..3 {
-                    r[a][c] += y[b] * g[a][b][c];
-                    s[a][c] += dy[b] * g[a][b][c];
-                }
+        let mut r = [f32x4::ZERO; 3];
+        let mut s = [f32x4::ZERO; 3];
+        for (b, gt) in gt.iter().enumerate() {
+            let (y, dy) = (f32x4::splat(basis.y[b][j]), f32x4::splat(basis.dy[b][j]));
+            for c in 0..3 {
+                r[c] += y * gt[c];
+                s[c] += dy * gt[c];
             }
         }
-        let row = j * n..(j + 1) * n;
-        for (((q, m), x), d) in positions[row.clone()]
-            .iter_mut()
-            .zip(&mut normals[row])
-            .zip(&basis.x_rows)
-            .zip(&basis.dx_rows)
-        {
+        // Every coordinate of the four contracted points, broadcast for the point lanes.
+        let (r, s) = (r.map(f32x4::to_array), s.map(f32x4::to_array));
+        let ra: [[f32x4; 3]; 4] = std::array::from_fn(|a| r.map(|c| f32x4::splat(c[a])));
+        let sa: [[f32x4; 3]; 4] = std::array::from_fn(|a| s.map(|c| f32x4::splat(c[a])));
+        let row = j * n;
+        for (k, (x, dx)) in basis.x_lanes.iter().zip(&basis.dx_lanes).enumerate() {
             let mut p = origin;
-            let mut du = [0.0f32; 3];
-            let mut dv = [0.0f32; 3];
+            let mut du = [f32x4::ZERO; 3];
+            let mut dv = [f32x4::ZERO; 3];
             for a in 0..4 {
                 for c in 0..3 {
-                    p[c] += x[a] * r[a][c];
-                    du[c] += d[a] * r[a][c];
-                    dv[c] += x[a] * s[a][c];
+                    p[c] += x[a] * ra[a][c];
+                    du[c] += dx[a] * ra[a][c];
+                    dv[c] += x[a] * sa[a][c];
                 }
             }
-            *q = p;
-            *m = unit(cross(du, dv));
+            let normal = unit_cross_x4(du, dv);
+            let [px, py, pz] = p.map(f32x4::to_array);
+            let points: [[f32; 3]; LANES] = std::array::from_fn(|k| [px[k], py[k], pz[k]]);
+            let start = row + k * LANES;
+            let count = LANES.min(row + n - start);
+            let (positions, normals) = (
+                &mut positions[start..start + count],
+                &mut normals[start..start + count],
+            );
+            if count == LANES {
+                // A full group: stores at constant offsets.
+                positions[..LANES].copy_from_slice(&points);
+                normals[..LANES].copy_from_slice(&normal);
+            } else {
+                positions.copy_from_slice(&points[..count]);
+                normals.copy_from_slice(&normal[..count]);
+            }
         }
     }
 }
@@ -1055,4 +1116,69 @@ pub fn tessellate(
             seconds: planned.elapsed().as_secs_f64(),
         },
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tessellate::kernel::{cross, unit};
+
+    /// The lanes give the scalar tensor-product sums (the formulas of [`evaluate_separable`]'s
+    /// doc, one point at a time, as the evaluator computed them before the lanes) bit for bit,
+    /// for rates with full and short last groups and more groups than one [`row_sums`] call.
+    #[test]
+    fn separable_lanes_are_the_scalar_sums_bit_for_bit() {
+        let mut state = 0x9e37_79b9u32;
+        let mut next = move || {
+            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (state >> 8) as f32 / (1u32 << 24) as f32 - 0.5
+        };
+        for n in [1usize, 2, 3, 4, 5, 7, 8, 16, 24, 33, 40] {
+            let mut factor =
+                || -> [Vec<f32>; 4] { std::array::from_fn(|_| (0..n).map(|_| next()).collect()) };
+            let (x, dx, y, dy) = (factor(), factor(), factor(), factor());
+            let basis = SeparableBasis::from_factors(x.clone(), dx.clone(), y.clone(), dy.clone());
+            let g: [[[f32; 3]; 4]; 4] =
+                std::array::from_fn(|_| std::array::from_fn(|_| [next(), next(), next()]));
+            let origin = [next() * 100.0, next(), -3.0];
+            let mut positions = vec![[0.0f32; 3]; n * n];
+            let mut normals = vec![[0.0f32; 3]; n * n];
+            evaluate_separable(&g, origin, &basis, n, &mut positions, &mut normals);
+            for j in 0..n {
+                let mut r = [[0.0f32; 3]; 4];
+                let mut s = [[0.0f32; 3]; 4];
+                for a in 0..4 {
+                    for b in 0..4 {
+                        for c in 0..3 {
+                            r[a][c] += y[b][j] * g[a][b][c];
+                            s[a][c] += dy[b][j] * g[a][b][c];
+                        }
+                    }
+                }
+                for i in 0..n {
+                    let mut p = origin;
+                    let mut du = [0.0f32; 3];
+                    let mut dv = [0.0f32; 3];
+                    for a in 0..4 {
+                        for c in 0..3 {
+                            p[c] += x[a][i] * r[a][c];
+                            du[c] += dx[a][i] * r[a][c];
+                            dv[c] += x[a][i] * s[a][c];
+                        }
+                    }
+                    let at = j * n + i;
+                    assert_eq!(
+                        positions[at].map(f32::to_bits),
+                        p.map(f32::to_bits),
+                        "n {n} ({i}, {j})"
+                    );
+                    assert_eq!(
+                        normals[at].map(f32::to_bits),
+                        unit(cross(du, dv)).map(f32::to_bits),
+                        "n {n} ({i}, {j})"
+                    );
+                }
+            }
+        }
+    }
 }

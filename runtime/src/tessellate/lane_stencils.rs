@@ -19,6 +19,8 @@
 //! bit-identical to the point-by-point sums ([`crate::tessellate::kernel::weighted_point`]),
 //! in about a quarter of the instructions.
 
+use wide::{f32x4, CmpGe, CmpLt};
+
 use crate::tessellate::kernel::{cross, unit, Stencils};
 
 /// Points evaluated together (SSE's four f32, the baseline x86-64 vector).
@@ -138,7 +140,7 @@ impl LaneStencils {
     fn write(
         &self,
         first: usize,
-        sums: &[Sums],
+        sums: &[LaneSums],
         positions: &mut [[f32; 3]],
         normals: &mut [[f32; 3]],
     ) {
@@ -154,7 +156,7 @@ impl LaneStencils {
 }
 
 /// One group's sums: `[position, d/du, d/dv][coordinate][lane]`.
-type Sums = [[[f32; LANES]; 3]; 3];
+type LaneSums = [[[f32; LANES]; 3]; 3];
 
 /// Groups whose sums are made by one call of [`chunk_sums_fixed`] or [`chunk_sums_any`].
 const CHUNK: usize = 8;
@@ -171,7 +173,7 @@ fn chunk_sums_fixed<const K: usize>(
     weights: &[LaneWeights],
     q: &[[f32; 3]; K],
     origin: [f32; 3],
-    out: &mut [Sums; CHUNK],
+    out: &mut [LaneSums; CHUNK],
 ) {
     for (out, weights) in out.iter_mut().zip(weights.chunks_exact(K)) {
         *out = sums(weights, q, origin);
@@ -185,7 +187,7 @@ fn chunk_sums_any(
     weights: &[LaneWeights],
     q: &[[f32; 3]],
     origin: [f32; 3],
-    out: &mut [Sums; CHUNK],
+    out: &mut [LaneSums; CHUNK],
 ) {
     for (out, weights) in out.iter_mut().zip(weights.chunks_exact(k)) {
         *out = sums(weights, q, origin);
@@ -203,7 +205,7 @@ fn multiply_add(acc: &mut [f32; LANES], w: &[f32; LANES], q: f32) {
 /// One group's sums over the control points `q`, the position's started at `origin`, each in
 /// the order of `q`.
 #[inline(always)]
-fn sums(weights: &[LaneWeights], q: &[[f32; 3]], origin: [f32; 3]) -> Sums {
+fn sums(weights: &[LaneWeights], q: &[[f32; 3]], origin: [f32; 3]) -> LaneSums {
     let mut p = origin.map(|c| [c; LANES]);
     let mut du = [[0.0f32; LANES]; 3];
     let mut dv = [[0.0f32; LANES]; 3];
@@ -222,35 +224,35 @@ fn sums(weights: &[LaneWeights], q: &[[f32; 3]], origin: [f32; 3]) -> Sums {
 /// is a normal float.
 #[inline(always)]
 pub(crate) fn unit_cross(a: [[f32; LANES]; 3], b: [[f32; LANES]; 3]) -> [[f32; 3]; LANES] {
-    let mut m = [[0.0f32; LANES]; 3];
-    let mut squared = [0.0f32; LANES];
-    for k in 0..LANES {
-        m[0][k] = a[1][k] * b[2][k] - a[2][k] * b[1][k];
-        m[1][k] = a[2][k] * b[0][k] - a[0][k] * b[2][k];
-        m[2][k] = a[0][k] * b[1][k] - a[1][k] * b[0][k];
-        squared[k] = m[0][k] * m[0][k] + m[1][k] * m[1][k] + m[2][k] * m[2][k];
-    }
-    let mut out = [[0.0f32; 3]; LANES];
-    if squared.iter().all(|s| s.is_normal()) {
-        let mut length = [0.0f32; LANES];
-        for k in 0..LANES {
-            length[k] = squared[k].sqrt();
-        }
-        for k in 0..LANES {
-            for x in 0..3 {
-                out[k][x] = m[x][k] / length[k];
-            }
-        }
+    unit_cross_x4(a.map(f32x4::new), b.map(f32x4::new))
+}
+
+/// [`unit_cross`] on vectors (`[coordinate]`, a lane per pair).
+#[inline(always)]
+pub(crate) fn unit_cross_x4(a: [f32x4; 3], b: [f32x4; 3]) -> [[f32; 3]; LANES] {
+    let m = [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ];
+    let squared = m[0] * m[0] + m[1] * m[1] + m[2] * m[2];
+    // `is_normal` in every lane: finite, not zero and not subnormal (NaN fails both).
+    let normal = squared.cmp_ge(f32x4::splat(f32::MIN_POSITIVE))
+        & squared.cmp_lt(f32x4::splat(f32::INFINITY));
+    if normal.all() {
+        let length = squared.sqrt();
+        let [x, y, z] = m.map(|c| (c / length).to_array());
+        std::array::from_fn(|k| [x[k], y[k], z[k]])
     } else {
         // A degenerate or tiny tangent pair somewhere: unit's careful path, lane by lane.
-        for (k, out) in out.iter_mut().enumerate() {
-            *out = unit(cross(
+        let (a, b) = (a.map(f32x4::to_array), b.map(f32x4::to_array));
+        std::array::from_fn(|k| {
+            unit(cross(
                 [a[0][k], a[1][k], a[2][k]],
                 [b[0][k], b[1][k], b[2][k]],
-            ));
-        }
+            ))
+        })
     }
-    out
 }
 
 #[cfg(test)]
