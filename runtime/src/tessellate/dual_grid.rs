@@ -58,10 +58,13 @@ struct SeparableBasis {
     dx: [Vec<f32>; 4],
     y: [Vec<f32>; 4],
     dy: [Vec<f32>; 4],
-    /// `x` and `dx` by groups of [`LANES`] points: `x_lanes[g][a][lane]` is `x[a][g * LANES +
-    /// lane]`; the last group's unused lanes repeat the last point (evaluated, not written).
-    x_lanes: Vec<[f32x4; 4]>,
-    dx_lanes: Vec<[f32x4; 4]>,
+    /// `y` and `dy` by groups of [`LANES`] rows: `y_lanes[g][b]` holds `y[b][g * LANES + lane]`
+    /// in its lanes; the last group's unused lanes repeat the last row (evaluated, not written).
+    y_lanes: Vec<[f32x4; 4]>,
+    dy_lanes: Vec<[f32x4; 4]>,
+    /// `x` and `dx` broadcast: `x_splat[i][a]` holds `x[a][i]` in every lane.
+    x_splat: Vec<[f32x4; 4]>,
+    dx_splat: Vec<[f32x4; 4]>,
 }
 
 /// Grid coordinates `(a, b)` (each in -1..=2) of the regular patch's layout entries
@@ -93,7 +96,7 @@ impl SeparableBasis {
         y: [Vec<f32>; 4],
         dy: [Vec<f32>; 4],
     ) -> Self {
-        let n = x[0].len();
+        let n = y[0].len();
         let lanes = |f: &[Vec<f32>; 4]| {
             (0..n.div_ceil(LANES))
                 .map(|g| {
@@ -102,9 +105,16 @@ impl SeparableBasis {
                 })
                 .collect()
         };
+        let splat = |f: &[Vec<f32>; 4]| {
+            (0..f[0].len())
+                .map(|i| f.each_ref().map(|w| f32x4::splat(w[i])))
+                .collect()
+        };
         SeparableBasis {
-            x_lanes: lanes(&x),
-            dx_lanes: lanes(&dx),
+            y_lanes: lanes(&y),
+            dy_lanes: lanes(&dy),
+            x_splat: splat(&x),
+            dx_splat: splat(&dx),
             x,
             dx,
             y,
@@ -1022,9 +1032,10 @@ fn connect_strip(strip: &Strip, out: &mut [[u32; 3]]) {
 /// 4-term combination of those. `g` is relative to `origin` ([`gather_relative`]), where every
 /// position's sum starts.
 ///
-/// Both steps run in vectors of [`LANES`]: the contraction with the grid's four columns `a` in
-/// the lanes, the row's points [`LANES`] at a time. Every lane makes its sums in the order of the
-/// scalar formulas (`r[a] = sum_b y_b g[a][b]`, then `P = O + sum_a x_a r[a]`,
+/// In vectors of [`LANES`] rows: the contraction of rows `j..j + 4` is made once, a row in each
+/// lane, and each column `i` then gives the points `(i, j..j + 4)` with the weights of `i`
+/// broadcast (precomputed in the basis, so no lane is ever moved). Every lane makes its sums in
+/// the order of the scalar formulas (`r[a] = sum_b y_b g[a][b]`, then `P = O + sum_a x_a r[a]`,
 /// `P_u = sum_a x'_a r[a]`, `P_v = sum_a x_a s[a]`, each over `b, a = 0..4` from zero or `O`),
 /// so the output is bit-identical to one point at a time
 /// (`separable_lanes_are_the_scalar_sums_bit_for_bit`).
@@ -1036,53 +1047,40 @@ fn evaluate_separable(
     positions: &mut [[f32; 3]],
     normals: &mut [[f32; 3]],
 ) {
-    // gt[b][c]: coordinate c of the grid's row b, the columns a in the lanes.
-    let gt: [[f32x4; 3]; 4] = std::array::from_fn(|b| {
-        std::array::from_fn(|c| f32x4::new([g[0][b][c], g[1][b][c], g[2][b][c], g[3][b][c]]))
-    });
+    let (positions, normals) = (&mut positions[..n * n], &mut normals[..n * n]);
     let origin = origin.map(f32x4::splat);
-    for j in 0..n {
-        let mut r = [f32x4::ZERO; 3];
-        let mut s = [f32x4::ZERO; 3];
-        for (b, gt) in gt.iter().enumerate() {
-            let (y, dy) = (f32x4::splat(basis.y[b][j]), f32x4::splat(basis.dy[b][j]));
-            for c in 0..3 {
-                r[c] += y * gt[c];
-                s[c] += dy * gt[c];
+    for (k, (y, dy)) in basis.y_lanes.iter().zip(&basis.dy_lanes).enumerate() {
+        // r[a][c] = sum_b y_b g[a][b][c], s the same with dy: the group's rows in the lanes.
+        let mut r = [[f32x4::ZERO; 3]; 4];
+        let mut s = [[f32x4::ZERO; 3]; 4];
+        for a in 0..4 {
+            for b in 0..4 {
+                for c in 0..3 {
+                    let w = f32x4::splat(g[a][b][c]);
+                    r[a][c] += y[b] * w;
+                    s[a][c] += dy[b] * w;
+                }
             }
         }
-        // Every coordinate of the four contracted points, broadcast for the point lanes.
-        let (r, s) = (r.map(f32x4::to_array), s.map(f32x4::to_array));
-        let ra: [[f32x4; 3]; 4] = std::array::from_fn(|a| r.map(|c| f32x4::splat(c[a])));
-        let sa: [[f32x4; 3]; 4] = std::array::from_fn(|a| s.map(|c| f32x4::splat(c[a])));
-        let row = j * n;
-        for (k, (x, dx)) in basis.x_lanes.iter().zip(&basis.dx_lanes).enumerate() {
+        let first = k * LANES;
+        let rows = LANES.min(n - first);
+        for (i, (x, dx)) in basis.x_splat.iter().zip(&basis.dx_splat).enumerate() {
             let mut p = origin;
             let mut du = [f32x4::ZERO; 3];
             let mut dv = [f32x4::ZERO; 3];
             for a in 0..4 {
                 for c in 0..3 {
-                    p[c] += x[a] * ra[a][c];
-                    du[c] += dx[a] * ra[a][c];
-                    dv[c] += x[a] * sa[a][c];
+                    p[c] += x[a] * r[a][c];
+                    du[c] += dx[a] * r[a][c];
+                    dv[c] += x[a] * s[a][c];
                 }
             }
             let normal = unit_cross_x4(du, dv);
             let [px, py, pz] = p.map(f32x4::to_array);
-            let points: [[f32; 3]; LANES] = std::array::from_fn(|k| [px[k], py[k], pz[k]]);
-            let start = row + k * LANES;
-            let count = LANES.min(row + n - start);
-            let (positions, normals) = (
-                &mut positions[start..start + count],
-                &mut normals[start..start + count],
-            );
-            if count == LANES {
-                // A full group: stores at constant offsets.
-                positions[..LANES].copy_from_slice(&points);
-                normals[..LANES].copy_from_slice(&normal);
-            } else {
-                positions.copy_from_slice(&points[..count]);
-                normals.copy_from_slice(&normal[..count]);
+            for lane in 0..rows {
+                let at = (first + lane) * n + i;
+                positions[at] = [px[lane], py[lane], pz[lane]];
+                normals[at] = normal[lane];
             }
         }
     }
