@@ -1,5 +1,6 @@
-//! Table stencils regrouped for evaluating [`LANES`] points at once, for the triangle dual
-//! grid's faces ([`crate::tessellate::triangle_dual_grid`]).
+//! Table stencils regrouped for evaluating [`LANES`] points at once, for the faces of both dual
+//! grids that take their table stencils ([`crate::tessellate::triangle_dual_grid`], and the
+//! quad faces of [`crate::tessellate::dual_grid`] that are not tensor products).
 //!
 //! A face's point `t` is, as everywhere in the dual grid, three dot products over the patch's
 //! `K` control points `q_l` (relative to the first, [`crate::tessellate::kernel::gather_relative`]):
