@@ -820,10 +820,11 @@ mod tests {
     /// two flaps on its edge 1-2, so that the edge has four faces and vertices 1 and 2 have the
     /// flaps' boundary edges. OpenSubdiv (`Far::TopologyRefinerFactory`) takes every face at a
     /// vertex with an untagged boundary edge out, the pillow's included (the shape
-    /// `catmark_val2_nonman` under mode 0 has no patch in OpenSubdiv). Splitting the vertices
-    /// first left the pillow's closed fans, and a surface OpenSubdiv does not have. With the
-    /// flaps' boundary edges tagged infinitely sharp, no face goes (the split's own boundary
-    /// edges took every face before).
+    /// `catmark_val2_nonman` under mode 0 has no patch in OpenSubdiv). On this mesh the rule
+    /// decided after the split takes every face out too; what tells the two apart is the second
+    /// case: with the flaps' boundary edges tagged infinitely sharp, no face goes here, while
+    /// the split's own boundary edges took every face before (checked by swapping the old rule
+    /// back in; `catmark_val2_nonman` shows the other difference, closed fans kept).
     #[test]
     fn no_boundary_interpolation_decides_on_the_input_edges() {
         let positions = vec![

@@ -25,7 +25,7 @@
 //! B-spline weights of the two directions (checked when the plan is built), so a point costs 12
 //! multiply-adds per coordinate for position, d/du and d/dv together instead of 48, four points
 //! (four rows) in each vector operation. The other faces' stencils are interleaved four points a
-//! group ([`LaneStencils`]).
+//! group (`tessellate::lane_stencils`).
 
 use std::collections::HashMap;
 use std::ops::Range;
@@ -1125,7 +1125,7 @@ mod tests {
 
     /// The lanes give the scalar tensor-product sums (the formulas of [`evaluate_separable`]'s
     /// doc, one point at a time, as the evaluator computed them before the lanes) bit for bit,
-    /// for rates with full and short last groups and more groups than one [`row_sums`] call.
+    /// for rates whose last group of rows is full or short.
     #[test]
     fn separable_lanes_are_the_scalar_sums_bit_for_bit() {
         let mut state = 0x9e37_79b9u32;

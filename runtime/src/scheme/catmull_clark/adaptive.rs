@@ -1255,8 +1255,8 @@ mod tests {
     /// each face's diagonal, reached by refinement down to B-spline patches (an independent
     /// route), converge to the vertex's masks like `e^(3/4)` or faster (the largest eigenvalue
     /// below 1 is at most 0.6 here), the normals like `e^normal_rate` (the ratio of the third
-    /// eigenvalue to the second decides it).
-    fn check_approached(mesh: &Mesh, corners: &[(u32, f64, f64)], normal_rate: f64) {
+    /// eigenvalue to the second decides it; `None`: the positions only).
+    fn check_approached(mesh: &Mesh, corners: &[(u32, f64, f64)], normal_rate: Option<f64>) {
         let normal = |d: [[f64; 3]; 3]| {
             let [_, a, b] = d;
             let n = [
@@ -1284,21 +1284,24 @@ mod tests {
                 let d = (0..3)
                     .map(|c| (near[0][c] - at_vertex[0][c]).abs())
                     .fold(0.0, f64::max);
-                let (a, b) = (normal(near), normal(at_vertex));
-                let angle = (a[0] * b[0] + a[1] * b[1] + a[2] * b[2])
-                    .clamp(-1.0, 1.0)
-                    .acos();
-                println!("face {f} e 2^-{k}: position {d:.2e}, normal {angle:.2e} rad");
+                println!("face {f} e 2^-{k}: position {d:.2e}");
                 assert!(
                     d < 2.0 * e.powf(0.75),
                     "face {f} e 2^-{k}: {d:.2e} from the vertex's limit"
                 );
                 assert!(d < previous, "face {f}: not converging");
                 previous = d;
-                assert!(
-                    angle < 0.6 * e.powf(normal_rate),
-                    "face {f} e 2^-{k}: normal off by {angle:.2e}"
-                );
+                if let Some(rate) = normal_rate {
+                    let (a, b) = (normal(near), normal(at_vertex));
+                    let angle = (a[0] * b[0] + a[1] * b[1] + a[2] * b[2])
+                        .clamp(-1.0, 1.0)
+                        .acos();
+                    println!("face {f} e 2^-{k}: normal {angle:.2e} rad");
+                    assert!(
+                        angle < 0.6 * e.powf(rate),
+                        "face {f} e 2^-{k}: normal off by {angle:.2e}"
+                    );
+                }
             }
         }
     }
@@ -1327,7 +1330,7 @@ mod tests {
                 (face(2, 2), 1.0, 1.0),
                 (face(3, 2), 0.0, 1.0),
             ],
-            0.5,
+            Some(0.5),
         );
     }
 
@@ -1337,7 +1340,11 @@ mod tests {
     /// valence 2, not planar; positions only (the normals at such a vertex depend on the face).
     #[test]
     fn a_valence_two_limit_is_the_limit_of_the_points_approaching_it() {
-        check_pillow_corners(&pillow(), &[(0, 0.0, 0.0), (0, 1.0, 1.0), (1, 0.0, 1.0)]);
+        check_approached(
+            &pillow(),
+            &[(0, 0.0, 0.0), (0, 1.0, 1.0), (1, 0.0, 1.0)],
+            None,
+        );
     }
 
     /// A dart of valence 2: the pillow with edge 1-2 infinitely sharp, so that vertices 1 and
@@ -1349,7 +1356,7 @@ mod tests {
     fn a_valence_two_dart_is_the_limit_of_the_points_approaching_it() {
         let mut mesh = pillow();
         mesh.set_edge_sharpness(1, 2, INFINITE).expect("an edge");
-        check_pillow_corners(&mesh, &[(0, 1.0, 0.0), (0, 1.0, 1.0), (1, 0.0, 0.0)]);
+        check_approached(&mesh, &[(0, 1.0, 0.0), (0, 1.0, 1.0), (1, 0.0, 0.0)], None);
     }
 
     /// Two quads back to back, every vertex of valence 2, not planar.
@@ -1369,33 +1376,6 @@ mod tests {
         .expect("a pillow")
     }
 
-    /// The limit at each face corner `(face, u0, v0)` is the limit of the points approaching
-    /// it along the diagonal, at the rate of a subdominant eigenvalue below `2^-0.75`.
-    fn check_pillow_corners(mesh: &Mesh, corners: &[(u32, f64, f64)]) {
-        for &(face, u0, v0) in corners {
-            let q = |e: f64| LimitQuery {
-                face,
-                u: u0 + e * (1.0 - 2.0 * u0),
-                v: v0 + e * (1.0 - 2.0 * v0),
-            };
-            let at_vertex = limit_of(&limit_stencils(mesh, &[q(0.0)]).expect("reached")[0], mesh);
-            let mut previous = f64::INFINITY;
-            for k in [10, 14, 18, 22] {
-                let e = (0.5f64).powi(k);
-                let near = limit_of(&limit_stencils(mesh, &[q(e)]).expect("reached")[0], mesh);
-                let d = (0..3)
-                    .map(|c| (near[0][c] - at_vertex[0][c]).abs())
-                    .fold(0.0, f64::max);
-                assert!(
-                    d < 2.0 * e.powf(0.75),
-                    "face {face} e 2^-{k}: {d:.2e} from the limit"
-                );
-                assert!(d < previous, "face {face}: not converging");
-                previous = d;
-            }
-        }
-    }
-
     /// A crease vertex with three faces on one side (a loop of infinitely sharp edges around
     /// the middle face of a 3 x 3 grid): the tangent across that sector is the limit of the
     /// normals approaching it, slowly (eigenvalues 0.58, 0.5, 0.41 below 1: about
@@ -1410,6 +1390,10 @@ mod tests {
             mesh.set_edge_sharpness(a, b, INFINITE).expect("an edge");
         }
         // Vertex 5 = (1, 1): faces 0, 1 and 3 on the loop's outer side.
-        check_approached(&mesh, &[(0, 1.0, 1.0), (1, 0.0, 1.0), (3, 1.0, 0.0)], 0.25);
+        check_approached(
+            &mesh,
+            &[(0, 1.0, 1.0), (1, 0.0, 1.0), (3, 1.0, 0.0)],
+            Some(0.25),
+        );
     }
 }
