@@ -1122,17 +1122,14 @@ pub fn tessellate(
 mod tests {
     use super::*;
     use crate::tessellate::kernel::{cross, unit};
+    use crate::tessellate::lane_stencils::test_numbers;
 
     /// The lanes give the scalar tensor-product sums (the formulas of [`evaluate_separable`]'s
     /// doc, one point at a time, as the evaluator computed them before the lanes) bit for bit,
     /// for rates whose last group of rows is full or short.
     #[test]
     fn separable_lanes_are_the_scalar_sums_bit_for_bit() {
-        let mut state = 0x9e37_79b9u32;
-        let mut next = move || {
-            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            (state >> 8) as f32 / (1u32 << 24) as f32 - 0.5
-        };
+        let mut next = test_numbers(0x9e37_79b9);
         for n in [1usize, 2, 3, 4, 5, 7, 8, 16, 24, 33, 40] {
             let mut factor =
                 || -> [Vec<f32>; 4] { std::array::from_fn(|_| (0..n).map(|_| next()).collect()) };

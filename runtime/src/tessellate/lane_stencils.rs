@@ -256,6 +256,17 @@ pub(crate) fn unit_cross_x4(a: [f32x4; 3], b: [f32x4; 3]) -> [[f32; 3]; LANES] {
     }
 }
 
+/// Deterministic pseudo-random numbers in `[-1/2, 1/2)` (a linear congruential sequence from
+/// `seed`), for the tests that compare lanes with scalar sums.
+#[cfg(test)]
+pub(crate) fn test_numbers(seed: u32) -> impl FnMut() -> f32 {
+    let mut state = seed;
+    move || {
+        state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        (state >> 8) as f32 / (1u32 << 24) as f32 - 0.5
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -265,12 +276,7 @@ mod tests {
     /// short last groups) and patch size (the unrolled ones and others).
     #[test]
     fn lanes_are_the_point_by_point_sums_bit_for_bit() {
-        // Deterministic pseudo-random weights and points (a linear congruential sequence).
-        let mut state = 0x2545_f491u32;
-        let mut next = move || {
-            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            (state >> 8) as f32 / (1u32 << 24) as f32 - 0.5
-        };
+        let mut next = test_numbers(0x2545_f491);
         for k in [5, 12, 13, 27, 33] {
             for points in [1, 3, 4, 7, 19] {
                 let block = |next: &mut dyn FnMut() -> f32| -> Vec<f32> {
