@@ -37,8 +37,8 @@ use std::path::PathBuf;
 /// Random tag sets per shape.
 const VARIANTS: u64 = 4;
 /// The largest position difference asserted, over the bounding-box diagonal: twice the
-/// faithful bound (one variant, `catmark_pyramid_creases2_tags1`, is at 1.2e-5, at a vertex of
-/// a triangle's sub-face).
+/// faithful bound (one variant, `catmark_pyramid_creases2_tags1`, is at 1.2e-5, at a dart
+/// whose limit OpenSubdiv takes from the smooth mask: docs/results.md).
 const POSITION: f64 = 2.0 * FAITHFUL_POSITION;
 /// Shapes with more vertices are left out (the compare evaluates Far at isolation level 10).
 const MAX_VERTICES: usize = 32;
