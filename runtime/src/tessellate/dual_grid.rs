@@ -40,9 +40,8 @@ use crate::scheme::patch::{dual_index_in_patch, FacePatch};
 use crate::stencil_table::StencilTable;
 pub use crate::tessellate::kernel::TessellationTime;
 use crate::tessellate::kernel::{
-    evaluate_points, for_each_range, gather_relative, merge_rows, patch_origin, relative,
-    table_may_describe, unless_absent, weighted_point, Connectivity, GridPlan, PointPlan, Stencils,
-    MAX_PATCH,
+    evaluate_points, for_each_range, gather_relative, merge_rows, relative, table_may_describe,
+    unless_absent, Connectivity, GridPlan, PointPlan, Stencils, MAX_PATCH,
 };
 use crate::tessellate::lane_stencils::{unit_cross_x4, LaneStencils, LANES};
 use crate::RuntimeError;
@@ -185,9 +184,9 @@ enum FaceEval {
     Table { lanes: u32, control: Range<u32> },
     /// A face the tables do not describe (sharp features, a valence beyond the table's):
     /// stencils from feature-adaptive refinement ([`crate::scheme::catmull_clark::adaptive`]),
-    /// in the face's own parameters, `control.len()` weights a point in three blocks (position,
-    /// d/du, d/dv) from `weights` in [`DualGrid::local_weights`].
-    Local { control: Range<u32>, weights: usize },
+    /// in the face's own parameters, over its own control points (the union of its points'
+    /// supports, any number), in lanes of their own (`DualGrid::lanes[lanes]`).
+    Local { control: Range<u32>, lanes: u32 },
     /// A hole: no points, no triangles.
     Hole,
 }
@@ -236,14 +235,13 @@ pub struct DualGrid {
     faces: Vec<FaceEval>,
     /// Separable factors by rate (index `n`).
     bases: Vec<Option<SeparableBasis>>,
-    /// The table faces' stencils in lanes, one per section, corner and patch size met.
+    /// The table faces' stencils in lanes, one per section, corner and patch size met, and
+    /// one per local face.
     lanes: Vec<LaneStencils>,
     /// Control points of the table-evaluated patches, concatenated.
     control: Vec<u32>,
     /// Boundary-curve points (vertex limit points first, then edges' interior points).
     boundary_points: Vec<PointPlan>,
-    /// The stencils of [`FaceEval::Local`] faces.
-    local_weights: Vec<f32>,
     /// Boundary points of local faces still to be computed (index into `boundary_points`).
     local_points: Vec<(usize, LimitQuery)>,
     strips: Vec<Strip>,
@@ -381,7 +379,6 @@ impl DualGrid {
             lanes: Vec::new(),
             control: Vec::new(),
             boundary_points: Vec::new(),
-            local_weights: Vec::new(),
             local_points: Vec::new(),
             strips: Vec::new(),
             connectivity: Connectivity::default(),
@@ -416,7 +413,7 @@ impl DualGrid {
                 local_faces.push(f);
                 grid.faces.push(FaceEval::Local {
                     control: 0..0,
-                    weights: 0,
+                    lanes: 0,
                 });
                 continue;
             };
@@ -580,13 +577,23 @@ impl DualGrid {
             let points = &stencils[at..at + n * n];
             at += n * n;
             let (control, weights) = dense(points);
+            let block = n * n * control.len();
+            let s = Stencils {
+                position: &weights[..block],
+                du: &weights[block..2 * block],
+                dv: &weights[2 * block..],
+            };
+            // `None` only for a face without points (rate 0, refused before the plan).
+            let lanes = LaneStencils::new(control.len(), n * n, |t| (&s, t)).ok_or_else(|| {
+                RuntimeError::Unsupported(format!("face {f} has no points at rate {n}"))
+            })?;
             let start = self.control.len() as u32;
             self.control.extend_from_slice(&control);
             self.faces[f] = FaceEval::Local {
                 control: start..self.control.len() as u32,
-                weights: self.local_weights.len(),
+                lanes: self.lanes.len() as u32,
             };
-            self.local_weights.extend_from_slice(&weights);
+            self.lanes.push(lanes);
         }
         for (&(plan, _), stencil) in self.local_points.iter().zip(&stencils[at..]) {
             let (control, weights) = dense(std::slice::from_ref(stencil));
@@ -853,41 +860,31 @@ impl DualGrid {
             FaceEval::Table {
                 lanes,
                 control: range,
+            }
+            | FaceEval::Local {
+                lanes,
+                control: range,
             } => {
                 let points = &self.control[range.start as usize..range.end as usize];
-                let mut local = [[0.0f32; 3]; MAX_PATCH];
-                let origin = gather_relative(points, control, &mut local);
-                if let Some(lanes) = self.lanes.get(*lanes as usize) {
-                    if lanes.control_points() == points.len() {
-                        lanes.evaluate(&local[..points.len()], origin, positions, normals);
-                    }
+                let Some(lanes) = self.lanes.get(*lanes as usize) else {
+                    return;
+                };
+                if lanes.control_points() != points.len() {
+                    return;
+                }
+                if points.len() <= MAX_PATCH {
+                    let mut local = [[0.0f32; 3]; MAX_PATCH];
+                    let origin = gather_relative(points, control, &mut local);
+                    lanes.evaluate(&local[..points.len()], origin, positions, normals);
+                } else {
+                    // A local face next to a high valence (729 points around valence 360):
+                    // made relative once per face, on the heap.
+                    let mut local = vec![[0.0f32; 3]; points.len()];
+                    let origin = gather_relative(points, control, &mut local);
+                    lanes.evaluate(&local, origin, positions, normals);
                 }
             }
             FaceEval::Hole => {}
-            FaceEval::Local {
-                control: range,
-                weights,
-            } => {
-                let points = &self.control[range.start as usize..range.end as usize];
-                let block = n * n * points.len();
-                let w = &self.local_weights[*weights..*weights + 3 * block];
-                let s = Stencils {
-                    position: &w[..block],
-                    du: &w[block..2 * block],
-                    dv: &w[2 * block..],
-                };
-                // Any number of control points (the union of the stencils' supports): made
-                // relative once per face, on the heap.
-                let origin = patch_origin(points, control);
-                let local: Vec<[f32; 3]> = points
-                    .iter()
-                    .map(|&v| relative(control[v as usize], origin))
-                    .collect();
-                let origin = origin.map(|c| c as f32);
-                for at in 0..n * n {
-                    (positions[at], normals[at]) = weighted_point(&s, &local, origin, at);
-                }
-            }
         }
     }
 

@@ -248,7 +248,7 @@ pub(crate) fn gather_relative(
 /// control points `q(0..k)`, relative to `origin` ([`gather_relative`]): the position `origin +
 /// sum w q`, and the cross product of the two derivatives `sum w_u q`, `sum w_v q`.
 #[inline(always)]
-fn stencil_point(
+pub(crate) fn stencil_point(
     s: &Stencils,
     k: usize,
     point: usize,
@@ -267,17 +267,6 @@ fn stencil_point(
         }
     }
     (p[0], unit(cross(p[1], p[2])))
-}
-
-/// Position and unit normal of table point `point` (row of the stencils) from the patch's
-/// control points `local`, relative to `origin` ([`gather_relative`]).
-pub(crate) fn weighted_point(
-    s: &Stencils,
-    local: &[[f32; 3]],
-    origin: [f32; 3],
-    point: usize,
-) -> ([f32; 3], [f32; 3]) {
-    stencil_point(s, local.len(), point, origin, |l| local[l])
 }
 
 /// Running totals of `counts`: item `i` owns `[ends[i-1], ends[i])`.

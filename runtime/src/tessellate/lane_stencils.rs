@@ -17,7 +17,7 @@
 //! (`[l][position, d/du, d/dv][lane]`), once per table section, face corner and rate when the
 //! plan is built: a step `l` is then one vector multiply-add per quantity and coordinate for
 //! all the lanes, each lane still summing its own point in the order `l = 0..K`. The result is
-//! bit-identical to the point-by-point sums ([`crate::tessellate::kernel::weighted_point`]),
+//! bit-identical to the point-by-point sums ([`crate::tessellate::kernel::stencil_point`]),
 //! in about a quarter of the instructions.
 
 use wide::{f32x4, CmpGe, CmpLt};
@@ -270,7 +270,7 @@ pub(crate) fn test_numbers(seed: u32) -> impl FnMut() -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::tessellate::kernel::weighted_point;
+    use crate::tessellate::kernel::stencil_point;
 
     /// The lanes give the point-by-point sums bit for bit, for every count of points (full and
     /// short last groups) and patch size (the unrolled ones and others).
@@ -297,7 +297,7 @@ mod tests {
                 let mut normals = vec![[0.0f32; 3]; points];
                 lanes.evaluate(&local, origin, &mut positions, &mut normals);
                 for t in 0..points {
-                    let (p, n) = weighted_point(&s, &local, origin, points - 1 - t);
+                    let (p, n) = stencil_point(&s, k, points - 1 - t, origin, |l| local[l]);
                     assert_eq!(positions[t].map(f32::to_bits), p.map(f32::to_bits));
                     assert_eq!(normals[t].map(f32::to_bits), n.map(f32::to_bits));
                 }
