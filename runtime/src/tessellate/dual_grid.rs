@@ -40,10 +40,10 @@ use crate::scheme::patch::{dual_index_in_patch, FacePatch};
 use crate::stencil_table::StencilTable;
 pub use crate::tessellate::kernel::TessellationTime;
 use crate::tessellate::kernel::{
-    evaluate_points, for_each_range, gather_relative, merge_rows, relative, table_may_describe,
-    unless_absent, Connectivity, GridPlan, PointPlan, Stencils, MAX_PATCH,
+    for_each_range, merge_rows, relative, table_may_describe, unless_absent, Connectivity,
+    GridPlan, PointPlan, Stencils,
 };
-use crate::tessellate::lane_stencils::{unit_cross_x4, LaneStencils, LANES};
+use crate::tessellate::lane_stencils::{unit_cross_x4, LaneStencils, PointGroups, LANES};
 use crate::RuntimeError;
 use wide::f32x4;
 
@@ -240,8 +240,12 @@ pub struct DualGrid {
     lanes: Vec<LaneStencils>,
     /// Control points of the table-evaluated patches, concatenated.
     control: Vec<u32>,
-    /// Boundary-curve points (vertex limit points first, then edges' interior points).
+    /// Boundary-curve points (vertex limit points first, then edges' interior points), while
+    /// the plan is built.
     boundary_points: Vec<PointPlan>,
+    /// The boundary points' stencils, in lanes ([`PointGroups`]), and where they lie.
+    boundary_groups: PointGroups,
+    boundary_sources: Vec<VertexSource>,
     /// Boundary points of local faces still to be computed (index into `boundary_points`).
     local_points: Vec<(usize, LimitQuery)>,
     strips: Vec<Strip>,
@@ -379,6 +383,8 @@ impl DualGrid {
             lanes: Vec::new(),
             control: Vec::new(),
             boundary_points: Vec::new(),
+            boundary_groups: PointGroups::default(),
+            boundary_sources: Vec::new(),
             local_points: Vec::new(),
             strips: Vec::new(),
             connectivity: Connectivity::default(),
@@ -471,6 +477,11 @@ impl DualGrid {
             let copy = &mut grid.boundary_points[(copy - dual_total) as usize];
             (copy.weights, copy.control) = (original.weights, original.control);
         }
+        let points = std::mem::take(&mut grid.boundary_points);
+        grid.boundary_groups = PointGroups::new(&points, &grid.control).ok_or_else(|| {
+            RuntimeError::Unsupported("a boundary point's stencil is not its patch's".to_owned())
+        })?;
+        grid.boundary_sources = points.into_iter().map(|p| p.source).collect();
         Ok(grid)
     }
 
@@ -866,22 +877,8 @@ impl DualGrid {
                 control: range,
             } => {
                 let points = &self.control[range.start as usize..range.end as usize];
-                let Some(lanes) = self.lanes.get(*lanes as usize) else {
-                    return;
-                };
-                if lanes.control_points() != points.len() {
-                    return;
-                }
-                if points.len() <= MAX_PATCH {
-                    let mut local = [[0.0f32; 3]; MAX_PATCH];
-                    let origin = gather_relative(points, control, &mut local);
-                    lanes.evaluate(&local[..points.len()], origin, positions, normals);
-                } else {
-                    // A local face next to a high valence (729 points around valence 360):
-                    // made relative once per face, on the heap.
-                    let mut local = vec![[0.0f32; 3]; points.len()];
-                    let origin = gather_relative(points, control, &mut local);
-                    lanes.evaluate(&local, origin, positions, normals);
+                if let Some(lanes) = self.lanes.get(*lanes as usize) {
+                    lanes.evaluate_patch(points, control, positions, normals);
                 }
             }
             FaceEval::Hole => {}
@@ -936,7 +933,7 @@ impl GridPlan for DualGrid {
                 }
             }
         }
-        out.extend(self.boundary_points.iter().map(|p| p.source));
+        out.extend_from_slice(&self.boundary_sources);
         out
     }
 
@@ -952,13 +949,8 @@ impl GridPlan for DualGrid {
             (face_positions, face_normals),
             |f, (p, q)| self.evaluate_face(f, control, p, q),
         );
-        evaluate_points(
-            &self.boundary_points,
-            &self.control,
-            control,
-            curve_positions,
-            curve_normals,
-        );
+        self.boundary_groups
+            .evaluate(&self.control, control, curve_positions, curve_normals);
     }
 
     /// Write every triangle (`triangle_count()` of them).

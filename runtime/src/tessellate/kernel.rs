@@ -173,38 +173,6 @@ pub(crate) fn merge_rows(
     }
 }
 
-/// Evaluate points planned one by one (`plans[i]` into `positions[i]`, `normals[i]`), in
-/// parallel: each plan's control points are `indices[plan.control]`, vertices of `control`,
-/// taken relative to the first of them ([`relative`]).
-pub(crate) fn evaluate_points(
-    plans: &[PointPlan],
-    indices: &[u32],
-    control: &[[f64; 3]],
-    positions: &mut [[f32; 3]],
-    normals: &mut [[f32; 3]],
-) {
-    positions
-        .par_iter_mut()
-        .zip(normals.par_iter_mut())
-        .zip(plans.par_iter())
-        .for_each(|((p, q), plan)| {
-            let points = &indices[plan.control.start as usize..plan.control.end as usize];
-            let k = points.len();
-            let (wp, rest) = plan.weights.split_at(k);
-            let (wu, wv) = rest.split_at(k);
-            let s = Stencils {
-                position: wp,
-                du: wu,
-                dv: wv,
-            };
-            // One point per plan: each control point is made relative once either way.
-            let origin = patch_origin(points, control);
-            (*p, *q) = stencil_point(&s, k, 0, origin.map(|c| c as f32), |l| {
-                relative(control[points[l] as usize], origin)
-            });
-        });
-}
-
 /// The origin of a patch whose control points are `control[points[l]]`: its first point (zero
 /// for none); see [`gather_relative`].
 #[inline(always)]
@@ -242,31 +210,6 @@ pub(crate) fn gather_relative(
         *l = relative(control[v as usize], origin);
     }
     origin.map(|c| c as f32)
-}
-
-/// Position and unit normal of row `point` of `s`, a stencil of `k` weights a point, over the
-/// control points `q(0..k)`, relative to `origin` ([`gather_relative`]): the position `origin +
-/// sum w q`, and the cross product of the two derivatives `sum w_u q`, `sum w_v q`.
-#[inline(always)]
-pub(crate) fn stencil_point(
-    s: &Stencils,
-    k: usize,
-    point: usize,
-    origin: [f32; 3],
-    q: impl Fn(usize) -> [f32; 3],
-) -> ([f32; 3], [f32; 3]) {
-    let rows = point * k..(point + 1) * k;
-    let (wp, wu, wv) = (&s.position[rows.clone()], &s.du[rows.clone()], &s.dv[rows]);
-    let mut p = [origin, [0.0; 3], [0.0; 3]];
-    for l in 0..k {
-        let q = q(l);
-        for x in 0..3 {
-            p[0][x] += wp[l] * q[x];
-            p[1][x] += wu[l] * q[x];
-            p[2][x] += wv[l] * q[x];
-        }
-    }
-    (p[0], unit(cross(p[1], p[2])))
 }
 
 /// Running totals of `counts`: item `i` owns `[ends[i-1], ends[i])`.

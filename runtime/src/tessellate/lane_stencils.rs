@@ -17,12 +17,16 @@
 //! (`[l][position, d/du, d/dv][lane]`), once per table section, face corner and rate when the
 //! plan is built: a step `l` is then one vector multiply-add per quantity and coordinate for
 //! all the lanes, each lane still summing its own point in the order `l = 0..K`. The result is
-//! bit-identical to the point-by-point sums ([`crate::tessellate::kernel::stencil_point`]),
+//! bit-identical to the point-by-point sums (`tests::stencil_point`, the scalar formula),
 //! in about a quarter of the instructions.
 
 use wide::{f32x4, CmpGe, CmpLt};
 
-use crate::tessellate::kernel::{cross, unit, Stencils};
+use std::ops::Range;
+
+use crate::tessellate::kernel::{
+    cross, for_each_range, gather_relative, unit, PointPlan, Stencils, MAX_PATCH,
+};
 
 /// Points evaluated together (SSE's four f32, the baseline x86-64 vector).
 pub(crate) const LANES: usize = 4;
@@ -78,6 +82,30 @@ impl LaneStencils {
     /// Control points of the patch.
     pub(crate) fn control_points(&self) -> usize {
         self.k
+    }
+
+    /// Every point from the patch whose control points are the vertices `points` of `control`
+    /// ([`gather_relative`]; nothing if they are not `K`), into `positions[t]`, `normals[t]`.
+    pub(crate) fn evaluate_patch(
+        &self,
+        points: &[u32],
+        control: &[[f64; 3]],
+        positions: &mut [[f32; 3]],
+        normals: &mut [[f32; 3]],
+    ) {
+        if points.len() != self.k {
+            return;
+        }
+        if self.k <= MAX_PATCH {
+            let mut local = [[0.0f32; 3]; MAX_PATCH];
+            let origin = gather_relative(points, control, &mut local);
+            self.evaluate(&local[..self.k], origin, positions, normals);
+        } else {
+            // Feature-adaptive stencils can be wider (729 points next to a valence-360 vertex).
+            let mut local = vec![[0.0f32; 3]; self.k];
+            let origin = gather_relative(points, control, &mut local);
+            self.evaluate(&local, origin, positions, normals);
+        }
     }
 
     /// Every point of a face from its control points `local` (relative to `origin`, `K` of
@@ -153,6 +181,71 @@ impl LaneStencils {
                 normals[start + lane] = normal[lane];
             }
         }
+    }
+}
+
+/// The points evaluated on their own (boundary curves, limit points, their seam copies), in
+/// runs of consecutive points over the same control points, each run's stencils in lanes.
+///
+/// Why: a point planned on its own reads its patch's `K` control points and makes each
+/// relative ([`gather_relative`]) for one point, which costs as much as its sums; the `n - 1`
+/// curve points of an edge come from one face's patch, so one gather serves them all, and their
+/// sums run four at a time. Each point is still its own stencil summed in its own order from the
+/// run's first control point, the origin it had alone: bit-identical.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct PointGroups {
+    /// Every run's control points (a range of the plan's indices) and stencils.
+    runs: Vec<(Range<u32>, LaneStencils)>,
+    /// Points up to the end of each run (prefix sums).
+    ends: Vec<usize>,
+}
+
+impl PointGroups {
+    /// The runs of `plans` (point `i` over `indices[plans[i].control]`, its position, d/du and
+    /// d/dv weights one block after the other); `None` if a plan's weights are not three
+    /// blocks as long as its control points.
+    pub(crate) fn new(plans: &[PointPlan], indices: &[u32]) -> Option<Self> {
+        let control =
+            |plan: &PointPlan| indices.get(plan.control.start as usize..plan.control.end as usize);
+        let mut groups = PointGroups::default();
+        let mut start = 0;
+        while start < plans.len() {
+            let first = control(&plans[start])?;
+            let mut end = start + 1;
+            while end < plans.len() && control(&plans[end])? == first {
+                end += 1;
+            }
+            let k = first.len();
+            let stencils = plans[start..end]
+                .iter()
+                .map(|plan| {
+                    let (position, rest) = plan.weights.split_at_checked(k)?;
+                    let (du, dv) = rest.split_at_checked(k)?;
+                    (dv.len() == k).then_some(Stencils { position, du, dv })
+                })
+                .collect::<Option<Vec<_>>>()?;
+            let lanes = LaneStencils::new(k, end - start, |t| (&stencils[t], 0))?;
+            groups.runs.push((plans[start].control.clone(), lanes));
+            groups.ends.push(end);
+            start = end;
+        }
+        Some(groups)
+    }
+
+    /// Every point from the vertices `control` (the plan's `indices` name them), into
+    /// `positions[i]`, `normals[i]`, the runs in parallel.
+    pub(crate) fn evaluate(
+        &self,
+        indices: &[u32],
+        control: &[[f64; 3]],
+        positions: &mut [[f32; 3]],
+        normals: &mut [[f32; 3]],
+    ) {
+        for_each_range(&self.ends, (positions, normals), |r, (p, q)| {
+            let (range, lanes) = &self.runs[r];
+            let points = &indices[range.start as usize..range.end as usize];
+            lanes.evaluate_patch(points, control, p, q);
+        });
     }
 }
 
@@ -270,7 +363,93 @@ pub(crate) fn test_numbers(seed: u32) -> impl FnMut() -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::tessellate::kernel::stencil_point;
+    use crate::mesh::triangle_mesh::VertexSource;
+
+    /// The point-by-point formula the lanes must reproduce: position and unit normal of row
+    /// `point` of `s`, a stencil of `k` weights a point, over the control points `q(0..k)`,
+    /// relative to `origin` ([`gather_relative`]): the position `origin + sum w q`, and the
+    /// cross product of the two derivatives `sum w_u q`, `sum w_v q`.
+    fn stencil_point(
+        s: &Stencils,
+        k: usize,
+        point: usize,
+        origin: [f32; 3],
+        q: impl Fn(usize) -> [f32; 3],
+    ) -> ([f32; 3], [f32; 3]) {
+        let rows = point * k..(point + 1) * k;
+        let (wp, wu, wv) = (&s.position[rows.clone()], &s.du[rows.clone()], &s.dv[rows]);
+        let mut p = [origin, [0.0; 3], [0.0; 3]];
+        for l in 0..k {
+            let q = q(l);
+            for x in 0..3 {
+                p[0][x] += wp[l] * q[x];
+                p[1][x] += wu[l] * q[x];
+                p[2][x] += wv[l] * q[x];
+            }
+        }
+        (p[0], unit(cross(p[1], p[2])))
+    }
+
+    /// Points planned one by one come out as each alone would: runs of equal control points
+    /// (also from different ranges of the indices) share a gather, other points do not, and a
+    /// patch wider than [`MAX_PATCH`] is taken too.
+    #[test]
+    fn point_groups_are_each_point_alone_bit_for_bit() {
+        let mut next = test_numbers(0x9e37_79b9);
+        let vertices: Vec<[f64; 3]> = (0..60)
+            .map(|_| [0, 1, 2].map(|_| f64::from(next()) * 10.0 + 1000.0))
+            .collect();
+        let wide: Vec<u32> = (0..45).collect();
+        let mut indices = Vec::new();
+        let mut plans = Vec::new();
+        for (points, count) in [
+            (vec![3u32, 7, 1, 9, 12], 3),
+            (vec![3, 7, 1, 9, 12], 2),
+            (vec![20, 21, 22, 5, 6, 7, 8], 1),
+            (wide, 5),
+            (vec![3, 7, 1, 9, 12], 1),
+        ] {
+            for _ in 0..count {
+                let start = indices.len() as u32;
+                indices.extend_from_slice(&points);
+                let weights = (0..3 * points.len()).map(|_| next()).collect();
+                plans.push(PointPlan {
+                    weights,
+                    control: start..indices.len() as u32,
+                    source: VertexSource::default(),
+                });
+            }
+        }
+        let groups = PointGroups::new(&plans, &indices).expect("three blocks a plan");
+        assert_eq!(groups.ends, [5, 6, 11, 12], "runs of equal control points");
+        let mut positions = vec![[0.0f32; 3]; plans.len()];
+        let mut normals = vec![[0.0f32; 3]; plans.len()];
+        groups.evaluate(&indices, &vertices, &mut positions, &mut normals);
+        for (i, plan) in plans.iter().enumerate() {
+            let points = &indices[plan.control.start as usize..plan.control.end as usize];
+            let k = points.len();
+            let s = Stencils {
+                position: &plan.weights[..k],
+                du: &plan.weights[k..2 * k],
+                dv: &plan.weights[2 * k..],
+            };
+            let origin = vertices[points[0] as usize];
+            let (p, n) = stencil_point(&s, k, 0, origin.map(|c| c as f32), |l| {
+                let v = vertices[points[l] as usize];
+                [0, 1, 2].map(|x| (v[x] - origin[x]) as f32)
+            });
+            assert_eq!(
+                positions[i].map(f32::to_bits),
+                p.map(f32::to_bits),
+                "point {i}"
+            );
+            assert_eq!(
+                normals[i].map(f32::to_bits),
+                n.map(f32::to_bits),
+                "point {i}"
+            );
+        }
+    }
 
     /// The lanes give the point-by-point sums bit for bit, for every count of points (full and
     /// short last groups) and patch size (the unrolled ones and others).

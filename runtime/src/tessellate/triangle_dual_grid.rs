@@ -46,10 +46,10 @@ use crate::scheme::triangle::patch::{
 };
 pub use crate::stencil_table::TriangleStencils;
 use crate::tessellate::kernel::{
-    evaluate_points, for_each_range, gather_relative, merge_rows, Connectivity, GridPlan,
-    PointPlan, Stencils, TessellationTime,
+    for_each_range, gather_relative, merge_rows, Connectivity, GridPlan, PointPlan, Stencils,
+    TessellationTime,
 };
-use crate::tessellate::lane_stencils::LaneStencils;
+use crate::tessellate::lane_stencils::{LaneStencils, PointGroups};
 use crate::tessellate::loop_quartic::{self, QuarticBasis};
 use crate::RuntimeError;
 
@@ -210,8 +210,11 @@ pub struct TriangleDualGrid {
     /// Control points of every patch, concatenated.
     control: Vec<u32>,
     /// Points evaluated on their own: every vertex's limit point, then the boundary curves'
-    /// interior points.
+    /// interior points, while the plan is built.
     points: Vec<PointPlan>,
+    /// Those points' stencils, in lanes ([`PointGroups`]), and where they lie.
+    point_groups: PointGroups,
+    point_sources: Vec<VertexSource>,
     strips: Vec<TriangleStrip>,
     /// The output vertex of every mesh vertex's limit point ([`NONE`] for unused vertices).
     limit_points: Vec<u32>,
@@ -314,6 +317,8 @@ impl TriangleDualGrid {
             quartic: None,
             control: Vec::new(),
             points: Vec::new(),
+            point_groups: PointGroups::default(),
+            point_sources: Vec::new(),
             strips: Vec::new(),
             limit_points: Vec::new(),
             connectivity: Connectivity::default(),
@@ -394,6 +399,13 @@ impl TriangleDualGrid {
             });
         }
         grid.plan_connectivity(table, mesh, patches)?;
+        let points = std::mem::take(&mut grid.points);
+        grid.point_groups = PointGroups::new(&points, &grid.control).ok_or_else(|| {
+            RuntimeError::Unsupported(
+                "a limit or curve point's stencil is not its patch's".to_owned(),
+            )
+        })?;
+        grid.point_sources = points.into_iter().map(|p| p.source).collect();
         Ok(grid)
     }
 
@@ -684,7 +696,7 @@ impl GridPlan for TriangleDualGrid {
                 }
             }
         }
-        out.extend(self.points.iter().map(|p| p.source));
+        out.extend_from_slice(&self.point_sources);
         out
     }
 
@@ -709,13 +721,8 @@ impl GridPlan for TriangleDualGrid {
                 })
             },
             || {
-                evaluate_points(
-                    &self.points,
-                    &self.control,
-                    control,
-                    point_positions,
-                    point_normals,
-                )
+                self.point_groups
+                    .evaluate(&self.control, control, point_positions, point_normals)
             },
         );
     }
