@@ -411,6 +411,9 @@ pub fn render(
 }
 
 #[cfg(test)]
+// Two tests render the shipped cube through the embedded Catmull–Clark table; without it, their
+// helpers go unused.
+#[cfg_attr(not(feature = "catmull-clark"), allow(unused))]
 mod tests {
     use super::*;
     use crate::{Mesh, Rates, Scheme, Surface};
@@ -433,6 +436,7 @@ mod tests {
 
     /// The same mesh renders to the same bytes, on one thread as on several.
     #[test]
+    #[cfg(feature = "catmull-clark")]
     fn rendering_is_deterministic() {
         let cube = limit_cube();
         let options = RenderOptions {
@@ -498,6 +502,7 @@ mod tests {
     /// projected vertices: the rasterized coverage matches the hull's area (an independent
     /// computation) within 0.5%, from several directions and distances.
     #[test]
+    #[cfg(feature = "catmull-clark")]
     fn the_silhouette_of_a_convex_limit_surface_covers_its_hull() {
         let cube = limit_cube();
         for (azimuth, elevation, distance) in [

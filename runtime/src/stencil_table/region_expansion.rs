@@ -862,7 +862,8 @@ fn strictly_inside(corners: &[(i64, i64); 3], y: (i64, i64), d: i64) -> bool {
     })
 }
 
-#[cfg(test)]
+// The test reads the embedded region tables.
+#[cfg(all(test, feature = "butterfly", feature = "sqrt3"))]
 mod tests {
     use super::*;
     use schemes::lattice_symmetry::{rotate_back, to_quarter, to_wedge};

@@ -466,6 +466,7 @@ fn eval_evaluates_loop_surfaces_exactly() {
 }
 
 #[test]
+#[cfg(feature = "loop")]
 fn loop_scheme_takes_view_dependent_rates() {
     let mesh = temp("octahedron-view.obj");
     std::fs::write(&mesh, OCTAHEDRON).expect("written");
@@ -496,6 +497,7 @@ fn loop_scheme_takes_view_dependent_rates() {
 }
 
 #[test]
+#[cfg(feature = "loop")]
 fn loop_scheme_tessellates_triangles() {
     let mesh = temp("octahedron.obj");
     std::fs::write(&mesh, OCTAHEDRON).expect("written");
@@ -566,6 +568,7 @@ fn every_rate_is_watertight(mesh: &std::path::Path, out_path: &std::path::Path, 
 }
 
 #[test]
+#[cfg(feature = "butterfly")]
 fn butterfly_scheme_tessellates_closed_triangle_meshes() {
     let mesh = temp("octahedron-b.obj");
     std::fs::write(&mesh, OCTAHEDRON).expect("written");
@@ -610,6 +613,7 @@ fn butterfly_scheme_tessellates_closed_triangle_meshes() {
 }
 
 #[test]
+#[cfg(feature = "sqrt3")]
 fn sqrt3_scheme_tessellates_closed_triangle_meshes() {
     let mesh = temp("octahedron-s.obj");
     std::fs::write(&mesh, OCTAHEDRON).expect("written");
@@ -653,6 +657,7 @@ fn sqrt3_scheme_tessellates_closed_triangle_meshes() {
 }
 
 #[test]
+#[cfg(feature = "loop")]
 fn loop_scheme_errors_name_the_problem() {
     let obj = temp("never.obj");
     // The cube's first face is a quad.
@@ -684,6 +689,7 @@ fn loop_scheme_errors_name_the_problem() {
 /// the stats report the tolerance and the triangles that cannot meet it (with a warning), and
 /// `--method adaptive` is still refused.
 #[test]
+#[cfg(all(feature = "loop", feature = "butterfly", feature = "sqrt3"))]
 fn triangle_schemes_take_a_tolerance() {
     let mesh = temp("octahedron-tolerance.obj");
     std::fs::write(&mesh, OCTAHEDRON).expect("written");

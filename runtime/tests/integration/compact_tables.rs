@@ -233,6 +233,7 @@ fn inconsistent_compact_tables_are_refused_at_load() {
 /// The embedded default Loop table (compact) against a grid table of the same patches at
 /// `rates`, solved now by `stencilgen`'s grid systems; returns the largest difference in ulps
 /// and the number of weights compared.
+#[cfg(feature = "loop")]
 fn compare_loop(rates: Vec<u32>) -> (f64, usize) {
     use stencilgen::triangle_table::{build_triangle_table, TriangleLayout, TriangleTableSpec};
     let mut spec = TriangleTableSpec::default_loop().expect("spec");
@@ -250,6 +251,7 @@ fn compare_loop(rates: Vec<u32>) -> (f64, usize) {
 /// weights (about 4 s in the dev profile on two cores, mostly the grid solves). Measured: 0 ulp
 /// everywhere (the expansion evaluates the basis and substitutes in `stencilgen`'s order).
 #[test]
+#[cfg(feature = "loop")]
 fn compact_loop_grids_equal_solved_grids() {
     let (worst, count) = compare_loop((1..=8).chain([24]).collect());
     eprintln!("{count} weights, largest difference {worst} ulp");
@@ -260,6 +262,7 @@ fn compact_loop_grids_equal_solved_grids() {
 /// (30 to 45 s in the dev profile on two shared cores). Measured: 0 ulp everywhere.
 #[test]
 #[ignore = "30 to 45 s in the dev profile; the default test covers rates 1..=8 and 24"]
+#[cfg(feature = "loop")]
 fn compact_loop_grids_equal_solved_grids_at_every_rate() {
     let (worst, count) = compare_loop((1..=24).collect());
     eprintln!("{count} weights, largest difference {worst} ulp");
@@ -447,6 +450,7 @@ fn compact_nonpolynomial_quad_grids_equal_solved_grids() {
 /// the embedded defaults' valences at `rates`, generated now: each rate's regular basis solved
 /// on its whole grid by the orbit solver (exact and rounded, or by the SVD at the butterfly's
 /// odd grids), as the tables before the compact layout were made.
+#[cfg(all(feature = "butterfly", feature = "sqrt3"))]
 fn region_grids(scheme: &str, rates: Vec<u32>) -> StencilTable {
     use stencilgen::region_table::{RegionLayout, RegionTableSpec};
     let mut spec = match scheme {
@@ -464,6 +468,7 @@ fn region_grids(scheme: &str, rates: Vec<u32>) -> StencilTable {
 }
 
 /// The embedded compact table of `scheme`.
+#[cfg(all(feature = "butterfly", feature = "sqrt3"))]
 fn region_compact(scheme: &str) -> StencilTable {
     match scheme {
         "butterfly" => StencilTable::default_butterfly(),
@@ -491,6 +496,7 @@ fn region_floor(row: &[f32]) -> f32 {
 /// derivatives, rates 1..=8: the stencils plans read are today's to 1 ulp of f32 (weights
 /// below 2^-20 of their row's largest weight at that weight's ulp, [`region_floor`]).
 #[test]
+#[cfg(all(feature = "butterfly", feature = "sqrt3"))]
 fn compact_region_grids_equal_solved_grids() {
     for (scheme, want) in [("butterfly", 1_341_360), ("sqrt3", 1_341_360)] {
         let (worst, count) = same_grids_above(
@@ -509,6 +515,7 @@ fn compact_region_grids_equal_solved_grids() {
 /// weights per scheme, largest difference 0.5 ulp (butterfly) and 0.125 ulp (√3).
 #[test]
 #[ignore = "the grid layout's orbit solves at n = 9..=24 take tens of minutes"]
+#[cfg(all(feature = "butterfly", feature = "sqrt3"))]
 fn compact_region_grids_equal_solved_grids_at_every_rate() {
     for scheme in ["butterfly", "sqrt3"] {
         let (worst, count) = same_grids_above(
@@ -529,6 +536,7 @@ fn compact_region_grids_equal_solved_grids_at_every_rate() {
 /// rates 1..=8, and `stencilgen::region_basis`'s test at the rates 3..=15) this covers every
 /// rate the tables hold.
 #[test]
+#[cfg(all(feature = "butterfly", feature = "sqrt3"))]
 fn compact_region_grids_are_the_region_evaluation_at_every_rate() {
     use stencilgen::cone_regions::ConeRegionStencils;
     use stencilgen::region_basis::CanonicalBasis;

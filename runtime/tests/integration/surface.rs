@@ -194,6 +194,7 @@ fn the_cube_through_the_facade() {
 }
 
 #[test]
+#[cfg(all(feature = "loop", feature = "butterfly", feature = "sqrt3"))]
 fn the_triangle_schemes_through_the_facade() {
     let octahedron = Mesh::read_obj(data("octahedron.obj")).expect("shipped octahedron");
     for scheme in [Scheme::Loop, Scheme::Butterfly, Scheme::Sqrt3] {
@@ -213,6 +214,7 @@ fn the_triangle_schemes_through_the_facade() {
     not(shared_models),
     ignore = "needs ../shared/models beside the repository"
 )]
+#[cfg(feature = "loop")]
 fn spot_and_a_boundary_mesh_through_the_facade() {
     let spot = shared("crane/spot_control_mesh.obj");
     check("spot control mesh", &spot, Scheme::CatmullClark, 4);
@@ -301,6 +303,7 @@ fn the_cli_writes_the_frame_the_library_makes() {
 }
 
 #[test]
+#[cfg(feature = "loop")]
 fn rates_per_input_face_and_errors() {
     let cube = Mesh::read_obj(data("cube.obj")).expect("cube");
     let surface = Surface::new(&cube, Scheme::CatmullClark).expect("surface");
