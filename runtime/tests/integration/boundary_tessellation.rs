@@ -135,6 +135,7 @@ fn check_grid(rates: &[u32]) {
 }
 
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn a_grid_reaches_the_limit_boundary_curve() {
     for n in [1, 2, 3, 8, 24] {
         check_grid(&[n; 9]);
@@ -147,6 +148,7 @@ proptest! {
 
     /// Random per-face rates on the grid: still a disc with one boundary loop on the B-spline.
     #[test]
+    #[cfg(feature = "catmull-clark")]
     fn random_rates_on_the_grid(rates in proptest::collection::vec(1u32..=24, 9)) {
         check_grid(&rates);
     }

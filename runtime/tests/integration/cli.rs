@@ -40,6 +40,7 @@ fn json(out: &Output) -> serde_json::Value {
 }
 
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn tessellate_prints_the_stats_contract() {
     let obj = temp("cube.obj");
     let out = succeeds(&format!(
@@ -70,6 +71,7 @@ fn tessellate_prints_the_stats_contract() {
 }
 
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn per_face_rates_from_a_file() {
     let rates = temp("rates.txt");
     // The cube has 6 faces; each becomes 4 after isolation.
@@ -111,6 +113,7 @@ fn per_face_rates_from_a_file() {
 
 /// Every output format from the command line; the format is checked before any work.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn output_formats_by_extension() {
     for (ext, magic) in [
         ("ply", &b"ply\nformat binary_little_endian 1.0"[..]),
@@ -138,6 +141,7 @@ fn output_formats_by_extension() {
 }
 
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn bench_reports_throughput() {
     let out = succeeds("bench data/cube.obj --refine 2 --rate 4 --threads 1 --frames 3");
     let report = json(&out);
@@ -184,6 +188,7 @@ fn bad_input_is_a_clear_error() {
 /// `--tolerance`: a tighter tolerance never needs fewer triangles; `--view`: a nearer camera
 /// never fewer; malformed values are refused by the argument parser.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn tolerance_and_view_rates() {
     let obj = temp("rates-cube.obj");
     let triangles = |args: &str| -> u64 {
@@ -347,6 +352,7 @@ fn bezier_options_need_bezier_input() {
     not(shared_models),
     ignore = "needs ../shared/models beside the repository"
 )]
+#[cfg(feature = "catmull-clark")]
 fn pinned_corners_work_out_of_the_box() {
     let shape = crate::common::models().join("opensubdiv/catmark_edgecorner.obj");
     let obj = temp("edgecorner.obj");
@@ -364,6 +370,7 @@ fn pinned_corners_work_out_of_the_box() {
 /// `--method adaptive` (Lai-Cheng): polygons in OBJ, triangles elsewhere, watertight, the bound
 /// under the tolerance; it needs `--tolerance`.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn adaptive_method_from_the_command_line() {
     let obj = temp("adaptive.obj");
     let out = succeeds(&format!(
@@ -398,6 +405,7 @@ fn adaptive_method_from_the_command_line() {
 /// levels there, so squares stay over it, and stderr says how many; at 18 none does. Beyond
 /// the parameter grid's 24 levels, or 0, is a usage error.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn adaptive_max_depth_and_the_squares_left_over() {
     let ply = temp("cone.ply");
     let base = format!(
@@ -658,6 +666,7 @@ fn sqrt3_scheme_tessellates_closed_triangle_meshes() {
 
 #[test]
 #[cfg(feature = "loop")]
+#[cfg(feature = "catmull-clark")]
 fn loop_scheme_errors_name_the_problem() {
     let obj = temp("never.obj");
     // The cube's first face is a quad.
@@ -751,6 +760,7 @@ fn triangle_schemes_take_a_tolerance() {
 /// `subtess render` draws every format `tessellate` writes, side by side, into the same bytes
 /// every time, and refuses sizes and views it cannot draw.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn render_draws_what_tessellate_writes() {
     let (ply, glb, png, again) = (
         temp("render.ply"),

@@ -203,6 +203,7 @@ fn dart_prism(v: usize, mirrored: bool) -> Mesh {
 /// Darts of every table valence (3..=8), in both orientations, at rates 1, 2, 3, 5 and 8: every
 /// sector of every dart patch, with the valence-4 darts at the crease's other end.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn dart_patches_equal_adaptive_refinement_on_prisms() {
     let mut kinds = std::collections::BTreeSet::new();
     let (mut points, mut position, mut normal) = (0, 0f64, 0f64);
@@ -241,6 +242,7 @@ fn dart_patches_equal_adaptive_refinement_on_prisms() {
     not(shared_models),
     ignore = "needs ../shared/models beside the repository"
 )]
+#[cfg(feature = "catmull-clark")]
 fn dart_patches_equal_adaptive_refinement_on_opensubdiv_shapes() {
     for name in ["catmark_inf_crease0.obj", "catmark_cubes_infsharp.obj"] {
         let path = crate::common::models().join("opensubdiv").join(name);
@@ -264,6 +266,7 @@ fn dart_patches_equal_adaptive_refinement_on_opensubdiv_shapes() {
 /// A tessellation through the dart patches stays watertight: every edge of the closed prisms'
 /// output is shared by exactly two triangles, at rates 1 and 6.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn dart_patches_tessellate_watertight() {
     for v in [3, 4, 5, 8] {
         let mesh = dart_prism(v, false);

@@ -566,6 +566,7 @@ fn cube() -> Mesh {
 }
 
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn grid_points_agree_with_the_embedded_f32_table() {
     let table = StencilTable::default_catmull_clark().expect("embedded table");
     let mut worst = 0.0f64;

@@ -49,6 +49,7 @@ fn uvs_from_positions(path: &Path, k: u8) -> String {
 /// Under the default mode (OpenSubdiv's `FVAR_LINEAR_ALL`) every output vertex's texture
 /// coordinates are the bilinear interpolation of its face's corner values at its `(u, v)`.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn the_linear_mode_is_bilinear_in_the_corner_values() {
     let text = std::fs::read_to_string(data("cube_uv.obj")).expect("readable");
     let obj = parse_obj(&text).expect("parses");
@@ -93,6 +94,7 @@ fn cube_seam_copies(surface: &Surface, n: u32) -> u32 {
 /// vertices are split, the copies share the original's position and normal bits, and the
 /// output stays watertight in positions.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn seams_split_vertices_with_the_same_position_bits() {
     let mesh = Mesh::read_obj(data("cube_uv.obj")).expect("reads");
     let surface = Surface::new(&mesh, subtess::Scheme::CatmullClark).expect("surface");
@@ -134,6 +136,7 @@ fn seams_split_vertices_with_the_same_position_bits() {
 /// positions' x and y, on a mesh with boundary and extraordinary vertices and on one with
 /// creases and corners.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn smooth_texture_coordinates_follow_the_positions_rules() {
     for name in ["disc.obj", "cube_creased.obj"] {
         let mesh = mesh_from(&uvs_from_positions(&data(name), 0));
@@ -155,6 +158,7 @@ fn smooth_texture_coordinates_follow_the_positions_rules() {
 /// `(E_a + 4 V + E_b) / 6` over the two boundary neighbours (`(1/6, 1/6)`) when smooth (0).
 /// Along a side between pinned corners the channel is linear.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn one_face_corners_are_pinned_by_every_mode_but_none() {
     for mode in FaceVaryingMode::ALL {
         let text = format!(
@@ -214,6 +218,7 @@ fn subtess(args: &[&str]) -> String {
 /// and a glTF that a standard parser loads with `TEXCOORD_0` as long as `POSITION`; `--stats`
 /// reports the seam vertices and watertightness in positions.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn every_writer_carries_texture_coordinates() {
     let dir = std::env::temp_dir().join(format!("subtess-uv-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp dir");
@@ -296,6 +301,7 @@ fn every_writer_carries_texture_coordinates() {
 /// sources of its vertices, in every mode, on the atlas cube and on the disc with texture
 /// coordinates from its positions (where the exact limit's x, y are the reference).
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn eval_gives_the_texture_coordinates_of_the_tessellation() {
     use num_bigint::BigInt;
     use num_rational::BigRational;
@@ -344,6 +350,7 @@ fn eval_gives_the_texture_coordinates_of_the_tessellation() {
 /// symmetry the limit point lies on the diagonal through the corner and the normal is the
 /// diagonal's direction.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn seam_limit_points_at_extraordinary_vertices_are_exact() {
     let mesh = Mesh::read_obj(data("cube_uv.obj")).expect("reads");
     let surface = Surface::new(&mesh, subtess::Scheme::CatmullClark).expect("surface");
@@ -378,6 +385,7 @@ fn seam_limit_points_at_extraordinary_vertices_are_exact() {
 /// `--no-uvs` drops the texture coordinates: no `vt`, no seam vertices, and the output of the
 /// mesh without them.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn no_uvs_drops_the_texture_coordinates() {
     let dir = std::env::temp_dir().join(format!("subtess-no-uv-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp dir");

@@ -113,6 +113,7 @@ fn absurd_table_files_are_refused_from_the_header() {
 /// closes the pipe before `subtess` has loaded and verified its table, so every line it
 /// prints meets a closed pipe.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn a_closed_pipe_ends_quietly() {
     let mut child = Command::new(env!("CARGO_BIN_EXE_subtess"))
         .args(["tables", "info"])
@@ -129,6 +130,7 @@ fn a_closed_pipe_ends_quietly() {
 
 /// `bench --threads 20000` started 20,000 threads; the limit is 256.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn thread_counts_are_capped() {
     let cube = data("cube.obj");
     for threads in ["20000", "257", "0"] {
@@ -185,6 +187,7 @@ fn scaled_obj(text: &str, s: f64) -> String {
 /// an octahedron, scaled.
 #[test]
 #[cfg(feature = "loop")]
+#[cfg(feature = "catmull-clark")]
 fn normals_are_unit_at_any_scale() {
     let cube = std::fs::read_to_string(data("cube.obj")).expect("cube.obj");
     let octahedron = "v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\n\
@@ -224,6 +227,7 @@ fn normals_are_unit_at_any_scale() {
 /// `bench --refine`, the face count after refinement) is refused above `--max-triangles`
 /// (200 million by default) before anything of its size is allocated.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn outputs_over_the_triangle_budget_are_refused() {
     let cube = data("cube.obj");
     let cube = cube.to_str().expect("a UTF-8 path");
@@ -309,6 +313,7 @@ fn outputs_over_the_triangle_budget_are_refused() {
 /// are made, and the run fails at `--max-polygons` (20 million by default) naming the
 /// tolerance it could not meet.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn adaptive_tessellation_stops_at_its_polygon_cap() {
     let out = temp("adaptive-cap.obj");
     let stderr = refused(&[
@@ -403,6 +408,7 @@ fn eval_rationals_are_bounded() {
 /// Error messages echoed a whole 200 MB token. Now the OBJ reader, the Bézier readers and the
 /// rates file quote at most `EXCERPT_CHARS` = 60 characters of it, then `...` and its length.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn long_tokens_are_quoted_short() {
     let token = "x".repeat(1_000_000);
     let cube = std::fs::read_to_string(data("cube.obj")).expect("cube.obj");

@@ -208,6 +208,7 @@ fn options(tolerance: f64) -> AdaptiveOptions {
 }
 
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn the_cube_meets_the_tolerance_everywhere_sampled() {
     let mesh = cube();
     let scale = size(&mesh);
@@ -234,6 +235,7 @@ fn the_cube_meets_the_tolerance_everywhere_sampled() {
     not(shared_models),
     ignore = "needs ../shared/models beside the repository"
 )]
+#[cfg(feature = "catmull-clark")]
 fn spot_meets_the_tolerance_everywhere_sampled() {
     let mesh = spot();
     let scale = size(&mesh);
@@ -272,6 +274,7 @@ fn spot_meets_the_tolerance_everywhere_sampled() {
     not(shared_models),
     ignore = "needs ../shared/models beside the repository"
 )]
+#[cfg(feature = "catmull-clark")]
 fn the_penguin_meets_the_extraordinary_bound() {
     let mesh = load(&crate::common::models().join("odedstein/penguin_control_mesh.obj"));
     let scale = size(&mesh);
@@ -304,6 +307,7 @@ fn the_penguin_meets_the_extraordinary_bound() {
 
 /// The cube's adaptive output is closed (`check_watertight`).
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn the_cube_gives_watertight_polygons_and_triangles() {
     check_watertight("cube", &cube());
 }
@@ -313,6 +317,7 @@ fn the_cube_gives_watertight_polygons_and_triangles() {
     not(shared_models),
     ignore = "needs ../shared/models beside the repository"
 )]
+#[cfg(feature = "catmull-clark")]
 fn spot_gives_watertight_polygons_and_triangles() {
     check_watertight("spot", &spot());
 }
@@ -350,6 +355,7 @@ fn check_watertight(name: &str, mesh: &Mesh) {
 
 /// Output vertices are limit points at their recorded sources (exact evaluation).
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn vertices_are_limit_points_at_their_sources() {
     let mesh = cube();
     let iso = isolate(&mesh);
@@ -378,6 +384,7 @@ fn vertices_are_limit_points_at_their_sources() {
 /// quadrilateral's longer diagonal; the result is invariant under scaling (by 8, exact in f64),
 /// while absolute flatness is not (and is again with `T` scaled too).
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn relative_flatness_is_scale_invariant_and_bounded_by_the_diagonal() {
     let mesh = cube();
     let mut big = mesh.clone();
@@ -429,6 +436,7 @@ fn grid(n: i64, mode: BoundaryMode) -> Mesh {
 /// A flat region needs depth 0: a uniform planar grid's limit surface is affine, so every
 /// regular face is one polygon however small the tolerance.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn a_flat_region_needs_depth_zero() {
     let flat = grid(5, BoundaryMode::EdgeAndCorner);
     let iso = isolate(&flat);
@@ -457,6 +465,7 @@ fn a_flat_region_needs_depth_zero() {
 }
 
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn bad_options_are_refused() {
     let iso = isolate(&cube());
     for o in [
@@ -481,6 +490,7 @@ fn bad_options_are_refused() {
 /// The uniform tessellation (min_depth = max_depth) through the same machinery has
 /// `faces * 4^depth` polygons: the A/U denominator.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn uniform_depth_gives_the_uniform_count() {
     let iso = isolate(&cube());
     let o = AdaptiveOptions {
@@ -614,6 +624,7 @@ fn output_boundary_loops(out: &AdaptiveMesh) -> usize {
     not(shared_models),
     ignore = "needs ../shared/models beside the repository"
 )]
+#[cfg(feature = "catmull-clark")]
 fn tagged_shapes_meet_the_tolerance() {
     for name in [
         "catmark_cube_creases0",
@@ -668,6 +679,7 @@ fn tagged_shapes_meet_the_tolerance() {
     not(shared_models),
     ignore = "needs ../shared/models beside the repository"
 )]
+#[cfg(feature = "catmull-clark")]
 fn relative_flatness_on_a_tagged_shape() {
     let mesh = tagged("catmark_cube_creases1");
     let iso = isolate(&mesh);

@@ -81,6 +81,7 @@ fn every_opensubdiv_shape_is_accepted() {
     not(shared_models),
     ignore = "needs ../shared/models beside the repository"
 )]
+#[cfg(feature = "catmull-clark")]
 fn every_accepted_opensubdiv_shape_tessellates_watertight() {
     let dir = models();
     let table = StencilTable::default_catmull_clark().expect("embedded table");
@@ -168,6 +169,7 @@ fn every_accepted_opensubdiv_shape_tessellates_watertight() {
     not(shared_models),
     ignore = "needs ../shared/models beside the repository"
 )]
+#[cfg(feature = "catmull-clark")]
 fn doubled_corners_close_the_surface_at_their_vertex() {
     let (mesh, _) = load(&models().join("opensubdiv/catmark_nonman_quadpole8.obj"));
     assert_eq!(mesh.boundary_loops(), 2);

@@ -82,6 +82,7 @@ fn check_refinement_invariance(name: &str, mesh: Mesh, table: &StencilTable) {
     not(shared_models),
     ignore = "needs ../shared/models beside the repository"
 )]
+#[cfg(feature = "catmull-clark")]
 fn spot_limit_surface_is_invariant_under_refinement() {
     check_refinement_invariance(
         "spot",
@@ -95,6 +96,7 @@ fn spot_limit_surface_is_invariant_under_refinement() {
     not(shared_models),
     ignore = "needs ../shared/models beside the repository"
 )]
+#[cfg(feature = "catmull-clark")]
 fn boundary_limit_surfaces_are_invariant_under_refinement() {
     let table = StencilTable::default_catmull_clark().expect("embedded table");
     for name in ["opensubdiv/catmark_flap.obj", "opensubdiv/catmark_tent.obj"] {
@@ -109,6 +111,7 @@ fn boundary_limit_surfaces_are_invariant_under_refinement() {
     not(shared_models),
     ignore = "needs ../shared/models beside the repository"
 )]
+#[cfg(feature = "catmull-clark")]
 fn pinned_corners_need_a_corner_table() {
     let mesh = model("opensubdiv/catmark_edgecorner.obj");
     let isolated = refine(&refine(&mesh).mesh).mesh;

@@ -133,6 +133,7 @@ fn check(label: &str, mesh: Mesh, scheme: Scheme, rate: u32) -> usize {
 /// isolation step), the cube itself (isolation steps: the control points come from the
 /// refinement map) and the cube with every kind of sharp feature (feature-adaptive stencils).
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn catmull_clark_normals_do_not_depend_on_where_the_mesh_sits() {
     let refined = refine(&refine(&cube()).mesh).mesh;
     let separable = check("refined cube", refined, Scheme::CatmullClark, 6);
@@ -184,6 +185,7 @@ const PARITY_NORMAL_BOUND: f64 = 2e-3;
     not(shared_models),
     ignore = "needs ../shared/models beside the repository"
 )]
+#[cfg(feature = "catmull-clark")]
 fn bishop_normals_agree_with_f64_limit_stencils() {
     let (worst, points) = agreement_with_limit_stencils("catmark_bishop", 4);
     assert!(points > 200_000, "{points} dual points");
@@ -201,6 +203,7 @@ fn bishop_normals_agree_with_f64_limit_stencils() {
     not(shared_models),
     ignore = "needs ../shared/models beside the repository"
 )]
+#[cfg(feature = "catmull-clark")]
 fn pole360_normals_agree_with_f64_limit_stencils() {
     let (worst, _) = agreement_with_limit_stencils("catmark_pole360", 4);
     assert!(

@@ -59,6 +59,7 @@ fn independent_samples(mesh: &Mesh, patches: &[FacePatch], rates: &[u32]) -> Vec
 }
 
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn tolerance_rates_meet_the_tolerance_on_independent_samples() {
     check_tolerance_met("cube", &cube());
 }
@@ -69,6 +70,7 @@ fn tolerance_rates_meet_the_tolerance_on_independent_samples() {
     not(shared_models),
     ignore = "needs ../shared/models beside the repository"
 )]
+#[cfg(feature = "catmull-clark")]
 fn tolerance_rates_meet_the_tolerance_on_the_pyramid() {
     check_tolerance_met("pyramid", &opensubdiv("catmark_pyramid"));
 }
@@ -114,6 +116,7 @@ fn check_tolerance_met(name: &str, mesh: &Mesh) {
 /// `e_f(n)` is never below the plain distance from the face's samples to the uniform rate-`n`
 /// output (it is a parametric distance, or a distance to part of the output).
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn face_deviation_bounds_the_distance_to_the_uniform_output() {
     let mesh = load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("data/cube.obj"));
     let (isolated, patches, _) = isolate(&mesh).expect("isolates");
@@ -130,6 +133,7 @@ fn face_deviation_bounds_the_distance_to_the_uniform_output() {
 }
 
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn smaller_tolerances_never_lower_a_rate() {
     check_monotone("cube", &cube());
 }
@@ -139,6 +143,7 @@ fn smaller_tolerances_never_lower_a_rate() {
     not(shared_models),
     ignore = "needs ../shared/models beside the repository"
 )]
+#[cfg(feature = "catmull-clark")]
 fn smaller_tolerances_never_lower_a_rate_on_the_pyramid_and_torus() {
     check_monotone("pyramid", &opensubdiv("catmark_pyramid"));
     check_monotone("torus", &opensubdiv("catmark_torus"));
@@ -214,6 +219,7 @@ fn inner_faces(mesh: &Mesh, patches: &[FacePatch], cells: usize) -> Vec<usize> {
 /// tolerance `1.01 a / 4m^2` selects exactly `m` (for `m - 1` the nearest sample is at most
 /// `1/48` from a midpoint, where the error is still `a (1/4(m-1)^2 - 1/48^2) > T`).
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn tolerance_rates_are_minimal_on_a_closed_form() {
     let cells = 8;
     let a = 0.25;
@@ -249,6 +255,7 @@ fn tolerance_rates_are_minimal_on_a_closed_form() {
 }
 
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn a_flat_region_gets_rate_one_for_any_tolerance() {
     let cells = 8;
     let mesh = parabolic_grid(cells, 0.0);
@@ -265,6 +272,7 @@ fn a_flat_region_gets_rate_one_for_any_tolerance() {
 }
 
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn faces_that_cannot_meet_the_tolerance_get_the_largest_rate_and_are_reported() {
     let mesh = load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("data/cube.obj"));
     let (isolated, patches, _) = isolate(&mesh).expect("isolates");
@@ -283,6 +291,7 @@ fn faces_that_cannot_meet_the_tolerance_get_the_largest_rate_and_are_reported() 
 /// The primal evaluator agrees with the reference dual evaluator where the grids share points:
 /// primal point `(2i+1, 2j+1)` at rate `2m` is dual point `(i, j)` at rate `m`.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn primal_positions_agree_with_the_dual_reference() {
     let mesh = load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("data/cube.obj"));
     let (isolated, patches, _) = isolate(&mesh).expect("isolates");
@@ -434,6 +443,7 @@ fn invalid_cameras_are_refused() {
 /// still pick what trying every rate in full picks: per face the smallest `n` with
 /// `e_f(n) <= T` (and that `e_f(n)`), or 24 and `e_f(24)` when none does.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn tolerance_rates_equal_the_full_search() {
     let (isolated, patches, _) = isolate(&cube()).expect("isolates");
     for t in [3e-2, 1e-3, 2e-5] {
@@ -525,6 +535,7 @@ fn cone_cube() -> Mesh {
 /// step: no rate up to 24 met 1% of the diagonal before the tessellator closed that fan around
 /// the limit point.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn tolerance_rates_cover_valences_beyond_the_table_and_sharp_features() {
     for (name, mesh) in [
         ("spindle of valence 11", spindle(11)),

@@ -44,6 +44,7 @@ fn manifold_boundary_loops(frame: &Frame) -> usize {
 }
 
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn every_feature_tessellates_closed_and_a_hole_opens_one_loop() {
     for (hole, loops) in [(false, 0), (true, 1)] {
         let mesh = featured_cube(hole);
@@ -64,6 +65,7 @@ fn every_feature_tessellates_closed_and_a_hole_opens_one_loop() {
 /// cube's symmetry about its diagonal, the diagonal (before, one face's corner normal:
 /// `(-1, -1, 5)/sqrt(27)` at rate 1, 1.23 rad off it). Every rate, a closed manifold.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn a_cone_tip_is_an_output_vertex_with_the_cones_axis_as_normal() {
     let mut mesh = crate::common::cube();
     let tip = 7;
@@ -95,6 +97,7 @@ fn a_cone_tip_is_an_output_vertex_with_the_cones_axis_as_normal() {
 /// loop, depends on its own four vertices only, all at z = 1, so its whole tessellation lies in
 /// that plane; moving every other vertex leaves it in place, and nothing rises above it.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn a_crease_loop_isolates_the_face_inside_it() {
     let mesh = featured_cube(false);
     let surface = Surface::new(&mesh, Scheme::CatmullClark).expect("a surface");
@@ -126,6 +129,7 @@ fn a_crease_loop_isolates_the_face_inside_it() {
 /// `(±1, ±1, 1)` (DeRose et al. 1998: an infinitely sharp crease is the B-spline of its
 /// vertices), and both sides share those points (the output stays closed).
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn the_crease_is_sampled_on_its_b_spline() {
     let mesh = featured_cube(false);
     let surface = Surface::new(&mesh, Scheme::CatmullClark).expect("a surface");
@@ -206,6 +210,7 @@ proptest! {
     /// Random per-face rates on the featured cube (with and without its hole), and on a grid
     /// with boundary in both boundary modes and in "none" (boundary faces are holes).
     #[test]
+    #[cfg(feature = "catmull-clark")]
     fn random_rates_stay_manifold(rates in proptest::collection::vec(1u32..7, 6), hole in any::<bool>()) {
         let mesh = featured_cube(hole);
         let surface = Surface::new(&mesh, Scheme::CatmullClark).expect("a surface");
@@ -219,6 +224,7 @@ proptest! {
 /// sharp makes no surface (OpenSubdiv's `VTX_BOUNDARY_NONE`); a 4 x 4 grid keeps its inner
 /// 2 x 2 faces, one loop around them.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn no_boundary_interpolation_drops_the_boundary_faces() {
     let mut text = String::new();
     for j in 0..5 {
@@ -251,6 +257,7 @@ fn no_boundary_interpolation_drops_the_boundary_faces() {
 /// reaches the shared edge along the same straight segment (a crease between two pinned
 /// corners); frames take the input's six vertices.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn a_non_manifold_fin_splits_into_sheets_meeting_on_the_edge() {
     let positions = vec![
         [0.0, 0.0, 0.0],

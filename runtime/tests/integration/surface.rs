@@ -186,6 +186,7 @@ fn check(label: &str, mesh: &Mesh, scheme: Scheme, n: u32) {
 }
 
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn the_cube_through_the_facade() {
     let cube = Mesh::read_obj(data("cube.obj")).expect("shipped cube");
     for n in [1, 4, 7] {
@@ -215,6 +216,7 @@ fn the_triangle_schemes_through_the_facade() {
     ignore = "needs ../shared/models beside the repository"
 )]
 #[cfg(feature = "loop")]
+#[cfg(feature = "catmull-clark")]
 fn spot_and_a_boundary_mesh_through_the_facade() {
     let spot = shared("crane/spot_control_mesh.obj");
     check("spot control mesh", &spot, Scheme::CatmullClark, 4);
@@ -233,6 +235,7 @@ fn spot_and_a_boundary_mesh_through_the_facade() {
 }
 
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn no_refinement_runs_when_none_is_needed() {
     // The octahedron's vertices all have valence 4: Loop needs isolation, Catmull–Clark of the
     // isolated cube needs none, and a surface with no steps maps the input directly.
@@ -276,6 +279,7 @@ fn read_triangles(path: &Path) -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {
 }
 
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn the_cli_writes_the_frame_the_library_makes() {
     let out = std::env::temp_dir().join(format!("subtess-facade-{}.obj", std::process::id()));
     let run = Command::new(env!("CARGO_BIN_EXE_subtess"))
@@ -304,6 +308,7 @@ fn the_cli_writes_the_frame_the_library_makes() {
 
 #[test]
 #[cfg(feature = "loop")]
+#[cfg(feature = "catmull-clark")]
 fn rates_per_input_face_and_errors() {
     let cube = Mesh::read_obj(data("cube.obj")).expect("cube");
     let surface = Surface::new(&cube, Scheme::CatmullClark).expect("surface");

@@ -37,6 +37,7 @@ fn key(
 /// Default-table weights agree with exact substitution stencils to f32 rounding (1e-6 relative
 /// to the largest weight), at every dual point of a few sections, and sum to 1 / 0.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn default_table_weights_match_exact_stencils() {
     let table = StencilTable::default_catmull_clark().expect("embedded table");
     let cc = QuadScheme::by_name("catmull-clark").expect("catalogued");
@@ -86,6 +87,7 @@ fn default_table_weights_match_exact_stencils() {
 }
 
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn a_missing_valence_names_what_the_table_has() {
     let table = StencilTable::default_catmull_clark().expect("embedded table");
     let e = table

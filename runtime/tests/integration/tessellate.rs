@@ -67,6 +67,7 @@ fn check(name: &str, mesh: &Mesh, convex: bool) {
 }
 
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn the_shipped_cube_tessellates_watertight() {
     let mesh = load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("data/cube.obj"));
     check("cube", &mesh, true);
@@ -77,6 +78,7 @@ fn the_shipped_cube_tessellates_watertight() {
     not(shared_models),
     ignore = "needs ../shared/models beside the repository"
 )]
+#[cfg(feature = "catmull-clark")]
 fn spot_tessellates_watertight() {
     check("spot", &spot(), false);
 }
@@ -111,6 +113,7 @@ proptest! {
 
     /// Random per-face rates, any of 1..=24, on the cube.
     #[test]
+    #[cfg(feature = "catmull-clark")]
     fn random_per_face_rates_stay_watertight(seed in proptest::collection::vec(1u32..=24, 64)) {
         let cube = load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("data/cube.obj"));
         check_random_rates(&cube, &seed, 24)?;
@@ -125,6 +128,7 @@ proptest! {
     /// Random per-face rates, any of 1..=6, on Spot.
     #[test]
     #[cfg_attr(not(shared_models), ignore = "needs ../shared/models beside the repository")]
+    #[cfg(feature = "catmull-clark")]
     fn random_per_face_rates_on_spot_stay_watertight(seed in proptest::collection::vec(1u32..=24, 64)) {
         check_random_rates(&spot(), &seed, 6)?;
     }
@@ -133,6 +137,7 @@ proptest! {
 /// On a refined cube every face away from the eight valence-3 corners is regular and takes the
 /// tensor-product path, whose factors are recovered from (and checked against) the table.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn regular_faces_are_evaluated_as_tensor_products() {
     let mesh = load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("data/cube.obj"));
     let table = StencilTable::default_catmull_clark().expect("embedded table");
@@ -173,6 +178,7 @@ fn cubic_bspline(t: f64) -> ([f64; 4], [f64; 4]) {
 /// over the 4 x 4 grid of its neighbours (the closed form, independent of the tables), and every
 /// output vertex and normal must be that patch at the vertex's (face, u, v), at any rate.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn valence_4_regions_reproduce_the_bicubic_b_spline() {
     let (m, k) = (12usize, 8usize);
     let point = |i: usize, j: usize| {
@@ -264,6 +270,7 @@ fn valence_4_regions_reproduce_the_bicubic_b_spline() {
 /// at the source the tessellator reports for it, mapped back through isolation to the input
 /// face's own parameters (or an n-gon's sub-face): positions to f32 accuracy, normals to 1e-4.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn output_vertices_are_exact_evaluation_at_their_input_sources() {
     // A pyramid with a pentagonal base (an n-gon) and a boundary: five triangles around the apex
     // with one removed.
@@ -293,6 +300,7 @@ fn output_vertices_are_exact_evaluation_at_their_input_sources() {
     not(shared_models),
     ignore = "needs ../shared/models beside the repository"
 )]
+#[cfg(feature = "catmull-clark")]
 fn spots_output_vertices_are_exact_evaluation_at_their_input_sources() {
     check_exact_at_input_sources("spot", &spot(), 37);
 }

@@ -29,6 +29,7 @@ fn agreed(mesh: &TriangleMesh, what: &str) -> bool {
 }
 
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn tessellations_are_closed_by_both_checks() {
     for n in [1, 2, 3, 8] {
         assert!(agreed(&tessellated("cube.obj", Rates::Uniform(n)), "cube"));
@@ -52,6 +53,7 @@ fn tessellations_are_closed_by_both_checks() {
 /// edge. The grid pairs its own two; only the check of other triangles against the grids'
 /// inner edges sees the other two.
 #[test]
+#[cfg(feature = "catmull-clark")]
 fn a_fin_on_a_grid_edge_is_not_closed() {
     let mut mesh = tessellated("cube.obj", Rates::Uniform(6));
     // The second triangle of the first face's first quad: [a, c, d]; its diagonal a-c is
@@ -70,6 +72,7 @@ proptest! {
     /// One triangle removed, reversed, duplicated or moved to other vertices: both checks say
     /// the same.
     #[test]
+    #[cfg(feature = "catmull-clark")]
     fn broken_tessellations_agree(rate in 2u32..7, pick in 0usize..10_000, how in 0u8..4) {
         let mut mesh = tessellated("cube.obj", Rates::Uniform(rate));
         let t = pick % mesh.triangles.len();
