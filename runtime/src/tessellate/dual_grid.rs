@@ -245,7 +245,6 @@ pub struct DualGrid {
     boundary_points: Vec<PointPlan>,
     /// The boundary points' stencils, in lanes ([`PointGroups`]), and where they lie.
     boundary_groups: PointGroups,
-    boundary_sources: Vec<VertexSource>,
     /// Boundary points of local faces still to be computed (index into `boundary_points`).
     local_points: Vec<(usize, LimitQuery)>,
     strips: Vec<Strip>,
@@ -384,7 +383,6 @@ impl DualGrid {
             control: Vec::new(),
             boundary_points: Vec::new(),
             boundary_groups: PointGroups::default(),
-            boundary_sources: Vec::new(),
             local_points: Vec::new(),
             strips: Vec::new(),
             connectivity: Connectivity::default(),
@@ -477,11 +475,8 @@ impl DualGrid {
             let copy = &mut grid.boundary_points[(copy - dual_total) as usize];
             (copy.weights, copy.control) = (original.weights, original.control);
         }
-        let points = std::mem::take(&mut grid.boundary_points);
-        grid.boundary_groups = PointGroups::new(&points, &grid.control).ok_or_else(|| {
-            RuntimeError::Unsupported("a boundary point's stencil is not its patch's".to_owned())
-        })?;
-        grid.boundary_sources = points.into_iter().map(|p| p.source).collect();
+        grid.boundary_groups =
+            PointGroups::new(&std::mem::take(&mut grid.boundary_points), &grid.control)?;
         Ok(grid)
     }
 
@@ -933,7 +928,7 @@ impl GridPlan for DualGrid {
                 }
             }
         }
-        out.extend_from_slice(&self.boundary_sources);
+        out.extend_from_slice(self.boundary_groups.sources());
         out
     }
 

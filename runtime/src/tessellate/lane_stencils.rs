@@ -24,9 +24,11 @@ use wide::{f32x4, CmpGe, CmpLt};
 
 use std::ops::Range;
 
+use crate::mesh::triangle_mesh::VertexSource;
 use crate::tessellate::kernel::{
     cross, for_each_range, gather_relative, unit, PointPlan, Stencils, MAX_PATCH,
 };
+use crate::RuntimeError;
 
 /// Points evaluated together (SSE's four f32, the baseline x86-64 vector).
 pub(crate) const LANES: usize = 4;
@@ -198,13 +200,26 @@ pub(crate) struct PointGroups {
     runs: Vec<(Range<u32>, LaneStencils)>,
     /// Points up to the end of each run (prefix sums).
     ends: Vec<usize>,
+    /// Where every point lies, in order.
+    sources: Vec<VertexSource>,
 }
 
 impl PointGroups {
     /// The runs of `plans` (point `i` over `indices[plans[i].control]`, its position, d/du and
-    /// d/dv weights one block after the other); `None` if a plan's weights are not three
+    /// d/dv weights one block after the other); an error if a plan's weights are not three
     /// blocks as long as its control points.
-    pub(crate) fn new(plans: &[PointPlan], indices: &[u32]) -> Option<Self> {
+    pub(crate) fn new(plans: &[PointPlan], indices: &[u32]) -> Result<Self, RuntimeError> {
+        Self::runs(plans, indices).ok_or_else(|| {
+            RuntimeError::Unsupported("a point's stencil is not its patch's".to_owned())
+        })
+    }
+
+    /// Where every point lies, in order.
+    pub(crate) fn sources(&self) -> &[VertexSource] {
+        &self.sources
+    }
+
+    fn runs(plans: &[PointPlan], indices: &[u32]) -> Option<Self> {
         let control =
             |plan: &PointPlan| indices.get(plan.control.start as usize..plan.control.end as usize);
         let mut groups = PointGroups::default();
@@ -229,6 +244,7 @@ impl PointGroups {
             groups.ends.push(end);
             start = end;
         }
+        groups.sources = plans.iter().map(|p| p.source).collect();
         Some(groups)
     }
 
@@ -363,7 +379,6 @@ pub(crate) fn test_numbers(seed: u32) -> impl FnMut() -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::triangle_mesh::VertexSource;
 
     /// The point-by-point formula the lanes must reproduce: position and unit normal of row
     /// `point` of `s`, a stencil of `k` weights a point, over the control points `q(0..k)`,
@@ -421,6 +436,7 @@ mod tests {
             }
         }
         let groups = PointGroups::new(&plans, &indices).expect("three blocks a plan");
+        assert_eq!(groups.sources().len(), plans.len());
         assert_eq!(groups.ends, [5, 6, 11, 12], "runs of equal control points");
         let mut positions = vec![[0.0f32; 3]; plans.len()];
         let mut normals = vec![[0.0f32; 3]; plans.len()];

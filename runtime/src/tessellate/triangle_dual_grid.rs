@@ -214,7 +214,6 @@ pub struct TriangleDualGrid {
     points: Vec<PointPlan>,
     /// Those points' stencils, in lanes ([`PointGroups`]), and where they lie.
     point_groups: PointGroups,
-    point_sources: Vec<VertexSource>,
     strips: Vec<TriangleStrip>,
     /// The output vertex of every mesh vertex's limit point ([`NONE`] for unused vertices).
     limit_points: Vec<u32>,
@@ -318,7 +317,6 @@ impl TriangleDualGrid {
             control: Vec::new(),
             points: Vec::new(),
             point_groups: PointGroups::default(),
-            point_sources: Vec::new(),
             strips: Vec::new(),
             limit_points: Vec::new(),
             connectivity: Connectivity::default(),
@@ -399,13 +397,7 @@ impl TriangleDualGrid {
             });
         }
         grid.plan_connectivity(table, mesh, patches)?;
-        let points = std::mem::take(&mut grid.points);
-        grid.point_groups = PointGroups::new(&points, &grid.control).ok_or_else(|| {
-            RuntimeError::Unsupported(
-                "a limit or curve point's stencil is not its patch's".to_owned(),
-            )
-        })?;
-        grid.point_sources = points.into_iter().map(|p| p.source).collect();
+        grid.point_groups = PointGroups::new(&std::mem::take(&mut grid.points), &grid.control)?;
         Ok(grid)
     }
 
@@ -696,7 +688,7 @@ impl GridPlan for TriangleDualGrid {
                 }
             }
         }
-        out.extend_from_slice(&self.point_sources);
+        out.extend_from_slice(self.point_groups.sources());
         out
     }
 

@@ -1,8 +1,9 @@
 //! The runtime's integration tests, one binary: every module links the embedded tables, and
 //! one binary instead of one per file keeps the test build small (a table-linking binary is
 //! about 100 MB) and links once. A module or test that needs a scheme's embedded table is
-//! compiled only with that scheme's feature, so that the suite runs on every subset of the
-//! tables, e.g. `cargo test -p subtess --no-default-features --features catmull-clark`.
+//! compiled only with that scheme's feature, so that the suite builds on every subset of the
+//! tables and runs with one, e.g. `cargo test -p subtess --no-default-features --features
+//! catmull-clark`.
 
 // With a subset of the tables, the helpers of the tests left out go unused.
 #![cfg_attr(
