@@ -43,7 +43,9 @@ use crate::tessellate::kernel::{
     for_each_range, merge_rows, relative, table_may_describe, unless_absent, Connectivity,
     GridPlan, PointPlan, Stencils,
 };
-use crate::tessellate::lane_stencils::{unit_cross_x4, LaneStencils, PointGroups, LANES};
+use crate::tessellate::lane_stencils::{
+    store_points, unit_cross_x4, LaneStencils, PointGroups, LANES,
+};
 use crate::RuntimeError;
 use wide::f32x4;
 
@@ -59,13 +61,14 @@ struct SeparableBasis {
     dx: [Vec<f32>; 4],
     y: [Vec<f32>; 4],
     dy: [Vec<f32>; 4],
-    /// `y` and `dy` by groups of [`LANES`] rows: `y_lanes[g][b]` holds `y[b][g * LANES + lane]`
-    /// in its lanes; the last group's unused lanes repeat the last row (evaluated, not written).
-    y_lanes: Vec<[f32x4; 4]>,
-    dy_lanes: Vec<[f32x4; 4]>,
-    /// `x` and `dx` broadcast: `x_splat[i][a]` holds `x[a][i]` in every lane.
-    x_splat: Vec<[f32x4; 4]>,
-    dx_splat: Vec<[f32x4; 4]>,
+    /// `x` and `dx` by groups of [`LANES`] columns: `x_lanes[g][a]` holds `x[a][g * LANES +
+    /// lane]` in its lanes; the last group's unused lanes repeat the last column (evaluated, not
+    /// written).
+    x_lanes: Vec<[f32x4; 4]>,
+    dx_lanes: Vec<[f32x4; 4]>,
+    /// `y` and `dy` broadcast: `y_splat[j][b]` holds `y[b][j]` in every lane.
+    y_splat: Vec<[f32x4; 4]>,
+    dy_splat: Vec<[f32x4; 4]>,
 }
 
 /// Grid coordinates `(a, b)` (each in -1..=2) of the regular patch's layout entries
@@ -97,7 +100,7 @@ impl SeparableBasis {
         y: [Vec<f32>; 4],
         dy: [Vec<f32>; 4],
     ) -> Self {
-        let n = y[0].len();
+        let n = x[0].len();
         let lanes = |f: &[Vec<f32>; 4]| {
             (0..n.div_ceil(LANES))
                 .map(|g| {
@@ -112,10 +115,10 @@ impl SeparableBasis {
                 .collect()
         };
         SeparableBasis {
-            y_lanes: lanes(&y),
-            dy_lanes: lanes(&dy),
-            x_splat: splat(&x),
-            dx_splat: splat(&dx),
+            x_lanes: lanes(&x),
+            dx_lanes: lanes(&dx),
+            y_splat: splat(&y),
+            dy_splat: splat(&dy),
             x,
             dx,
             y,
@@ -1018,12 +1021,13 @@ fn connect_strip(strip: &Strip, out: &mut [[u32; 3]]) {
 /// 4-term combination of those. `g` is relative to `origin` ([`gather_relative`]), where every
 /// position's sum starts.
 ///
-/// In vectors of [`LANES`] rows: the contraction of rows `j..j + 4` is made once, a row in each
-/// lane, and each column `i` then gives the points `(i, j..j + 4)` with the weights of `i`
-/// broadcast (precomputed in the basis, so no lane is ever moved). Every lane makes its sums in
-/// the order of the scalar formulas (`r[a] = sum_b y_b g[a][b]`, then `P = O + sum_a x_a r[a]`,
-/// `P_u = sum_a x'_a r[a]`, `P_v = sum_a x_a s[a]`, each over `b, a = 0..4` from zero or `O`),
-/// so the output is bit-identical to one point at a time
+/// In vectors of [`LANES`] columns: a row's contraction is made once, the four points `a` in
+/// the lanes, and broadcast; each group of columns `i..i + 4` then gives the points
+/// `(i..i + 4, j)` with the weights of those columns in the lanes (precomputed in the basis), so
+/// a group's points are consecutive in the output and leave in whole vectors. Every lane makes
+/// its sums in the order of the scalar formulas (`r[a] = sum_b y_b g[a][b]`, then
+/// `P = O + sum_a x_a r[a]`, `P_u = sum_a x'_a r[a]`, `P_v = sum_a x_a s[a]`, each over
+/// `b, a = 0..4` from zero or `O`), so the output is bit-identical to one point at a time
 /// (`separable_lanes_are_the_scalar_sums_bit_for_bit`).
 fn evaluate_separable(
     g: &[[[f32; 3]; 4]; 4],
@@ -1035,22 +1039,31 @@ fn evaluate_separable(
 ) {
     let (positions, normals) = (&mut positions[..n * n], &mut normals[..n * n]);
     let origin = origin.map(f32x4::splat);
-    for (k, (y, dy)) in basis.y_lanes.iter().zip(&basis.dy_lanes).enumerate() {
-        // r[a][c] = sum_b y_b g[a][b][c], s the same with dy: the group's rows in the lanes.
-        let mut r = [[f32x4::ZERO; 3]; 4];
-        let mut s = [[f32x4::ZERO; 3]; 4];
-        for a in 0..4 {
-            for b in 0..4 {
-                for c in 0..3 {
-                    let w = f32x4::splat(g[a][b][c]);
-                    r[a][c] += y[b] * w;
-                    s[a][c] += dy[b] * w;
-                }
+    // The grid with the four points `a` of each `(b, c)` in the lanes.
+    let columns: [[f32x4; 3]; 4] = std::array::from_fn(|b| {
+        std::array::from_fn(|c| f32x4::new(std::array::from_fn(|a| g[a][b][c])))
+    });
+    let rows = positions
+        .chunks_exact_mut(n)
+        .zip(normals.chunks_exact_mut(n));
+    for ((y, dy), (row_positions, row_normals)) in
+        basis.y_splat.iter().zip(&basis.dy_splat).zip(rows)
+    {
+        // r[a][c] = sum_b y_b g[a][b][c], s the same with dy: `a` in the lanes, then broadcast.
+        let mut r = [f32x4::ZERO; 3];
+        let mut s = [f32x4::ZERO; 3];
+        for b in 0..4 {
+            for c in 0..3 {
+                r[c] += y[b] * columns[b][c];
+                s[c] += dy[b] * columns[b][c];
             }
         }
-        let first = k * LANES;
-        let rows = LANES.min(n - first);
-        for (i, (x, dx)) in basis.x_splat.iter().zip(&basis.dx_splat).enumerate() {
+        let splat = |v: [f32x4; 3]| -> [[f32x4; 3]; 4] {
+            let v = v.map(f32x4::to_array);
+            std::array::from_fn(|a| std::array::from_fn(|c| f32x4::splat(v[c][a])))
+        };
+        let (r, s) = (splat(r), splat(s));
+        for (k, (x, dx)) in basis.x_lanes.iter().zip(&basis.dx_lanes).enumerate() {
             let mut p = origin;
             let mut du = [f32x4::ZERO; 3];
             let mut dv = [f32x4::ZERO; 3];
@@ -1061,13 +1074,10 @@ fn evaluate_separable(
                     dv[c] += x[a] * s[a][c];
                 }
             }
-            let normal = unit_cross_x4(du, dv);
-            let [px, py, pz] = p.map(f32x4::to_array);
-            for lane in 0..rows {
-                let at = (first + lane) * n + i;
-                positions[at] = [px[lane], py[lane], pz[lane]];
-                normals[at] = normal[lane];
-            }
+            let at = k * LANES;
+            let end = n.min(at + LANES);
+            store_points(p, &mut row_positions[at..end]);
+            store_points(unit_cross_x4(du, dv), &mut row_normals[at..end]);
         }
     }
 }

@@ -176,12 +176,11 @@ impl LaneStencils {
         normals: &mut [[f32; 3]],
     ) {
         for (g, [p, du, dv]) in sums.iter().enumerate() {
-            let normal = unit_cross(*du, *dv);
+            let normal = unit_cross_x4(du.map(f32x4::new), dv.map(f32x4::new));
             let start = (first + g) * LANES;
-            for lane in 0..LANES.min(self.points - start) {
-                positions[start + lane] = [p[0][lane], p[1][lane], p[2][lane]];
-                normals[start + lane] = normal[lane];
-            }
+            let end = self.points.min(start + LANES);
+            store_points(p.map(f32x4::new), &mut positions[start..end]);
+            store_points(normal, &mut normals[start..end]);
         }
     }
 }
@@ -334,12 +333,13 @@ fn sums(weights: &[LaneWeights], q: &[[f32; 3]], origin: [f32; 3]) -> LaneSums {
 /// is a normal float.
 #[inline(always)]
 pub(crate) fn unit_cross(a: [[f32; LANES]; 3], b: [[f32; LANES]; 3]) -> [[f32; 3]; LANES] {
-    unit_cross_x4(a.map(f32x4::new), b.map(f32x4::new))
+    let [x, y, z] = unit_cross_x4(a.map(f32x4::new), b.map(f32x4::new)).map(f32x4::to_array);
+    std::array::from_fn(|k| [x[k], y[k], z[k]])
 }
 
-/// [`unit_cross`] on vectors (`[coordinate]`, a lane per pair).
+/// [`unit_cross`] on vectors (`[coordinate]`, a lane per pair), the result the same way.
 #[inline(always)]
-pub(crate) fn unit_cross_x4(a: [f32x4; 3], b: [f32x4; 3]) -> [[f32; 3]; LANES] {
+pub(crate) fn unit_cross_x4(a: [f32x4; 3], b: [f32x4; 3]) -> [f32x4; 3] {
     let m = [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],
@@ -351,17 +351,40 @@ pub(crate) fn unit_cross_x4(a: [f32x4; 3], b: [f32x4; 3]) -> [[f32; 3]; LANES] {
         & squared.cmp_lt(f32x4::splat(f32::INFINITY));
     if normal.all() {
         let length = squared.sqrt();
-        let [x, y, z] = m.map(|c| (c / length).to_array());
-        std::array::from_fn(|k| [x[k], y[k], z[k]])
+        m.map(|c| c / length)
     } else {
         // A degenerate or tiny tangent pair somewhere: unit's careful path, lane by lane.
         let (a, b) = (a.map(f32x4::to_array), b.map(f32x4::to_array));
-        std::array::from_fn(|k| {
+        let units: [[f32; 3]; LANES] = std::array::from_fn(|k| {
             unit(cross(
                 [a[0][k], a[1][k], a[2][k]],
                 [b[0][k], b[1][k], b[2][k]],
             ))
-        })
+        });
+        std::array::from_fn(|c| f32x4::new(units.map(|u| u[c])))
+    }
+}
+
+/// Write the points `[x, y, z]` (a point per lane) to `out`, the first `out.len()` lanes (at
+/// most [`LANES`]).
+///
+/// Why: built lane by lane, a group's points went through the stack in pieces the next loads
+/// could not take from the store buffer (15% of a rate-16 frame stalled on one such load);
+/// transposed in registers, a whole group leaves in four stores, each point's fourth lane
+/// spilling onto the next point's first coordinate, which that point's own store then writes.
+#[inline(always)]
+pub(crate) fn store_points(v: [f32x4; 3], out: &mut [[f32; 3]]) {
+    let t = f32x4::transpose([v[0], v[1], v[2], f32x4::ZERO]).map(f32x4::to_array);
+    if let Ok(out) = <&mut [[f32; 3]; LANES]>::try_from(&mut *out) {
+        let flat = out.as_flattened_mut();
+        flat[0..4].copy_from_slice(&t[0]);
+        flat[3..7].copy_from_slice(&t[1]);
+        flat[6..10].copy_from_slice(&t[2]);
+        flat[9..12].copy_from_slice(&t[3][..3]);
+    } else {
+        for (o, t) in out.iter_mut().zip(&t) {
+            *o = [t[0], t[1], t[2]];
+        }
     }
 }
 
