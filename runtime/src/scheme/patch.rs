@@ -185,32 +185,75 @@ pub fn table_dart(mesh: &Mesh, face: usize) -> Option<(usize, usize)> {
     let fan = mesh.fan(centre);
     let d = dart_edge(mesh, centre)?;
     let e1 = mesh.head(fan[d]) as usize;
-    let crease_vertex = || {
-        let e1_fan = mesh.fan(e1);
-        let Some(back) = e1_fan.iter().position(|&h| mesh.head(h) as usize == centre) else {
-            return false;
-        };
-        !mesh.is_boundary_vertex(e1)
-            && e1_fan.len() == 4
-            && mesh.vertex_sharpness[e1] == 0.0
-            && e1_fan.iter().enumerate().all(|(i, &h)| {
-                let on_crease = i == back || i == (back + 2) % 4;
-                if on_crease {
-                    infinitely_sharp(mesh, h)
-                } else {
-                    mesh.edge_sharpness[h] == 0.0
-                }
-            })
-    };
+    // The dart's sharp edge is one of `E_1`'s two, so a crease vertex continues it straight on.
     let others_fit = (0..4).filter(|&k| k != corner).all(|k| {
         let v = corners[k] as usize;
         if v == e1 {
-            crease_vertex()
+            crease_vertex(mesh, v)
         } else {
             smooth_regular(mesh, v)
         }
     });
     others_fit.then_some((corner, d))
+}
+
+/// Whether `v` is an interior valence-4 vertex with no sharpness of its own whose only sharp
+/// edges are two opposite ones in its fan, both infinitely sharp: a crease runs straight through
+/// it with two faces on either side, and the crease rule `(1, 6, 1) / 8` holds at every level.
+fn crease_vertex(mesh: &Mesh, v: usize) -> bool {
+    if mesh.is_boundary_vertex(v) || mesh.vertex_sharpness[v] != 0.0 {
+        return false;
+    }
+    let fan = mesh.fan(v);
+    let sharp: Vec<usize> = (0..fan.len())
+        .filter(|&i| mesh.edge_sharpness[fan[i]] != 0.0)
+        .collect();
+    fan.len() == 4
+        && matches!(sharp[..], [a, b] if b == a + 2)
+        && sharp.iter().all(|&i| infinitely_sharp(mesh, fan[i]))
+}
+
+/// The sides of quad face `face` along a straight infinitely sharp crease, a bit per side `k`
+/// (the edge from corner `k` to corner `k + 1`), when the face's limit is the bicubic B-spline
+/// patch of its topologically regular 4 x 4 neighbourhood with the row beyond each such side
+/// replaced by phantom points `2 P_0 - P_1` (`P_0` on the crease, `P_1` the row inside).
+///
+/// Why that is the limit: an infinitely sharp crease separates the faces on either side, each
+/// refined as if the crease were a boundary (its vertices by the crease rule
+/// `(P_- + 6 P + P_+) / 8`, its edges by midpoints), and the regular boundary patch is the
+/// B-spline patch whose phantom row is the reflection `2 P_0 - P_1`: the curve scheme's rules at
+/// the crease row are then exactly the crease rules (OpenSubdiv builds its regular boundary
+/// patches so). Only the rules at the face's corners and at their edges reach the face's
+/// refined neighbourhoods (as for [`is_smooth_patch`]), so each corner must be a
+/// [`crease_vertex`] on exactly one such side, or an interior valence-4 vertex with nothing sharp
+/// at it on none. `None` for anything else (a semi-sharp edge, a crease that turns or ends at a
+/// corner, a boundary edge: boundaries take the table's boundary patches), and for a face with
+/// no crease side.
+pub fn crease_phantoms(mesh: &Mesh, face: usize) -> Option<u8> {
+    let corners = mesh.face(face);
+    if corners.len() != 4 {
+        return None;
+    }
+    let mut sides = 0u8;
+    for (k, h) in mesh.face_halfedges(face).enumerate() {
+        if mesh.edge_sharpness[h] != 0.0 {
+            if mesh.twin[h] == NONE || !infinitely_sharp(mesh, h) {
+                return None;
+            }
+            sides |= 1 << k;
+        }
+    }
+    let fits = (0..4).all(|k| {
+        // Corner k ends side k - 1 and starts side k.
+        let on = ((sides >> k) & 1) + ((sides >> ((k + 3) % 4)) & 1);
+        let v = corners[k] as usize;
+        match on {
+            0 => smooth_regular(mesh, v),
+            1 => crease_vertex(mesh, v),
+            _ => false,
+        }
+    });
+    (sides != 0 && fits).then_some(sides)
 }
 
 /// The patch of quad face `face`.

@@ -36,7 +36,7 @@ use table_format::{PointSet, SectionKey, StencilKind};
 use crate::mesh::topology::{Cut, Mesh, NONE};
 use crate::mesh::triangle_mesh::{TriangleMesh, VertexSource};
 use crate::scheme::catmull_clark::adaptive::{limit_stencils, LimitQuery, LimitStencil};
-use crate::scheme::patch::{dual_index_in_patch, FacePatch};
+use crate::scheme::patch::{crease_phantoms, dual_index_in_patch, FacePatch};
 use crate::stencil_table::StencilTable;
 pub use crate::tessellate::kernel::TessellationTime;
 use crate::tessellate::kernel::{
@@ -179,8 +179,10 @@ impl SeparableBasis {
 #[derive(Clone, Debug)]
 enum FaceEval {
     /// A regular interior face: the 4 x 4 control grid (`grid[a][b]`, columns along `u`) and the
-    /// separable factors of its rate.
-    Separable { grid: [[u32; 4]; 4] },
+    /// separable factors of its rate; beyond each side in `phantoms` (a bit per side, as
+    /// [`crease_phantoms`] gives them) a straight infinitely sharp crease, where the row of
+    /// `grid` beyond it is replaced by `2 P_0 - P_1` when evaluated.
+    Separable { grid: [[u32; 4]; 4], phantoms: u8 },
     /// Any other patch: its table stencils in the face's point order, [`LANES`] points at a
     /// time (`DualGrid::lanes[lanes]`, shared by every face of the same section, corner and
     /// patch size), and its control points.
@@ -406,6 +408,7 @@ impl DualGrid {
         // Faces the tables describe exactly (smooth patches and settled darts) take their
         // stencils; the others (other sharp features nearby, a valence or patch beyond the table) are refined adaptively below.
         let mut local_faces = Vec::new();
+        let mut crease_faces = Vec::new();
         for (f, (patch, &n)) in patches.iter().zip(rates).enumerate() {
             if mesh.holes[f] {
                 grid.faces.push(FaceEval::Hole);
@@ -417,6 +420,26 @@ impl DualGrid {
                 None
             };
             let Some(s) = s else {
+                // Along a straight crease: a tensor product with phantom points, if the table
+                // has the regular patch at this rate to factor. The face stays `Local` until
+                // the plan is made, so its crease points are planned as local ones.
+                let phantoms = regular(patch).then(|| crease_phantoms(mesh, f)).flatten();
+                if let Some(phantoms) = phantoms {
+                    if !factored[n as usize] {
+                        factored[n as usize] = true;
+                        if let Some(s) = unless_absent(stencils(table, patch, PointSet::Dual, n))? {
+                            grid.bases[n as usize] = SeparableBasis::from_stencils(&s, n as usize);
+                        }
+                    }
+                    if grid.bases[n as usize].is_some() {
+                        crease_faces.push((f, regular_cells(patch), phantoms));
+                        grid.faces.push(FaceEval::Local {
+                            control: 0..0,
+                            lanes: 0,
+                        });
+                        continue;
+                    }
+                }
                 local_faces.push(f);
                 grid.faces.push(FaceEval::Local {
                     control: 0..0,
@@ -429,11 +452,10 @@ impl DualGrid {
                 grid.bases[n as usize] = SeparableBasis::from_stencils(&s, n as usize);
             }
             if regular(patch) && grid.bases[n as usize].is_some() {
-                let mut cells = [[0u32; 4]; 4];
-                for (&(a, b), &v) in REGULAR_LAYOUT.iter().zip(&patch.points) {
-                    cells[(a + 1) as usize][(b + 1) as usize] = v;
-                }
-                grid.faces.push(FaceEval::Separable { grid: cells });
+                grid.faces.push(FaceEval::Separable {
+                    grid: regular_cells(patch),
+                    phantoms: 0,
+                });
             } else {
                 let k = patch.points.len();
                 let key = (
@@ -471,6 +493,12 @@ impl DualGrid {
         }
         grid.plan_connectivity(table, mesh, patches, channel)?;
         grid.plan_local(mesh, &local_faces)?;
+        for (f, grid_cells, phantoms) in crease_faces {
+            grid.faces[f] = FaceEval::Separable {
+                grid: grid_cells,
+                phantoms,
+            };
+        }
         // Copies take their original's stencil (local ones are known only now).
         let dual_total = grid.first[patches.len()];
         for &[copy, original] in &grid.seam_copies {
@@ -857,10 +885,14 @@ impl DualGrid {
     ) {
         let n = self.rates[f] as usize;
         match &self.faces[f] {
-            FaceEval::Separable { grid } => {
+            FaceEval::Separable { grid, phantoms } => {
                 // The face's corner at (0, 0) is the origin.
                 let origin = control[grid[1][1] as usize];
-                let g = grid.map(|column| column.map(|v| relative(control[v as usize], origin)));
+                let mut g =
+                    grid.map(|column| column.map(|v| relative(control[v as usize], origin)));
+                if *phantoms != 0 {
+                    reflect_phantoms(&mut g, *phantoms);
+                }
                 if let Some(basis) = &self.bases[n] {
                     let origin = origin.map(|c| c as f32);
                     evaluate_separable(&g, origin, basis, n, positions, normals);
@@ -1013,6 +1045,37 @@ fn connect_strip(strip: &Strip, out: &mut [[u32; 3]]) {
                 out,
             );
         }
+    }
+}
+
+/// The 4 x 4 control grid of a regular interior patch at corner 0, `cells[a][b]` at layout
+/// position `(a - 1, b - 1)` (columns along `u`).
+fn regular_cells(patch: &FacePatch) -> [[u32; 4]; 4] {
+    let mut cells = [[0u32; 4]; 4];
+    for (&(a, b), &v) in REGULAR_LAYOUT.iter().zip(&patch.points) {
+        cells[(a + 1) as usize][(b + 1) as usize] = v;
+    }
+    cells
+}
+
+/// Replace the row of `g` beyond every side in `phantoms` (side 0: `v = 0`, 1: `u = 1`,
+/// 2: `v = 1`, 3: `u = 0`) by the reflection `2 P_0 - P_1` of the next two rows through the
+/// crease row ([`crease_phantoms`]).
+fn reflect_phantoms(g: &mut [[[f32; 3]; 4]; 4], phantoms: u8) {
+    let reflect = |p0: [f32; 3], p1: [f32; 3]| std::array::from_fn(|c| 2.0 * p0[c] - p1[c]);
+    for column in g.iter_mut() {
+        if phantoms & 1 != 0 {
+            column[0] = reflect(column[1], column[2]);
+        }
+        if phantoms & 4 != 0 {
+            column[3] = reflect(column[2], column[1]);
+        }
+    }
+    if phantoms & 2 != 0 {
+        g[3] = std::array::from_fn(|t| reflect(g[2][t], g[1][t]));
+    }
+    if phantoms & 8 != 0 {
+        g[0] = std::array::from_fn(|t| reflect(g[1][t], g[2][t]));
     }
 }
 

@@ -204,6 +204,109 @@ fn the_crease_is_sampled_on_its_b_spline() {
     assert!(on_crease >= 4 * 6, "{on_crease} points on the crease");
 }
 
+/// Faces beside a straight infinitely sharp crease take the tensor-product path, their rows
+/// beyond the crease replaced by phantom points (`scheme::patch::crease_phantoms`): on a torus
+/// crossed by two crease loops every face but the four at the crossing (a corner) is separable,
+/// and every output point is the feature-adaptive limit at its source (f64 refinement with the
+/// crease rules, `adaptive::limit_stencils`, no patch and no table): positions to 1e-6 of the
+/// torus's size, the normals of the faces' own points to 1e-5 rad.
+#[test]
+#[cfg(feature = "catmull-clark")]
+fn faces_along_a_straight_crease_are_b_spline_patches_with_phantom_points() {
+    use schemes::crease::INFINITE;
+    use subtess::scheme::catmull_clark::adaptive::{limit_of, limit_stencils, LimitQuery};
+    let (n, m) = (16i64, 8i64);
+    let at = |i: i64, j: i64| i.rem_euclid(n) * m + j.rem_euclid(m);
+    let positions = (0..n)
+        .flat_map(|i| {
+            (0..m).map(move |j| {
+                let (a, b) = (
+                    std::f64::consts::TAU * i as f64 / n as f64,
+                    std::f64::consts::TAU * j as f64 / m as f64,
+                );
+                let r = 3.0 + b.cos() + 0.1 * (3.0 * a).sin();
+                [r * a.cos(), r * a.sin(), b.sin()]
+            })
+        })
+        .collect();
+    let faces: Vec<Vec<i64>> = (0..n)
+        .flat_map(|i| {
+            (0..m).map(move |j| vec![at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)])
+        })
+        .collect();
+    let mut mesh = Mesh::new(positions, &faces, &[], BoundaryMode::EdgeOnly).expect("a torus");
+    for i in 0..n {
+        let (a, b) = (at(i, 0) as usize, at(i + 1, 0) as usize);
+        mesh.set_edge_sharpness(a, b, INFINITE).expect("an edge");
+    }
+    for j in 0..m {
+        let (a, b) = (at(n / 2, j) as usize, at(n / 2, j + 1) as usize);
+        mesh.set_edge_sharpness(a, b, INFINITE).expect("an edge");
+    }
+    let surface = Surface::new(&mesh, Scheme::CatmullClark).expect("a surface");
+    let mut tessellator = surface.tessellator(&Rates::Uniform(5)).expect("a plan");
+    assert_eq!(tessellator.separable_faces(), (n * m - 4) as usize);
+    let frame = tessellator
+        .evaluate(&mesh.positions_f32())
+        .expect("a frame");
+    assert_eq!(manifold_boundary_loops(&frame), 0);
+    let queries: Vec<LimitQuery> = frame
+        .sources()
+        .iter()
+        .map(|s| {
+            let (u, v) = s.uv();
+            LimitQuery { face: s.face, u, v }
+        })
+        .collect();
+    let limits = limit_stencils(&mesh, &queries).expect("a limit at every source");
+    let unit = |d: [f64; 3]| {
+        let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        d.map(|c| c / l)
+    };
+    let (mut worst_position, mut worst_normal) = (0.0f64, 0.0f64);
+    for ((p, normal), (s, stencil)) in frame
+        .positions()
+        .iter()
+        .zip(frame.normals())
+        .zip(frame.sources().iter().zip(&limits))
+    {
+        let [q, du, dv] = limit_of(stencil, &mesh);
+        let e = (0..3)
+            .map(|c| (f64::from(p[c]) - q[c]).abs())
+            .fold(0.0, f64::max);
+        worst_position = worst_position.max(e);
+        let inside = 0 < s.u && s.u < s.denominator && 0 < s.v && s.v < s.denominator;
+        if inside {
+            let want = unit([
+                du[1] * dv[2] - du[2] * dv[1],
+                du[2] * dv[0] - du[0] * dv[2],
+                du[0] * dv[1] - du[1] * dv[0],
+            ]);
+            // The angle from the cross product's length (acos loses it near 0).
+            let n = normal.map(f64::from);
+            let cross = [
+                n[1] * want[2] - n[2] * want[1],
+                n[2] * want[0] - n[0] * want[2],
+                n[0] * want[1] - n[1] * want[0],
+            ];
+            let dot: f64 = (0..3).map(|c| n[c] * want[c]).sum();
+            let a = (cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2])
+                .sqrt()
+                .atan2(dot);
+            worst_normal = worst_normal.max(a);
+        }
+    }
+    // The torus spans 8.2 units.
+    assert!(
+        worst_position < 8.2e-6,
+        "positions {worst_position:e} from the limit"
+    );
+    assert!(
+        worst_normal < 1e-5,
+        "normals {worst_normal:e} rad from the limit"
+    );
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 12, ..ProptestConfig::default() })]
 
