@@ -418,6 +418,12 @@ impl DualGrid {
                 grid.faces.push(FaceEval::Hole);
                 continue;
             }
+            // The regular patch's factors, once per rate (regular and crease faces share them).
+            if regular(patch) && !factored[n as usize] {
+                factored[n as usize] = true;
+                grid.bases[n as usize] = unless_absent(stencils(table, patch, PointSet::Dual, n))?
+                    .and_then(|s| SeparableBasis::from_stencils(&s, n as usize));
+            }
             let s = if table_may_describe(mesh, patch, f) {
                 unless_absent(stencils(table, patch, PointSet::Dual, n))?
             } else {
@@ -428,12 +434,6 @@ impl DualGrid {
                 // has the regular patch at this rate to factor. The face stays `Local` until
                 // the plan is made, so its crease points are planned as local ones.
                 let phantoms = regular(patch).then(|| crease_phantoms(mesh, f)).flatten();
-                if phantoms.is_some() && !factored[n as usize] {
-                    factored[n as usize] = true;
-                    if let Some(s) = unless_absent(stencils(table, patch, PointSet::Dual, n))? {
-                        grid.bases[n as usize] = SeparableBasis::from_stencils(&s, n as usize);
-                    }
-                }
                 match phantoms.filter(|_| grid.bases[n as usize].is_some()) {
                     Some(phantoms) => crease_faces.push((f, regular_cells(patch), phantoms)),
                     None => local_faces.push(f),
@@ -444,10 +444,6 @@ impl DualGrid {
                 });
                 continue;
             };
-            if regular(patch) && !factored[n as usize] {
-                factored[n as usize] = true;
-                grid.bases[n as usize] = SeparableBasis::from_stencils(&s, n as usize);
-            }
             if regular(patch) && grid.bases[n as usize].is_some() {
                 grid.faces.push(FaceEval::Separable {
                     grid: regular_cells(patch),
