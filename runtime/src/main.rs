@@ -527,6 +527,7 @@ fn plan_stats(surface: &Surface, tessellator: &Tessellator<'_>) -> serde_json::V
         "isolation_seconds": surface.isolation_seconds(),
         "refinement_weights": surface.refinement_weights(),
         "separable_faces": tessellator.separable_faces(),
+        "refined_faces": tessellator.refined_faces(),
         "rate_min": rates.iter().min(),
         "rate_max": rates.iter().max(),
         "faces_over_tolerance": tessellator.faces_over_tolerance(),

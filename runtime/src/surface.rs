@@ -487,6 +487,13 @@ impl<'s> Tessellator<'s> {
         self.grid.separable_faces()
     }
 
+    /// How many faces are evaluated by feature-adaptive refinement: next to sharp features the
+    /// tables do not describe (semi-sharp ones, a crease that turns between two irregular
+    /// corners, ...) or at a valence beyond the table (0 for the triangle schemes).
+    pub fn refined_faces(&self) -> usize {
+        self.grid.refined_faces()
+    }
+
     /// Seconds spent planning (rates, table lookups, connectivity, triangles, sources).
     pub fn plan_seconds(&self) -> f64 {
         self.plan_seconds

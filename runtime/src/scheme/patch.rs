@@ -123,9 +123,12 @@ pub fn is_smooth_patch(mesh: &Mesh, face: usize) -> bool {
 }
 
 /// Whether the limit over face `face` is one the tables describe: a smooth patch
-/// ([`is_smooth_patch`]) or a dart patch ([`table_dart`]).
+/// ([`is_smooth_patch`]), a dart patch ([`table_dart`]) or a boundary patch of a crease sector
+/// ([`crease_sector`]).
 pub fn is_table_patch(mesh: &Mesh, face: usize) -> bool {
-    is_smooth_patch(mesh, face) || table_dart(mesh, face).is_some()
+    is_smooth_patch(mesh, face)
+        || table_dart(mesh, face).is_some()
+        || crease_sector(mesh, face).is_some()
 }
 
 /// Whether the edge of half-edge `h` is infinitely sharp.
@@ -197,20 +200,123 @@ pub fn table_dart(mesh: &Mesh, face: usize) -> Option<(usize, usize)> {
     others_fit.then_some((corner, d))
 }
 
-/// Whether `v` is an interior valence-4 vertex with no sharpness of its own whose only sharp
-/// edges are two opposite ones in its fan, both infinitely sharp: a crease runs straight through
-/// it with two faces on either side, and the crease rule `(1, 6, 1) / 8` holds at every level.
-fn crease_vertex(mesh: &Mesh, v: usize) -> bool {
+/// The fan positions `(a, b)`, `a < b`, of the two sharp edges at `v` when `v` is a crease
+/// vertex: an interior vertex with no sharpness of its own whose only sharp edges are two, both
+/// infinitely sharp. The crease rule `(1, 6, 1) / 8` then holds at every level, and the two
+/// sectors of its fan (fan faces `a..b` and the rest; fan edge `i` lies between fan faces
+/// `i - 1` and `i`) subdivide apart, each from its own points and the crease's only.
+fn crease_edges(mesh: &Mesh, v: usize) -> Option<(usize, usize)> {
     if mesh.is_boundary_vertex(v) || mesh.vertex_sharpness[v] != 0.0 {
-        return false;
+        return None;
     }
+    let mut sharp = mesh
+        .fan(v)
+        .into_iter()
+        .enumerate()
+        .filter(|&(_, h)| mesh.edge_sharpness[h] != 0.0);
+    match (sharp.next(), sharp.next(), sharp.next()) {
+        (Some((a, ha)), Some((b, hb)), None)
+            if infinitely_sharp(mesh, ha) && infinitely_sharp(mesh, hb) =>
+        {
+            Some((a, b))
+        }
+        _ => None,
+    }
+}
+
+/// Whether `v` is an interior valence-4 crease vertex ([`crease_edges`]) whose sharp edges are
+/// opposite in its fan: a crease runs straight through it with two faces on either side.
+fn crease_vertex(mesh: &Mesh, v: usize) -> bool {
+    mesh.fan(v).len() == 4 && matches!(crease_edges(mesh, v), Some((a, b)) if b == a + 2)
+}
+
+/// A face's place at a crease vertex: the sector of the vertex's fan that holds it, between the
+/// two sharp edges.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CreaseSector {
+    /// The face corner at the crease vertex.
+    pub corner: usize,
+    /// The fan position of the sector's first face (its first sharp edge's).
+    pub start: usize,
+    /// The sector's faces.
+    pub faces: usize,
+    /// The face's place in the sector, `0..faces`.
+    pub sector: usize,
+}
+
+/// The crease sector of face `face` at its corner `k`, if that corner is a crease vertex
+/// ([`crease_edges`]).
+fn sector_at(mesh: &Mesh, face: usize, k: usize) -> Option<CreaseSector> {
+    let h = mesh.face_halfedges(face).start + k;
+    let v = mesh.face_vertices[h] as usize;
+    let (a, b) = crease_edges(mesh, v)?;
     let fan = mesh.fan(v);
-    let sharp: Vec<usize> = (0..fan.len())
-        .filter(|&i| mesh.edge_sharpness[fan[i]] != 0.0)
-        .collect();
-    fan.len() == 4
-        && matches!(sharp[..], [a, b] if b == a + 2)
-        && sharp.iter().all(|&i| infinitely_sharp(mesh, fan[i]))
+    let p = fan.iter().position(|&g| g == h)?;
+    let (start, faces) = if (a..b).contains(&p) {
+        (a, b - a)
+    } else {
+        (b, fan.len() - (b - a))
+    };
+    Some(CreaseSector {
+        corner: k,
+        start,
+        faces,
+        sector: (p + fan.len() - start) % fan.len(),
+    })
+}
+
+/// The crease sector whose boundary patch describes face `face`, when the face lies at an
+/// infinitely sharp crease the tables describe as a boundary: a crease vertex's sectors
+/// subdivide apart ([`crease_edges`]), each exactly as a boundary vertex with as many faces
+/// (the crease rule is the boundary rule, a crease edge's rule the boundary edge's midpoint),
+/// so the table's boundary patch of `faces` faces, sector `sector`, gathered on the face's side
+/// of the crease, is the face's limit.
+///
+/// The corners must be what that patch assumes, as for [`is_smooth_patch`] only the corners
+/// and their edges mattering: the patch vertex `V` a crease vertex (the one whose sector is not
+/// two faces, if any), the face's sides at `V` sharp exactly where the sector ends, its two
+/// other sides smooth, a corner on the crease a crease vertex with two faces on the face's side
+/// (the crease goes on as a regular boundary), any other corner an interior valence-4 vertex
+/// with nothing sharp at it ([`smooth_regular`]). A one-face sector takes the crease rule, so
+/// in "edge and corner" mode, whose table pins one-face boundary vertices, it is not one. A face
+/// [`crease_phantoms`] takes (a straight crease through valence-4 vertices) is left to it: a
+/// B-spline patch with phantom points costs less than the table's stencils.
+pub fn crease_sector(mesh: &Mesh, face: usize) -> Option<CreaseSector> {
+    if mesh.face(face).len() != 4 || crease_phantoms(mesh, face).is_some() {
+        return None;
+    }
+    let sectors: [Option<CreaseSector>; 4] = std::array::from_fn(|k| sector_at(mesh, face, k));
+    let irregular = || sectors.iter().flatten().filter(|s| s.faces != 2);
+    if irregular().count() > 1 {
+        return None;
+    }
+    let at = irregular()
+        .next()
+        .or_else(|| sectors.iter().flatten().next())
+        .copied()?;
+    if at.faces == 1 && mesh.boundary == schemes::BoundaryMode::EdgeAndCorner {
+        return None;
+    }
+    let c = at.corner;
+    // Side `c` leaves V, side `c - 1` enters it; corner `c + 1` ends side `c`.
+    let first = at.sector == 0;
+    let last = at.sector + 1 == at.faces;
+    let halfedges = mesh.face_halfedges(face);
+    let sides_fit = (0..4).all(|side| {
+        let sharp = mesh.edge_sharpness[halfedges.start + side] != 0.0;
+        sharp == ((side == c && first) || (side == (c + 3) % 4 && last))
+    });
+    let corners = mesh.face(face);
+    let corners_fit = (1..4).all(|d| {
+        let k = (c + d) % 4;
+        let on_crease = (d == 1 && first) || (d == 3 && last);
+        if on_crease {
+            matches!(sectors[k], Some(s) if s.faces == 2)
+        } else {
+            smooth_regular(mesh, corners[k] as usize)
+        }
+    });
+    (sides_fit && corners_fit).then_some(at)
 }
 
 /// The sides of quad face `face` along a straight infinitely sharp crease, a bit per side `k`
@@ -256,6 +362,35 @@ pub fn crease_phantoms(mesh: &Mesh, face: usize) -> Option<u8> {
     (sides != 0 && fits).then_some(sides)
 }
 
+/// The patch corner of a quad face by its topology alone: its irregular corner if any, else a
+/// boundary corner, else corner 0; an error for a face that is no patch (two irregular
+/// corners, an interior irregular corner beside a boundary one).
+fn topological_corner(mesh: &Mesh, face: usize) -> Result<usize, MeshError> {
+    let not_isolated = |reason: String| MeshError::NotIsolated { face, reason };
+    let corners = mesh.face(face);
+    let irregular: Vec<usize> = (0..corners.len())
+        .filter(|&k| is_irregular(mesh, corners[k] as usize))
+        .collect();
+    if irregular.len() > 1 {
+        return Err(not_isolated(format!(
+            "{} of its corners are irregular",
+            irregular.len()
+        )));
+    }
+    let boundary = |k: usize| mesh.is_boundary_vertex(corners[k] as usize);
+    let corner = irregular
+        .first()
+        .copied()
+        .or_else(|| (0..corners.len()).find(|&k| boundary(k)))
+        .unwrap_or(0);
+    if !boundary(corner) && (0..corners.len()).any(boundary) {
+        return Err(not_isolated(
+            "an interior irregular corner and a boundary corner".to_owned(),
+        ));
+    }
+    Ok(corner)
+}
+
 /// The patch of quad face `face`.
 pub fn face_patch(mesh: &Mesh, face: usize) -> Result<FacePatch, MeshError> {
     let not_isolated = |reason: String| MeshError::NotIsolated { face, reason };
@@ -266,51 +401,32 @@ pub fn face_patch(mesh: &Mesh, face: usize) -> Result<FacePatch, MeshError> {
             corners.len()
         )));
     }
-    let special: Vec<usize> = (0..4)
-        .filter(|&k| {
-            is_irregular(mesh, corners[k] as usize) || mesh.is_boundary_vertex(corners[k] as usize)
-        })
-        .collect();
-    let irregular = (0..4)
-        .filter(|&k| is_irregular(mesh, corners[k] as usize))
-        .count();
-    if irregular > 1 {
-        return Err(not_isolated(format!(
-            "{irregular} of its corners are irregular"
-        )));
-    }
-    // A dart the table describes; else the irregular corner if any, else a boundary corner,
-    // else corner 0.
+    // A crease sector or a dart the table describes; else the irregular corner if any, else a
+    // boundary corner, else corner 0.
+    let crease = crease_sector(mesh, face);
     let dart = table_dart(mesh, face);
-    let corner = dart
-        .map(|(k, _)| k)
-        .or_else(|| (0..4).find(|&k| is_irregular(mesh, corners[k] as usize)))
-        .or_else(|| special.first().copied())
-        .unwrap_or(0);
+    let corner = match (crease, dart) {
+        (Some(c), _) => c.corner,
+        (None, Some((k, _))) => k,
+        (None, None) => topological_corner(mesh, face)?,
+    };
     let h0 = mesh.face_halfedges(face).start + corner;
     let centre = mesh.face_vertices[h0] as usize;
-    if special
-        .iter()
-        .any(|&k| k != corner && is_irregular(mesh, corners[k] as usize))
-    {
-        return Err(not_isolated("two irregular corners".to_owned()));
-    }
-    if (0..4).any(|k| k != corner && mesh.is_boundary_vertex(corners[k] as usize))
-        && !mesh.is_boundary_vertex(centre)
-    {
-        return Err(not_isolated(
-            "an interior irregular corner and a boundary corner".to_owned(),
-        ));
-    }
     let fan = mesh.fan(centre);
-    let boundary = mesh.is_boundary_vertex(centre);
+    let boundary = crease.is_some() || mesh.is_boundary_vertex(centre);
     let position = fan
         .iter()
         .position(|&h| h == h0)
         .ok_or_else(|| not_isolated("the face is not in its corner's fan".to_owned()))?;
     // Interior: the fan starts at the patch face. Boundary: at the boundary, the face is sector
-    // s. Dart: at the sharp edge, the face is sector s.
-    let (fan, sector) = if boundary {
+    // s. Crease: the sector's faces from its first sharp edge, as if the crease were the
+    // boundary. Dart: at the sharp edge, the face is sector s.
+    let (fan, sector) = if let Some(c) = crease {
+        let sector = (0..c.faces)
+            .map(|i| fan[(c.start + i) % fan.len()])
+            .collect();
+        (sector, c.sector)
+    } else if boundary {
         (fan, position)
     } else if let Some((_, d)) = dart {
         let mut rotated = fan[d..].to_vec();
@@ -344,9 +460,11 @@ pub fn face_patch(mesh: &Mesh, face: usize) -> Result<FacePatch, MeshError> {
         points.push(mesh.head(mesh.next(h)));
     }
     // Outer points, walking cells from the patch face. `across(h)` is the twin, if any.
+    // A crease patch's side of the crease ends at it, as a boundary patch's at the boundary.
     let across = |h: usize| -> Result<Option<usize>, MeshError> {
         match mesh.twin[h] {
             NONE => Ok(None),
+            _ if crease.is_some() && infinitely_sharp(mesh, h) => Ok(None),
             t => quad(t as usize).map(Some),
         }
     };

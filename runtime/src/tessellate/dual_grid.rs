@@ -1001,6 +1001,13 @@ impl GridPlan for DualGrid {
             .filter(|f| matches!(f, FaceEval::Separable { .. } | FaceEval::Crease { .. }))
             .count()
     }
+
+    fn refined_faces(&self) -> usize {
+        self.faces
+            .iter()
+            .filter(|f| matches!(f, FaceEval::Local { .. }))
+            .count()
+    }
 }
 
 fn connect_strip(strip: &Strip, out: &mut [[u32; 3]]) {

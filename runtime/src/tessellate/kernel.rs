@@ -341,6 +341,12 @@ pub trait GridPlan: Sync + Send + std::fmt::Debug {
         0
     }
 
+    /// How many faces are evaluated by feature-adaptive refinement (sharp features the tables
+    /// do not describe, a valence or patch beyond the table): the slow path.
+    fn refined_faces(&self) -> usize {
+        0
+    }
+
     /// Output vertices repeating another's position across a face-varying seam, `[copy,
     /// original]` (none unless the plan has a face-varying channel).
     fn seam_copies(&self) -> &[[u32; 2]] {

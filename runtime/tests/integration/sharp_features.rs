@@ -204,19 +204,13 @@ fn the_crease_is_sampled_on_its_b_spline() {
     assert!(on_crease >= 4 * 6, "{on_crease} points on the crease");
 }
 
-/// Faces beside a straight infinitely sharp crease take the tensor-product path, their rows
-/// beyond the crease replaced by phantom points (`scheme::patch::crease_phantoms`): on a torus
-/// crossed by two crease loops every face but the four at the crossing (a corner) is separable,
-/// and every output point is the feature-adaptive limit at its source (f64 refinement with the
-/// crease rules, `adaptive::limit_stencils`, no patch and no table): positions to 1e-6 of the
-/// torus's size, the normals of the faces' own points to 1e-5 rad.
-#[test]
-#[cfg(feature = "catmull-clark")]
-fn faces_along_a_straight_crease_are_b_spline_patches_with_phantom_points() {
-    use schemes::crease::INFINITE;
-    use subtess::scheme::catmull_clark::adaptive::{limit_of, limit_stencils, LimitQuery};
-    let (n, m) = (16i64, 8i64);
-    let at = |i: i64, j: i64| i.rem_euclid(n) * m + j.rem_euclid(m);
+/// Vertex `(i, j)` (indices taken modulo the sides) of [`wavy_torus`]`(n, m)`.
+fn torus_vertex(n: i64, m: i64, i: i64, j: i64) -> usize {
+    (i.rem_euclid(n) * m + j.rem_euclid(m)) as usize
+}
+
+/// A torus of `n x m` quads (all valence 4), its tube's radius rippled three times around.
+fn wavy_torus(n: i64, m: i64) -> Mesh {
     let positions = (0..n)
         .flat_map(|i| {
             (0..m).map(move |j| {
@@ -229,27 +223,61 @@ fn faces_along_a_straight_crease_are_b_spline_patches_with_phantom_points() {
             })
         })
         .collect();
+    let at = |i, j| torus_vertex(n, m, i, j) as i64;
     let faces: Vec<Vec<i64>> = (0..n)
         .flat_map(|i| {
             (0..m).map(move |j| vec![at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)])
         })
         .collect();
-    let mut mesh = Mesh::new(positions, &faces, &[], BoundaryMode::EdgeOnly).expect("a torus");
+    Mesh::new(positions, &faces, &[], BoundaryMode::EdgeOnly).expect("a torus")
+}
+
+/// `mesh` with the edges `crease` infinitely sharp.
+fn creased(mut mesh: Mesh, crease: &[(usize, usize)]) -> Mesh {
+    for &(a, b) in crease {
+        mesh.set_edge_sharpness(a, b, schemes::crease::INFINITE)
+            .expect("an edge");
+    }
+    mesh
+}
+
+/// Faces beside a straight infinitely sharp crease take the tensor-product path, their rows
+/// beyond the crease replaced by phantom points (`scheme::patch::crease_phantoms`): on a torus
+/// crossed by two crease loops every face but the four at the crossing (a corner) is separable,
+/// and every output point is the feature-adaptive limit at its source (f64 refinement with the
+/// crease rules, `adaptive::limit_stencils`, no patch and no table): positions to 1e-6 of the
+/// torus's size, the normals of the faces' own points to 1e-5 rad.
+#[test]
+#[cfg(feature = "catmull-clark")]
+fn faces_along_a_straight_crease_are_b_spline_patches_with_phantom_points() {
+    let (n, m) = (16, 8);
+    let at = |i, j| torus_vertex(n, m, i, j);
+    let mut crease = Vec::new();
     for i in 0..n {
-        let (a, b) = (at(i, 0) as usize, at(i + 1, 0) as usize);
-        mesh.set_edge_sharpness(a, b, INFINITE).expect("an edge");
+        crease.push((at(i, 0), at(i + 1, 0)));
     }
     for j in 0..m {
-        let (a, b) = (at(n / 2, j) as usize, at(n / 2, j + 1) as usize);
-        mesh.set_edge_sharpness(a, b, INFINITE).expect("an edge");
+        crease.push((at(n / 2, j), at(n / 2, j + 1)));
     }
+    let mesh = creased(wavy_torus(n, m), &crease);
     let surface = Surface::new(&mesh, Scheme::CatmullClark).expect("a surface");
     let mut tessellator = surface.tessellator(&Rates::Uniform(5)).expect("a plan");
     assert_eq!(tessellator.separable_faces(), (n * m - 4) as usize);
     let frame = tessellator
         .evaluate(&mesh.positions_f32())
         .expect("a frame");
-    assert_eq!(manifold_boundary_loops(&frame), 0);
+    // The torus spans 8.2 units.
+    assert_on_the_adaptive_limit(&mesh, &frame, 8.2e-6, 1e-5);
+}
+
+/// Every output point of `frame` is the feature-adaptive limit of `mesh` at its source (f64
+/// refinement with the crease rules, `adaptive::limit_stencils`: no patch, no table) within
+/// `position` in each coordinate, and the normals of the faces' own points (not on an edge)
+/// within `normal` rad; the output is closed.
+#[cfg(feature = "catmull-clark")]
+fn assert_on_the_adaptive_limit(mesh: &Mesh, frame: &Frame, position: f64, normal: f64) {
+    use subtess::scheme::catmull_clark::adaptive::{limit_of, limit_stencils, LimitQuery};
+    assert_eq!(manifold_boundary_loops(frame), 0);
     let queries: Vec<LimitQuery> = frame
         .sources()
         .iter()
@@ -258,7 +286,7 @@ fn faces_along_a_straight_crease_are_b_spline_patches_with_phantom_points() {
             LimitQuery { face: s.face, u, v }
         })
         .collect();
-    let limits = limit_stencils(&mesh, &queries).expect("a limit at every source");
+    let limits = limit_stencils(mesh, &queries).expect("a limit at every source");
     let unit = |d: [f64; 3]| {
         let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
         d.map(|c| c / l)
@@ -270,7 +298,7 @@ fn faces_along_a_straight_crease_are_b_spline_patches_with_phantom_points() {
         .zip(frame.normals())
         .zip(frame.sources().iter().zip(&limits))
     {
-        let [q, du, dv] = limit_of(stencil, &mesh);
+        let [q, du, dv] = limit_of(stencil, mesh);
         let e = (0..3)
             .map(|c| (f64::from(p[c]) - q[c]).abs())
             .fold(0.0, f64::max);
@@ -296,15 +324,72 @@ fn faces_along_a_straight_crease_are_b_spline_patches_with_phantom_points() {
             worst_normal = worst_normal.max(a);
         }
     }
-    // The torus spans 8.2 units.
     assert!(
-        worst_position < 8.2e-6,
+        worst_position < position,
         "positions {worst_position:e} from the limit"
     );
     assert!(
-        worst_normal < 1e-5,
+        worst_normal < normal,
         "normals {worst_normal:e} rad from the limit"
     );
+}
+
+/// An infinitely sharp crease vertex splits its fan into two sectors that subdivide apart, each
+/// as a boundary vertex with as many faces: the faces there take the table's boundary patches
+/// (`scheme::patch::crease_sector`), not the refinement. A cube whose top face's rim is a crease
+/// (after one isolation step, valence-3 corners with sectors of one face on top and two on the
+/// sides) and a torus crossed by a rectangular crease loop (valence-4 corners with sectors of
+/// one and three faces): no face is refined, and every output point is the feature-adaptive
+/// limit at its source.
+#[test]
+#[cfg(feature = "catmull-clark")]
+fn faces_at_crease_vertices_are_boundary_patches_of_their_sectors() {
+    use subtess::scheme::catmull_clark::isolate::isolate;
+    use subtess::scheme::patch::crease_sector;
+    let cube_positions = (0..8)
+        .map(|k| [f64::from(k & 1), f64::from((k >> 1) & 1), f64::from(k >> 2)])
+        .collect();
+    let cube_faces = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ]
+    .map(|f| f.to_vec());
+    let cube = Mesh::new(cube_positions, &cube_faces, &[], BoundaryMode::EdgeOnly).expect("a cube");
+    let cube = creased(cube, &[(4, 5), (5, 7), (7, 6), (6, 4)]);
+    let (n, m) = (16, 8);
+    let at = |i, j| torus_vertex(n, m, i, j);
+    // The rectangle with corners (2, 2) and (6, 5).
+    let mut rim = Vec::new();
+    for i in 2..6 {
+        rim.extend([(at(i, 2), at(i + 1, 2)), (at(i, 5), at(i + 1, 5))]);
+    }
+    for j in 2..5 {
+        rim.extend([(at(2, j), at(2, j + 1)), (at(6, j), at(6, j + 1))]);
+    }
+    let torus = creased(wavy_torus(n, m), &rim);
+    // The cube's 12 faces at its top rim are sector patches (4 one-face sectors on top, 8 at a
+    // two-face sector of a valence-3 corner), the rest smooth; the torus's 16 faces at the
+    // rectangle's corners are (one-face sectors inside, three-face ones outside), the faces
+    // along its sides B-spline patches with phantom points.
+    for (mesh, size, sector_faces, separable) in [(&cube, 1.0, 12, 0), (&torus, 8.2, 16, 112)] {
+        let (isolated, _, _) = isolate(mesh).expect("an isolation");
+        let sectors = (0..isolated.faces())
+            .filter(|&f| crease_sector(&isolated, f).is_some())
+            .count();
+        assert_eq!(sectors, sector_faces);
+        let surface = Surface::new(mesh, Scheme::CatmullClark).expect("a surface");
+        let mut tessellator = surface.tessellator(&Rates::Uniform(6)).expect("a plan");
+        assert_eq!(tessellator.refined_faces(), 0);
+        assert_eq!(tessellator.separable_faces(), separable);
+        let frame = tessellator
+            .evaluate(&mesh.positions_f32())
+            .expect("a frame");
+        assert_on_the_adaptive_limit(mesh, &frame, 1e-6 * size, 1e-5);
+    }
 }
 
 proptest! {
