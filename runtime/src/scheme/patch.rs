@@ -278,11 +278,9 @@ fn sector_at(mesh: &Mesh, face: usize, k: usize) -> Option<CreaseSector> {
 /// other sides smooth, a corner on the crease a crease vertex with two faces on the face's side
 /// (the crease goes on as a regular boundary), any other corner an interior valence-4 vertex
 /// with nothing sharp at it ([`smooth_regular`]). A one-face sector takes the crease rule, so
-/// in "edge and corner" mode, whose table pins one-face boundary vertices, it is not one. A face
-/// [`crease_phantoms`] takes (a straight crease through valence-4 vertices) is left to it: a
-/// B-spline patch with phantom points costs less than the table's stencils.
+/// in "edge and corner" mode, whose table pins one-face boundary vertices, it is not one.
 pub fn crease_sector(mesh: &Mesh, face: usize) -> Option<CreaseSector> {
-    if mesh.face(face).len() != 4 || crease_phantoms(mesh, face).is_some() {
+    if mesh.face(face).len() != 4 {
         return None;
     }
     let sectors: [Option<CreaseSector>; 4] = std::array::from_fn(|k| sector_at(mesh, face, k));
@@ -317,49 +315,6 @@ pub fn crease_sector(mesh: &Mesh, face: usize) -> Option<CreaseSector> {
         }
     });
     (sides_fit && corners_fit).then_some(at)
-}
-
-/// The sides of quad face `face` along a straight infinitely sharp crease, a bit per side `k`
-/// (the edge from corner `k` to corner `k + 1`), when the face's limit is the bicubic B-spline
-/// patch of its topologically regular 4 x 4 neighbourhood with the row beyond each such side
-/// replaced by phantom points `2 P_0 - P_1` (`P_0` on the crease, `P_1` the row inside).
-///
-/// Why that is the limit: an infinitely sharp crease separates the faces on either side, each
-/// refined as if the crease were a boundary (its vertices by the crease rule
-/// `(P_- + 6 P + P_+) / 8`, its edges by midpoints), and the regular boundary patch is the
-/// B-spline patch whose phantom row is the reflection `2 P_0 - P_1`: the curve scheme's rules at
-/// the crease row are then exactly the crease rules (OpenSubdiv builds its regular boundary
-/// patches so). Only the rules at the face's corners and at their edges reach the face's
-/// refined neighbourhoods (as for [`is_smooth_patch`]), so each corner must be a
-/// [`crease_vertex`] on exactly one such side, or an interior valence-4 vertex with nothing sharp
-/// at it on none. `None` for anything else (a semi-sharp edge, a crease that turns or ends at a
-/// corner, a boundary edge: boundaries take the table's boundary patches), and for a face with
-/// no crease side.
-pub fn crease_phantoms(mesh: &Mesh, face: usize) -> Option<u8> {
-    let corners = mesh.face(face);
-    if corners.len() != 4 {
-        return None;
-    }
-    let mut sides = 0u8;
-    for (k, h) in mesh.face_halfedges(face).enumerate() {
-        if mesh.edge_sharpness[h] != 0.0 {
-            if mesh.twin[h] == NONE || !infinitely_sharp(mesh, h) {
-                return None;
-            }
-            sides |= 1 << k;
-        }
-    }
-    let fits = (0..4).all(|k| {
-        // Corner k ends side k - 1 and starts side k.
-        let on = ((sides >> k) & 1) + ((sides >> ((k + 3) % 4)) & 1);
-        let v = corners[k] as usize;
-        match on {
-            0 => smooth_regular(mesh, v),
-            1 => crease_vertex(mesh, v),
-            _ => false,
-        }
-    });
-    (sides != 0 && fits).then_some(sides)
 }
 
 /// The patch corner of a quad face by its topology alone: its irregular corner if any, else a

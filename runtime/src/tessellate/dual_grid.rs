@@ -35,8 +35,10 @@ use table_format::{PointSet, SectionKey, StencilKind};
 
 use crate::mesh::topology::{Cut, Mesh, NONE};
 use crate::mesh::triangle_mesh::{TriangleMesh, VertexSource};
-use crate::scheme::catmull_clark::adaptive::{limit_stencils, LimitQuery, LimitStencil};
-use crate::scheme::patch::{crease_phantoms, dual_index_in_patch, FacePatch};
+use crate::scheme::catmull_clark::adaptive::{
+    limit_stencils, phantom_grid, LimitQuery, LimitStencil,
+};
+use crate::scheme::patch::{dual_index_in_patch, FacePatch, PatchKind};
 use crate::stencil_table::StencilTable;
 pub use crate::tessellate::kernel::TessellationTime;
 use crate::tessellate::kernel::{
@@ -181,12 +183,12 @@ enum FaceEval {
     /// A regular interior face: the 4 x 4 control grid (`grid[a][b]`, columns along `u`) and the
     /// separable factors of its rate.
     Separable { grid: [[u32; 4]; 4] },
-    /// A face along straight infinitely sharp creases, a bit per side in `phantoms` (as
-    /// [`crease_phantoms`] gives them): [`FaceEval::Separable`] with the row of `grid` beyond
-    /// each such side replaced by `2 P_0 - P_1` when evaluated. (A variant of its own keeps the
-    /// regular faces' code as it was: a test for phantoms there cost 5% more instructions at
-    /// rate 4.)
-    Crease { grid: [[u32; 4]; 4], phantoms: u8 },
+    /// A B-spline patch with phantom points (`adaptive::phantom_grid`: along a boundary or a
+    /// straight infinitely sharp crease, at a pinned corner), a bit per such side in
+    /// `phantoms`: [`FaceEval::Separable`] with the row of `grid` beyond each such side replaced
+    /// by `2 P_0 - P_1` when evaluated. (A variant of its own keeps the regular faces' code as
+    /// it was: a test for phantoms there cost 5% more instructions at rate 4.)
+    Phantom { grid: [[u32; 4]; 4], phantoms: u8 },
     /// Any other patch: its table stencils in the face's point order, [`LANES`] points at a
     /// time (`DualGrid::lanes[lanes]`, shared by every face of the same section, corner and
     /// patch size), and its control points.
@@ -276,18 +278,40 @@ fn stencils<'t>(
     points: PointSet,
     n: u32,
 ) -> Result<Stencils<'t>, RuntimeError> {
+    kind_stencils(table, &patch.kind, patch.points.len(), points, n)
+}
+
+/// The dual stencils of the regular interior patch (valence 4, 16 points) at rate `n`: what the
+/// tensor-product faces' factors come from.
+fn regular_stencils(table: &StencilTable, n: u32) -> Result<Stencils<'_>, RuntimeError> {
+    let regular = PatchKind {
+        boundary: false,
+        feature: table_format::Feature::None,
+        faces: 4,
+        sector: 0,
+    };
+    kind_stencils(table, &regular, REGULAR_LAYOUT.len(), PointSet::Dual, n)
+}
+
+/// The stencils of patch kind `kind` over `k` control points.
+fn kind_stencils<'t>(
+    table: &'t StencilTable,
+    kind: &PatchKind,
+    k: usize,
+    points: PointSet,
+    n: u32,
+) -> Result<Stencils<'t>, RuntimeError> {
     let [position, du, dv] = [
         StencilKind::Position,
         StencilKind::DerivativeU,
         StencilKind::DerivativeV,
     ]
-    .map(|kind| table.weights(&section(patch, kind, points, n)));
+    .map(|stencil| table.weights(&kind.section(stencil, points, n)));
     let (position, du, dv) = (position?, du?, dv?);
     let count = points.count(n) as usize;
-    let k = patch.points.len();
     if position.len() != count * k || du.len() != position.len() || dv.len() != du.len() {
         return Err(RuntimeError::LayoutMismatch {
-            key: section(patch, StencilKind::Position, points, n),
+            key: kind.section(StencilKind::Position, points, n),
             table: position.len() / count.max(1),
             patch: k,
         });
@@ -409,85 +433,107 @@ impl DualGrid {
         let mut factored = vec![false; MAX_RATE as usize + 1];
         // The index in `grid.lanes` of every section, corner and patch size met.
         let mut layouts: HashMap<(SectionKey, u8, usize), u32> = HashMap::new();
-        // Faces the tables describe exactly (smooth patches and settled darts) take their
-        // stencils; the others (other sharp features nearby, a valence or patch beyond the table) are refined adaptively below.
+        // Faces the tables describe exactly (smooth patches, settled darts, crease sectors)
+        // take their stencils, or the tensor product where they are B-spline patches; the
+        // others (other sharp features nearby, a valence or patch beyond the table) are refined
+        // adaptively below.
         let mut local_faces = Vec::new();
-        let mut crease_faces = Vec::new();
+        let mut phantom_faces = Vec::new();
         for (f, (patch, &n)) in patches.iter().zip(rates).enumerate() {
             if mesh.holes[f] {
                 grid.faces.push(FaceEval::Hole);
                 continue;
             }
-            // The regular patch's factors, once per rate (regular and crease faces share them).
-            if regular(patch) && !factored[n as usize] {
+            let described = table_may_describe(mesh, patch, f);
+            // The regular patch's factors, once per rate (every tensor-product face shares them).
+            let tensor = regular(patch) || !described || patch.kind.boundary;
+            if tensor && !factored[n as usize] {
                 factored[n as usize] = true;
-                grid.bases[n as usize] = unless_absent(stencils(table, patch, PointSet::Dual, n))?
+                grid.bases[n as usize] = unless_absent(regular_stencils(table, n))?
                     .and_then(|s| SeparableBasis::from_stencils(&s, n as usize));
             }
-            let s = if table_may_describe(mesh, patch, f) {
+            let factors = grid.bases[n as usize].is_some();
+            let s = if described {
                 unless_absent(stencils(table, patch, PointSet::Dual, n))?
             } else {
                 None
             };
-            let Some(s) = s else {
-                // Along a straight crease: a tensor product with phantom points, if the table
-                // has the regular patch at this rate to factor. The face stays `Local` until
-                // the plan is made, so its crease points are planned as local ones.
-                let phantoms = regular(patch).then(|| crease_phantoms(mesh, f)).flatten();
-                match phantoms.filter(|_| grid.bases[n as usize].is_some()) {
-                    Some(phantoms) => crease_faces.push((f, regular_cells(patch), phantoms)),
-                    None => local_faces.push(f),
+            if regular(patch) && s.is_some() && factors {
+                grid.faces.push(FaceEval::Separable {
+                    grid: regular_cells(patch),
+                });
+                continue;
+            }
+            // A B-spline patch with phantom points beyond its infinitely sharp sides (a
+            // boundary, a straight crease, a pinned corner): the tensor product, cheaper than
+            // any stencil. A face the table does not describe stays `Local` until the plan is
+            // made, so that its curve points are planned by the refinement.
+            let phantom = if tensor && factors {
+                phantom_grid(mesh, f)
+            } else {
+                None
+            };
+            if let Some((cells, phantoms)) = phantom {
+                if s.is_some() {
+                    grid.faces.push(FaceEval::Phantom {
+                        grid: cells,
+                        phantoms,
+                    });
+                } else {
+                    phantom_faces.push((f, cells, phantoms));
+                    grid.faces.push(FaceEval::Local {
+                        control: 0..0,
+                        lanes: 0,
+                    });
                 }
+                continue;
+            }
+            let Some(s) = s else {
+                local_faces.push(f);
                 grid.faces.push(FaceEval::Local {
                     control: 0..0,
                     lanes: 0,
                 });
                 continue;
             };
-            if regular(patch) && grid.bases[n as usize].is_some() {
-                grid.faces.push(FaceEval::Separable {
-                    grid: regular_cells(patch),
-                });
-            } else {
-                let k = patch.points.len();
-                let key = (
-                    section(patch, StencilKind::Position, PointSet::Dual, n),
-                    patch.corner as u8,
-                    k,
-                );
-                let lanes = match layouts.get(&key) {
-                    Some(&lanes) => lanes,
-                    None => {
-                        let n = n as usize;
-                        let corner = patch.corner;
-                        let lanes = LaneStencils::new(k, n * n, |t| {
-                            let (pi, pj) = dual_index_in_patch(corner, t % n, t / n, n);
-                            (&s, pj * n + pi)
-                        })
-                        .ok_or_else(|| RuntimeError::LayoutMismatch {
-                            key: key.0,
-                            table: s.position.len() / (n * n).max(1),
-                            patch: k,
-                        })?;
-                        let index = grid.lanes.len() as u32;
-                        grid.lanes.push(lanes);
-                        layouts.insert(key, index);
-                        index
-                    }
-                };
-                let start = grid.control.len() as u32;
-                grid.control.extend_from_slice(&patch.points);
-                grid.faces.push(FaceEval::Table {
-                    lanes,
-                    control: start..grid.control.len() as u32,
-                });
-            }
+            let k = patch.points.len();
+            let key = (
+                section(patch, StencilKind::Position, PointSet::Dual, n),
+                patch.corner as u8,
+                k,
+            );
+            let lanes = match layouts.get(&key) {
+                Some(&lanes) => lanes,
+                None => {
+                    let n = n as usize;
+                    let corner = patch.corner;
+                    let lanes = LaneStencils::new(k, n * n, |t| {
+                        let (pi, pj) = dual_index_in_patch(corner, t % n, t / n, n);
+                        (&s, pj * n + pi)
+                    })
+                    .ok_or_else(|| RuntimeError::LayoutMismatch {
+                        key: key.0,
+                        table: s.position.len() / (n * n).max(1),
+                        patch: k,
+                    })?;
+                    let index = grid.lanes.len() as u32;
+                    grid.lanes.push(lanes);
+                    layouts.insert(key, index);
+                    index
+                }
+            };
+            let start = grid.control.len() as u32;
+            grid.control.extend_from_slice(&patch.points);
+            grid.faces.push(FaceEval::Table {
+                lanes,
+                control: start..grid.control.len() as u32,
+            });
         }
         grid.plan_connectivity(table, mesh, patches, channel)?;
         grid.plan_local(mesh, &local_faces)?;
-        for (f, grid_cells, phantoms) in crease_faces {
-            grid.faces[f] = FaceEval::Crease {
-                grid: grid_cells,
+        for (f, cells, phantoms) in phantom_faces {
+            grid.faces[f] = FaceEval::Phantom {
+                grid: cells,
                 phantoms,
             };
         }
@@ -886,7 +932,7 @@ impl DualGrid {
                     evaluate_separable(&g, origin, basis, n, positions, normals);
                 }
             }
-            FaceEval::Crease { grid, phantoms } => {
+            FaceEval::Phantom { grid, phantoms } => {
                 let origin = control[grid[1][1] as usize];
                 let mut g =
                     grid.map(|column| column.map(|v| relative(control[v as usize], origin)));
@@ -998,7 +1044,7 @@ impl GridPlan for DualGrid {
     fn separable_faces(&self) -> usize {
         self.faces
             .iter()
-            .filter(|f| matches!(f, FaceEval::Separable { .. } | FaceEval::Crease { .. }))
+            .filter(|f| matches!(f, FaceEval::Separable { .. } | FaceEval::Phantom { .. }))
             .count()
     }
 
@@ -1065,7 +1111,8 @@ fn regular_cells(patch: &FacePatch) -> [[u32; 4]; 4] {
 
 /// Replace the row of `g` beyond every side in `phantoms` (side 0: `v = 0`, 1: `u = 1`,
 /// 2: `v = 1`, 3: `u = 0`) by the reflection `2 P_0 - P_1` of the next two rows through the
-/// crease row ([`crease_phantoms`]).
+/// side's row; rows after columns, so that a corner beyond two sides becomes
+/// `4 P_00 - 2 P_10 - 2 P_01 + P_11` (`adaptive::phantom_grid`).
 fn reflect_phantoms(g: &mut [[[f32; 3]; 4]; 4], phantoms: u8) {
     let reflect = |p0: [f32; 3], p1: [f32; 3]| std::array::from_fn(|c| 2.0 * p0[c] - p1[c]);
     for column in g.iter_mut() {

@@ -242,9 +242,10 @@ fn creased(mut mesh: Mesh, crease: &[(usize, usize)]) -> Mesh {
 }
 
 /// Faces beside a straight infinitely sharp crease take the tensor-product path, their rows
-/// beyond the crease replaced by phantom points (`scheme::patch::crease_phantoms`): on a torus
-/// crossed by two crease loops every face but the four at the crossing (a corner) is separable,
-/// and every output point is the feature-adaptive limit at its source (f64 refinement with the
+/// beyond the crease replaced by phantom points (`adaptive::phantom_grid`): on a torus crossed
+/// by two crease loops every face is separable (the four at the crossing too: four sharp edges
+/// pin it, and each face there is a pinned corner's patch, phantoms beyond both sides), and
+/// every output point is the feature-adaptive limit at its source (f64 refinement with the
 /// crease rules, `adaptive::limit_stencils`, no patch and no table): positions to 1e-6 of the
 /// torus's size, the normals of the faces' own points to 1e-5 rad.
 #[test]
@@ -262,22 +263,28 @@ fn faces_along_a_straight_crease_are_b_spline_patches_with_phantom_points() {
     let mesh = creased(wavy_torus(n, m), &crease);
     let surface = Surface::new(&mesh, Scheme::CatmullClark).expect("a surface");
     let mut tessellator = surface.tessellator(&Rates::Uniform(5)).expect("a plan");
-    assert_eq!(tessellator.separable_faces(), (n * m - 4) as usize);
+    assert_eq!(tessellator.separable_faces(), (n * m) as usize);
     let frame = tessellator
         .evaluate(&mesh.positions_f32())
         .expect("a frame");
     // The torus spans 8.2 units.
-    assert_on_the_adaptive_limit(&mesh, &frame, 8.2e-6, 1e-5);
+    assert_on_the_adaptive_limit(&mesh, &frame, 8.2e-6, 1e-5, 0);
 }
 
 /// Every output point of `frame` is the feature-adaptive limit of `mesh` at its source (f64
 /// refinement with the crease rules, `adaptive::limit_stencils`: no patch, no table) within
 /// `position` in each coordinate, and the normals of the faces' own points (not on an edge)
-/// within `normal` rad; the output is closed.
+/// within `normal` rad; the output is manifold with `boundary_loops` loops.
 #[cfg(feature = "catmull-clark")]
-fn assert_on_the_adaptive_limit(mesh: &Mesh, frame: &Frame, position: f64, normal: f64) {
+fn assert_on_the_adaptive_limit(
+    mesh: &Mesh,
+    frame: &Frame,
+    position: f64,
+    normal: f64,
+    boundary_loops: usize,
+) {
     use subtess::scheme::catmull_clark::adaptive::{limit_of, limit_stencils, LimitQuery};
-    assert_eq!(manifold_boundary_loops(frame), 0);
+    assert_eq!(manifold_boundary_loops(frame), boundary_loops);
     let queries: Vec<LimitQuery> = frame
         .sources()
         .iter()
@@ -334,6 +341,45 @@ fn assert_on_the_adaptive_limit(mesh: &Mesh, frame: &Frame, position: f64, norma
     );
 }
 
+/// Faces along a boundary are B-spline patches with phantom points too (the boundary rules are
+/// the crease rules), and so are the one-face corners "edge and corner" pins: on a 5 x 4 grid of
+/// quads every face is separable in that mode, all but the four corner faces in "edge only"
+/// mode (there a one-face corner takes the crease rule, a table patch), and every output point
+/// is the feature-adaptive limit at its source.
+#[test]
+#[cfg(feature = "catmull-clark")]
+fn boundary_faces_and_pinned_corners_are_b_spline_patches_with_phantom_points() {
+    let (w, h) = (5i64, 4i64);
+    let positions: Vec<[f64; 3]> = (0..=h)
+        .flat_map(|j| {
+            (0..=w).map(move |i| {
+                let (x, y) = (i as f64, j as f64);
+                [x, y, 0.3 * (1.3 * x).sin() * (0.9 * y).cos()]
+            })
+        })
+        .collect();
+    let at = |i: i64, j: i64| j * (w + 1) + i;
+    let faces: Vec<Vec<i64>> = (0..h)
+        .flat_map(|j| {
+            (0..w).map(move |i| vec![at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)])
+        })
+        .collect();
+    for (mode, separable) in [
+        (BoundaryMode::EdgeAndCorner, 20),
+        (BoundaryMode::EdgeOnly, 16),
+    ] {
+        let mesh = Mesh::new(positions.clone(), &faces, &[], mode).expect("a grid");
+        let surface = Surface::new(&mesh, Scheme::CatmullClark).expect("a surface");
+        let mut tessellator = surface.tessellator(&Rates::Uniform(5)).expect("a plan");
+        assert_eq!(tessellator.separable_faces(), separable, "{mode:?}");
+        assert_eq!(tessellator.refined_faces(), 0, "{mode:?}");
+        let frame = tessellator
+            .evaluate(&mesh.positions_f32())
+            .expect("a frame");
+        assert_on_the_adaptive_limit(&mesh, &frame, 1e-6 * 6.5, 1e-5, 1);
+    }
+}
+
 /// An infinitely sharp crease vertex splits its fan into two sectors that subdivide apart, each
 /// as a boundary vertex with as many faces: the faces there take the table's boundary patches
 /// (`scheme::patch::crease_sector`), not the refinement. A cube whose top face's rim is a crease
@@ -371,11 +417,12 @@ fn faces_at_crease_vertices_are_boundary_patches_of_their_sectors() {
         rim.extend([(at(2, j), at(2, j + 1)), (at(6, j), at(6, j + 1))]);
     }
     let torus = creased(wavy_torus(n, m), &rim);
-    // The cube's 12 faces at its top rim are sector patches (4 one-face sectors on top, 8 at a
-    // two-face sector of a valence-3 corner), the rest smooth; the torus's 16 faces at the
-    // rectangle's corners are (one-face sectors inside, three-face ones outside), the faces
-    // along its sides B-spline patches with phantom points.
-    for (mesh, size, sector_faces, separable) in [(&cube, 1.0, 12, 0), (&torus, 8.2, 16, 112)] {
+    // The cube's 12 faces at its top rim are sector patches: 4 one-face sectors on top, 8 at a
+    // two-face sector of a valence-3 corner, which are B-spline patches with phantom points
+    // (tensor products); the rest are smooth. The torus's 28 faces at the rectangle are: the 16
+    // at its corners table patches (one-face sectors inside, three-face ones outside), the 12
+    // along its sides tensor products.
+    for (mesh, size, sector_faces, separable) in [(&cube, 1.0, 12, 8), (&torus, 8.2, 28, 112)] {
         let (isolated, _, _) = isolate(mesh).expect("an isolation");
         let sectors = (0..isolated.faces())
             .filter(|&f| crease_sector(&isolated, f).is_some())
@@ -388,7 +435,7 @@ fn faces_at_crease_vertices_are_boundary_patches_of_their_sectors() {
         let frame = tessellator
             .evaluate(&mesh.positions_f32())
             .expect("a frame");
-        assert_on_the_adaptive_limit(mesh, &frame, 1e-6 * size, 1e-5);
+        assert_on_the_adaptive_limit(mesh, &frame, 1e-6 * size, 1e-5, 0);
     }
 }
 

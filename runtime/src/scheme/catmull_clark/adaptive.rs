@@ -186,6 +186,41 @@ pub(crate) fn bspline_patch<W: Weight>(mesh: &Mesh, g: usize) -> Option<[[Combo<
     Some(grid)
 }
 
+/// The 4 x 4 control grid of quad `g` (`grid[a + 1][b + 1]` at `(a, b)`, `a` along the face's
+/// `u`) as mesh vertices, when the face is a B-spline patch ([`bspline_patch`]), and its sides
+/// with phantom points beyond, a bit per side `k` (the edge from corner `k` to corner `k + 1`:
+/// 0 `v = 0`, 1 `u = 1`, 2 `v = 1`, 3 `u = 0`): its infinitely sharp sides (boundary edges
+/// included). Beyond those sides the net's points are reflections, `2 P_0 - P_1` through the
+/// side's row and `4 P_00 - 2 P_10 - 2 P_01 + P_11` beyond two sides at a pinned corner, which the
+/// evaluation makes from the grid's other cells; the grid holds the face's first corner there.
+/// Why the reflections are the limit: the crease and boundary rules are the B-spline rules of the
+/// reflected net (`bspline_patch`).
+pub(crate) fn phantom_grid(mesh: &Mesh, g: usize) -> Option<([[u32; 4]; 4], u8)> {
+    let net = bspline_patch::<f64>(mesh, g)?;
+    let sides = mesh.face_halfedges(g);
+    let phantoms = (0..4)
+        .filter(|&k| is_infinite(mesh.edge_sharpness[sides.start + k]))
+        .fold(0u8, |bits, k| bits | 1 << k);
+    // Cell (a, b) lies beyond side 0 at b = 0, side 1 at a = 3, side 2 at b = 3, side 3 at a = 0.
+    let beyond = |a: usize, b: usize| {
+        let side = |k: u8| phantoms & (1 << k) != 0;
+        (b == 0 && side(0)) || (a == 3 && side(1)) || (b == 3 && side(2)) || (a == 0 && side(3))
+    };
+    let placeholder = *mesh.face(g).first()?;
+    let mut grid = [[placeholder; 4]; 4];
+    for (a, column) in net.iter().enumerate() {
+        for (b, combo) in column.iter().enumerate() {
+            match combo.as_slice() {
+                _ if beyond(a, b) => {}
+                &[(v, 1.0)] => grid[a][b] = v,
+                // A reflected point inside the grid: not a net the evaluation makes.
+                _ => return None,
+            }
+        }
+    }
+    Some((grid, phantoms))
+}
+
 /// How the limit position at a vertex is known exactly ([`vertex_limit`]).
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) enum LimitPosition {
