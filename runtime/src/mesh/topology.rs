@@ -437,21 +437,20 @@ impl Mesh {
     /// Outgoing half-edges of vertex `v` in fan order (counter-clockwise for faces listed
     /// counter-clockwise), starting at [`Mesh::vertex_halfedge`]; empty for unused vertices.
     pub fn fan(&self, v: usize) -> Vec<usize> {
+        self.fan_iter(v).collect()
+    }
+
+    /// [`Mesh::fan`] without allocating.
+    pub fn fan_iter(&self, v: usize) -> impl Iterator<Item = usize> + '_ {
         let start = self.vertex_halfedge[v];
-        if start == NONE {
-            return Vec::new();
-        }
-        let mut out = vec![start as usize];
-        let mut h = start as usize;
-        loop {
+        let mut next = (start != NONE).then_some(start as usize);
+        std::iter::from_fn(move || {
+            let h = next?;
             // The half-edge into v in this face, then across to the next face's outgoing one.
             let t = self.twin[self.prev(h)];
-            if t == NONE || t == start {
-                return out;
-            }
-            h = t as usize;
-            out.push(h);
-        }
+            next = (t != NONE && t != start).then_some(t as usize);
+            Some(h)
+        })
     }
 
     /// The number of faces around every vertex (`fan(v).len()`, 0 for unused vertices), in

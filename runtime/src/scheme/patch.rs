@@ -210,8 +210,7 @@ fn crease_edges(mesh: &Mesh, v: usize) -> Option<(usize, usize)> {
         return None;
     }
     let mut sharp = mesh
-        .fan(v)
-        .into_iter()
+        .fan_iter(v)
         .enumerate()
         .filter(|&(_, h)| mesh.edge_sharpness[h] != 0.0);
     match (sharp.next(), sharp.next(), sharp.next()) {
