@@ -20,10 +20,9 @@ use table_format::TableError;
 pub(crate) const MAX_PATCH: usize = 40;
 
 /// Whether the tessellators evaluate face `face` from its table patch: a patch the tables
-/// describe ([`is_table_patch`]: nothing sharp at its corners, or a dart's) and the kernels
-/// take (at most [`MAX_PATCH`] points).
-/// Every other face is evaluated by feature-adaptive refinement, and so is a face whose patch
-/// the table lacks.
+/// describe ([`is_table_patch`]: nothing sharp at its corners, a dart's, or a crease sector's)
+/// and the kernels take (at most [`MAX_PATCH`] points). Every other face is evaluated by
+/// feature-adaptive refinement, and so is a face whose patch the table lacks.
 pub(crate) fn table_may_describe(mesh: &Mesh, patch: &FacePatch, face: usize) -> bool {
     is_table_patch(mesh, face) && patch.points.len() <= MAX_PATCH
 }

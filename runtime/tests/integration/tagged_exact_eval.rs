@@ -122,6 +122,61 @@ fn an_infinitely_sharp_crease_is_exactly_the_cubic_b_spline_of_its_vertices() {
     assert_eq!(checked, 24);
 }
 
+/// A cube whose top rim is an infinitely sharp crease: its corners are crease vertices of
+/// valence 3, with a one-face sector on top, so the top face's quarters there are boundary
+/// patches of their sectors (`patch::crease_sector`) where the descent stops. Along the top
+/// face's first edge the limit and its `d/du` are the closed cubic B-spline of the rim's four
+/// vertices, exactly, at the edge's midpoint too (a vertex of the first refinement, where the
+/// vertex masks would give a tangent's direction only).
+#[test]
+fn a_crease_through_valence_3_corners_is_exactly_the_cubic_b_spline_of_its_vertices() {
+    let positions = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [1.0, 0.0, 1.25],
+        [0.0, 1.0, 1.0],
+        [1.0, 1.0, 1.0],
+    ];
+    let faces = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ]
+    .map(|f| f.to_vec());
+    let mut mesh = Mesh::new(positions, &faces, &[], BoundaryMode::EdgeOnly).expect("a cube");
+    let rim = [6usize, 4, 5, 7];
+    for k in 0..4 {
+        mesh.set_edge_sharpness(rim[k], rim[(k + 1) % 4], INFINITE)
+            .expect("an edge");
+    }
+    let evaluator = ExactEvaluator::new(&mesh);
+    // Face 1 runs along its first edge from vertex 4 to vertex 5: the rim's points 6, 4, 5, 7.
+    for t in [q(1, 3), q(1, 2), q(5, 7), q(1, 1 << 20)] {
+        let got = evaluator.evaluate(1, &t, &q(0, 1)).expect("evaluates");
+        let (b, db) = bspline(&t);
+        for c in 0..3 {
+            let (mut curve, mut tangent) = (q(0, 1), q(0, 1));
+            for a in 0..4 {
+                let x = exact(mesh.positions[rim[a]][c]);
+                curve += &b[a] * &x;
+                tangent += &db[a] * &x;
+            }
+            let (curve, tangent) = (
+                curve.to_f64().expect("finite"),
+                tangent.to_f64().expect("finite"),
+            );
+            assert_eq!(got.position[c], curve, "u {t}: {got:?}");
+            assert_eq!(got.du[c], tangent, "u {t}: {got:?}");
+        }
+    }
+}
+
 /// Sharpness 1 is one infinitely sharp step, then smooth limits (OpenSubdiv's semantics of
 /// sharpness): the semi-sharp mesh's exact limit equals, bit for bit, the untagged exact limit
 /// (Schaefer–Warren substitution, the path without feature code) of the grid stepped once with

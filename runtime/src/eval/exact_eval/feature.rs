@@ -23,7 +23,9 @@
 //!    * a **table patch with no sharp feature on its support** ([`face_patch`] and
 //!      [`is_smooth_patch`]: only the edges and vertices at the face's corners decide the rules
 //!      of its refined neighbourhoods): Schaefer–Warren substitution, exactly as on untagged
-//!      meshes ([`super`]);
+//!      meshes ([`super`]); so is a face at an infinitely sharp crease vertex, the boundary
+//!      patch of its sector ([`crease_sector`]: the sector subdivides as a boundary vertex with
+//!      its faces);
 //!    * the point **at a corner** whose settled rule has a limit mask (`adaptive::vertex_limit`): the
 //!      position by OpenSubdiv's `Sdc` masks, rational — corner `V`, crease
 //!      `(E_a + 4 V + E_b) / 6`, smooth `(n^2 V + 4 sum E + sum F) / (n (n + 5))` — and at a
@@ -66,7 +68,7 @@ use crate::scheme::catmull_clark::adaptive::{
     bspline_patch, neighbourhood, stationary_step, submesh, vertex_limit, LimitPosition, RINGS,
 };
 use crate::scheme::catmull_clark::refine::{refine, refined_vertex, LevelEdges};
-use crate::scheme::patch::{face_patch, is_smooth_patch};
+use crate::scheme::patch::{crease_sector, face_patch, is_smooth_patch};
 use crate::{MeshError, RuntimeError};
 
 /// At most this many levels are refined below the input mesh for one point: a parameter's
@@ -232,7 +234,9 @@ fn stop(
         let [position, ds, dt] = bicubic(&Scaled::new(&net), s, t, &BigInt::one());
         return Ok(Some(to_face(jacobian, (position, ds, dt))));
     }
-    if is_smooth_patch(mesh, g) {
+    // A smooth patch, or a crease vertex's sector as a boundary patch: the scaling relation's
+    // exact operators of the patch (any sector size, not only the table's).
+    if is_smooth_patch(mesh, g) || crease_sector(mesh, g).is_some() {
         if let Ok(patch) = face_patch(mesh, g) {
             let points: Vec<Point> = patch
                 .points

@@ -694,8 +694,8 @@ pub fn tessellate_adaptive(
         )));
     }
     // Which faces take which path: a hole has no surface; a face the tables describe (no sharp
-    // feature on its support, or a settled dart the dart patches describe) its table patch; any
-    // other the feature descent.
+    // feature on its support, a settled dart the dart patches describe, a crease vertex's
+    // sector as a boundary patch) its table patch; any other the feature descent.
     let path: Vec<Path> = (0..mesh.faces())
         .map(|f| {
             if mesh.holes[f] {
