@@ -8,7 +8,7 @@ use proptest::prelude::*;
 use schemes::BoundaryMode;
 use subtess::{Frame, Mesh, Rates, Scheme, Surface};
 
-use crate::common::featured_cube;
+use crate::common::{cube, featured_cube};
 
 /// Every directed edge once (a manifold, consistently oriented output), and its boundary
 /// loops.
@@ -392,20 +392,7 @@ fn boundary_faces_and_pinned_corners_are_b_spline_patches_with_phantom_points() 
 fn faces_at_crease_vertices_are_boundary_patches_of_their_sectors() {
     use subtess::scheme::catmull_clark::isolate::isolate;
     use subtess::scheme::patch::crease_sector;
-    let cube_positions = (0..8)
-        .map(|k| [f64::from(k & 1), f64::from((k >> 1) & 1), f64::from(k >> 2)])
-        .collect();
-    let cube_faces = [
-        [0, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-    ]
-    .map(|f| f.to_vec());
-    let cube = Mesh::new(cube_positions, &cube_faces, &[], BoundaryMode::EdgeOnly).expect("a cube");
-    let cube = creased(cube, &[(4, 5), (5, 7), (7, 6), (6, 4)]);
+    let cube = creased(cube(), &[(4, 5), (5, 7), (7, 6), (6, 4)]);
     let (n, m) = (16, 8);
     let at = |i, j| torus_vertex(n, m, i, j);
     // The rectangle with corners (2, 2) and (6, 5).
@@ -422,7 +409,7 @@ fn faces_at_crease_vertices_are_boundary_patches_of_their_sectors() {
     // (tensor products); the rest are smooth. The torus's 28 faces at the rectangle are: the 16
     // at its corners table patches (one-face sectors inside, three-face ones outside), the 12
     // along its sides tensor products.
-    for (mesh, size, sector_faces, separable) in [(&cube, 1.0, 12, 8), (&torus, 8.2, 28, 112)] {
+    for (mesh, size, sector_faces, separable) in [(&cube, 2.0, 12, 8), (&torus, 8.2, 28, 112)] {
         let (isolated, _, _) = isolate(mesh).expect("an isolation");
         let sectors = (0..isolated.faces())
             .filter(|&f| crease_sector(&isolated, f).is_some())

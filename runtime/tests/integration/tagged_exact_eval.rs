@@ -22,7 +22,7 @@ use subtess::scheme::catmull_clark::adaptive::{limit_of, limit_stencils, LimitQu
 use subtess::scheme::catmull_clark::refine::refine;
 use subtess::Scheme;
 
-use crate::common::refined_query;
+use crate::common::{cube, refined_query};
 
 fn q(p: i64, d: i64) -> BigRational {
     BigRational::new(p.into(), d.into())
@@ -78,6 +78,20 @@ fn exact(x: f64) -> BigRational {
     BigRational::from_float(x).expect("finite")
 }
 
+/// The uniform cubic B-spline of `points` at `t` and its derivative, exact in rationals and
+/// rounded once to f64.
+fn curve_point(points: [[f64; 3]; 4], t: &BigRational) -> ([f64; 3], [f64; 3]) {
+    let (b, db) = bspline(t);
+    let sum = |w: &[BigRational; 4], c: usize| {
+        let total = (0..4).fold(q(0, 1), |acc, a| acc + &w[a] * exact(points[a][c]));
+        total.to_f64().expect("finite")
+    };
+    (
+        std::array::from_fn(|c| sum(&b, c)),
+        std::array::from_fn(|c| sum(&db, c)),
+    )
+}
+
 /// The sharp crease along row 2 of a 6 x 6 grid: the faces above it meet the crease along
 /// their first edge (`v = 0`); there the limit and its `d/du` are the cubic B-spline of the
 /// crease's vertices, exactly (the crease curve ends at the boundary in corners, so only the
@@ -97,24 +111,13 @@ fn an_infinitely_sharp_crease_is_exactly_the_cubic_b_spline_of_its_vertices() {
         let face = (2 * m + i) as usize;
         for t in [q(0, 1), q(1, 3), q(1, 2), q(5, 7), q(1, 1), q(1, 1 << 20)] {
             let got = evaluator.evaluate(face, &t, &q(0, 1)).expect("evaluates");
-            let (b, db) = bspline(&t);
-            for c in 0..3 {
-                let (mut curve, mut tangent) = (q(0, 1), q(0, 1));
-                for a in 0..4 {
-                    let x = exact(mesh.positions[row(i - 1 + a as i64)][c]);
-                    curve += &b[a] * &x;
-                    tangent += &db[a] * &x;
-                }
-                let (curve, tangent) = (
-                    curve.to_f64().expect("finite"),
-                    tangent.to_f64().expect("finite"),
-                );
-                assert_eq!(got.position[c], curve, "face {face} u {t}: {got:?}");
-                // At the segment's ends the point is a crease vertex: its frame tangents are
-                // masks, not derivatives; inside, `d/du` is the curve's.
-                if t != q(0, 1) && t != q(1, 1) {
-                    assert_eq!(got.du[c], tangent, "face {face} u {t}: {got:?}");
-                }
+            let points = std::array::from_fn(|a| mesh.positions[row(i - 1 + a as i64)]);
+            let (curve, tangent) = curve_point(points, &t);
+            assert_eq!(got.position, curve, "face {face} u {t}: {got:?}");
+            // At the segment's ends the point is a crease vertex: its frame tangents are
+            // masks, not derivatives; inside, `d/du` is the curve's.
+            if t != q(0, 1) && t != q(1, 1) {
+                assert_eq!(got.du, tangent, "face {face} u {t}: {got:?}");
             }
             checked += 1;
         }
@@ -130,26 +133,9 @@ fn an_infinitely_sharp_crease_is_exactly_the_cubic_b_spline_of_its_vertices() {
 /// vertex masks would give a tangent's direction only).
 #[test]
 fn a_crease_through_valence_3_corners_is_exactly_the_cubic_b_spline_of_its_vertices() {
-    let positions = vec![
-        [0.0, 0.0, 0.0],
-        [1.0, 0.0, 0.0],
-        [0.0, 1.0, 0.0],
-        [1.0, 1.0, 0.0],
-        [0.0, 0.0, 1.0],
-        [1.0, 0.0, 1.25],
-        [0.0, 1.0, 1.0],
-        [1.0, 1.0, 1.0],
-    ];
-    let faces = [
-        [0, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-    ]
-    .map(|f| f.to_vec());
-    let mut mesh = Mesh::new(positions, &faces, &[], BoundaryMode::EdgeOnly).expect("a cube");
+    let mut mesh = cube();
+    // Off the cube's symmetry, by a dyadic step (exact in f64).
+    mesh.positions[5][2] = 1.25;
     let rim = [6usize, 4, 5, 7];
     for k in 0..4 {
         mesh.set_edge_sharpness(rim[k], rim[(k + 1) % 4], INFINITE)
@@ -159,21 +145,9 @@ fn a_crease_through_valence_3_corners_is_exactly_the_cubic_b_spline_of_its_verti
     // Face 1 runs along its first edge from vertex 4 to vertex 5: the rim's points 6, 4, 5, 7.
     for t in [q(1, 3), q(1, 2), q(5, 7), q(1, 1 << 20)] {
         let got = evaluator.evaluate(1, &t, &q(0, 1)).expect("evaluates");
-        let (b, db) = bspline(&t);
-        for c in 0..3 {
-            let (mut curve, mut tangent) = (q(0, 1), q(0, 1));
-            for a in 0..4 {
-                let x = exact(mesh.positions[rim[a]][c]);
-                curve += &b[a] * &x;
-                tangent += &db[a] * &x;
-            }
-            let (curve, tangent) = (
-                curve.to_f64().expect("finite"),
-                tangent.to_f64().expect("finite"),
-            );
-            assert_eq!(got.position[c], curve, "u {t}: {got:?}");
-            assert_eq!(got.du[c], tangent, "u {t}: {got:?}");
-        }
+        let (curve, tangent) = curve_point(rim.map(|v| mesh.positions[v]), &t);
+        assert_eq!(got.position, curve, "u {t}: {got:?}");
+        assert_eq!(got.du, tangent, "u {t}: {got:?}");
     }
 }
 
