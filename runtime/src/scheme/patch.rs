@@ -226,7 +226,7 @@ fn crease_edges(mesh: &Mesh, v: usize) -> Option<(usize, usize)> {
 /// Whether `v` is an interior valence-4 crease vertex ([`crease_edges`]) whose sharp edges are
 /// opposite in its fan: a crease runs straight through it with two faces on either side.
 fn crease_vertex(mesh: &Mesh, v: usize) -> bool {
-    mesh.fan(v).len() == 4 && matches!(crease_edges(mesh, v), Some((a, b)) if b == a + 2)
+    mesh.fan_iter(v).count() == 4 && matches!(crease_edges(mesh, v), Some((a, b)) if b == a + 2)
 }
 
 /// A face's place at a crease vertex: the sector of the vertex's fan that holds it, between the

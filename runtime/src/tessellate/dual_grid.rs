@@ -1145,8 +1145,8 @@ fn reflect_phantoms(g: &mut [[[f32; 3]; 4]; 4], phantoms: u8) {
 /// `b, a = 0..4` from zero or `O`), so the output is bit-identical to one point at a time
 /// (`separable_lanes_are_the_scalar_sums_bit_for_bit`).
 ///
-/// Inlined into both of its callers (regular and crease faces): called, it cost a rate-4 frame
-/// 5% more instructions.
+/// Inlined into both of its callers (regular faces and those with phantom rows): called, it cost
+/// a rate-4 frame 5% more instructions.
 #[inline(always)]
 fn evaluate_separable(
     g: &[[[f32; 3]; 4]; 4],
