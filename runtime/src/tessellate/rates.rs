@@ -42,17 +42,19 @@
 //! # Faces the table does not describe
 //!
 //! The faces the tessellator evaluates by feature-adaptive refinement (infinitely sharp
-//! creases, corners and darts at their corners, the rims of holes) and those whose patch the
-//! table lacks (a valence beyond it, interior valence 2) are sampled at the same points from
-//! the same refinement ([`limit_points`]), so `S_f` is the true surface there. `L_{f,n}` follows
-//! the tessellator's cuts: an infinitely sharp edge or a hole's side is a limit curve both
-//! sides' strips meet, as a boundary is, and a vertex the cuts reach closes each sector's
-//! polygon with its limit point, as a pinned vertex that no cut reaches closes its whole fan (a
-//! cone's tip). Hole faces take the smallest rate and no samples. One
-//! heuristic remains: a face next to a semi-sharp feature whose patch the table has is measured
-//! on that patch, the surface without the feature (its exact limit needs as many levels of
-//! refinement as the sharpness everywhere on the face: 100 s of selection on `catmark_bishop`
-//! instead of 5 s).
+//! creases, corners and darts at their corners, the rims of holes, semi-sharp features at a
+//! corner) and those whose patch the table lacks (a valence beyond it, interior valence 2) are
+//! sampled at the same points from the same refinement ([`limit_points`]), so `S_f` is the true
+//! surface there. `L_{f,n}` follows the tessellator's cuts: an infinitely sharp edge or a hole's
+//! side is a limit curve both sides' strips meet, as a boundary is, and a vertex the cuts reach
+//! closes each sector's polygon with its limit point, as a pinned vertex that no cut reaches
+//! closes its whole fan (a cone's tip). Hole faces take the smallest rate and no samples.
+//! A face next to a semi-sharp feature needs as many levels of refinement as the sharpness
+//! everywhere on it, and the cost of a descent is its refinement, not its points: so one
+//! descent makes the grids of several rates at once (`rate_chunk`), for the face and the
+//! adaptive faces around it. (Until 2026-12-03 such faces were measured on the table's patch,
+//! the surface without the feature, to save that cost; the output then missed the tolerance,
+//! by 1.8 `T` on a cube with semi-sharp creases: `tolerance_rates_cover_valences_beyond_the_table_and_sharp_features`.)
 //!
 //! On a uniform grid on `z = a x^2` this is the closed form `e_f(n) = a / 4n^2` whenever `n`
 //! divides 24 (the midpoints of the cells are samples); `runtime/tests/integration/rates.rs` checks it.
@@ -83,7 +85,6 @@ use std::cell::Cell;
 use std::sync::{Mutex, OnceLock};
 
 use rayon::prelude::*;
-use schemes::crease::is_infinite;
 use table_format::{PointSet, StencilKind};
 
 use crate::mesh::topology::{Cut, Mesh};
@@ -405,18 +406,22 @@ impl Grid<'_> {
 }
 
 /// The grids of the faces the tables do not describe, from feature-adaptive refinement
-/// ([`limit_points`]), computed the first time a face asks for a grid. The faces around it
-/// that share a vertex with it are computed in the same descent: they share its refinement
-/// (around a high-valence vertex, all of them), and they are the faces whose rows and corner
-/// points its deviation reads.
+/// ([`limit_points`]), computed the first time a face asks for one. The faces around it that
+/// share a vertex with it are computed in the same descent: they share its refinement (around
+/// a high-valence vertex, all of them), and they are the faces whose rows and corner points its
+/// deviation reads. So are the other grids of the asked rate's *chunk* ([`rate_chunk`]), both
+/// point sets: a descent's cost is its refinement (building each level's neighbourhood), not its
+/// points, and the selection asks for the rates in order.
 struct AdaptiveGrids<'a> {
     mesh: &'a Mesh,
     /// The faces evaluated adaptively, ascending.
     faces: Vec<usize>,
     /// Per grid (`2 (n - 1)` primal, `2 (n - 1) + 1` dual), per face of `faces`: its positions
-    /// once computed; and the lock one computation of the grid holds, so that faces asking
+    /// once computed.
+    grids: Vec<OnceLock<FaceGrids>>,
+    /// Per chunk of rates, the lock one computation of its grids holds, so that faces asking
     /// at once wait for it rather than compute their common neighbours again.
-    grids: Vec<(Mutex<()>, OnceLock<FaceGrids>)>,
+    chunks: Vec<Mutex<()>>,
 }
 
 /// One grid of every adaptive face, each set once computed.
@@ -425,12 +430,49 @@ type FaceGrids = Vec<OnceLock<Vec<[f64; 3]>>>;
 /// The largest rate of an adaptive face's grid: the largest the tessellators use.
 const MAX_ADAPTIVE_RATE: u32 = 64;
 
+/// The rates whose grids are computed together with rate `n`'s, and the chunk's number: `1`,
+/// `2..=3`, `4..=7`, `8..=15`, `16..=23`, then [`SELECTION_GRID`] alone (every face's samples),
+/// `25..=31`, `32..=63`, `64`. Doubling chunks keep the points computed for rates a face never
+/// reaches below those of the rates it does, with a handful of descents where one a grid made
+/// up to `2 n`.
+fn rate_chunk(n: u32) -> (usize, std::ops::RangeInclusive<u32>) {
+    const CHUNKS: [(u32, u32); 9] = [
+        (1, 1),
+        (2, 3),
+        (4, 7),
+        (8, 15),
+        (16, SELECTION_GRID - 1),
+        (SELECTION_GRID, SELECTION_GRID),
+        (SELECTION_GRID + 1, 31),
+        (32, 63),
+        (64, MAX_ADAPTIVE_RATE),
+    ];
+    let k = CHUNKS
+        .iter()
+        .position(|&(_, last)| n <= last)
+        .unwrap_or(CHUNKS.len() - 1);
+    (k, CHUNKS[k].0..=CHUNKS[k].1)
+}
+
+/// Where grid `(primal, n)` (`n >= 1`) is kept in [`AdaptiveGrids::grids`].
+fn grid_slot(primal: bool, n: u32) -> usize {
+    2 * (n as usize - 1) + usize::from(!primal)
+}
+
 impl<'a> AdaptiveGrids<'a> {
     fn new(mesh: &'a Mesh, faces: Vec<usize>) -> Self {
         let grids = (0..2 * MAX_ADAPTIVE_RATE)
-            .map(|_| (Mutex::new(()), OnceLock::new()))
+            .map(|_| OnceLock::new())
             .collect();
-        AdaptiveGrids { mesh, faces, grids }
+        let chunks = (0..=rate_chunk(MAX_ADAPTIVE_RATE).0)
+            .map(|_| Mutex::new(()))
+            .collect();
+        AdaptiveGrids {
+            mesh,
+            faces,
+            grids,
+            chunks,
+        }
     }
 
     /// The positions of face `face`'s grid `points` at rate `n`, `j` outer.
@@ -439,20 +481,23 @@ impl<'a> AdaptiveGrids<'a> {
             RuntimeError::Unsupported(format!("face {face} is not evaluated adaptively"))
         })?;
         let primal = points == PointSet::Primal;
-        let (lock, cells) = n
-            .checked_sub(1)
-            .and_then(|k| self.grids.get(2 * k as usize + usize::from(!primal)))
-            .ok_or_else(|| RuntimeError::InvalidParameter {
+        if !(1..=MAX_ADAPTIVE_RATE).contains(&n) {
+            return Err(RuntimeError::InvalidParameter {
                 name: "rate".to_owned(),
                 reason: format!("{n} (faces evaluated adaptively take 1..={MAX_ADAPTIVE_RATE})"),
-            })?;
-        let cells = cells.get_or_init(|| self.faces.iter().map(|_| OnceLock::new()).collect());
+            });
+        }
+        let cells = self.cells(primal, n);
         if cells[slot].get().is_none() {
+            let (chunk, rates) = rate_chunk(n);
             // A poisoned lock only means that another computation failed; this one reports
             // its own error, if any.
-            let _computing = lock.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+            let _computing = self.chunks[chunk]
+                .lock()
+                .unwrap_or_else(|poisoned| poisoned.into_inner());
             if cells[slot].get().is_none() {
-                // The face and the adaptive faces sharing a vertex with it, not yet computed.
+                // The face and the adaptive faces sharing a vertex with it, not yet computed
+                // (a chunk's grids are set together, so one grid tells).
                 let mut around: Vec<usize> = self
                     .mesh
                     .face(face)
@@ -469,8 +514,13 @@ impl<'a> AdaptiveGrids<'a> {
                 around.sort_unstable();
                 around.dedup();
                 let faces: Vec<usize> = around.iter().map(|&k| self.faces[k]).collect();
-                for (k, positions) in around.into_iter().zip(self.compute(&faces, primal, n)?) {
-                    let _ = cells[k].set(positions);
+                let wanted: Vec<(bool, u32)> =
+                    rates.flat_map(|r| [(true, r), (false, r)]).collect();
+                let computed = self.compute(&faces, &wanted)?;
+                for (k, face_grids) in around.into_iter().zip(computed) {
+                    for (&(primal, r), positions) in wanted.iter().zip(face_grids) {
+                        let _ = self.cells(primal, r)[k].set(positions);
+                    }
                 }
             }
         }
@@ -480,36 +530,51 @@ impl<'a> AdaptiveGrids<'a> {
             .ok_or_else(|| RuntimeError::Unsupported(format!("no adaptive grid for face {face}")))
     }
 
-    /// The grids (`primal` or dual) at rate `n` of `faces`, in order.
+    /// Grid `(primal, n)` of every adaptive face (`1 <= n <=` [`MAX_ADAPTIVE_RATE`]).
+    fn cells(&self, primal: bool, n: u32) -> &FaceGrids {
+        self.grids[grid_slot(primal, n)]
+            .get_or_init(|| self.faces.iter().map(|_| OnceLock::new()).collect())
+    }
+
+    /// The grids `wanted` (`(primal, n)`; primal `(n + 1)^2` points, dual `n^2`) of `faces`,
+    /// in order: one descent for all of them.
     fn compute(
         &self,
         faces: &[usize],
-        primal: bool,
-        n: u32,
-    ) -> Result<Vec<Vec<[f64; 3]>>, RuntimeError> {
-        let side = if primal { n + 1 } else { n };
-        let at = |k: u32| {
-            if primal {
-                f64::from(k) / f64::from(n)
-            } else {
-                f64::from(2 * k + 1) / f64::from(2 * n)
-            }
+        wanted: &[(bool, u32)],
+    ) -> Result<Vec<Vec<Vec<[f64; 3]>>>, RuntimeError> {
+        let grid_queries = |f: usize, (primal, n): (bool, u32)| {
+            let side = if primal { n + 1 } else { n };
+            let at = move |k: u32| {
+                if primal {
+                    f64::from(k) / f64::from(n)
+                } else {
+                    f64::from(2 * k + 1) / f64::from(2 * n)
+                }
+            };
+            (0..side * side).map(move |p| LimitQuery {
+                face: f as u32,
+                u: at(p % side),
+                v: at(p / side),
+            })
         };
-        let per_face = (side * side) as usize;
         let queries: Vec<LimitQuery> = faces
             .iter()
-            .flat_map(|&f| {
-                (0..side * side).map(move |p| LimitQuery {
-                    face: f as u32,
-                    u: at(p % side),
-                    v: at(p / side),
-                })
-            })
+            .flat_map(|&f| wanted.iter().flat_map(move |&g| grid_queries(f, g)))
             .collect();
         let points = limit_points(self.mesh, &queries)?;
-        Ok(points
-            .chunks(per_face)
-            .map(|grid| grid.iter().map(|p| p[0]).collect())
+        let mut points = points.iter().map(|p| p[0]);
+        Ok(faces
+            .iter()
+            .map(|_| {
+                wanted
+                    .iter()
+                    .map(|&(primal, n)| {
+                        let side = (if primal { n + 1 } else { n }) as usize;
+                        points.by_ref().take(side * side).collect()
+                    })
+                    .collect()
+            })
             .collect())
     }
 }
@@ -994,11 +1059,8 @@ impl<'a> Context<'a> {
 }
 
 /// The surface faces the table does not describe exactly, ascending: those the tessellator
-/// evaluates by feature-adaptive refinement ([`table_may_describe`]), and those whose patch the
-/// table lacks (a valence beyond it). A face next to a semi-sharp feature whose patch the table
-/// has is measured on that patch, the surface without the feature (a heuristic: its adaptive
-/// limit needs as many levels of refinement as the sharpness, everywhere on the face, which
-/// made the selection 100 s on `catmark_bishop` against 5 s).
+/// evaluates by feature-adaptive refinement ([`table_may_describe`]: sharp and semi-sharp
+/// features at a corner), and those whose patch the table lacks (a valence beyond it).
 fn adaptive_faces<'a>(
     table: &StencilTable,
     mesh: &'a Mesh,
@@ -1012,7 +1074,7 @@ fn adaptive_faces<'a>(
             let key = patch
                 .kind
                 .section(StencilKind::Position, PointSet::Dual, SELECTION_GRID);
-            let described = table_may_describe(mesh, patch, f) || semi_sharp(mesh, f);
+            let described = table_may_describe(mesh, patch, f);
             let from_table = described && unless_absent(table.weights(&key))?.is_some();
             Ok((!mesh.holes[f] && !from_table).then_some(f))
         })
@@ -1021,19 +1083,6 @@ fn adaptive_faces<'a>(
         mesh,
         faces.into_iter().flatten().collect(),
     ))
-}
-
-/// Whether a corner of face `f` has a semi-sharp edge or vertex (finite, non-zero sharpness).
-fn semi_sharp(mesh: &Mesh, f: usize) -> bool {
-    let semi = |s: f32| s > 0.0 && !is_infinite(s);
-    mesh.face(f).iter().any(|&v| {
-        let v = v as usize;
-        semi(mesh.vertex_sharpness[v])
-            || mesh
-                .vertex_edges(v)
-                .iter()
-                .any(|&h| semi(mesh.edge_sharpness[h]))
-    })
 }
 
 /// The faces around the corner at half-edge `h` whose corner points make its vertex polygon in

@@ -1134,3 +1134,87 @@ fn limit_surface_matches_opensubdiv() {
         );
     }
 }
+
+/// Why subtess refuses a face whose repeated corners lie in one fan (the smallest case: a
+/// hexagon `v a b v c d` closed by the triangles `a v b` and `c v d`, `v` a manifold vertex of
+/// valence 4): OpenSubdiv 3.7 accepts it but numbers the hexagon's two corners at `v` alike
+/// (`Vtr::Level::populateLocalIndices` expects a face's repeated incidences of a vertex to be
+/// successive in the vertex's ordered faces, as at non-manifold vertices only), and its first
+/// refinement is inconsistent: the child of `v` lists one sub-face twice and omits another
+/// that contains it. There is no OpenSubdiv surface to match there
+/// (docs/algorithms/sharp-features.md, *Not yet*).
+#[test]
+fn opensubdiv_misnumbers_repeated_corners_in_one_fan() {
+    use opensubdiv_petite::Index;
+    let (v, hexagon) = (0u32, 0u32);
+    let sizes = [6u32, 3, 3];
+    let indices = [0u32, 1, 2, 0, 3, 4, 1, 0, 2, 3, 0, 4];
+    let positions = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [-1.0, -1.0, 0.0],
+    ];
+    let faces: Vec<Vec<i64>> = vec![vec![0, 1, 2, 0, 3, 4], vec![1, 0, 2], vec![3, 0, 4]];
+    let refused = subtess::Mesh::new(
+        positions.to_vec(),
+        &faces,
+        &[],
+        subtess::BoundaryMode::EdgeOnly,
+    );
+    assert!(refused.is_err(), "subtess refuses the face");
+
+    let desc = far::TopologyDescriptor::new(positions.len(), &sizes, &indices).expect("topology");
+    let mut refiner = far::TopologyRefiner::new(desc, far::TopologyRefinerOptions::default())
+        .expect("OpenSubdiv accepts the mesh");
+    let base = refiner.level(0).expect("level 0");
+    let v0 = Index::from(v);
+    assert!(
+        !base.is_vertex_non_manifold(v0),
+        "v is manifold for OpenSubdiv"
+    );
+    let in_faces = base.vertex_faces(v0).expect("faces at v");
+    let local = base
+        .vertex_face_local_indices(v0)
+        .expect("local indices at v");
+    let corners: Vec<u16> = in_faces
+        .iter()
+        .zip(local)
+        .filter(|(f, _)| **f == Index::from(hexagon))
+        .map(|(_, &l)| l)
+        .collect();
+    assert_eq!(corners.len(), 2, "the hexagon is at v twice");
+    assert_eq!(
+        corners[0], corners[1],
+        "OpenSubdiv numbers both corners alike (they are 0 and 3)"
+    );
+
+    refiner.refine_uniform(far::UniformRefinementOptions {
+        refinement_level: 1,
+        order_vertices_from_faces_first: false,
+        full_topology_in_last_level: true,
+    });
+    let child = refiner.level(0).expect("level 0").vertex_child_vertex(v0);
+    let level1 = refiner.level(1).expect("level 1");
+    let listed = level1.vertex_faces(child).expect("faces at the child");
+    let containing: Vec<Index> = (0..level1.face_count() as u32)
+        .map(Index::from)
+        .filter(|&f| {
+            level1
+                .face_vertices(f)
+                .is_some_and(|vs| vs.contains(&child))
+        })
+        .collect();
+    let mut distinct = listed.to_vec();
+    distinct.sort();
+    distinct.dedup();
+    assert!(
+        distinct.len() < listed.len(),
+        "a sub-face listed twice: {listed:?}"
+    );
+    assert!(
+        containing.iter().any(|f| !listed.contains(f)),
+        "a sub-face at the child not listed: {listed:?} against {containing:?}"
+    );
+}

@@ -519,6 +519,25 @@ fn featured_cube() -> Mesh {
     mesh
 }
 
+/// The shipped cube with semi-sharp creases of sharpness 0.5 to 3 (one with a sharpness that
+/// changes along it) and a semi-sharp corner.
+fn semi_sharp_cube(creasing: schemes::CreaseMethod) -> Mesh {
+    let mut mesh = cube();
+    for (a, b, s) in [
+        (4, 5, 3.0),
+        (5, 6, 1.5),
+        (6, 7, 0.5),
+        (0, 1, 2.0),
+        (0, 3, 2.5),
+    ] {
+        mesh.set_edge_sharpness(a, b, s)
+            .expect("an edge of the cube");
+    }
+    mesh.set_vertex_sharpness(2, 1.5).expect("a vertex");
+    mesh.creasing = creasing;
+    mesh
+}
+
 /// The shipped cube with one vertex pinned (a `corner` tag) and every edge smooth: the limit
 /// surface is a cone there, its tip the vertex itself.
 fn cone_cube() -> Mesh {
@@ -529,8 +548,10 @@ fn cone_cube() -> Mesh {
 }
 
 /// Faces the table does not describe (a valence beyond it, infinitely sharp creases and
-/// corners, the rim of a hole, a pinned vertex on smooth edges) take rates too, and the output
-/// meets the tolerance on the true surface there, at samples the selection never saw. At the
+/// corners, the rim of a hole, a pinned vertex on smooth edges, semi-sharp creases and corners
+/// under both crease methods) take rates too, and the output meets the tolerance on the true
+/// surface there, at samples the selection never saw. (Semi-sharp faces measured on the
+/// table's patch, the surface without the feature, missed it by 1.81 `T`.) At the
 /// cone's tip the corner points alone cut the tip off by a distance of the order of the sampling
 /// step: no rate up to 24 met 1% of the diagonal before the tessellator closed that fan around
 /// the limit point.
@@ -541,6 +562,14 @@ fn tolerance_rates_cover_valences_beyond_the_table_and_sharp_features() {
         ("spindle of valence 11", spindle(11)),
         ("cube with features", featured_cube()),
         ("cube with a cone point", cone_cube()),
+        (
+            "cube with semi-sharp features",
+            semi_sharp_cube(schemes::CreaseMethod::Uniform),
+        ),
+        (
+            "cube with Chaikin creases",
+            semi_sharp_cube(schemes::CreaseMethod::Chaikin),
+        ),
     ] {
         let (isolated, patches, _) = isolate(&mesh).expect("isolates");
         let samples = adaptive_samples(&isolated);
@@ -556,6 +585,7 @@ fn tolerance_rates_cover_valences_beyond_the_table_and_sharp_features() {
             let (out, _) =
                 tessellate(table(), &isolated, &patches, &chosen.rates).expect("tessellates");
             let measured = brute_force_deviation(&samples, &out);
+            eprintln!("{name}: T = {t}, measured / T = {}", measured / t);
             assert!(
                 measured <= t,
                 "{name}: T = {t}, measured {measured} with rates {:?}",
