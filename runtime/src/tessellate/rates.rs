@@ -432,9 +432,9 @@ const MAX_ADAPTIVE_RATE: u32 = 64;
 
 /// The rates whose grids are computed together with rate `n`'s, and the chunk's number: `1`,
 /// `2..=3`, `4..=7`, `8..=15`, `16..=23`, then [`SELECTION_GRID`] alone (every face's samples),
-/// `25..=31`, `32..=63`, `64`. Doubling chunks keep the points computed for rates a face never
-/// reaches below those of the rates it does, with a handful of descents where one a grid made
-/// up to `2 n`.
+/// `25..=31`, `32..=63`, `64`. With doubling chunks the points made for rates a face never
+/// reaches are fewer than those of the rates it does, and a face reaching rate `n` takes a
+/// handful of descents instead of one per grid, up to `2 n`.
 fn rate_chunk(n: u32) -> (usize, std::ops::RangeInclusive<u32>) {
     const CHUNKS: [(u32, u32); 9] = [
         (1, 1),
