@@ -33,14 +33,15 @@ pub fn neighbours(mesh: &Mesh, v: usize) -> Vec<u32> {
     out
 }
 
-/// Refuse a mesh that `scheme` (named in the message) cannot refine because its boundary rules
-/// are not implemented: not all triangles, or with a boundary edge (named).
+/// Refuse a mesh that `scheme` (named in the message) cannot tessellate because it has no
+/// boundary patches (the butterfly has no boundary rules either; √3's are in
+/// [`crate::scheme::sqrt3::refine`]): not all triangles, or with a boundary edge (named).
 pub fn require_closed_triangles(mesh: &Mesh, scheme: &str) -> Result<(), RuntimeError> {
     require_triangles(mesh)?;
     if let Some(h) = mesh.twin.iter().position(|&t| t == NONE) {
         return Err(RuntimeError::Unsupported(format!(
-            "edge ({}, {}) is on the boundary, and the boundary rules of --scheme {scheme} are \
-             not implemented: it tessellates closed triangle meshes",
+            "edge ({}, {}) is on the boundary, and --scheme {scheme} does not tessellate \
+             boundaries yet: it tessellates closed triangle meshes",
             mesh.face_vertices[h],
             mesh.head(h)
         )));

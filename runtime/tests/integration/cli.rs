@@ -648,7 +648,7 @@ fn sqrt3_scheme_tessellates_closed_triangle_meshes() {
     assert_eq!(json(&bench)["triangles"], 8 * 81 * 9);
     // Issue 18: the embedded (compact) table covers every rate 1..=24, each one watertight.
     every_rate_is_watertight(&mesh, &out_path, "sqrt3");
-    // A mesh with a boundary: √3's boundary rules are not implemented.
+    // A mesh with a boundary: the √3 tables have no boundary patches yet.
     let open = temp("open-triangle-s.obj");
     std::fs::write(&open, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").expect("written");
     let err = fails(&format!(

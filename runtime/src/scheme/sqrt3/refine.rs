@@ -1,4 +1,4 @@
-//! Two uniform steps of √3 subdivision (Kobbelt 2000) on a closed triangle mesh, taken as one
+//! Two uniform steps of √3 subdivision (Kobbelt 2000) on a triangle mesh, taken as one
 //! ternary step aligned with the mesh (Schaefer–Warren section 5.1): the rules of
 //! `schemes::TriangleScheme` "sqrt3" that the √3 stencil tables were generated with, numbered
 //! as the ternary split of [`crate::scheme::triangle::split`] says.
@@ -18,15 +18,41 @@
 //!   (`alpha_6 = 1/3`), `2/3 c_f + 1/18 (h_a + h_b + h_c + c_g1 + c_g2 + c_g3)`, `g_i` the
 //!   triangles across `f`'s edges.
 //!
-//! Old vertices keep their valence; every new vertex has valence 6. Kobbelt's boundary rules
-//! (a different step on odd and even levels) are not implemented: a mesh with a boundary is
-//! refused.
+//! Old vertices keep their valence; every new vertex has valence 6.
+//!
+//! # Boundaries
+//!
+//! Kobbelt's boundary rules (2000, section 4) take the two steps differently. The first step
+//! keeps the boundary vertices where they are and does not flip boundary edges: a triangle
+//! `f = (a, b, c)` with boundary edge `(a, b)` keeps `(a, b, c_f)`. The second step trisects
+//! every boundary edge by the univariate ternary rules
+//! `(p_{i-1} + 16 p_i + 10 p_{i+1}) / 27` (the third nearer `p_i`) and moves every boundary vertex
+//! to `(4 p_{i-1} + 19 p_i + 4 p_{i+1}) / 27`; a triangle with a boundary edge gets no centroid
+//! but is split into three by the edge's thirds, and its two inner edges are flipped with the
+//! rest. Interior points follow the interior rules, with the valences they have:
+//!
+//! * an interior vertex's neighbours are counted boundary vertices included;
+//! * the centroid `c_f` of a triangle with `j` inner (non-boundary) edges has valence `3 + j`
+//!   after the first step (its three corners and the centroids across the inner edges), so it
+//!   moves to `(1 - alpha_{3+j}) c_f + (alpha_{3+j} / (3 + j)) (h_a + h_b + h_c + sum c_g)`;
+//!   `j = 3` is the interior rule above;
+//! * the thirds of an inner edge are `(h_a + c_f + c_g) / 3` as above, with `h = p` at a
+//!   boundary vertex.
+//!
+//! The two steps together split every triangle as the ternary split does (the boundary edge's
+//! thirds, the centre `c_f` and the inner edges' thirds are the nine children's corners), so the
+//! numbering of [`crate::scheme::triangle::split`] holds with a boundary too. Along the boundary
+//! the composed rule reads boundary points only, and it is the ternary subdivision of the
+//! uniform cubic B-spline (mask `(1 + z + z^2)^4 / 27`): the limit boundary is the cubic B-spline
+//! of the boundary polygon, and a boundary vertex's limit is `(p_{i-1} + 4 p_i + p_{i+1}) / 6`
+//! ([`sqrt3_boundary_limit_position`]).
 
 use schemes::triangle::TriangleVertexRule;
 
 use crate::mesh::geometry::{add, scale};
 use crate::mesh::topology::Mesh;
-use crate::mesh::triangle_topology::{neighbours, require_closed_triangles};
+use crate::mesh::topology::NONE;
+use crate::mesh::triangle_topology::{neighbours, require_triangles};
 use crate::scheme::stencil::Stencil;
 use crate::scheme::triangle::split::TriangleSplit;
 use crate::RuntimeError;
@@ -48,7 +74,17 @@ pub fn sqrt3_limit_position(p: [f64; 3], ring_average: [f64; 3], valence: usize)
     scale(1.0 / (1.0 + w), add(p, scale(w, ring_average)))
 }
 
-/// Two √3 steps of a closed triangle mesh as one ternary step, and the rules that made it.
+/// The limit position of a boundary vertex `p` between boundary neighbours `prev` and `next`:
+/// `(prev + 4 p + next) / 6`, the uniform cubic B-spline at its knot. Why: the composed step's
+/// boundary rules (module docs) are the ternary refinement of the cubic B-spline, whose mask
+/// `(1 + z + z^2)^4 / 27` maps the triple `(prev, p, next)` by `(4, 19, 4) / 27` and
+/// `(1, 16, 10) / 27`, `(10, 16, 1) / 27`; the left eigenvector for eigenvalue 1 is
+/// `(1, 4, 1) / 6`.
+pub fn sqrt3_boundary_limit_position(prev: [f64; 3], p: [f64; 3], next: [f64; 3]) -> [f64; 3] {
+    scale(1.0 / 6.0, add(add(prev, next), scale(4.0, p)))
+}
+
+/// Two √3 steps of a triangle mesh as one ternary step, and the rules that made it.
 #[derive(Clone, Debug)]
 pub struct Sqrt3Refinement {
     /// The refined mesh (nine triangles per triangle, `9f + c` from triangle `f`, numbered as
@@ -59,23 +95,36 @@ pub struct Sqrt3Refinement {
     pub stencil: Stencil<f64>,
 }
 
-/// Two √3 steps of the closed triangle mesh `mesh`, composed, as rows over its vertices (f64:
+/// Two √3 steps of the triangle mesh `mesh`, composed, as rows over its vertices (f64:
 /// `alpha_k` has a cosine): refined vertex `i`, numbered as the ternary split of
-/// [`crate::scheme::triangle::split`] says, is `sum w p_j` over row `i`. Why a map: the same
-/// rules then position the refined mesh ([`sqrt3_refine`]) and compose into the per-frame
-/// stencil of an isolation. Refuses a boundary.
+/// [`crate::scheme::triangle::split`] says, is `sum w p_j` over row `i`; Kobbelt's boundary
+/// rules where `mesh` has a boundary (module docs). Why a map: the same rules then position the
+/// refined mesh ([`sqrt3_refine`]) and compose into the per-frame stencil of an isolation.
+/// Refuses a face that is not a triangle.
 pub fn sqrt3_stencil(mesh: &Mesh) -> Result<Stencil<f64>, RuntimeError> {
-    require_closed_triangles(mesh, "sqrt3")?;
+    require_triangles(mesh)?;
     Ok(rows(mesh, &TriangleSplit::new(mesh)))
 }
 
-/// The module docs' two steps over `split`'s ternary numbering (`mesh` closed, all
-/// triangles), composed: the first step's points are the old vertices moved (`h_v`, numbered
-/// as the vertices) and then every triangle's centroid `c_f` (number `nv + f`); the second
-/// step's rows are over those.
+/// The boundary neighbours of boundary vertex `v`: the one before it along the boundary and
+/// the one after it (faces counter-clockwise: the interior lies to the left of `prev -> v ->
+/// next`).
+fn boundary_neighbours(mesh: &Mesh, v: usize) -> (u32, u32) {
+    let ring = neighbours(mesh, v);
+    (ring[ring.len() - 1], ring[0])
+}
+
+/// The module docs' two steps over `split`'s ternary numbering (`mesh` all triangles),
+/// composed: the first step's points are the old vertices moved (`h_v`, numbered as the
+/// vertices) and then every triangle's centroid `c_f` (number `nv + f`); the second step's rows
+/// are over those.
 fn rows(mesh: &Mesh, split: &TriangleSplit) -> Stencil<f64> {
     let nv = mesh.positions.len();
     let centroid = |f: usize| (nv + f) as u32;
+    let across = |h: usize| {
+        let t = mesh.twin[h];
+        (t != NONE).then(|| centroid(mesh.face_of[t as usize] as usize))
+    };
     let mut first = Stencil::new(nv);
     let mut second = Stencil::new(nv + mesh.faces());
     for v in 0..nv {
@@ -85,6 +134,17 @@ fn rows(mesh: &Mesh, split: &TriangleSplit) -> Stencil<f64> {
             // An unused vertex stays where it is.
             first.push_row(vec![(v as u32, 1.0)]);
             second.push_row(vec![(v as u32, 1.0)]);
+            continue;
+        }
+        if mesh.is_boundary_vertex(v) {
+            // Kept by the first step; the second reads the boundary neighbours, kept too.
+            let (prev, next) = boundary_neighbours(mesh, v);
+            first.push_row(vec![(v as u32, 1.0)]);
+            second.push_row(vec![
+                (prev, 4.0 / 27.0),
+                (v as u32, 19.0 / 27.0),
+                (next, 4.0 / 27.0),
+            ]);
             continue;
         }
         let alpha = sqrt3_alpha(k);
@@ -104,33 +164,49 @@ fn rows(mesh: &Mesh, split: &TriangleSplit) -> Stencil<f64> {
     }
     for (&[a, b], &h) in split.edges.iter().zip(&split.first_halfedge) {
         let h = h as usize;
-        let across = [
-            centroid(mesh.face_of[h] as usize),
-            centroid(mesh.face_of[mesh.twin[h] as usize] as usize),
-        ];
-        for end in [a, b] {
-            let mut third = vec![(end, 1.0 / 3.0)];
-            third.extend(across.iter().map(|&c| (c, 1.0 / 3.0)));
-            second.push_row(third);
+        match across(h) {
+            Some(g) => {
+                let f = centroid(mesh.face_of[h] as usize);
+                for end in [a, b] {
+                    second.push_row(vec![(end, 1.0 / 3.0), (f, 1.0 / 3.0), (g, 1.0 / 3.0)]);
+                }
+            }
+            None => {
+                // `a -> b` runs along the boundary: `a`'s other boundary neighbour comes
+                // before it, `b`'s after it.
+                let (before, _) = boundary_neighbours(mesh, a as usize);
+                let (_, after) = boundary_neighbours(mesh, b as usize);
+                second.push_row(vec![
+                    (before, 1.0 / 27.0),
+                    (a, 16.0 / 27.0),
+                    (b, 10.0 / 27.0),
+                ]);
+                second.push_row(vec![
+                    (a, 10.0 / 27.0),
+                    (b, 16.0 / 27.0),
+                    (after, 1.0 / 27.0),
+                ]);
+            }
         }
     }
     for f in 0..mesh.faces() {
-        let mut centre = vec![(centroid(f), 2.0 / 3.0)];
-        for h in mesh.face_halfedges(f) {
-            let g = mesh.face_of[mesh.twin[h] as usize] as usize;
-            centre.push((mesh.face_vertices[h], 1.0 / 18.0));
-            centre.push((centroid(g), 1.0 / 18.0));
-        }
+        let inner: Vec<u32> = mesh.face_halfedges(f).filter_map(across).collect();
+        let valence = 3 + inner.len();
+        let alpha = sqrt3_alpha(valence);
+        let ring = alpha / valence as f64;
+        let mut centre = vec![(centroid(f), 1.0 - alpha)];
+        centre.extend(mesh.face(f).iter().map(|&v| (v, ring)));
+        centre.extend(inner.iter().map(|&g| (g, ring)));
         second.push_row(centre);
     }
     first.then(&second)
 }
 
-/// Refine the closed triangle mesh `mesh` by two √3 steps, one ternary step (module docs): the
+/// Refine the triangle mesh `mesh` by two √3 steps, one ternary step (module docs): the
 /// positions are [`sqrt3_stencil`]'s rows applied to the coarse positions, and the rows come
 /// back with the mesh.
 pub fn sqrt3_refine(mesh: &Mesh) -> Result<Sqrt3Refinement, RuntimeError> {
-    require_closed_triangles(mesh, "sqrt3")?;
+    require_triangles(mesh)?;
     let nv = mesh.positions.len();
     let split = TriangleSplit::new(mesh);
     let stencil = rows(mesh, &split);
@@ -142,14 +218,349 @@ pub fn sqrt3_refine(mesh: &Mesh) -> Result<Sqrt3Refinement, RuntimeError> {
 
 #[cfg(test)]
 mod tests {
+    use std::collections::HashMap;
+
+    use schemes::BoundaryMode;
+
     use super::*;
     use crate::mesh::test_meshes::{lattice_torus, octahedron};
 
-    /// Kobbelt's closed form: `alpha_3 = 5/9`, `alpha_4 = 4/9`, `alpha_6 = 1/3`.
+    /// One √3 step done literally, as Kobbelt describes it and independent of the composed
+    /// rows: relax the old vertices, insert centroids (on an odd step, split a triangle with a
+    /// boundary edge by the edge's two new points instead), then flip every old inner edge.
+    /// Faces are vertex triples, counter-clockwise.
+    fn literal_step(
+        positions: &[[f64; 3]],
+        faces: &[[u32; 3]],
+        odd: bool,
+    ) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+        let edges = |fs: &[[u32; 3]]| -> HashMap<(u32, u32), usize> {
+            let mut map = HashMap::new();
+            for (f, t) in fs.iter().enumerate() {
+                for i in 0..3 {
+                    assert!(map.insert((t[i], t[(i + 1) % 3]), f).is_none(), "manifold");
+                }
+            }
+            map
+        };
+        let old = edges(faces);
+        let boundary = |a: u32, b: u32| !old.contains_key(&(b, a));
+        let n = positions.len();
+        let mut ring: Vec<Vec<u32>> = vec![Vec::new(); n];
+        let (mut next, mut prev) = (vec![u32::MAX; n], vec![u32::MAX; n]);
+        for &(a, b) in old.keys() {
+            if !ring[a as usize].contains(&b) {
+                ring[a as usize].push(b);
+            }
+            if !ring[b as usize].contains(&a) {
+                ring[b as usize].push(a);
+            }
+            if boundary(a, b) {
+                next[a as usize] = b;
+                prev[b as usize] = a;
+            }
+        }
+        let p = |v: u32| positions[v as usize];
+        let combine = |terms: &[(u32, f64)]| {
+            terms
+                .iter()
+                .fold([0.0; 3], |acc, &(v, w)| add(acc, scale(w, p(v))))
+        };
+        let mut out: Vec<[f64; 3]> = (0..n as u32)
+            .map(|v| {
+                let i = v as usize;
+                if next[i] != u32::MAX {
+                    if odd {
+                        combine(&[
+                            (prev[i], 4.0 / 27.0),
+                            (v, 19.0 / 27.0),
+                            (next[i], 4.0 / 27.0),
+                        ])
+                    } else {
+                        p(v)
+                    }
+                } else {
+                    let k = ring[i].len();
+                    let alpha = sqrt3_alpha(k);
+                    let mut terms = vec![(v, 1.0 - alpha)];
+                    terms.extend(ring[i].iter().map(|&e| (e, alpha / k as f64)));
+                    combine(&terms)
+                }
+            })
+            .collect();
+        let mut split = Vec::new();
+        for t in faces {
+            let cut = (0..3).find(|&i| odd && boundary(t[i], t[(i + 1) % 3]));
+            if let Some(i) = cut {
+                let (a, b, c) = (t[i], t[(i + 1) % 3], t[(i + 2) % 3]);
+                let (l, r) = (out.len() as u32, out.len() as u32 + 1);
+                out.push(
+                    combine(&[(prev[a as usize], 1.0), (a, 16.0), (b, 10.0)]).map(|x| x / 27.0),
+                );
+                out.push(
+                    combine(&[(a, 10.0), (b, 16.0), (next[b as usize], 1.0)]).map(|x| x / 27.0),
+                );
+                split.extend([[a, l, c], [l, r, c], [r, b, c]]);
+            } else {
+                let m = out.len() as u32;
+                out.push(combine(&[
+                    (t[0], 1.0 / 3.0),
+                    (t[1], 1.0 / 3.0),
+                    (t[2], 1.0 / 3.0),
+                ]));
+                split.extend([[t[0], t[1], m], [t[1], t[2], m], [t[2], t[0], m]]);
+            }
+        }
+        let new = edges(&split);
+        let mut flipped = vec![false; split.len()];
+        let mut result = Vec::new();
+        for (&(a, b), _) in old.iter().filter(|(&(a, b), _)| a < b && !boundary(a, b)) {
+            // Faces (a, b, u) and (b, a, w) become (a, w, u) and (w, b, u).
+            let (f, g) = (new[&(a, b)], new[&(b, a)]);
+            let apex = |t: [u32; 3], x: u32, y: u32| {
+                t.into_iter()
+                    .find(|&z| z != x && z != y)
+                    .expect("a triangle")
+            };
+            let (u, w) = (apex(split[f], a, b), apex(split[g], a, b));
+            assert!(!flipped[f] && !flipped[g], "one old edge per new triangle");
+            flipped[f] = true;
+            flipped[g] = true;
+            result.extend([[a, w, u], [w, b, u]]);
+        }
+        result.extend((0..split.len()).filter(|&f| !flipped[f]).map(|f| split[f]));
+        (out, result)
+    }
+
+    /// A mesh from vertex triples, positions perturbed by a fixed pseudo-random offset so that
+    /// refined vertices can be matched by position.
+    fn jittered(positions: Vec<[f64; 3]>, faces: &[[u32; 3]]) -> Mesh {
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut jitter = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 0.2 - 0.1
+        };
+        let positions = positions
+            .into_iter()
+            .map(|p| p.map(|x| x + jitter()))
+            .collect();
+        let faces: Vec<Vec<i64>> = faces
+            .iter()
+            .map(|t| t.iter().map(|&v| i64::from(v)).collect())
+            .collect();
+        Mesh::new(positions, &faces, &[], BoundaryMode::EdgeOnly).expect("a valid mesh")
+    }
+
+    /// The lattice triangles with every corner `(a, b)` in `0..=m` squared, at `(a, b, 0)`:
+    /// a parallelogram whose corners have one and two triangles and whose sides are regular
+    /// boundary vertices (three triangles).
+    fn lattice_patch(m: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+        let index = |a: u32, b: u32| a + (m + 1) * b;
+        let positions = (0..(m + 1) * (m + 1))
+            .map(|k| [f64::from(k % (m + 1)), f64::from(k / (m + 1)), 0.0])
+            .collect();
+        let mut faces = Vec::new();
+        for b in 0..m {
+            for a in 0..m {
+                faces.push([index(a, b), index(a + 1, b), index(a, b + 1)]);
+                faces.push([index(a + 1, b), index(a + 1, b + 1), index(a, b + 1)]);
+            }
+        }
+        (positions, faces)
+    }
+
+    /// Meshes with boundaries: one triangle, an open fan of five triangles, the octahedron
+    /// without one face, and a lattice parallelogram.
+    fn open_meshes() -> Vec<(&'static str, Mesh)> {
+        let fan: Vec<[f64; 3]> = (0..6)
+            .map(|i| {
+                let t = f64::from(i) * 0.9;
+                [t.cos(), t.sin(), 0.3 * f64::from(i % 2)]
+            })
+            .chain([[0.0, 0.0, 0.5]])
+            .collect();
+        let octahedron_faces: Vec<[u32; 3]> = (0..octahedron().faces())
+            .skip(1)
+            .map(|f| {
+                let t = octahedron().face(f).to_vec();
+                [t[0], t[1], t[2]]
+            })
+            .collect();
+        let (patch, patch_faces) = lattice_patch(4);
+        vec![
+            (
+                "triangle",
+                jittered(
+                    vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+                    &[[0, 1, 2]],
+                ),
+            ),
+            (
+                "open fan",
+                jittered(fan, &(0..5).map(|i| [6, i, i + 1]).collect::<Vec<_>>()),
+            ),
+            (
+                "octahedron without a face",
+                jittered(octahedron().positions, &octahedron_faces),
+            ),
+            ("lattice parallelogram", jittered(patch, &patch_faces)),
+        ]
+    }
+
+    /// Kobbelt's two steps, taken literally (an even step, then an odd one), give the mesh
+    /// and the positions of the composed ternary step: the same vertices (matched by position,
+    /// to 1e-13) and the same triangles.
     #[test]
-    fn alpha_is_kobbelts() {
-        for (k, alpha) in [(3, 5.0 / 9.0), (4, 4.0 / 9.0), (6, 1.0 / 3.0)] {
-            assert!((sqrt3_alpha(k) - alpha).abs() < 1e-15, "valence {k}");
+    fn the_composed_step_is_two_literal_steps_with_boundaries() {
+        let mut cases = open_meshes();
+        cases.push(("octahedron", octahedron()));
+        for (name, mesh) in cases {
+            let faces: Vec<[u32; 3]> = (0..mesh.faces())
+                .map(|f| {
+                    let t = mesh.face(f);
+                    [t[0], t[1], t[2]]
+                })
+                .collect();
+            let (p1, f1) = literal_step(&mesh.positions, &faces, false);
+            let (p2, f2) = literal_step(&p1, &f1, true);
+            let refined = sqrt3_refine(&mesh).expect("refines").mesh;
+            assert_eq!(p2.len(), refined.positions.len(), "{name}: vertices");
+            assert_eq!(f2.len(), refined.faces(), "{name}: triangles");
+            let matched: Vec<u32> = p2
+                .iter()
+                .map(|q| {
+                    let distance =
+                        |r: &[f64; 3]| (0..3).map(|x| (q[x] - r[x]).abs()).fold(0.0, f64::max);
+                    let (best, d) = refined
+                        .positions
+                        .iter()
+                        .enumerate()
+                        .map(|(i, r)| (i as u32, distance(r)))
+                        .min_by(|x, y| x.1.total_cmp(&y.1))
+                        .expect("vertices");
+                    assert!(
+                        d < 1e-13,
+                        "{name}: literal vertex {q:?} is {d} from the nearest"
+                    );
+                    best
+                })
+                .collect();
+            let canonical = |t: [u32; 3]| {
+                let i = (0..3).min_by_key(|&i| t[i]).expect("three");
+                [t[i], t[(i + 1) % 3], t[(i + 2) % 3]]
+            };
+            let mut want: Vec<[u32; 3]> = f2
+                .iter()
+                .map(|t| canonical(t.map(|v| matched[v as usize])))
+                .collect();
+            let mut got: Vec<[u32; 3]> = (0..refined.faces())
+                .map(|f| {
+                    let t = refined.face(f);
+                    canonical([t[0], t[1], t[2]])
+                })
+                .collect();
+            want.sort_unstable();
+            got.sort_unstable();
+            assert_eq!(want, got, "{name}: triangles");
+        }
+    }
+
+    /// Along the boundary the composed step is the ternary refinement of the uniform cubic
+    /// B-spline: refined boundary point `3i + r` is `sum_j s[3(i - j) + r + 4] p_j` over the
+    /// coarse boundary polygon, `s` the coefficients of `(1 + z + z^2)^4 / 27` (the B-spline's
+    /// symbol, expanded here). And the boundary limit `(prev + 4 p + next) / 6` of every coarse
+    /// boundary vertex, the interior one of every interior vertex, is where the refined vertex's
+    /// limit is.
+    #[test]
+    fn the_boundary_is_the_ternary_cubic_b_spline() {
+        let mut symbol = vec![1.0];
+        for _ in 0..4 {
+            let mut next = vec![0.0; symbol.len() + 2];
+            for (i, c) in symbol.iter().enumerate() {
+                for d in 0..3 {
+                    next[i + d] += c;
+                }
+            }
+            symbol = next;
+        }
+        let mask: Vec<f64> = symbol.iter().map(|c| c / 27.0).collect();
+        assert_eq!(mask.len(), 9);
+        let limit = |m: &Mesh, v: usize| {
+            let ring = neighbours(m, v);
+            if m.is_boundary_vertex(v) {
+                let (prev, next) = boundary_neighbours(m, v);
+                sqrt3_boundary_limit_position(
+                    m.positions[prev as usize],
+                    m.positions[v],
+                    m.positions[next as usize],
+                )
+            } else {
+                let sum = ring
+                    .iter()
+                    .fold([0.0; 3], |acc, &e| add(acc, m.positions[e as usize]));
+                sqrt3_limit_position(
+                    m.positions[v],
+                    scale(1.0 / ring.len() as f64, sum),
+                    ring.len(),
+                )
+            }
+        };
+        for (name, coarse) in open_meshes() {
+            let fine = sqrt3_refine(&coarse).expect("refines").mesh;
+            // The boundary loop through coarse vertex `start`, in boundary order.
+            let walk = |m: &Mesh, start: usize| {
+                let mut loop_ = vec![start as u32];
+                loop {
+                    let (_, next) = boundary_neighbours(m, loop_[loop_.len() - 1] as usize);
+                    if next as usize == start {
+                        break loop_;
+                    }
+                    loop_.push(next);
+                }
+            };
+            let start = (0..coarse.positions.len())
+                .find(|&v| coarse.is_boundary_vertex(v))
+                .expect("a boundary");
+            let coarse_loop = walk(&coarse, start);
+            let fine_loop = walk(&fine, start);
+            let n = coarse_loop.len();
+            assert_eq!(fine_loop.len(), 3 * n, "{name}");
+            for (k, &v) in fine_loop.iter().enumerate() {
+                let (i, r) = (k / 3, k % 3);
+                let mut want = [0.0; 3];
+                for dj in -2i64..=2 {
+                    let index = 3 * dj + r as i64 + 4;
+                    if !(0..9).contains(&index) {
+                        continue;
+                    }
+                    let j = (i as i64 - dj).rem_euclid(n as i64) as usize;
+                    want = add(
+                        want,
+                        scale(
+                            mask[index as usize],
+                            coarse.positions[coarse_loop[j] as usize],
+                        ),
+                    );
+                }
+                let got = fine.positions[v as usize];
+                for x in 0..3 {
+                    assert!(
+                        (got[x] - want[x]).abs() < 1e-14,
+                        "{name}: boundary point {k}"
+                    );
+                }
+            }
+            for v in 0..coarse.positions.len() {
+                let (a, b) = (limit(&coarse, v), limit(&fine, v));
+                for x in 0..3 {
+                    assert!(
+                        (a[x] - b[x]).abs() < 1e-14,
+                        "{name}: vertex {v}: {a:?} {b:?}"
+                    );
+                }
+            }
         }
     }
 
