@@ -28,6 +28,7 @@ pub mod quad;
 pub mod rational;
 pub mod sqrt3_local;
 pub mod sqrt3_regions;
+pub mod sqrt3_strip;
 pub mod tangent_frame;
 pub mod triangle;
 pub mod triangle_local;

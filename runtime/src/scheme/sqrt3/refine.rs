@@ -50,8 +50,7 @@
 use schemes::triangle::TriangleVertexRule;
 
 use crate::mesh::geometry::{add, scale};
-use crate::mesh::topology::Mesh;
-use crate::mesh::topology::NONE;
+use crate::mesh::topology::{Mesh, NONE};
 use crate::mesh::triangle_topology::{neighbours, require_triangles};
 use crate::scheme::stencil::Stencil;
 use crate::scheme::triangle::split::TriangleSplit;
@@ -562,6 +561,78 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The half-plane rules of `schemes::sqrt3_strip` (the generator's side, written in lattice
+    /// coordinates) are this whole-mesh step's: on a lattice parallelogram with jittered
+    /// positions, every vertex after one and after two ternary steps, away from the three sides
+    /// other than `b = 0`, is its strip row applied to the coarse positions (to 1e-14).
+    #[test]
+    fn the_strip_rules_are_the_whole_mesh_rules_beside_a_straight_boundary() {
+        use schemes::sqrt3_strip::StripRows;
+        let m = 12i64;
+        let (positions, faces) = lattice_patch(m as u32);
+        let coarse = jittered(positions, &faces);
+        let mut coords: Vec<(i64, i64)> = (0..(m + 1) * (m + 1))
+            .map(|k| (k % (m + 1), k / (m + 1)))
+            .collect();
+        let mut mesh = coarse.clone();
+        let mut rows = StripRows::new();
+        let mut checked = 0;
+        for level in 1..=2u32 {
+            let fine = sqrt3_refine(&mesh).expect("refines").mesh;
+            let mut fine_coords = vec![None; fine.positions.len()];
+            for f in 0..mesh.faces() {
+                let c: Vec<(i64, i64)> = mesh.face(f).iter().map(|&v| coords[v as usize]).collect();
+                for g in 9 * f..9 * f + 9 {
+                    for (&corner, (s, t)) in fine.face(g).iter().zip([(0, 0), (1, 0), (0, 1)]) {
+                        let (u, v) = crate::scheme::triangle::split::ternary_child_to_parent(
+                            (g % 9) as u8,
+                            s,
+                            t,
+                            1,
+                        );
+                        let (u, v) = (i64::from(u), i64::from(v));
+                        let q = (
+                            3 * c[0].0 + u * (c[1].0 - c[0].0) + v * (c[2].0 - c[0].0),
+                            3 * c[0].1 + u * (c[1].1 - c[0].1) + v * (c[2].1 - c[0].1),
+                        );
+                        assert!(
+                            fine_coords[corner as usize].map_or(true, |p| p == q),
+                            "consistent"
+                        );
+                        fine_coords[corner as usize] = Some(q);
+                    }
+                }
+            }
+            coords = fine_coords
+                .into_iter()
+                .map(|q| q.expect("every vertex in a face"))
+                .collect();
+            let unit = 3i64.pow(level);
+            for (v, &q) in coords.iter().enumerate() {
+                let inside = |x: i64| x >= 4 * unit && x <= (m - 4) * unit;
+                if !inside(q.0) || q.1 > (m - 4) * unit {
+                    continue;
+                }
+                let want = rows
+                    .row(level, q)
+                    .iter()
+                    .fold([0.0; 3], |acc, (&(a, b), &w)| {
+                        add(acc, scale(w, coarse.positions[(a + (m + 1) * b) as usize]))
+                    });
+                let got = fine.positions[v];
+                for x in 0..3 {
+                    assert!(
+                        (got[x] - want[x]).abs() < 1e-14,
+                        "level {level} point {q:?}: {got:?} {want:?}"
+                    );
+                }
+                checked += 1;
+            }
+            mesh = fine;
+        }
+        assert!(checked > 1000, "{checked} points checked");
     }
 
     /// Affine functions are reproduced: on a lattice torus whose positions are the lattice
