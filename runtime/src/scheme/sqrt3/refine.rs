@@ -563,76 +563,137 @@ mod tests {
         }
     }
 
-    /// The half-plane rules of `schemes::sqrt3_strip` (the generator's side, written in lattice
-    /// coordinates) are this whole-mesh step's: on a lattice parallelogram with jittered
-    /// positions, every vertex after one and after two ternary steps, away from the three sides
-    /// other than `b = 0`, is its strip row applied to the coarse positions (to 1e-14).
-    #[test]
-    fn the_strip_rules_are_the_whole_mesh_rules_beside_a_straight_boundary() {
-        use schemes::sqrt3_strip::StripRows;
-        let m = 12i64;
-        let (positions, faces) = lattice_patch(m as u32);
-        let coarse = jittered(positions, &faces);
-        let mut coords: Vec<(i64, i64)> = (0..(m + 1) * (m + 1))
-            .map(|k| (k % (m + 1), k / (m + 1)))
+    /// The faces' corners after a ternary step, in their parents' charts: a face lies in one
+    /// chart, its corners at `corners[f]` in it; a child's corner is at three times the
+    /// parent's coordinates plus its ternary offset. Also every refined vertex's chart and
+    /// coordinates (from any face it is in).
+    #[allow(clippy::type_complexity)]
+    fn refined_corners(
+        mesh: &Mesh,
+        fine: &Mesh,
+        corners: &[[(i64, i64); 3]],
+        chart: &[i64],
+    ) -> (Vec<[(i64, i64); 3]>, Vec<i64>, Vec<(i64, (i64, i64))>) {
+        let mut out = vec![None; fine.positions.len()];
+        let mut fine_corners = vec![[(0, 0); 3]; fine.faces()];
+        let mut fine_chart = vec![0; fine.faces()];
+        for f in 0..mesh.faces() {
+            let c = corners[f];
+            for g in 9 * f..9 * f + 9 {
+                fine_chart[g] = chart[f];
+                for (i, (&corner, (s, t))) in fine
+                    .face(g)
+                    .iter()
+                    .zip([(0, 0), (1, 0), (0, 1)])
+                    .enumerate()
+                {
+                    let (u, v) = crate::scheme::triangle::split::ternary_child_to_parent(
+                        (g % 9) as u8,
+                        s,
+                        t,
+                        1,
+                    );
+                    let (u, v) = (i64::from(u), i64::from(v));
+                    let q = (
+                        3 * c[0].0 + u * (c[1].0 - c[0].0) + v * (c[2].0 - c[0].0),
+                        3 * c[0].1 + u * (c[1].1 - c[0].1) + v * (c[2].1 - c[0].1),
+                    );
+                    fine_corners[g][i] = q;
+                    out[corner as usize].get_or_insert((chart[f], q));
+                }
+            }
+        }
+        let out = out
+            .into_iter()
+            .map(|q| q.expect("every vertex in a face"))
             .collect();
-        let mut mesh = coarse.clone();
-        let mut rows = StripRows::new();
+        (fine_corners, fine_chart, out)
+    }
+
+    /// The boundary rules of `schemes::sqrt3_boundary` (the generator's side, written in
+    /// lattice charts) are this whole-mesh step's: on the fan of `K = 1..=7` triangles around
+    /// a boundary vertex (seven rings, jittered positions), every vertex after one and after
+    /// two ternary steps within three level-0 units of the fan's vertex is its row applied to the
+    /// coarse positions (to 1e-14); `K = 3` is the half-plane beside a straight boundary.
+    #[test]
+    fn the_fan_rules_are_the_whole_mesh_rules_next_to_a_boundary_vertex() {
+        use schemes::sqrt3_boundary::{BoundaryFan, BoundaryRows, FanPoint};
+        let rings = 7i64;
         let mut checked = 0;
-        for level in 1..=2u32 {
-            let fine = sqrt3_refine(&mesh).expect("refines").mesh;
-            let mut fine_coords = vec![None; fine.positions.len()];
-            for f in 0..mesh.faces() {
-                let c: Vec<(i64, i64)> = mesh.face(f).iter().map(|&v| coords[v as usize]).collect();
-                for g in 9 * f..9 * f + 9 {
-                    for (&corner, (s, t)) in fine.face(g).iter().zip([(0, 0), (1, 0), (0, 1)]) {
-                        let (u, v) = crate::scheme::triangle::split::ternary_child_to_parent(
-                            (g % 9) as u8,
-                            s,
-                            t,
-                            1,
-                        );
-                        let (u, v) = (i64::from(u), i64::from(v));
-                        let q = (
-                            3 * c[0].0 + u * (c[1].0 - c[0].0) + v * (c[2].0 - c[0].0),
-                            3 * c[0].1 + u * (c[1].1 - c[0].1) + v * (c[2].1 - c[0].1),
-                        );
-                        assert!(
-                            fine_coords[corner as usize].map_or(true, |p| p == q),
-                            "consistent"
-                        );
-                        fine_coords[corner as usize] = Some(q);
+        for k in 1..=7u32 {
+            let fan = BoundaryFan::new(k);
+            // The level-0 points: V, then every sector's points up to `rings`, then E_K's ray.
+            let mut names: Vec<FanPoint> = Vec::new();
+            let mut faces: Vec<[u32; 3]> = Vec::new();
+            let mut chart = Vec::new();
+            let mut corner_coords = Vec::new();
+            let id = |p: FanPoint, names: &mut Vec<FanPoint>| {
+                names.iter().position(|&q| q == p).unwrap_or_else(|| {
+                    names.push(p);
+                    names.len() - 1
+                }) as u32
+            };
+            for s in 0..i64::from(k) {
+                let name = |q: (i64, i64)| fan.canonical(s, q).expect("in the fan");
+                for b in 0..rings {
+                    for a in 0..rings - b {
+                        let up = [(a, b), (a + 1, b), (a, b + 1)];
+                        faces.push(up.map(|q| id(name(q), &mut names)));
+                        chart.push(s);
+                        corner_coords.push(up);
+                        if a + b + 2 <= rings {
+                            let down = [(a + 1, b), (a + 1, b + 1), (a, b + 1)];
+                            faces.push(down.map(|q| id(name(q), &mut names)));
+                            chart.push(s);
+                            corner_coords.push(down);
+                        }
                     }
                 }
             }
-            coords = fine_coords
-                .into_iter()
-                .map(|q| q.expect("every vertex in a face"))
+            let positions: Vec<[f64; 3]> = names
+                .iter()
+                .map(|&p| {
+                    let t = f64::from(p.0) + 0.1 * p.1 as f64;
+                    [
+                        p.1 as f64 * t.cos(),
+                        p.1 as f64 * t.sin() + p.2 as f64,
+                        0.2 * p.2 as f64,
+                    ]
+                })
                 .collect();
-            let unit = 3i64.pow(level);
-            for (v, &q) in coords.iter().enumerate() {
-                let inside = |x: i64| x >= 4 * unit && x <= (m - 4) * unit;
-                if !inside(q.0) || q.1 > (m - 4) * unit {
-                    continue;
-                }
-                let want = rows
-                    .row(level, q)
-                    .iter()
-                    .fold([0.0; 3], |acc, (&(a, b), &w)| {
-                        add(acc, scale(w, coarse.positions[(a + (m + 1) * b) as usize]))
+            let coarse = jittered(positions, &faces);
+            let mut corners: Vec<[(i64, i64); 3]> = corner_coords;
+            let mut rows = BoundaryRows::new(fan);
+            let (mut mesh, mut mesh_chart) = (coarse.clone(), chart.clone());
+            for level in 1..=2u32 {
+                let fine = sqrt3_refine(&mesh).expect("refines").mesh;
+                let (fine_corners, fine_chart, located) =
+                    refined_corners(&mesh, &fine, &corners, &mesh_chart);
+                let unit = 3i64.pow(level);
+                for (v, &(s, q)) in located.iter().enumerate() {
+                    if q.0.max(0) + q.1.max(0) > 3 * unit {
+                        continue;
+                    }
+                    let name = fan.canonical(s, q).expect("in the fan");
+                    let want = rows.row(level, name).iter().fold([0.0; 3], |acc, (p, &w)| {
+                        let i = names.iter().position(|q| q == p).expect("a coarse vertex");
+                        add(acc, scale(w, coarse.positions[i]))
                     });
-                let got = fine.positions[v];
-                for x in 0..3 {
-                    assert!(
-                        (got[x] - want[x]).abs() < 1e-14,
-                        "level {level} point {q:?}: {got:?} {want:?}"
-                    );
+                    let got = fine.positions[v];
+                    for x in 0..3 {
+                        assert!(
+                            (got[x] - want[x]).abs() < 1e-14,
+                            "K = {k}, level {level}, {name:?}: {got:?} {want:?}"
+                        );
+                    }
+                    checked += 1;
                 }
-                checked += 1;
+                corners = fine_corners;
+                mesh_chart = fine_chart;
+                mesh = fine;
             }
-            mesh = fine;
         }
-        assert!(checked > 1000, "{checked} points checked");
+        assert!(checked > 2000, "{checked} points checked");
     }
 
     /// Affine functions are reproduced: on a lattice torus whose positions are the lattice

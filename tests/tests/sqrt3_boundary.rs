@@ -1,0 +1,102 @@
+//! √3 next to a boundary vertex, with Kobbelt's boundary rules (`schemes::sqrt3_boundary`):
+//! the spectrum of the local subdivision matrix of the fan of `K` triangles, which the
+//! boundary patches of docs/algorithms/sqrt3.md rely on.
+
+use nalgebra::DMatrix;
+use schemes::sqrt3_boundary::{BoundaryFan, FanPoint, V};
+
+/// The local matrix of the fan of `k` triangles on the ball of fan points within three units
+/// of `V` (hex norm in their charts), which the ternary step maps into itself: row `i` is the
+/// level-1 point at layout point `i`'s coordinates, over the layout's level-0 points.
+fn local_matrix(k: u32) -> (Vec<FanPoint>, DMatrix<f64>) {
+    local_matrix_within(k, 3)
+}
+
+/// [`local_matrix`] on the ball of radius `r`.
+fn local_matrix_within(k: u32, r: i64) -> (Vec<FanPoint>, DMatrix<f64>) {
+    let fan = BoundaryFan::new(k);
+    let mut layout: Vec<FanPoint> = Vec::new();
+    for s in 0..=i64::from(k) {
+        for b in 0..=r {
+            for a in 0..=r - b {
+                if let Some(p) = fan.canonical(s, (a, b)) {
+                    if !layout.contains(&p) {
+                        layout.push(p);
+                    }
+                }
+            }
+        }
+    }
+    let n = layout.len();
+    let mut a = DMatrix::<f64>::zeros(n, n);
+    for (i, &q) in layout.iter().enumerate() {
+        for (p, w) in fan.level1_row(q) {
+            let j = layout
+                .iter()
+                .position(|&x| x == p)
+                .unwrap_or_else(|| panic!("K = {k}: {q:?} reads {p:?} outside the ball"));
+            a[(i, j)] = w;
+        }
+    }
+    (layout, a)
+}
+
+/// The moduli of `a`'s eigenvalues, largest first, by a bounded Schur iteration (a matrix it
+/// cannot settle fails the test instead of hanging it).
+fn moduli(a: &DMatrix<f64>) -> Vec<f64> {
+    let schur = nalgebra::linalg::Schur::try_new(a.clone(), 1e-14, 100_000)
+        .expect("the Schur iteration converges");
+    let mut m: Vec<f64> = schur
+        .complex_eigenvalues()
+        .iter()
+        .map(|z| z.norm())
+        .collect();
+    m.sort_by(|x, y| y.total_cmp(x));
+    m
+}
+
+/// For every `K = 1..=8`: the largest eigenvalue is 1, simple (a convergent scheme), and the
+/// boundary curve's tangent at `V`, `(E_0 - E_K) / 2` (the cubic B-spline's derivative at its
+/// knot: the boundary rules are its ternary refinement), is a left eigenvector for `1/3`,
+/// exactly; the ball of radius 4 has the same six largest eigenvalues. `--nocapture` prints
+/// the spectra that docs/algorithms/sqrt3.md quotes.
+#[test]
+fn the_boundary_tangent_is_a_left_eigenvector_for_a_third() {
+    for k in 1..=8 {
+        let (layout, a) = local_matrix(k);
+        let index = |p: FanPoint| layout.iter().position(|&q| q == p).expect("in the ball");
+        let mut t = DMatrix::<f64>::zeros(1, layout.len());
+        t[(0, index((0, 1, 0)))] = 0.5;
+        t[(0, index((k, 1, 0)))] = -0.5;
+        assert!(((&t * &a) - &t / 3.0).amax() < 1e-15, "K = {k}");
+        assert!(index(V) == 0);
+        let m = moduli(&a);
+        println!("K = {k}: {} points, moduli {:?}", layout.len(), &m[..6]);
+        assert!((m[0] - 1.0).abs() < 1e-12 && m[1] < 0.99, "K = {k}: {m:?}");
+        // The ball is wide enough: one more ring adds only smaller eigenvalues.
+        let (_, wider) = local_matrix_within(k, 4);
+        for (x, y) in m.iter().zip(&moduli(&wider)).take(6) {
+            assert!((x - y).abs() < 1e-10, "K = {k}: {m:?}");
+        }
+    }
+}
+
+/// At the regular boundary vertex (`K = 3`, the half-plane) the next eigenvalue is `1/3` again,
+/// with its own eigenvector (no Jordan block, which would put a `k 3^-k` term, a kink, into the
+/// cross-boundary derivative), and `1/9` follows: the cross-boundary mode scales like the
+/// boundary's tangent, so the surface is C1 there with an isotropic characteristic map, the
+/// hypothesis the strip patches' derivatives rest on.
+#[test]
+fn the_regular_boundary_vertex_has_a_double_subdominant_third() {
+    let (layout, a) = local_matrix(3);
+    let m = moduli(&a);
+    for x in &m[1..3] {
+        assert!((x - 1.0 / 3.0).abs() < 1e-12, "{m:?}");
+    }
+    assert!((m[3] - 1.0 / 9.0).abs() < 1e-12, "{m:?}");
+    let n = layout.len();
+    let shifted = a.transpose() - DMatrix::<f64>::identity(n, n) / 3.0;
+    let mut singular: Vec<f64> = shifted.singular_values().iter().copied().collect();
+    singular.sort_by(f64::total_cmp);
+    assert!(singular[1] < 1e-12 && singular[2] > 1e-3, "{singular:?}");
+}
