@@ -88,7 +88,7 @@ impl<S: Scalar> RegionBasis<S> {
         Ok(out)
     }
 
-    fn get(&self, kind: StencilKind) -> Result<&TriangleStencils<S>, StencilError> {
+    pub(crate) fn get(&self, kind: StencilKind) -> Result<&TriangleStencils<S>, StencilError> {
         self.kinds[kind_index(kind)]
             .as_ref()
             .ok_or_else(|| StencilError::OutOfDomain {

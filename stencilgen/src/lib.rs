@@ -52,6 +52,7 @@ pub mod scaling_system;
 pub mod solve;
 pub mod sqrt3_patch;
 pub mod sqrt3_regions;
+pub mod sqrt3_strip;
 pub mod sqrt3_table;
 pub mod stencil_set;
 pub mod substitution;

@@ -45,6 +45,7 @@ mod precision;
 mod rates;
 mod reader_properties;
 mod sharp_features;
+mod sqrt3_boundary;
 #[cfg(feature = "sqrt3")]
 mod sqrt3_tessellation;
 mod surface;
