@@ -17,9 +17,11 @@
 //! point `j` after `N` ternary steps of the true rules, [`BoundaryRows`]; `psi_i` the skew-axis
 //! derivatives of `psi`). `y` has denominator `d`, so `psi` is needed on the grid `1/d` only.
 //! On the line itself the surface is the uniform cubic B-spline of the boundary points (the
-//! boundary rules are its ternary refinement), and so is its derivative along the line; the
-//! derivative across the line is the limit of the points above it, which this module does not
-//! take yet.
+//! boundary rules are its ternary refinement), and so is its derivative along the line. The
+//! derivative across the line has no finite value there in general: at the midpoint of a
+//! boundary edge the local matrix has a cross mode of `0.3722 > 1/3`, so `d phi/d x_2` grows like
+//! `x_2^-0.10` towards the line (docs/algorithms/sqrt3.md); the tangent plane there is a
+//! direction, a tangent mask, which this module does not compute yet.
 
 use std::collections::BTreeMap;
 
@@ -95,7 +97,8 @@ impl StripEvaluator {
     }
 
     /// The stencil of `kind` (position, `d/dx_1`, `d/dx_2`) at `x = k/d` over the level-0
-    /// half-plane points. Refuses `k_2 < 0`, and the derivative across the line at `k_2 = 0`.
+    /// half-plane points. Refuses `k_2 < 0`, and the derivative across the line at `k_2 = 0`
+    /// (unbounded there in general, module docs).
     pub fn stencil(
         &mut self,
         k: (i64, i64),
@@ -105,7 +108,8 @@ impl StripEvaluator {
         if k.1 < 0 || (k.1 == 0 && kind == StencilKind::DerivativeV) {
             return Err(StencilError::OutOfDomain {
                 what: format!(
-                    "{kind:?} at ({}/{d}, {}/{d}) beside the boundary x_2 = 0",
+                    "{kind:?} at ({}/{d}, {}/{d}): below the boundary, or across it on it \
+                     (unbounded there in general)",
                     k.0, k.1
                 ),
             });

@@ -3,7 +3,7 @@
 //! boundary patches of docs/algorithms/sqrt3.md rely on.
 
 use nalgebra::DMatrix;
-use schemes::sqrt3_boundary::{BoundaryFan, FanPoint, V};
+use schemes::sqrt3_boundary::{half_plane_row, BoundaryFan, FanPoint, V};
 
 /// The local matrix of the fan of `k` triangles on the ball of fan points within three units
 /// of `V` (hex norm in their charts), which the ternary step maps into itself: row `i` is the
@@ -99,4 +99,35 @@ fn the_regular_boundary_vertex_has_a_double_subdominant_third() {
     let mut singular: Vec<f64> = shifted.singular_values().iter().copied().collect();
     singular.sort_by(f64::total_cmp);
     assert!(singular[1] < 1e-12 && singular[2] > 1e-3, "{singular:?}");
+}
+
+/// At the midpoint `(1/2, 0)` of a straight boundary's edge, the fixed point of
+/// `y -> 3y - (1, 0)`, the local matrix (row `i`: the level-1 point at layout point `i` plus
+/// `(1, 0)`, over the layout's level-0 points; the box `-4..=5` by `0..=4` is closed) has 1
+/// simple and the cubic B-spline's derivative at `u = 1/2`, `(-1, -5, 5, 1) / 8` over the
+/// boundary points `-1..=2`, as a left eigenvector for `1/3` exactly. `--nocapture` prints
+/// the leading moduli, which docs/algorithms/sqrt3.md quotes: a cross mode of `0.3722 > 1/3`
+/// there, against `1/3` at a vertex.
+#[test]
+fn the_boundary_edge_midpoint_spectrum() {
+    let layout: Vec<(i64, i64)> = (0..=4)
+        .flat_map(|b| (-4..=5).map(move |a| (a, b)))
+        .collect();
+    let index = |p: (i64, i64)| layout.iter().position(|&q| q == p);
+    let n = layout.len();
+    let mut a = DMatrix::<f64>::zeros(n, n);
+    for (i, &q) in layout.iter().enumerate() {
+        for (p, w) in half_plane_row((q.0 + 1, q.1)) {
+            let j = index(p).unwrap_or_else(|| panic!("{q:?} reads {p:?} outside the box"));
+            a[(i, j)] = w;
+        }
+    }
+    let mut t = DMatrix::<f64>::zeros(1, n);
+    for (x, w) in [(-1, -1.0), (0, -5.0), (1, 5.0), (2, 1.0)] {
+        t[(0, index((x, 0)).expect("in the box"))] = w / 8.0;
+    }
+    assert!(((&t * &a) - &t / 3.0).amax() < 1e-15);
+    let m = moduli(&a);
+    println!("edge midpoint: moduli {:?}", &m[..6]);
+    assert!((m[0] - 1.0).abs() < 1e-12 && m[1] < 0.99, "{m:?}");
 }
