@@ -244,14 +244,14 @@ impl<'a> PatchPoints<'a> {
     /// (`n` or `n + 1` points).
     fn grid(&self, points: PointSet, n: u32) -> Result<Grid<'a>, RuntimeError> {
         let side = match points {
-            PointSet::Primal => n as usize + 1,
-            PointSet::Dual => n as usize,
+            PointSet::Primal => grid_side(true, n),
+            PointSet::Dual => grid_side(false, n),
             _ => {
                 return Err(RuntimeError::Unsupported(format!(
                     "tolerance rates on {points:?} grids: only the quad primal and dual grids"
                 )))
             }
-        };
+        } as usize;
         let (table, patch) = match self {
             PatchPoints::Table { table, patch, .. } => (*table, *patch),
             PatchPoints::Adaptive { face, grids } => {
@@ -544,7 +544,7 @@ impl<'a> AdaptiveGrids<'a> {
         wanted: &[(bool, u32)],
     ) -> Result<Vec<Vec<Vec<[f64; 3]>>>, RuntimeError> {
         let grid_queries = |f: usize, (primal, n): (bool, u32)| {
-            let side = if primal { n + 1 } else { n };
+            let side = grid_side(primal, n);
             let at = move |k: u32| {
                 if primal {
                     f64::from(k) / f64::from(n)
@@ -570,12 +570,21 @@ impl<'a> AdaptiveGrids<'a> {
                 wanted
                     .iter()
                     .map(|&(primal, n)| {
-                        let side = (if primal { n + 1 } else { n }) as usize;
+                        let side = grid_side(primal, n) as usize;
                         points.by_ref().take(side * side).collect()
                     })
                     .collect()
             })
             .collect())
+    }
+}
+
+/// Points on a side of a quad's grid at rate `n`: `n + 1` primal points, `n` dual ones.
+fn grid_side(primal: bool, n: u32) -> u32 {
+    if primal {
+        n + 1
+    } else {
+        n
     }
 }
 
