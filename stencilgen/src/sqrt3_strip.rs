@@ -1,31 +1,37 @@
-//! The √3 surface beside a straight boundary (Kobbelt's boundary rules), evaluated exactly at
-//! the points `k/d` of the half-plane by the scaling relation: the strip patches of
-//! docs/algorithms/sqrt3.md ("The plan for boundary patches").
+//! The √3 surface next to a boundary (Kobbelt's boundary rules), evaluated exactly at the
+//! points `k/d` by the scaling relation without a system: beside a straight boundary (the
+//! strip patches of docs/algorithms/sqrt3.md, "The plan for boundary patches") and on the fan
+//! of `K` triangles around a boundary vertex `V` (`schemes::sqrt3_boundary`'s charts).
 //!
-//! In half-plane skew coordinates (`schemes::sqrt3_boundary`, the boundary the line
-//! `x_2 = 0`), a level-`N` triangle in row 4 or higher (`N`-level coordinates `y_2 >= 4`) is
-//! regular: `T + int S`, `S = H/2` the support of the regular basis `psi` (reaching two and a
-//! half rows down), misses the points within two thirds of a level unit of the boundary, the
-//! only ones whose rules differ from the interior's. So for `x_2 > 0`, with `N` the smallest
-//! level at which `y = 3^N x` has `y_2 >= 4`,
+//! **Certified levels.** A level-`N` triangle `T` (level-`N` chart coordinates) is regular when
+//! `T + int S`, `S = H/2` the support of the regular basis `psi` (within hex norm 2.5, and two
+//! and a half rows on either side of a line), misses every point whose rules differ from the
+//! interior's: the points within two thirds of a level unit of the boundary and, on a fan,
+//! `V`. So `T` is certified when its corners lie [`REGULAR_ROW`] `= 4` units or more from the
+//! boundary rays (rows, in the charts of the sectors next to them) and, on a fan, from `V` (hex
+//! norm). With `N` the smallest level at which the triangle holding `y = 3^N x` is certified,
 //!
 //! ```text
 //!   phi(x) = sum_j psi(y - j) R_N[j],     d phi / d x_i = 3^N sum_j psi_i(y - j) R_N[j]
 //! ```
 //!
-//! over the level-`N` lattice points `j` (Schaefer–Warren eq. (2); `R_N[j]` the level-0 row of
-//! point `j` after `N` ternary steps of the true rules, [`BoundaryRows`]; `psi_i` the skew-axis
-//! derivatives of `psi`). `y` has denominator `d`, so `psi` is needed on the grid `1/d` only.
-//! On the line itself the surface is the uniform cubic B-spline of the boundary points (the
-//! boundary rules are its ternary refinement), and so is its derivative along the line. The
-//! derivative across the line has no finite value there in general: at the midpoint of a
-//! boundary edge the local matrix has a cross mode of `0.3722 > 1/3`, so `d phi/d x_2` grows like
-//! `x_2^-0.10` towards the line (docs/algorithms/sqrt3.md); the tangent plane there is a
-//! direction, a tangent mask, which this module does not compute yet.
+//! over the level-`N` lattice points `j` named in the fan (Schaefer–Warren eq. (2); `R_N[j]`
+//! the level-0 row of point `j` after `N` ternary steps of the true rules, [`BoundaryRows`];
+//! `psi_i` the skew-axis derivatives of `psi`). `y` has denominator `d`, so `psi` is needed on
+//! the grid `1/d` only. A point off the boundary and off `V` is certified within
+//! `log_3(4d) + 1` levels.
+//!
+//! **On the boundary** the surface is the uniform cubic B-spline of the boundary polygon
+//! (`.., E_K, V, E_0, ..` on a fan; the boundary rules are its ternary refinement), and so is its
+//! derivative along the boundary. The derivative across the boundary has no finite value
+//! there in general: at the midpoint of a boundary edge the local matrix has a cross mode of
+//! `0.3722 > 1/3`, so `d phi/d x_2` grows like `x_2^-0.10` towards the line
+//! (docs/algorithms/sqrt3.md); the tangent plane there is a direction, a tangent mask, and so
+//! are the derivatives at `V`, which this module does not compute yet.
 
 use std::collections::BTreeMap;
 
-use schemes::sqrt3_boundary::{BoundaryFan, BoundaryRows};
+use schemes::sqrt3_boundary::{BoundaryFan, BoundaryRows, FanPoint, V};
 use schemes::TriangleScheme;
 
 use crate::cone_regions::RegionBasis;
@@ -36,16 +42,23 @@ use crate::StencilError;
 /// A stencil over level-0 half-plane points `(a, b)`, `b >= 0`.
 pub type StripStencil = BTreeMap<(i64, i64), f64>;
 
-/// The lowest row of a level-`N` triangle that is certified regular (module docs).
+/// A stencil over the level-0 points of a fan.
+pub type FanStencil = BTreeMap<FanPoint, f64>;
+
+/// The lowest row of a level-`N` triangle that is certified regular (module docs); also the
+/// least hex-norm distance of its corners from a fan's vertex `V`.
 pub const REGULAR_ROW: i64 = 4;
 
-/// Evaluates the surface beside a straight boundary at the points `k/d` (module docs).
+/// Evaluates the surface beside a straight boundary ([`BoundaryEvaluator::strip`]) or on the fan
+/// around a boundary vertex ([`BoundaryEvaluator::fan`]) at the points `k/d` (module docs).
 #[derive(Clone, Debug)]
-pub struct StripEvaluator {
+pub struct BoundaryEvaluator {
     d: u32,
     basis: RegionBasis<f64>,
     fan: BoundaryFan,
     rows: BoundaryRows,
+    /// The half-plane: no vertex is special, so only the rows count.
+    strip: bool,
 }
 
 /// The uniform cubic B-spline's four basis functions at `u` in `[0, 1]` (for the points
@@ -69,10 +82,12 @@ fn cubic_b_spline(u: f64, derivative: bool) -> [f64; 4] {
     }
 }
 
-impl StripEvaluator {
-    /// An evaluator on the grid `1/d` (`1..=`[`MAX_BASIS_RATE`]): solves `psi` and its two
-    /// skew-axis derivatives there.
-    pub fn new(d: u32) -> Result<Self, StencilError> {
+fn hex_norm((a, b): (i64, i64)) -> i64 {
+    a.abs().max(b.abs()).max((a + b).abs())
+}
+
+impl BoundaryEvaluator {
+    fn new(fan: BoundaryFan, strip: bool, d: u32) -> Result<Self, StencilError> {
         if d == 0 || d > MAX_BASIS_RATE {
             return Err(StencilError::RateOutOfRange {
                 n: d,
@@ -87,46 +102,112 @@ impl StripEvaluator {
             StencilKind::DerivativeU,
             StencilKind::DerivativeV,
         ];
-        let fan = BoundaryFan::new(3);
-        Ok(StripEvaluator {
+        Ok(BoundaryEvaluator {
             d,
             basis: RegionBasis::new(&scheme, d, &kinds)?,
             fan,
             rows: BoundaryRows::new(fan),
+            strip,
         })
     }
 
-    /// The stencil of `kind` (position, `d/dx_1`, `d/dx_2`) at `x = k/d` over the level-0
-    /// half-plane points. Refuses `k_2 < 0`, and the derivative across the line at `k_2 = 0`
-    /// (unbounded there in general, module docs).
-    pub fn stencil(
+    /// The half-plane beside a straight boundary, on the grid `1/d` (`1..=`[`MAX_BASIS_RATE`]):
+    /// solves `psi` and its two skew-axis derivatives there.
+    pub fn strip(d: u32) -> Result<Self, StencilError> {
+        Self::new(BoundaryFan::new(3), true, d)
+    }
+
+    /// The fan of `faces` triangles around a boundary vertex, on the grid `1/d`.
+    pub fn fan(faces: u32, d: u32) -> Result<Self, StencilError> {
+        if faces == 0 {
+            return Err(StencilError::OutOfDomain {
+                what: "a boundary vertex without a triangle".to_owned(),
+            });
+        }
+        Self::new(BoundaryFan::new(faces), false, d)
+    }
+
+    /// The half-plane stencil of `kind` (position, `d/dx_1`, `d/dx_2`) at `x = k/d` over the
+    /// level-0 half-plane points ([`BoundaryEvaluator::strip`]). Refuses `k_2 < 0`, and the
+    /// derivative across the line at `k_2 = 0` (unbounded there in general, module docs).
+    pub fn half_plane_stencil(
         &mut self,
         k: (i64, i64),
         kind: StencilKind,
     ) -> Result<StripStencil, StencilError> {
+        Ok(self
+            .stencil(0, k, kind)?
+            .into_iter()
+            .map(|(p, w)| (BoundaryFan::in_sector_zero(p), w))
+            .collect())
+    }
+
+    /// Whether the level-`N` triangle with these corners (sector `s`'s chart) is certified
+    /// regular: its corners at least [`REGULAR_ROW`] from the boundary rays (and, on a fan,
+    /// from `V`), so that `T + int S` misses every point whose rules differ from the interior's.
+    fn certified(&self, s: i64, corners: &[(i64, i64); 3]) -> bool {
+        if self.strip {
+            return corners.iter().all(|c| c.1 >= REGULAR_ROW);
+        }
+        let last = i64::from(self.fan.faces) - 1;
+        corners.iter().all(|&c| {
+            hex_norm(c) >= REGULAR_ROW
+                && (s != 0 || c.1 >= REGULAR_ROW)
+                && (s != last || c.0 >= REGULAR_ROW)
+        })
+    }
+
+    /// The stencil of `kind` (position, `d/du`, `d/dv` along sector `sector`'s chart axes) at
+    /// `x = k/d` of that chart, over the fan's level-0 points. On a boundary ray the position
+    /// is the boundary's cubic B-spline and the derivative along the ray its derivative; the
+    /// derivative across a ray on it, and every derivative at a fan's `V`, are refused
+    /// (unbounded or a direction only, module docs).
+    pub fn stencil(
+        &mut self,
+        sector: i64,
+        k: (i64, i64),
+        kind: StencilKind,
+    ) -> Result<FanStencil, StencilError> {
         let d = i64::from(self.d);
-        if k.1 < 0 || (k.1 == 0 && kind == StencilKind::DerivativeV) {
-            return Err(StencilError::OutOfDomain {
-                what: format!(
-                    "{kind:?} at ({}/{d}, {}/{d}): below the boundary, or across it on it \
-                     (unbounded there in general)",
-                    k.0, k.1
-                ),
-            });
+        let refuse = |why: &str| StencilError::OutOfDomain {
+            what: format!(
+                "{kind:?} at ({}/{d}, {}/{d}) of sector {sector}: {why}",
+                k.0, k.1
+            ),
+        };
+        let at_v = !self.strip && k == (0, 0);
+        if let Some((t, along)) = self.on_boundary(sector, k) {
+            if at_v && kind != StencilKind::Position {
+                return Err(refuse(
+                    "a derivative at the boundary vertex (a tangent mask)",
+                ));
+            }
+            let derivative = match (kind, along) {
+                (StencilKind::Position, _) => None,
+                (StencilKind::DerivativeU, Axis::U) => Some(1.0),
+                (StencilKind::DerivativeV, Axis::MinusV) => Some(-1.0),
+                _ => return Err(refuse("across the boundary on it (unbounded in general)")),
+            };
+            return Ok(self.boundary_curve(t, derivative));
         }
-        if k.1 == 0 {
-            let base = k.0.div_euclid(d);
-            let u = k.0.rem_euclid(d) as f64 / d as f64;
-            let weights = cubic_b_spline(u, kind == StencilKind::DerivativeU);
-            return Ok((-1..=2)
-                .zip(weights)
-                .map(|(m, w)| ((base + m, 0), w))
-                .filter(|&(_, w)| w != 0.0)
-                .collect());
-        }
-        // The smallest level at which x lies in row REGULAR_ROW or above.
+        // The smallest level at which the triangle holding x is certified regular.
         let (mut level, mut y, mut factor) = (0u32, k, 1.0);
-        while y.1 < REGULAR_ROW * d {
+        loop {
+            let (a, b) = (y.0.div_euclid(d), y.1.div_euclid(d));
+            let (fa, fb) = (y.0.rem_euclid(d), y.1.rem_euclid(d));
+            let corners = if fa + fb < d {
+                [(a, b), (a + 1, b), (a, b + 1)]
+            } else {
+                [(a + 1, b), (a + 1, b + 1), (a, b + 1)]
+            };
+            if self.certified(sector, &corners) {
+                break;
+            }
+            if level >= MAX_LEVEL {
+                return Err(refuse(
+                    "no certified level (too close to the boundary or V)",
+                ));
+            }
             level += 1;
             y = (3 * y.0, 3 * y.1);
             factor *= 3.0;
@@ -138,7 +219,7 @@ impl StripEvaluator {
         } else {
             factor
         };
-        let mut out = StripStencil::new();
+        let mut out = FanStencil::new();
         // j with y - d j in the support's box: d j_i in [y_i - h_i, y_i - l_i].
         for j2 in (y.1 - h2).div_euclid(d)..=(y.1 - l2).div_euclid(d) + 1 {
             for j1 in (y.0 - h1).div_euclid(d)..=(y.0 - l1).div_euclid(d) + 1 {
@@ -146,21 +227,77 @@ impl StripEvaluator {
                 if w == 0.0 {
                     continue;
                 }
-                let name =
-                    self.fan
-                        .canonical(0, (j1, j2))
-                        .ok_or_else(|| StencilError::OutOfDomain {
-                            what: format!("level-{level} point ({j1}, {j2}) below the boundary"),
-                        })?;
+                let name = self.fan.canonical(sector, (j1, j2)).ok_or_else(|| {
+                    refuse(&format!(
+                        "level-{level} point ({j1}, {j2}) is outside the fan"
+                    ))
+                })?;
                 for (p, r) in self.rows.row(level, name) {
-                    *out.entry(BoundaryFan::in_sector_zero(p)).or_insert(0.0) += scale * w * r;
+                    *out.entry(p).or_insert(0.0) += scale * w * r;
                 }
             }
         }
         out.retain(|_, w| *w != 0.0);
         Ok(out)
     }
+
+    /// Where `k/d` of sector `s`'s chart lies on the boundary: its parameter along the
+    /// boundary polygon (`V` at 0, `E_0` at 1, `E_K` at -1; the half-plane's line at `x_1`) and
+    /// the chart axis that runs along the boundary there, with its sign.
+    fn on_boundary(&self, s: i64, k: (i64, i64)) -> Option<(f64, Axis)> {
+        let d = self.d as f64;
+        if self.strip {
+            return (k.1 == 0).then_some((k.0 as f64 / d, Axis::U));
+        }
+        let last = i64::from(self.fan.faces) - 1;
+        if s == 0 && k.1 == 0 && k.0 >= 0 {
+            Some((k.0 as f64 / d, Axis::U))
+        } else if s == last && k.0 == 0 && k.1 >= 0 {
+            Some((-(k.1 as f64) / d, Axis::MinusV))
+        } else {
+            None
+        }
+    }
+
+    /// The boundary's cubic B-spline at parameter `t` (or its derivative along the boundary,
+    /// times `sign`), over the fan's boundary points.
+    fn boundary_curve(&self, t: f64, derivative: Option<f64>) -> FanStencil {
+        let base = t.floor();
+        let weights = cubic_b_spline(t - base, derivative.is_some());
+        let sign = derivative.unwrap_or(1.0);
+        let k = self.fan.faces;
+        let point = |i: i64| -> FanPoint {
+            if self.strip {
+                // The line's points, named in the fan of three (sector 0's chart).
+                self.fan.canonical(0, (i, 0)).unwrap_or(V)
+            } else if i == 0 {
+                V
+            } else if i > 0 {
+                (0, i, 0)
+            } else {
+                (k, -i, 0)
+            }
+        };
+        let mut out = FanStencil::new();
+        for (m, w) in (-1..=2).zip(weights) {
+            if w != 0.0 {
+                *out.entry(point(base as i64 + m)).or_insert(0.0) += sign * w;
+            }
+        }
+        out
+    }
 }
+
+/// A chart axis along the boundary, with its direction relative to the boundary polygon's.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Axis {
+    U,
+    MinusV,
+}
+
+/// Levels tried at most before a point is refused as too close to the boundary or `V` (a
+/// grid point off them is certified within `log_3(4 d) + 1` levels).
+const MAX_LEVEL: u32 = 12;
 
 #[cfg(test)]
 mod tests {
@@ -169,7 +306,7 @@ mod tests {
     /// Positions sum to 1 and derivatives to 0 (partition of unity), off the line and on it.
     #[test]
     fn stencils_are_affine() {
-        let mut e = StripEvaluator::new(6).expect("psi on 1/6");
+        let mut e = BoundaryEvaluator::strip(6).expect("psi on 1/6");
         for k in [(0, 0), (3, 0), (1, 1), (2, 3), (5, 1), (0, 6), (4, 2)] {
             for kind in [
                 StencilKind::Position,
@@ -177,10 +314,10 @@ mod tests {
                 StencilKind::DerivativeV,
             ] {
                 if k.1 == 0 && kind == StencilKind::DerivativeV {
-                    assert!(e.stencil(k, kind).is_err());
+                    assert!(e.half_plane_stencil(k, kind).is_err());
                     continue;
                 }
-                let s = e.stencil(k, kind).expect("evaluates");
+                let s = e.half_plane_stencil(k, kind).expect("evaluates");
                 let sum: f64 = s.values().sum();
                 let want = if kind == StencilKind::Position {
                     1.0

@@ -5,7 +5,7 @@
 
 use schemes::BoundaryMode;
 use stencilgen::regular_patch::StencilKind;
-use stencilgen::sqrt3_strip::{StripEvaluator, StripStencil};
+use stencilgen::sqrt3_strip::{BoundaryEvaluator, StripStencil};
 use subtess::mesh::topology::Mesh;
 use subtess::mesh::triangle_topology::neighbours;
 use subtess::scheme::sqrt3::refine::{
@@ -116,7 +116,7 @@ fn limit_position(mesh: &Mesh, v: usize) -> [f64; 3] {
 fn the_strip_is_the_limit_of_whole_mesh_refinement() {
     let m = 12;
     let (coarse, fine, at) = refined_lattice(m, 3);
-    let mut strip = StripEvaluator::new(27).expect("psi on 1/27");
+    let mut strip = BoundaryEvaluator::strip(27).expect("psi on 1/27");
     let mut checked = 0;
     for (v, &q) in at.iter().enumerate() {
         if q.0 < 108 || q.0 > 216 || q.1 > 81 {
@@ -124,7 +124,9 @@ fn the_strip_is_the_limit_of_whole_mesh_refinement() {
         }
         let want = limit_position(&fine, v);
         let got = apply(
-            &strip.stencil(q, StencilKind::Position).expect("evaluates"),
+            &strip
+                .half_plane_stencil(q, StencilKind::Position)
+                .expect("evaluates"),
             &coarse,
             m,
         );
@@ -153,9 +155,14 @@ fn strip_derivatives_are_the_positions_slopes() {
     let m = 12;
     let coarse = parallelogram(m);
     let d = 36;
-    let mut strip = StripEvaluator::new(d).expect("psi on 1/36");
-    let mut at =
-        |k: (i64, i64), kind| apply(&strip.stencil(k, kind).expect("evaluates"), &coarse, m);
+    let mut strip = BoundaryEvaluator::strip(d).expect("psi on 1/36");
+    let mut at = |k: (i64, i64), kind| {
+        apply(
+            &strip.half_plane_stencil(k, kind).expect("evaluates"),
+            &coarse,
+            m,
+        )
+    };
     for k in [
         (200, 2),
         (201, 5),

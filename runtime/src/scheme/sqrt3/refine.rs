@@ -610,6 +610,61 @@ mod tests {
         (fine_corners, fine_chart, out)
     }
 
+    /// The fan of `k` triangles around a boundary vertex with `rings` rings, named by
+    /// `schemes::sqrt3_boundary`'s charts, at jittered generic positions: its points' names
+    /// (vertex `i` is `names[i]`), the mesh, and every face's chart and corners in it.
+    #[allow(clippy::type_complexity)]
+    fn fan_mesh(
+        k: u32,
+        rings: i64,
+    ) -> (
+        Vec<schemes::sqrt3_boundary::FanPoint>,
+        Mesh,
+        Vec<i64>,
+        Vec<[(i64, i64); 3]>,
+    ) {
+        use schemes::sqrt3_boundary::{BoundaryFan, FanPoint};
+        let fan = BoundaryFan::new(k);
+        let mut names: Vec<FanPoint> = Vec::new();
+        let mut faces: Vec<[u32; 3]> = Vec::new();
+        let mut chart = Vec::new();
+        let mut corners = Vec::new();
+        let id = |p: FanPoint, names: &mut Vec<FanPoint>| {
+            names.iter().position(|&q| q == p).unwrap_or_else(|| {
+                names.push(p);
+                names.len() - 1
+            }) as u32
+        };
+        for s in 0..i64::from(k) {
+            let name = |q: (i64, i64)| fan.canonical(s, q).expect("in the fan");
+            for b in 0..rings {
+                for a in 0..rings - b {
+                    let mut triangles = vec![[(a, b), (a + 1, b), (a, b + 1)]];
+                    if a + b + 2 <= rings {
+                        triangles.push([(a + 1, b), (a + 1, b + 1), (a, b + 1)]);
+                    }
+                    for t in triangles {
+                        faces.push(t.map(|q| id(name(q), &mut names)));
+                        chart.push(s);
+                        corners.push(t);
+                    }
+                }
+            }
+        }
+        let positions: Vec<[f64; 3]> = names
+            .iter()
+            .map(|&p| {
+                let t = f64::from(p.0) + 0.1 * p.1 as f64;
+                [
+                    p.1 as f64 * t.cos(),
+                    p.1 as f64 * t.sin() + p.2 as f64,
+                    0.2 * p.2 as f64,
+                ]
+            })
+            .collect();
+        (names, jittered(positions, &faces), chart, corners)
+    }
+
     /// The boundary rules of `schemes::sqrt3_boundary` (the generator's side, written in
     /// lattice charts) are this whole-mesh step's: on the fan of `K = 1..=7` triangles around
     /// a boundary vertex (seven rings, jittered positions), every vertex after one and after
@@ -617,54 +672,13 @@ mod tests {
     /// coarse positions (to 1e-14); `K = 3` is the half-plane beside a straight boundary.
     #[test]
     fn the_fan_rules_are_the_whole_mesh_rules_next_to_a_boundary_vertex() {
-        use schemes::sqrt3_boundary::{BoundaryFan, BoundaryRows, FanPoint};
-        let rings = 7i64;
+        use schemes::sqrt3_boundary::{BoundaryFan, BoundaryRows};
         let mut checked = 0;
         for k in 1..=7u32 {
             let fan = BoundaryFan::new(k);
-            // The level-0 points: V, then every sector's points up to `rings`, then E_K's ray.
-            let mut names: Vec<FanPoint> = Vec::new();
-            let mut faces: Vec<[u32; 3]> = Vec::new();
-            let mut chart = Vec::new();
-            let mut corner_coords = Vec::new();
-            let id = |p: FanPoint, names: &mut Vec<FanPoint>| {
-                names.iter().position(|&q| q == p).unwrap_or_else(|| {
-                    names.push(p);
-                    names.len() - 1
-                }) as u32
-            };
-            for s in 0..i64::from(k) {
-                let name = |q: (i64, i64)| fan.canonical(s, q).expect("in the fan");
-                for b in 0..rings {
-                    for a in 0..rings - b {
-                        let up = [(a, b), (a + 1, b), (a, b + 1)];
-                        faces.push(up.map(|q| id(name(q), &mut names)));
-                        chart.push(s);
-                        corner_coords.push(up);
-                        if a + b + 2 <= rings {
-                            let down = [(a + 1, b), (a + 1, b + 1), (a, b + 1)];
-                            faces.push(down.map(|q| id(name(q), &mut names)));
-                            chart.push(s);
-                            corner_coords.push(down);
-                        }
-                    }
-                }
-            }
-            let positions: Vec<[f64; 3]> = names
-                .iter()
-                .map(|&p| {
-                    let t = f64::from(p.0) + 0.1 * p.1 as f64;
-                    [
-                        p.1 as f64 * t.cos(),
-                        p.1 as f64 * t.sin() + p.2 as f64,
-                        0.2 * p.2 as f64,
-                    ]
-                })
-                .collect();
-            let coarse = jittered(positions, &faces);
-            let mut corners: Vec<[(i64, i64); 3]> = corner_coords;
+            let (names, coarse, chart, mut corners) = fan_mesh(k, 7);
             let mut rows = BoundaryRows::new(fan);
-            let (mut mesh, mut mesh_chart) = (coarse.clone(), chart.clone());
+            let (mut mesh, mut mesh_chart) = (coarse.clone(), chart);
             for level in 1..=2u32 {
                 let fine = sqrt3_refine(&mesh).expect("refines").mesh;
                 let (fine_corners, fine_chart, located) =
@@ -694,6 +708,67 @@ mod tests {
             }
         }
         assert!(checked > 2000, "{checked} points checked");
+    }
+
+    /// The generator's surface on the fan (`stencilgen::sqrt3_strip::BoundaryEvaluator`: the
+    /// regular basis over certified levels, the B-spline on the boundary) is the limit of this
+    /// whole-mesh step: for `K = 1..=6`, at every ternary point `(i/9, j/9)` of a sector within
+    /// three units of the boundary vertex (`V` and the boundary rays included), the position
+    /// stencil applied to the coarse points is Kobbelt's limit position of the vertex two
+    /// whole-mesh steps put there (to 1e-12).
+    #[test]
+    fn the_fan_surface_is_the_limit_of_whole_mesh_refinement() {
+        use stencilgen::regular_patch::StencilKind;
+        use stencilgen::sqrt3_strip::BoundaryEvaluator;
+        let limit = |m: &Mesh, v: usize| {
+            let ring = neighbours(m, v);
+            let p = |i: u32| m.positions[i as usize];
+            if m.is_boundary_vertex(v) {
+                return sqrt3_boundary_limit_position(
+                    p(ring[ring.len() - 1]),
+                    m.positions[v],
+                    p(ring[0]),
+                );
+            }
+            let sum = ring.iter().fold([0.0; 3], |acc, &e| add(acc, p(e)));
+            sqrt3_limit_position(
+                m.positions[v],
+                scale(1.0 / ring.len() as f64, sum),
+                ring.len(),
+            )
+        };
+        let mut checked = 0;
+        for k in 1..=6u32 {
+            let (names, coarse, chart, corners) = fan_mesh(k, 7);
+            let one = sqrt3_refine(&coarse).expect("refines").mesh;
+            let (corners, chart, _) = refined_corners(&coarse, &one, &corners, &chart);
+            let two = sqrt3_refine(&one).expect("refines").mesh;
+            let (_, _, located) = refined_corners(&one, &two, &corners, &chart);
+            let mut surface = BoundaryEvaluator::fan(k, 9).expect("psi on 1/9");
+            for (v, &(s, q)) in located.iter().enumerate() {
+                if q.0 + q.1 > 27 {
+                    continue;
+                }
+                let stencil = surface
+                    .stencil(s, q, StencilKind::Position)
+                    .expect("evaluates");
+                let got = stencil.iter().fold([0.0; 3], |acc, (p, &w)| {
+                    let i = names.iter().position(|q| q == p).expect("a coarse vertex");
+                    add(acc, scale(w, coarse.positions[i]))
+                });
+                let want = limit(&two, v);
+                for x in 0..3 {
+                    assert!(
+                        (got[x] - want[x]).abs() < 1e-12,
+                        "K = {k}, sector {s}, ({}/9, {}/9): {got:?} {want:?}",
+                        q.0,
+                        q.1
+                    );
+                }
+                checked += 1;
+            }
+        }
+        assert!(checked > 1500, "{checked} points checked");
     }
 
     /// Affine functions are reproduced: on a lattice torus whose positions are the lattice
