@@ -9,10 +9,13 @@
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use num_bigint::BigInt;
+use num_integer::Integer;
 use num_rational::BigRational;
-use num_traits::Zero;
+use num_traits::{One, Signed, Zero};
 use schemes::curve::CURVE_SCHEME_NAMES;
 use schemes::quad::QUAD_SCHEME_NAMES;
+use schemes::sqrt3_boundary::FanPoint;
 use schemes::triangle::TRIANGLE_SCHEME_NAMES;
 use schemes::{BoundaryMode, CurveScheme, QuadScheme, TriangleScheme};
 use serde_json::{json, Value};
@@ -25,12 +28,13 @@ use stencilgen::region_table::RegionLayout;
 use stencilgen::regular_patch::StencilKind;
 use stencilgen::sqrt3_patch::Sqrt3Substitution;
 use stencilgen::sqrt3_regions::Sqrt3RegionSubstitution;
+use stencilgen::sqrt3_strip::{BoundaryEvaluator, FanStencil};
 use stencilgen::sqrt3_table::{build_sqrt3_table, Sqrt3TableSpec};
 use stencilgen::stencil_set::StencilSetSpec;
 use stencilgen::substitution::Substitution;
 use stencilgen::table::{build_table, QuadLayout, TableSpec};
 use stencilgen::triangle_patch::TriangleSubstitution;
-use stencilgen::triangle_system::{triangle_stencils, TriangleStencils};
+use stencilgen::triangle_system::{triangle_stencils, TriangleStencils, MAX_BASIS_RATE};
 use stencilgen::triangle_table::{build_triangle_table, TriangleLayout, TriangleTableSpec};
 use stencilgen::{curve_stencils, excerpt, CurveStencils, Scalar, StencilError};
 use table_format::Precision;
@@ -452,11 +456,29 @@ fn run(cli: Cli) -> Result<(), StencilError> {
                         })?
                     }
                 } else if triangle.name == "sqrt3" {
-                    let TrianglePatchChoice::Interior(valence) = patch else {
-                        return Err(StencilError::UnsupportedScheme {
-                            scheme,
-                            reason: "sqrt3 has no boundary rules here; give --valence".to_owned(),
-                        });
+                    let valence = match patch {
+                        TrianglePatchChoice::Interior(valence) => valence,
+                        TrianglePatchChoice::Boundary(faces, sector) => {
+                            if !float {
+                                return Err(StencilError::UnsupportedScheme {
+                                    scheme,
+                                    reason: "sqrt3's boundary stencils are f64 (a boundary \
+                                             triangle's centre has valence 5: alpha_5 is \
+                                             irrational); pass --f64"
+                                        .to_owned(),
+                                });
+                            }
+                            let out = sqrt3_boundary_stencil_json(faces, sector, &u, &v)?;
+                            if json {
+                                println!("{out}");
+                            } else {
+                                println!(
+                                    "{}",
+                                    serde_json::to_string_pretty(&out).unwrap_or_default()
+                                );
+                            }
+                            return Ok(());
+                        }
                     };
                     if float {
                         sqrt3_stencil_json::<f64>(&triangle, valence, &u, &v, |x| json!(x))?
@@ -770,6 +792,86 @@ fn sqrt3_stencil_json<S: Scalar>(
             "at the vertex du/dv are tangent masks (subdominant left eigenvectors normalized on \
              the reference net), not derivatives: those exist there only at valence 6"
         );
+    }
+    Ok(out)
+}
+
+/// √3's patch `sector` next to a boundary vertex with `faces` triangles (Kobbelt's boundary
+/// rules), f64, by [`BoundaryEvaluator::fan`] on the grid of the point's common denominator
+/// (at most [`MAX_BASIS_RATE`]): positions everywhere, `du`/`dv` off the boundary (`null`,
+/// with a note, where they are a direction only: across a boundary ray on it, or at `V`).
+/// Control points are named `[sector, a, b]` in `schemes::sqrt3_boundary`'s charts.
+fn sqrt3_boundary_stencil_json(
+    faces: u32,
+    sector: u32,
+    u: &BigRational,
+    v: &BigRational,
+) -> Result<Value, StencilError> {
+    let outside = |what: String| StencilError::OutOfDomain { what };
+    if faces == 0 || sector >= faces {
+        return Err(outside(format!(
+            "sector {sector}: a boundary vertex with {faces} triangles has sectors 0..{faces}"
+        )));
+    }
+    if u.is_negative() || v.is_negative() || u + v > BigRational::one() {
+        return Err(outside(format!("({u}, {v}) is outside the patch")));
+    }
+    let d = u.denom().lcm(v.denom());
+    let d = u32::try_from(&d)
+        .ok()
+        .filter(|&d| d <= MAX_BASIS_RATE)
+        .ok_or_else(|| {
+            outside(format!(
+                "({u}, {v}): the common denominator {d} is above {MAX_BASIS_RATE}"
+            ))
+        })?;
+    let numerator = |x: &BigRational| -> Result<i64, StencilError> {
+        i64::try_from(&(x * BigRational::from_integer(BigInt::from(d))).to_integer())
+            .map_err(|_| outside(format!("({u}, {v})")))
+    };
+    let k = (numerator(u)?, numerator(v)?);
+    let mut evaluator = BoundaryEvaluator::fan(faces, d)?;
+    let s = i64::from(sector);
+    let weights = evaluator.stencil(s, k, StencilKind::Position)?;
+    let mut notes = Vec::new();
+    let mut derivative = |kind: StencilKind| match evaluator.stencil(s, k, kind) {
+        Ok(stencil) => Some(stencil),
+        Err(e) => {
+            notes.push(e.to_string());
+            None
+        }
+    };
+    let (du, dv) = (
+        derivative(StencilKind::DerivativeU),
+        derivative(StencilKind::DerivativeV),
+    );
+    let mut order: Vec<FanPoint> = weights.keys().copied().collect();
+    for stencil in [&du, &dv].into_iter().flatten() {
+        order.extend(stencil.keys().copied());
+    }
+    order.sort_unstable();
+    order.dedup();
+    let row = |stencil: &FanStencil| -> Vec<f64> {
+        order
+            .iter()
+            .map(|p| stencil.get(p).copied().unwrap_or(0.0))
+            .collect()
+    };
+    let mut out = json!({
+        "scheme": "sqrt3",
+        "boundary": true,
+        "faces": faces,
+        "sector": sector,
+        "u": u.to_string(),
+        "v": v.to_string(),
+        "exact": false,
+        "order": order.iter().map(|p| json!([p.0, p.1, p.2])).collect::<Vec<_>>(),
+        "weights": row(&weights),
+        "du": du.as_ref().map(row),
+        "dv": dv.as_ref().map(row),
+    });
+    if !notes.is_empty() {
+        out["note"] = json!(notes.join("; "));
     }
     Ok(out)
 }

@@ -250,7 +250,10 @@ impl BoundaryEvaluator {
             return (k.1 == 0).then_some((k.0 as f64 / d, Axis::U));
         }
         let last = i64::from(self.fan.faces) - 1;
-        if s == 0 && k.1 == 0 && k.0 >= 0 {
+        if k == (0, 0) {
+            // V, from any sector's chart (its derivatives are refused before the axis counts).
+            Some((0.0, Axis::U))
+        } else if s == 0 && k.1 == 0 && k.0 >= 0 {
             Some((k.0 as f64 / d, Axis::U))
         } else if s == last && k.0 == 0 && k.1 >= 0 {
             Some((-(k.1 as f64) / d, Axis::MinusV))

@@ -99,7 +99,11 @@ fn sqrt3_errors() {
     );
     fails_with(
         "stencil --scheme sqrt3 --boundary 3 --u 1/3 --v 0",
-        "no boundary rules",
+        "pass --f64",
+    );
+    fails_with(
+        "stencil --scheme sqrt3 --boundary 2 --sector 2 --u 1/3 --v 0 --f64",
+        "sectors 0..2",
     );
     fails_with(
         "stencil --scheme sqrt3 --valence 4 --u 2/3 --v 2/3",
@@ -126,4 +130,52 @@ fn sqrt3_derivatives_are_central_differences_of_positions() {
     for ((d, p), m) in du.iter().zip(&plus).zip(&minus) {
         assert!((d - (p - m) * 6.0).abs() < 2e-2, "{d} vs {}", (p - m) * 6.0);
     }
+}
+
+/// Next to a boundary vertex (Kobbelt's boundary rules, `--boundary F --sector S`, f64): on the
+/// boundary edge `v = 0` of sector 0 the position is the uniform cubic B-spline of the boundary
+/// polygon `E_F, V, E_0, (2,0)_0` (closed form: `(1, 23, 23, 1) / 48` at `u = 1/2`, `(1, 4, 1) / 6`
+/// at `V`), the derivative along the edge its derivative `(-1, -5, 5, 1) / 8`, and the
+/// derivative across it is refused with a note; inside, positions sum to 1 and derivatives to 0.
+#[test]
+fn sqrt3_boundary_stencils_are_the_b_spline_on_the_boundary() {
+    let out = json("stencil --scheme sqrt3 --boundary 2 --sector 0 --u 1/2 --v 0 --f64 --json");
+    let order = out["order"].as_array().expect("order").clone();
+    let weight = |name: [i64; 3], key: &str| -> f64 {
+        let i = order
+            .iter()
+            .position(|p| {
+                p.as_array()
+                    .map(|a| a.iter().map(|x| x.as_i64()).collect::<Vec<_>>())
+                    == Some(name.iter().map(|&x| Some(x)).collect())
+            })
+            .unwrap_or_else(|| panic!("{name:?} in {order:?}"));
+        out[key][i].as_f64().expect("a number")
+    };
+    for (name, w, dw) in [
+        ([2, 1, 0], 1.0, -1.0),
+        ([0, 0, 0], 23.0, -5.0),
+        ([0, 1, 0], 23.0, 5.0),
+        ([0, 2, 0], 1.0, 1.0),
+    ] {
+        assert!(
+            (weight(name, "weights") - w / 48.0).abs() < 1e-15,
+            "{name:?}"
+        );
+        assert!((weight(name, "du") - dw / 8.0).abs() < 1e-15, "{name:?}");
+    }
+    assert!(out["dv"].is_null() && out["note"].as_str().is_some_and(|n| n.contains("across")));
+    let vertex = json("stencil --scheme sqrt3 --boundary 4 --sector 2 --u 0 --v 0 --f64 --json");
+    let w = numbers(&vertex["weights"]);
+    assert_eq!(w.len(), 3);
+    let mut sorted = w.clone();
+    sorted.sort_by(f64::total_cmp);
+    for (x, want) in sorted.iter().zip([1.0 / 6.0, 1.0 / 6.0, 4.0 / 6.0]) {
+        assert!((x - want).abs() < 1e-15, "{w:?}");
+    }
+    let inside =
+        json("stencil --scheme sqrt3 --boundary 5 --sector 4 --u 1/4 --v 1/3 --f64 --json");
+    let sum = |key: &str| numbers(&inside[key]).iter().sum::<f64>();
+    assert!((sum("weights") - 1.0).abs() < 1e-12);
+    assert!(sum("du").abs() < 1e-10 && sum("dv").abs() < 1e-10);
 }
