@@ -50,6 +50,7 @@ pub mod regular_patch;
 pub mod scalar;
 pub mod scaling_system;
 pub mod solve;
+pub mod sqrt3_fan_tangents;
 pub mod sqrt3_patch;
 pub mod sqrt3_regions;
 pub mod sqrt3_strip;

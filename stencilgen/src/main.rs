@@ -26,6 +26,7 @@ use stencilgen::patch_stencils::{curve_scheme, quad_scheme};
 use stencilgen::rational::parse_rational;
 use stencilgen::region_table::RegionLayout;
 use stencilgen::regular_patch::StencilKind;
+use stencilgen::sqrt3_fan_tangents::sqrt3_fan_tangents;
 use stencilgen::sqrt3_patch::Sqrt3Substitution;
 use stencilgen::sqrt3_regions::Sqrt3RegionSubstitution;
 use stencilgen::sqrt3_strip::{BoundaryEvaluator, FanStencil};
@@ -798,8 +799,9 @@ fn sqrt3_stencil_json<S: Scalar>(
 
 /// √3's patch `sector` next to a boundary vertex with `faces` triangles (Kobbelt's boundary
 /// rules), f64, by [`BoundaryEvaluator::fan`] on the grid of the point's common denominator
-/// (at most [`MAX_BASIS_RATE`]): positions everywhere, `du`/`dv` off the boundary (`null`,
-/// with a note, where they are a direction only: across a boundary ray on it, or at `V`).
+/// (at most [`MAX_BASIS_RATE`]): positions everywhere, `du`/`dv` off the boundary, the
+/// tangent masks of [`sqrt3_fan_tangents`] at `V` (with a note), and `null` with a note
+/// across a boundary ray on it (unbounded there in general).
 /// Control points are named `[sector, a, b]` in `schemes::sqrt3_boundary`'s charts.
 fn sqrt3_boundary_stencil_json(
     faces: u32,
@@ -841,10 +843,30 @@ fn sqrt3_boundary_stencil_json(
             None
         }
     };
-    let (du, dv) = (
-        derivative(StencilKind::DerivativeU),
-        derivative(StencilKind::DerivativeV),
-    );
+    let (du, dv) = if k == (0, 0) {
+        // At V the derivatives are the tangent masks (docs/algorithms/sqrt3.md).
+        let masks = sqrt3_fan_tangents(faces, sector)?;
+        let stencil = |w: &[f64]| -> FanStencil {
+            masks
+                .layout
+                .iter()
+                .zip(w)
+                .filter(|(_, &x)| x != 0.0)
+                .map(|(&p, &x)| (p, x))
+                .collect()
+        };
+        notes.push(format!(
+            "at the boundary vertex du/dv are tangent masks (the boundary tangent and the cross \
+             mode of eigenvalue {:.6}, normalized on the half-disk net), not derivatives",
+            masks.across
+        ));
+        (Some(stencil(&masks.du)), Some(stencil(&masks.dv)))
+    } else {
+        (
+            derivative(StencilKind::DerivativeU),
+            derivative(StencilKind::DerivativeV),
+        )
+    };
     let mut order: Vec<FanPoint> = weights.keys().copied().collect();
     for stencil in [&du, &dv].into_iter().flatten() {
         order.extend(stencil.keys().copied());

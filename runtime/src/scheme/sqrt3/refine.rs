@@ -352,6 +352,23 @@ mod tests {
         Mesh::new(positions, &faces, &[], BoundaryMode::EdgeOnly).expect("a valid mesh")
     }
 
+    /// Kobbelt's limit position of `m`'s vertex `v`: [`sqrt3_boundary_limit_position`] on the
+    /// boundary, [`sqrt3_limit_position`] inside (closed forms, no refinement).
+    fn kobbelt_limit(m: &Mesh, v: usize) -> [f64; 3] {
+        let ring = neighbours(m, v);
+        let p = |i: u32| m.positions[i as usize];
+        if m.is_boundary_vertex(v) {
+            let (prev, next) = boundary_neighbours(m, v);
+            return sqrt3_boundary_limit_position(p(prev), m.positions[v], p(next));
+        }
+        let sum = ring.iter().fold([0.0; 3], |acc, &e| add(acc, p(e)));
+        sqrt3_limit_position(
+            m.positions[v],
+            scale(1.0 / ring.len() as f64, sum),
+            ring.len(),
+        )
+    }
+
     /// The lattice triangles with every corner `(a, b)` in `0..=m` squared, at `(a, b, 0)`:
     /// a parallelogram whose corners have one and two triangles and whose sides are regular
     /// boundary vertices (three triangles).
@@ -486,26 +503,6 @@ mod tests {
         }
         let mask: Vec<f64> = symbol.iter().map(|c| c / 27.0).collect();
         assert_eq!(mask.len(), 9);
-        let limit = |m: &Mesh, v: usize| {
-            let ring = neighbours(m, v);
-            if m.is_boundary_vertex(v) {
-                let (prev, next) = boundary_neighbours(m, v);
-                sqrt3_boundary_limit_position(
-                    m.positions[prev as usize],
-                    m.positions[v],
-                    m.positions[next as usize],
-                )
-            } else {
-                let sum = ring
-                    .iter()
-                    .fold([0.0; 3], |acc, &e| add(acc, m.positions[e as usize]));
-                sqrt3_limit_position(
-                    m.positions[v],
-                    scale(1.0 / ring.len() as f64, sum),
-                    ring.len(),
-                )
-            }
-        };
         for (name, coarse) in open_meshes() {
             let fine = sqrt3_refine(&coarse).expect("refines").mesh;
             // The boundary loop through coarse vertex `start`, in boundary order.
@@ -552,7 +549,7 @@ mod tests {
                 }
             }
             for v in 0..coarse.positions.len() {
-                let (a, b) = (limit(&coarse, v), limit(&fine, v));
+                let (a, b) = (kobbelt_limit(&coarse, v), kobbelt_limit(&fine, v));
                 for x in 0..3 {
                     assert!(
                         (a[x] - b[x]).abs() < 1e-14,
@@ -720,23 +717,6 @@ mod tests {
     fn the_fan_surface_is_the_limit_of_whole_mesh_refinement() {
         use stencilgen::regular_patch::StencilKind;
         use stencilgen::sqrt3_strip::BoundaryEvaluator;
-        let limit = |m: &Mesh, v: usize| {
-            let ring = neighbours(m, v);
-            let p = |i: u32| m.positions[i as usize];
-            if m.is_boundary_vertex(v) {
-                return sqrt3_boundary_limit_position(
-                    p(ring[ring.len() - 1]),
-                    m.positions[v],
-                    p(ring[0]),
-                );
-            }
-            let sum = ring.iter().fold([0.0; 3], |acc, &e| add(acc, p(e)));
-            sqrt3_limit_position(
-                m.positions[v],
-                scale(1.0 / ring.len() as f64, sum),
-                ring.len(),
-            )
-        };
         let mut checked = 0;
         for k in 1..=6u32 {
             let (names, coarse, chart, corners) = fan_mesh(k, 7);
@@ -756,7 +736,7 @@ mod tests {
                     let i = names.iter().position(|q| q == p).expect("a coarse vertex");
                     add(acc, scale(w, coarse.positions[i]))
                 });
-                let want = limit(&two, v);
+                let want = kobbelt_limit(&two, v);
                 for x in 0..3 {
                     assert!(
                         (got[x] - want[x]).abs() < 1e-12,
@@ -769,6 +749,65 @@ mod tests {
             }
         }
         assert!(checked > 1500, "{checked} points checked");
+    }
+
+    /// The generator's tangent masks at a boundary vertex (`stencilgen::sqrt3_fan_tangents`,
+    /// from the local matrix's eigenvectors) give the plane the whole-mesh surface's normals
+    /// converge to: the normal of `V`'s ring of limit positions after `m = 1, 2, 3` ternary
+    /// steps (the sum of its triangles' normals) turns towards `du x dv` at every step, for the
+    /// fans with a tangent plane (`K = 1..=5`). `--nocapture` prints the angles.
+    #[test]
+    fn boundary_vertex_normals_converge_to_the_tangent_masks() {
+        use stencilgen::sqrt3_fan_tangents::sqrt3_fan_tangents;
+        let cross = |a: [f64; 3], b: [f64; 3]| {
+            [
+                a[1] * b[2] - a[2] * b[1],
+                a[2] * b[0] - a[0] * b[2],
+                a[0] * b[1] - a[1] * b[0],
+            ]
+        };
+        let angle = |a: [f64; 3], b: [f64; 3]| {
+            let dot: f64 = (0..3).map(|x| a[x] * b[x]).sum();
+            let norm = |v: [f64; 3]| (0..3).map(|x| v[x] * v[x]).sum::<f64>().sqrt();
+            (dot / (norm(a) * norm(b))).clamp(-1.0, 1.0).acos()
+        };
+        for k in 1..=5u32 {
+            let (names, coarse, _, _) = fan_mesh(k, 7);
+            let masks = sqrt3_fan_tangents(k, 0).expect("tangents");
+            let apply = |w: &[f64]| {
+                masks.layout.iter().zip(w).fold([0.0; 3], |acc, (p, &x)| {
+                    let i = names.iter().position(|q| q == p).expect("a coarse vertex");
+                    add(acc, scale(x, coarse.positions[i]))
+                })
+            };
+            let normal = cross(apply(&masks.du), apply(&masks.dv));
+            let v = names.iter().position(|&q| q == (0, 0, 0)).expect("V");
+            let mut mesh = coarse.clone();
+            let mut angles = Vec::new();
+            for _ in 0..3 {
+                mesh = sqrt3_refine(&mesh).expect("refines").mesh;
+                let centre = kobbelt_limit(&mesh, v);
+                let ring: Vec<[f64; 3]> = neighbours(&mesh, v)
+                    .iter()
+                    .map(|&e| {
+                        let p = kobbelt_limit(&mesh, e as usize);
+                        [p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]]
+                    })
+                    .collect();
+                let ring_normal = ring
+                    .windows(2)
+                    .fold([0.0; 3], |acc, w| add(acc, cross(w[0], w[1])));
+                angles.push(angle(ring_normal, normal));
+            }
+            println!(
+                "K = {k}: angles {angles:?}, cross eigenvalue {}",
+                masks.across
+            );
+            assert!(
+                angles[1] < angles[0] && angles[2] < angles[1],
+                "K = {k}: {angles:?}"
+            );
+        }
     }
 
     /// Affine functions are reproduced: on a lattice torus whose positions are the lattice
@@ -824,20 +863,9 @@ mod tests {
         let coarse = octahedron();
         let fine = sqrt3_refine(&coarse).expect("refines").mesh;
         let finer = sqrt3_refine(&fine).expect("refines").mesh;
-        let limit = |m: &Mesh, v: usize| {
-            let ring = neighbours(m, v);
-            let sum = ring
-                .iter()
-                .fold([0.0; 3], |acc, &e| add(acc, m.positions[e as usize]));
-            sqrt3_limit_position(
-                m.positions[v],
-                scale(1.0 / ring.len() as f64, sum),
-                ring.len(),
-            )
-        };
         for (m, n) in [(&coarse, &fine), (&fine, &finer)] {
             for v in 0..m.positions.len() {
-                let (a, b) = (limit(m, v), limit(n, v));
+                let (a, b) = (kobbelt_limit(m, v), kobbelt_limit(n, v));
                 for x in 0..3 {
                     assert!((a[x] - b[x]).abs() < 1e-14, "vertex {v}: {a:?} {b:?}");
                 }
