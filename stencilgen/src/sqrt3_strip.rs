@@ -26,8 +26,9 @@
 //! derivative along the boundary. The derivative across the boundary has no finite value
 //! there in general: at the midpoint of a boundary edge the local matrix has a cross mode of
 //! `0.3722 > 1/3`, so `d phi/d x_2` grows like `x_2^-0.10` towards the line
-//! (docs/algorithms/sqrt3.md); the tangent plane there is a direction, a tangent mask, and so
-//! are the derivatives at `V`, which this module does not compute yet.
+//! (docs/algorithms/sqrt3.md); the tangent plane there is a direction, a tangent mask:
+//! [`BoundaryEvaluator::cross_mask_on_line`] on the half-plane (the fan's rays and `V` are not
+//! covered here; `V`'s masks are `crate::sqrt3_fan_tangents`').
 
 use std::collections::BTreeMap;
 
@@ -291,6 +292,132 @@ impl BoundaryEvaluator {
     }
 }
 
+impl BoundaryEvaluator {
+    /// One level down the half-plane's line: the cross-boundary stencil `D(t, e/3)` from
+    /// `v = D(t', e)`, `3t = t' + s`, `t = k/d`: `3 sum_r v[r] R_1[r + (s, 0)]` (translation
+    /// invariance along the line). The map triples the constant mode, which a derivative lacks
+    /// but rounding puts back; its left eigenvector is the position at `(t, 0)` (the same
+    /// relation without the factor 3), so the step removes `(sum) position(t)`.
+    fn line_step(&mut self, v: &FanStencil, s: i64, k: i64) -> Result<FanStencil, StencilError> {
+        let mut out = FanStencil::new();
+        for (&p, &w) in v {
+            let (a, b) = BoundaryFan::in_sector_zero(p);
+            let name =
+                self.fan
+                    .canonical(0, (a + s, b))
+                    .ok_or_else(|| StencilError::OutOfDomain {
+                        what: format!("({}, {b}) below the boundary", a + s),
+                    })?;
+            for (q, r) in self.rows.row(1, name) {
+                *out.entry(q).or_insert(0.0) += 3.0 * w * r;
+            }
+        }
+        let sum: f64 = out.values().sum();
+        for (q, w) in self.stencil(0, (k, 0), StencilKind::Position)? {
+            *out.entry(q).or_insert(0.0) -= sum * w;
+        }
+        out.retain(|_, w| *w != 0.0);
+        Ok(out)
+    }
+
+    /// The cross-boundary tangent mask at `(k/d, 0)` on the half-plane's line
+    /// ([`BoundaryEvaluator::strip`]): the direction the derivatives `D(t, e)` across the line
+    /// take as `e -> 0` (they grow without bound where a cross mode outgrows the tangent's
+    /// `1/3`, as at an edge's midpoint, and converge where it does not, as at a vertex),
+    /// normalized with the line's own tangent so that on the flat lattice (point `(a, b)` at
+    /// `(a, b)`) it maps to `(0, 1)`, the `x_2` axis, as a derivative would. So `du` (the
+    /// B-spline's derivative) and this mask span the surface's tangent plane there.
+    ///
+    /// The derivatives above the line relate level to level by [`Self::line_step`]; on the
+    /// grid `1/d` the numerators follow `t -> 3t mod d` into a cycle. Starting from the exact
+    /// derivative at `(t_p, 1/d)` above the cycle's first point, the cycle is walked backwards
+    /// level by level, renormalized every turn, until a turn changes the normalized mask by at
+    /// most [`SETTLED`]; the points before the cycle follow by the same step.
+    pub fn cross_mask_on_line(&mut self, k: i64) -> Result<StripStencil, StencilError> {
+        let d = i64::from(self.d);
+        let unsettled = || StencilError::OutOfDomain {
+            what: format!("the cross-boundary direction at ({k}/{d}, 0) did not settle"),
+        };
+        if !self.strip {
+            return Err(StencilError::OutOfDomain {
+                what: "the cross-boundary mask on the line is the half-plane's".to_owned(),
+            });
+        }
+        let (base, start_t) = (k.div_euclid(d), k.rem_euclid(d));
+        // The orbit t -> 3t mod d with each step's shift, until a numerator repeats.
+        let mut orbit: Vec<(i64, i64)> = Vec::new();
+        let mut t = start_t;
+        let start = loop {
+            if let Some(i) = orbit.iter().position(|&(u, _)| u == t) {
+                break i;
+            }
+            orbit.push((t, (3 * t).div_euclid(d)));
+            t = (3 * t).rem_euclid(d);
+        };
+        let normalized = |v: FanStencil| -> FanStencil {
+            let largest = v.values().fold(0.0f64, |m, w| m.max(w.abs()));
+            v.into_iter().map(|(p, w)| (p, w / largest)).collect()
+        };
+        let cycle: Vec<(i64, i64)> = orbit[start..].to_vec();
+        let mut v = normalized(self.stencil(0, (cycle[0].0, 1), StencilKind::DerivativeV)?);
+        let mut levels = 0;
+        loop {
+            let before = v.clone();
+            for &(u, s) in cycle.iter().rev() {
+                v = self.line_step(&v, s, u)?;
+                levels += 1;
+            }
+            v = normalized(v);
+            let change = v
+                .keys()
+                .chain(before.keys())
+                .map(|p| {
+                    (v.get(p).copied().unwrap_or(0.0) - before.get(p).copied().unwrap_or(0.0)).abs()
+                })
+                .fold(0.0f64, f64::max);
+            if change <= SETTLED {
+                break;
+            }
+            if levels > MAX_LINE_LEVELS {
+                return Err(unsettled());
+            }
+        }
+        for &(u, s) in orbit[..start].iter().rev() {
+            v = self.line_step(&v, s, u)?;
+        }
+        // Frame: the flat lattice's image of v is (g_1, g_2); the line's tangent maps it to
+        // (1, 0); so (v - g_1 tangent) / g_2 maps it to (0, 1).
+        let image = v.iter().fold([0.0, 0.0], |acc, (&p, &w)| {
+            let (a, b) = BoundaryFan::in_sector_zero(p);
+            [acc[0] + w * a as f64, acc[1] + w * b as f64]
+        });
+        if image[1].abs() < 1e-12 {
+            return Err(unsettled());
+        }
+        let tangent = self.stencil(0, (start_t, 0), StencilKind::DerivativeU)?;
+        let mut mask = v;
+        for (p, w) in tangent {
+            *mask.entry(p).or_insert(0.0) -= image[0] * w;
+        }
+        Ok(mask
+            .into_iter()
+            .filter(|&(_, w)| w != 0.0)
+            .map(|(p, w)| {
+                let (a, b) = BoundaryFan::in_sector_zero(p);
+                ((a + base, b), w / image[1])
+            })
+            .collect())
+    }
+}
+
+/// How much one turn of a cycle may change the normalized mask of
+/// [`BoundaryEvaluator::cross_mask_on_line`] (relative to its largest weight) when it stops.
+const SETTLED: f64 = 1e-12;
+
+/// Levels walked at most by [`BoundaryEvaluator::cross_mask_on_line`]: at an edge's midpoint
+/// the rest shrinks by `(1/3) / 0.3722 = 0.896` a level, which reaches [`SETTLED`] within 300.
+const MAX_LINE_LEVELS: usize = 5000;
+
 /// A chart axis along the boundary, with its direction relative to the boundary polygon's.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Axis {
@@ -307,6 +434,27 @@ mod tests {
     use super::*;
 
     /// Positions sum to 1 and derivatives to 0 (partition of unity), off the line and on it.
+    /// The cross masks on the line sum to 0 (a direction, no constant part), map the flat
+    /// lattice to `(0, 1)`, and settle at a vertex (`t = 0`), at the edge's midpoint (`1/2`,
+    /// where the derivative itself grows without bound) and at a point with a longer cycle
+    /// (`1/4 -> 3/4 -> 1/4`).
+    #[test]
+    fn cross_masks_on_the_line() {
+        let mut e = BoundaryEvaluator::strip(4).expect("psi on 1/4");
+        for k in [0, 1, 2, 4, 6] {
+            let m = e.cross_mask_on_line(k).expect("settles");
+            let sum: f64 = m.values().sum();
+            assert!(sum.abs() < 1e-10, "{k}: {sum}");
+            let image = m.iter().fold([0.0, 0.0], |acc, (&(a, b), &w)| {
+                [acc[0] + w * a as f64, acc[1] + w * b as f64]
+            });
+            assert!(
+                image[0].abs() < 1e-9 && (image[1] - 1.0).abs() < 1e-9,
+                "{k}: {image:?}"
+            );
+        }
+    }
+
     #[test]
     fn stencils_are_affine() {
         let mut e = BoundaryEvaluator::strip(6).expect("psi on 1/6");

@@ -196,3 +196,59 @@ fn strip_derivatives_are_the_positions_slopes() {
         }
     }
 }
+
+/// The cross-boundary tangent mask on the line (`cross_mask_on_line`, the direction the
+/// derivatives across the line take in the limit) gives the plane the surface's normals above
+/// the line converge to: with `du` the B-spline's derivative, the angle between `du x mask` at
+/// `(t, 0)` and the exact normal at `(t, e)`, `e = 1/3, 1/9, 1/36`, shrinks with `e`, at a
+/// vertex (`t = 6`) and at an edge's midpoint (`t = 6.5`, where the derivative across itself
+/// grows without bound). `--nocapture` prints the angles.
+#[test]
+fn normals_above_the_line_converge_to_the_cross_mask() {
+    let m = 12;
+    let coarse = parallelogram(m);
+    let d = 36i64;
+    let mut strip = BoundaryEvaluator::strip(d as u32).expect("psi on 1/36");
+    let cross = |a: [f64; 3], b: [f64; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let angle = |a: [f64; 3], b: [f64; 3]| {
+        let dot: f64 = (0..3).map(|x| a[x] * b[x]).sum();
+        let norm = |v: [f64; 3]| (0..3).map(|x| v[x] * v[x]).sum::<f64>().sqrt();
+        (dot / (norm(a) * norm(b))).clamp(-1.0, 1.0).acos()
+    };
+    for t in [6 * d, 6 * d + d / 2] {
+        let du = apply(
+            &strip
+                .half_plane_stencil((t, 0), StencilKind::DerivativeU)
+                .expect("along the line"),
+            &coarse,
+            m,
+        );
+        let mask = apply(&strip.cross_mask_on_line(t).expect("settles"), &coarse, m);
+        let limit = cross(du, mask);
+        let angles: Vec<f64> = [12, 4, 1]
+            .iter()
+            .map(|&e| {
+                let mut at = |kind| {
+                    apply(
+                        &strip.half_plane_stencil((t, e), kind).expect("evaluates"),
+                        &coarse,
+                        m,
+                    )
+                };
+                let (u, v) = (at(StencilKind::DerivativeU), at(StencilKind::DerivativeV));
+                angle(cross(u, v), limit)
+            })
+            .collect();
+        println!("t = {t}/{d}: angles {angles:?}");
+        assert!(
+            angles[1] < angles[0] && angles[2] < angles[1],
+            "t = {t}/{d}: {angles:?}"
+        );
+    }
+}
