@@ -43,7 +43,7 @@ const ROUNDING: f64 = 1e-12;
 /// within three level-1 units of `V` reads level-0 points within three units).
 const RADIUS: i64 = 3;
 
-/// The ball of [`RADIUS`] around `V` in `fan` and its local matrix (row `i`: the level-1 point
+/// The ball of radius 3 around `V` in `fan` and its local matrix (row `i`: the level-1 point
 /// at layout point `i`'s coordinates over the layout's level-0 points).
 pub fn fan_local_matrix(fan: BoundaryFan) -> Result<(Vec<FanPoint>, DMatrix<f64>), StencilError> {
     let mut layout = vec![V];

@@ -328,11 +328,12 @@ impl BoundaryEvaluator {
     /// `(a, b)`) it maps to `(0, 1)`, the `x_2` axis, as a derivative would. So `du` (the
     /// B-spline's derivative) and this mask span the surface's tangent plane there.
     ///
-    /// The derivatives above the line relate level to level by [`Self::line_step`]; on the
+    /// The derivatives above the line relate level to level, `D(t, e/3) = 3 sum_r D(t', e)[r]
+    /// R_1[r + (s, 0)]` with `3t = t' + s` (translation invariance along the line); on the
     /// grid `1/d` the numerators follow `t -> 3t mod d` into a cycle. Starting from the exact
     /// derivative at `(t_p, 1/d)` above the cycle's first point, the cycle is walked backwards
     /// level by level, renormalized every turn, until a turn changes the normalized mask by at
-    /// most [`SETTLED`]; the points before the cycle follow by the same step.
+    /// most 1e-12 of its largest weight; the points before the cycle follow by the same step.
     pub fn cross_mask_on_line(&mut self, k: i64) -> Result<StripStencil, StencilError> {
         let d = i64::from(self.d);
         let unsettled = || StencilError::OutOfDomain {
