@@ -32,8 +32,8 @@
 //! * every other point (the thirds of inner edges): the average of the three half-level points
 //!   among its six unit neighbours.
 //!
-//! `alpha_4` and `alpha_5` (a triangle with one or two boundary edges) have `cos(2π/k)` or are
-//! one, so the rows are f64.
+//! The centre of a triangle with one boundary edge has valence 5, and `alpha_5` has
+//! `cos(2π/5)`, so the rows are f64.
 
 use std::collections::{BTreeMap, HashMap};
 

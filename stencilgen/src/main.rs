@@ -74,8 +74,9 @@ enum Command {
     /// Stencil of the patch next to an extraordinary vertex at a rational (u, v).
     Stencil {
         /// Quad scheme name (catmull-clark, sw-nonpoly-quad), or a triangle scheme: `loop`
-        /// (interior and boundary vertices), `butterfly` or `sqrt3` (interior vertices); (u, v)
-        /// barycentric on the triangle V, E0, E1.
+        /// (interior and boundary vertices), `butterfly` (interior vertices) or `sqrt3`
+        /// (interior vertices; boundary vertices with `--f64`); (u, v) barycentric on the
+        /// triangle V, E0, E1.
         #[arg(long)]
         scheme: String,
         /// Valence of the (interior) extraordinary vertex at (0, 0).
