@@ -39,17 +39,22 @@ pub struct Sqrt3FanTangents {
 /// Weights below this fraction of a mask's largest are rounding, set to zero.
 const ROUNDING: f64 = 1e-12;
 
-/// The radius of the ball the local matrix acts on (closed under the step: a level-1 point
-/// within three level-1 units of `V` reads level-0 points within three units).
-const RADIUS: i64 = 3;
+/// The radius of the smallest ball the local matrix acts on: closed under the step (a level-1
+/// point within three level-1 units of `V` reads level-0 points within three units) and
+/// holding every point whose basis function reaches `V` (the support of `psi` reaches 2.5).
+pub const FAN_RADIUS: i64 = 3;
 
-/// The ball of radius 3 around `V` in `fan` and its local matrix (row `i`: the level-1 point
-/// at layout point `i`'s coordinates over the layout's level-0 points).
-pub fn fan_local_matrix(fan: BoundaryFan) -> Result<(Vec<FanPoint>, DMatrix<f64>), StencilError> {
+/// The ball of fan points within `radius` of `V` (hex norm in their charts, `V` first; at least
+/// [`FAN_RADIUS`]) and its local matrix (row `i`: the level-1 point at layout point `i`'s
+/// coordinates over the layout's level-0 points). A wider ball adds only smaller eigenvalues.
+pub fn fan_local_matrix(
+    fan: BoundaryFan,
+    radius: i64,
+) -> Result<(Vec<FanPoint>, DMatrix<f64>), StencilError> {
     let mut layout = vec![V];
     for s in 0..=i64::from(fan.faces) {
-        for b in 0..=RADIUS {
-            for a in 0..=RADIUS - b {
+        for b in 0..=radius {
+            for a in 0..=radius - b {
                 if let Some(p) = fan.canonical(s, (a, b)) {
                     if !layout.contains(&p) {
                         layout.push(p);
@@ -92,7 +97,7 @@ pub fn sqrt3_fan_tangents(faces: u32, sector: u32) -> Result<Sqrt3FanTangents, S
         });
     }
     let fan = BoundaryFan::new(faces);
-    let (layout, a) = fan_local_matrix(fan)?;
+    let (layout, a) = fan_local_matrix(fan, FAN_RADIUS)?;
     let n = layout.len();
     let index = |p: FanPoint| layout.iter().position(|&q| q == p);
     let mut t = vec![0.0; n];

@@ -4,41 +4,16 @@
 
 use nalgebra::DMatrix;
 use schemes::sqrt3_boundary::{half_plane_row, BoundaryFan, FanPoint, V};
+use stencilgen::sqrt3_fan_tangents::{fan_local_matrix, FAN_RADIUS};
 
-/// The local matrix of the fan of `k` triangles on the ball of fan points within three units
-/// of `V` (hex norm in their charts), which the ternary step maps into itself: row `i` is the
-/// level-1 point at layout point `i`'s coordinates, over the layout's level-0 points.
-fn local_matrix(k: u32) -> (Vec<FanPoint>, DMatrix<f64>) {
-    local_matrix_within(k, 3)
+/// The local matrix of the fan of `k` triangles on the ball of radius `r` around `V`
+/// (`stencilgen::sqrt3_fan_tangents::fan_local_matrix`: closed under the step, checked there).
+fn local_matrix_within(k: u32, r: i64) -> (Vec<FanPoint>, DMatrix<f64>) {
+    fan_local_matrix(BoundaryFan::new(k), r).expect("a closed ball")
 }
 
-/// [`local_matrix`] on the ball of radius `r`.
-fn local_matrix_within(k: u32, r: i64) -> (Vec<FanPoint>, DMatrix<f64>) {
-    let fan = BoundaryFan::new(k);
-    let mut layout: Vec<FanPoint> = Vec::new();
-    for s in 0..=i64::from(k) {
-        for b in 0..=r {
-            for a in 0..=r - b {
-                if let Some(p) = fan.canonical(s, (a, b)) {
-                    if !layout.contains(&p) {
-                        layout.push(p);
-                    }
-                }
-            }
-        }
-    }
-    let n = layout.len();
-    let mut a = DMatrix::<f64>::zeros(n, n);
-    for (i, &q) in layout.iter().enumerate() {
-        for (p, w) in fan.level1_row(q) {
-            let j = layout
-                .iter()
-                .position(|&x| x == p)
-                .unwrap_or_else(|| panic!("K = {k}: {q:?} reads {p:?} outside the ball"));
-            a[(i, j)] = w;
-        }
-    }
-    (layout, a)
+fn local_matrix(k: u32) -> (Vec<FanPoint>, DMatrix<f64>) {
+    local_matrix_within(k, FAN_RADIUS)
 }
 
 /// The moduli of `a`'s eigenvalues, largest first, by a bounded Schur iteration (a matrix it
