@@ -6,6 +6,7 @@
 use schemes::BoundaryMode;
 use stencilgen::regular_patch::StencilKind;
 use stencilgen::sqrt3_strip::{BoundaryEvaluator, StripStencil};
+use subtess::mesh::geometry::{add, cross, dot, norm, scale};
 use subtess::mesh::topology::Mesh;
 use subtess::mesh::triangle_topology::neighbours;
 use subtess::scheme::sqrt3::refine::{
@@ -83,8 +84,7 @@ fn refined_lattice(m: i64, steps: u32) -> (Mesh, Mesh, Vec<(i64, i64)>) {
 fn apply(stencil: &StripStencil, mesh: &Mesh, m: i64) -> [f64; 3] {
     stencil.iter().fold([0.0; 3], |acc, (&(a, b), &w)| {
         assert!((0..=m).contains(&a) && (0..=m).contains(&b), "({a}, {b})");
-        let p = mesh.positions[(a + (m + 1) * b) as usize];
-        [acc[0] + w * p[0], acc[1] + w * p[1], acc[2] + w * p[2]]
+        add(acc, scale(w, mesh.positions[(a + (m + 1) * b) as usize]))
     })
 }
 
@@ -100,12 +100,9 @@ fn limit_position(mesh: &Mesh, v: usize) -> [f64; 3] {
             p(ring[0]),
         );
     }
-    let sum = ring.iter().fold([0.0; 3], |acc, &e| {
-        let q = p(e);
-        [acc[0] + q[0], acc[1] + q[1], acc[2] + q[2]]
-    });
+    let sum = ring.iter().fold([0.0; 3], |acc, &e| add(acc, p(e)));
     let k = ring.len() as f64;
-    sqrt3_limit_position(mesh.positions[v], sum.map(|x| x / k), ring.len())
+    sqrt3_limit_position(mesh.positions[v], scale(1.0 / k, sum), ring.len())
 }
 
 /// At every ternary point `(i/27, j/27)` within three rows of the boundary `b = 0` (and four
@@ -209,18 +206,8 @@ fn normals_above_the_line_converge_to_the_cross_mask() {
     let coarse = parallelogram(m);
     let d = 36i64;
     let mut strip = BoundaryEvaluator::strip(d as u32).expect("psi on 1/36");
-    let cross = |a: [f64; 3], b: [f64; 3]| {
-        [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ]
-    };
-    let angle = |a: [f64; 3], b: [f64; 3]| {
-        let dot: f64 = (0..3).map(|x| a[x] * b[x]).sum();
-        let norm = |v: [f64; 3]| (0..3).map(|x| v[x] * v[x]).sum::<f64>().sqrt();
-        (dot / (norm(a) * norm(b))).clamp(-1.0, 1.0).acos()
-    };
+    let angle =
+        |a: [f64; 3], b: [f64; 3]| (dot(a, b) / (norm(a) * norm(b))).clamp(-1.0, 1.0).acos();
     for t in [6 * d, 6 * d + d / 2] {
         let du = apply(
             &strip

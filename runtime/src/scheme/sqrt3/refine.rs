@@ -758,19 +758,10 @@ mod tests {
     /// fans with a tangent plane (`K = 1..=5`). `--nocapture` prints the angles.
     #[test]
     fn boundary_vertex_normals_converge_to_the_tangent_masks() {
+        use crate::mesh::geometry::{cross, dot, norm, sub};
         use stencilgen::sqrt3_fan_tangents::sqrt3_fan_tangents;
-        let cross = |a: [f64; 3], b: [f64; 3]| {
-            [
-                a[1] * b[2] - a[2] * b[1],
-                a[2] * b[0] - a[0] * b[2],
-                a[0] * b[1] - a[1] * b[0],
-            ]
-        };
-        let angle = |a: [f64; 3], b: [f64; 3]| {
-            let dot: f64 = (0..3).map(|x| a[x] * b[x]).sum();
-            let norm = |v: [f64; 3]| (0..3).map(|x| v[x] * v[x]).sum::<f64>().sqrt();
-            (dot / (norm(a) * norm(b))).clamp(-1.0, 1.0).acos()
-        };
+        let angle =
+            |a: [f64; 3], b: [f64; 3]| (dot(a, b) / (norm(a) * norm(b))).clamp(-1.0, 1.0).acos();
         for k in 1..=5u32 {
             let (names, coarse, _, _) = fan_mesh(k, 7);
             let masks = sqrt3_fan_tangents(k, 0).expect("tangents");
@@ -789,10 +780,7 @@ mod tests {
                 let centre = kobbelt_limit(&mesh, v);
                 let ring: Vec<[f64; 3]> = neighbours(&mesh, v)
                     .iter()
-                    .map(|&e| {
-                        let p = kobbelt_limit(&mesh, e as usize);
-                        [p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]]
-                    })
+                    .map(|&e| sub(kobbelt_limit(&mesh, e as usize), centre))
                     .collect();
                 let ring_normal = ring
                     .windows(2)
