@@ -4,7 +4,10 @@
 //! (the columns of the subdivision matrix S in `p_{j+1} = S p_j`, Schaefer–Warren eq. (1))
 //! and, for stationary non-uniform schemes, the finite set of special columns around the
 //! non-uniformity. Nothing in this crate solves anything: `stencilgen` turns these data into
-//! evaluation stencils through the scaling relation (Schaefer–Warren eq. (3)).
+//! evaluation stencils through the scaling relation (Schaefer–Warren eq. (3)). One evaluation
+//! lives here because the generator and the runtime both make it from a basis they each hold:
+//! √3 beside a boundary by certified levels (`sqrt3_boundary_surface`), sums of a given regular
+//! basis over rows of the rules.
 //!
 //! ```
 //! use schemes::curve::CurveScheme;
@@ -27,6 +30,7 @@ pub mod loop_regular;
 pub mod quad;
 pub mod rational;
 pub mod sqrt3_boundary;
+pub mod sqrt3_boundary_surface;
 pub mod sqrt3_local;
 pub mod sqrt3_regions;
 pub mod tangent_frame;

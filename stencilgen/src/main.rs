@@ -29,7 +29,7 @@ use stencilgen::regular_patch::StencilKind;
 use stencilgen::sqrt3_fan_tangents::sqrt3_fan_tangents;
 use stencilgen::sqrt3_patch::Sqrt3Substitution;
 use stencilgen::sqrt3_regions::Sqrt3RegionSubstitution;
-use stencilgen::sqrt3_strip::{BoundaryEvaluator, FanStencil};
+use stencilgen::sqrt3_strip::{self, derivative, FanStencil};
 use stencilgen::sqrt3_table::{build_sqrt3_table, Sqrt3TableSpec};
 use stencilgen::stencil_set::StencilSetSpec;
 use stencilgen::substitution::Substitution;
@@ -799,7 +799,7 @@ fn sqrt3_stencil_json<S: Scalar>(
 }
 
 /// √3's patch `sector` next to a boundary vertex with `faces` triangles (Kobbelt's boundary
-/// rules), f64, by [`BoundaryEvaluator::fan`] on the grid of the point's common denominator
+/// rules), f64, by [`sqrt3_strip::fan`] on the grid of the point's common denominator
 /// (at most [`MAX_BASIS_RATE`]): positions everywhere, `du`/`dv` off the boundary, the
 /// tangent masks of [`sqrt3_fan_tangents`] at `V` (with a note), and `null` with a note
 /// across a boundary ray on it (unbounded there in general).
@@ -833,11 +833,11 @@ fn sqrt3_boundary_stencil_json(
             .map_err(|_| outside(format!("({u}, {v})")))
     };
     let k = (numerator(u)?, numerator(v)?);
-    let mut evaluator = BoundaryEvaluator::fan(faces, d)?;
+    let mut evaluator = sqrt3_strip::fan(faces, d)?;
     let s = i64::from(sector);
-    let weights = evaluator.stencil(s, k, StencilKind::Position)?;
+    let weights = evaluator.stencil(s, k, derivative(StencilKind::Position))?;
     let mut notes = Vec::new();
-    let mut derivative = |kind: StencilKind| match evaluator.stencil(s, k, kind) {
+    let mut derivative = |kind: StencilKind| match evaluator.stencil(s, k, derivative(kind)) {
         Ok(stencil) => Some(stencil),
         Err(e) => {
             notes.push(e.to_string());

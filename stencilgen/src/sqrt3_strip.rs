@@ -1,38 +1,13 @@
-//! The √3 surface next to a boundary (Kobbelt's boundary rules), evaluated exactly at the
-//! points `k/d` by the scaling relation without a system: beside a straight boundary (the
-//! strip patches of docs/algorithms/sqrt3.md, "The plan for boundary patches") and on the fan
-//! of `K` triangles around a boundary vertex `V` (`schemes::sqrt3_boundary`'s charts).
-//!
-//! **Certified levels.** A level-`N` triangle `T` (level-`N` chart coordinates) is regular when
-//! `T + int S`, `S = H/2` the support of the regular basis `psi` (within hex norm 2.5, and two
-//! and a half rows on either side of a line), misses every point whose rules differ from the
-//! interior's: the points within two thirds of a level unit of the boundary and, on a fan,
-//! `V`. So `T` is certified when its corners lie [`REGULAR_ROW`] `= 4` units or more from the
-//! boundary rays (rows, in the charts of the sectors next to them) and, on a fan, from `V` (hex
-//! norm). With `N` the smallest level at which the triangle holding `y = 3^N x` is certified,
-//!
-//! ```text
-//!   phi(x) = sum_j psi(y - j) R_N[j],     d phi / d x_i = 3^N sum_j psi_i(y - j) R_N[j]
-//! ```
-//!
-//! over the level-`N` lattice points `j` named in the fan (Schaefer–Warren eq. (2); `R_N[j]`
-//! the level-0 row of point `j` after `N` ternary steps of the true rules, [`BoundaryRows`];
-//! `psi_i` the skew-axis derivatives of `psi`). `y` has denominator `d`, so `psi` is needed on
-//! the grid `1/d` only. A point off the boundary and off `V` is certified within
-//! `log_3(4d) + 1` levels.
-//!
-//! **On the boundary** the surface is the uniform cubic B-spline of the boundary polygon
-//! (`.., E_K, V, E_0, ..` on a fan; the boundary rules are its ternary refinement), and so is its
-//! derivative along the boundary. The derivative across the boundary has no finite value
-//! there in general: at the midpoint of a boundary edge the local matrix has a cross mode of
-//! `0.3722 > 1/3`, so `d phi/d x_2` grows like `x_2^-0.10` towards the line
-//! (docs/algorithms/sqrt3.md); the tangent plane there is a direction, a tangent mask:
-//! [`BoundaryEvaluator::cross_mask_on_line`] on the half-plane (the fan's rays and `V` are not
-//! covered here; `V`'s masks are `crate::sqrt3_fan_tangents`').
+//! The √3 surface next to a boundary (Kobbelt's boundary rules) with the generator's own
+//! regular basis: `schemes::sqrt3_boundary_surface` evaluates it by certified levels (its docs
+//! have the method) from `psi` on the grid `1/d`, which this module solves
+//! ([`RegionBasis`], the same solve as the interior tables'). The runtime's boundary patches
+//! evaluate the same surface from the table's `psi`; this is the independent side of their
+//! checks, and what `stencilgen stencil --scheme sqrt3 --boundary` prints.
 
-use std::collections::BTreeMap;
-
-use schemes::sqrt3_boundary::{BoundaryFan, BoundaryRows, FanPoint, V};
+use schemes::loop_regular::RegularDerivative;
+use schemes::sqrt3_boundary_surface::{BoundarySurface, Refused, RegularBasis};
+pub use schemes::sqrt3_boundary_surface::{FanStencil, StripStencil, REGULAR_ROW};
 use schemes::TriangleScheme;
 
 use crate::cone_regions::RegionBasis;
@@ -40,395 +15,80 @@ use crate::regular_patch::StencilKind;
 use crate::triangle_system::MAX_BASIS_RATE;
 use crate::StencilError;
 
-/// A stencil over level-0 half-plane points `(a, b)`, `b >= 0`.
-pub type StripStencil = BTreeMap<(i64, i64), f64>;
+/// The surface beside a boundary with the generator's basis on the grid `1/d`.
+pub type BoundaryEvaluator = BoundarySurface<RegionBasis<f64>>;
 
-/// A stencil over the level-0 points of a fan.
-pub type FanStencil = BTreeMap<FanPoint, f64>;
+impl RegularBasis for RegionBasis<f64> {
+    fn denominator(&self) -> i64 {
+        i64::from(self.n)
+    }
 
-/// The lowest row of a level-`N` triangle that is certified regular (module docs); also the
-/// least hex-norm distance of its corners from a fan's vertex `V`.
-pub const REGULAR_ROW: i64 = 4;
+    fn support_box(&self, what: RegularDerivative) -> ((i64, i64), (i64, i64)) {
+        self.kinds[index(what)]
+            .as_ref()
+            .map_or(((0, -1), (0, -1)), |psi| psi.bbox)
+    }
 
-/// Evaluates the surface beside a straight boundary ([`BoundaryEvaluator::strip`]) or on the fan
-/// around a boundary vertex ([`BoundaryEvaluator::fan`]) at the points `k/d` (module docs).
-#[derive(Clone, Debug)]
-pub struct BoundaryEvaluator {
-    d: u32,
-    basis: RegionBasis<f64>,
-    fan: BoundaryFan,
-    rows: BoundaryRows,
-    /// The half-plane: no vertex is special, so only the rows count.
-    strip: bool,
-}
-
-/// The uniform cubic B-spline's four basis functions at `u` in `[0, 1]` (for the points
-/// `p_{-1}, p_0, p_1, p_2`), or their derivatives.
-fn cubic_b_spline(u: f64, derivative: bool) -> [f64; 4] {
-    let v = 1.0 - u;
-    if derivative {
-        [
-            -v * v / 2.0,
-            (3.0 * u * u - 4.0 * u) / 2.0,
-            (-3.0 * u * u + 2.0 * u + 1.0) / 2.0,
-            u * u / 2.0,
-        ]
-    } else {
-        [
-            v * v * v / 6.0,
-            (3.0 * u * u * u - 6.0 * u * u + 4.0) / 6.0,
-            (-3.0 * u * u * u + 3.0 * u * u + 3.0 * u + 1.0) / 6.0,
-            u * u * u / 6.0,
-        ]
+    fn value(&self, what: RegularDerivative, k: (i64, i64)) -> f64 {
+        self.kinds[index(what)]
+            .as_ref()
+            .map_or(0.0, |psi| psi.at(k.0, k.1))
     }
 }
 
-fn hex_norm((a, b): (i64, i64)) -> i64 {
-    a.abs().max(b.abs()).max((a + b).abs())
-}
-
-impl BoundaryEvaluator {
-    fn new(fan: BoundaryFan, strip: bool, d: u32) -> Result<Self, StencilError> {
-        if d == 0 || d > MAX_BASIS_RATE {
-            return Err(StencilError::RateOutOfRange {
-                n: d,
-                max: MAX_BASIS_RATE,
-            });
-        }
-        let scheme = TriangleScheme::by_name("sqrt3").ok_or_else(|| StencilError::OutOfDomain {
-            what: "the sqrt3 scheme".to_owned(),
-        })?;
-        let kinds = [
-            StencilKind::Position,
-            StencilKind::DerivativeU,
-            StencilKind::DerivativeV,
-        ];
-        Ok(BoundaryEvaluator {
-            d,
-            basis: RegionBasis::new(&scheme, d, &kinds)?,
-            fan,
-            rows: BoundaryRows::new(fan),
-            strip,
-        })
-    }
-
-    /// The half-plane beside a straight boundary, on the grid `1/d` (`1..=`[`MAX_BASIS_RATE`]):
-    /// solves `psi` and its two skew-axis derivatives there.
-    pub fn strip(d: u32) -> Result<Self, StencilError> {
-        Self::new(BoundaryFan::new(3), true, d)
-    }
-
-    /// The fan of `faces` triangles around a boundary vertex, on the grid `1/d`.
-    pub fn fan(faces: u32, d: u32) -> Result<Self, StencilError> {
-        if faces == 0 {
-            return Err(StencilError::OutOfDomain {
-                what: "a boundary vertex without a triangle".to_owned(),
-            });
-        }
-        Self::new(BoundaryFan::new(faces), false, d)
-    }
-
-    /// The half-plane stencil of `kind` (position, `d/dx_1`, `d/dx_2`) at `x = k/d` over the
-    /// level-0 half-plane points ([`BoundaryEvaluator::strip`]). Refuses `k_2 < 0`, and the
-    /// derivative across the line at `k_2 = 0` (unbounded there in general, module docs).
-    pub fn half_plane_stencil(
-        &mut self,
-        k: (i64, i64),
-        kind: StencilKind,
-    ) -> Result<StripStencil, StencilError> {
-        Ok(self
-            .stencil(0, k, kind)?
-            .into_iter()
-            .map(|(p, w)| (BoundaryFan::in_sector_zero(p), w))
-            .collect())
-    }
-
-    /// Whether the level-`N` triangle with these corners (sector `s`'s chart) is certified
-    /// regular: its corners at least [`REGULAR_ROW`] from the boundary rays (and, on a fan,
-    /// from `V`), so that `T + int S` misses every point whose rules differ from the interior's.
-    fn certified(&self, s: i64, corners: &[(i64, i64); 3]) -> bool {
-        if self.strip {
-            return corners.iter().all(|c| c.1 >= REGULAR_ROW);
-        }
-        let last = i64::from(self.fan.faces) - 1;
-        corners.iter().all(|&c| {
-            hex_norm(c) >= REGULAR_ROW
-                && (s != 0 || c.1 >= REGULAR_ROW)
-                && (s != last || c.0 >= REGULAR_ROW)
-        })
-    }
-
-    /// The stencil of `kind` (position, `d/du`, `d/dv` along sector `sector`'s chart axes) at
-    /// `x = k/d` of that chart, over the fan's level-0 points. On a boundary ray the position
-    /// is the boundary's cubic B-spline and the derivative along the ray its derivative; the
-    /// derivative across a ray on it, and every derivative at a fan's `V`, are refused
-    /// (unbounded or a direction only, module docs).
-    pub fn stencil(
-        &mut self,
-        sector: i64,
-        k: (i64, i64),
-        kind: StencilKind,
-    ) -> Result<FanStencil, StencilError> {
-        let d = i64::from(self.d);
-        let refuse = |why: &str| StencilError::OutOfDomain {
-            what: format!(
-                "{kind:?} at ({}/{d}, {}/{d}) of sector {sector}: {why}",
-                k.0, k.1
-            ),
-        };
-        let at_v = !self.strip && k == (0, 0);
-        if let Some((t, along)) = self.on_boundary(sector, k) {
-            if at_v && kind != StencilKind::Position {
-                return Err(refuse(
-                    "a derivative at the boundary vertex (a tangent mask)",
-                ));
-            }
-            let derivative = match (kind, along) {
-                (StencilKind::Position, _) => None,
-                (StencilKind::DerivativeU, Axis::U) => Some(1.0),
-                (StencilKind::DerivativeV, Axis::MinusV) => Some(-1.0),
-                _ => return Err(refuse("across the boundary on it (unbounded in general)")),
-            };
-            return Ok(self.boundary_curve(t, derivative));
-        }
-        // The smallest level at which the triangle holding x is certified regular.
-        let (mut level, mut y, mut factor) = (0u32, k, 1.0);
-        loop {
-            let (a, b) = (y.0.div_euclid(d), y.1.div_euclid(d));
-            let (fa, fb) = (y.0.rem_euclid(d), y.1.rem_euclid(d));
-            let corners = if fa + fb < d {
-                [(a, b), (a + 1, b), (a, b + 1)]
-            } else {
-                [(a + 1, b), (a + 1, b + 1), (a, b + 1)]
-            };
-            if self.certified(sector, &corners) {
-                break;
-            }
-            if level >= MAX_LEVEL {
-                return Err(refuse(
-                    "no certified level (too close to the boundary or V)",
-                ));
-            }
-            level += 1;
-            y = (3 * y.0, 3 * y.1);
-            factor *= 3.0;
-        }
-        let psi = self.basis.get(kind)?;
-        let ((l1, h1), (l2, h2)) = psi.bbox;
-        let scale = if kind == StencilKind::Position {
-            1.0
-        } else {
-            factor
-        };
-        let mut out = FanStencil::new();
-        // j with y - d j in the support's box: d j_i in [y_i - h_i, y_i - l_i].
-        for j2 in (y.1 - h2).div_euclid(d)..=(y.1 - l2).div_euclid(d) + 1 {
-            for j1 in (y.0 - h1).div_euclid(d)..=(y.0 - l1).div_euclid(d) + 1 {
-                let w = psi.at(y.0 - d * j1, y.1 - d * j2);
-                if w == 0.0 {
-                    continue;
-                }
-                let name = self.fan.canonical(sector, (j1, j2)).ok_or_else(|| {
-                    refuse(&format!(
-                        "level-{level} point ({j1}, {j2}) is outside the fan"
-                    ))
-                })?;
-                for (p, r) in self.rows.row(level, name) {
-                    *out.entry(p).or_insert(0.0) += scale * w * r;
-                }
-            }
-        }
-        out.retain(|_, w| *w != 0.0);
-        Ok(out)
-    }
-
-    /// Where `k/d` of sector `s`'s chart lies on the boundary: its parameter along the
-    /// boundary polygon (`V` at 0, `E_0` at 1, `E_K` at -1; the half-plane's line at `x_1`) and
-    /// the chart axis that runs along the boundary there, with its sign.
-    fn on_boundary(&self, s: i64, k: (i64, i64)) -> Option<(f64, Axis)> {
-        let d = self.d as f64;
-        if self.strip {
-            return (k.1 == 0).then_some((k.0 as f64 / d, Axis::U));
-        }
-        let last = i64::from(self.fan.faces) - 1;
-        if k == (0, 0) {
-            // V, from any sector's chart (its derivatives are refused before the axis counts).
-            Some((0.0, Axis::U))
-        } else if s == 0 && k.1 == 0 && k.0 >= 0 {
-            Some((k.0 as f64 / d, Axis::U))
-        } else if s == last && k.0 == 0 && k.1 >= 0 {
-            Some((-(k.1 as f64) / d, Axis::MinusV))
-        } else {
-            None
-        }
-    }
-
-    /// The boundary's cubic B-spline at parameter `t` (or its derivative along the boundary,
-    /// times `sign`), over the fan's boundary points.
-    fn boundary_curve(&self, t: f64, derivative: Option<f64>) -> FanStencil {
-        let base = t.floor();
-        let weights = cubic_b_spline(t - base, derivative.is_some());
-        let sign = derivative.unwrap_or(1.0);
-        let k = self.fan.faces;
-        let point = |i: i64| -> FanPoint {
-            if self.strip {
-                // The line's points, named in the fan of three (sector 0's chart).
-                self.fan.canonical(0, (i, 0)).unwrap_or(V)
-            } else if i == 0 {
-                V
-            } else if i > 0 {
-                (0, i, 0)
-            } else {
-                (k, -i, 0)
-            }
-        };
-        let mut out = FanStencil::new();
-        for (m, w) in (-1..=2).zip(weights) {
-            if w != 0.0 {
-                *out.entry(point(base as i64 + m)).or_insert(0.0) += sign * w;
-            }
-        }
-        out
+/// Where `what` sits in [`RegionBasis::kinds`].
+fn index(what: RegularDerivative) -> usize {
+    match what {
+        RegularDerivative::Position => 0,
+        RegularDerivative::U => 1,
+        RegularDerivative::V => 2,
     }
 }
 
-impl BoundaryEvaluator {
-    /// One level down the half-plane's line: the cross-boundary stencil `D(t, e/3)` from
-    /// `v = D(t', e)`, `3t = t' + s`, `t = k/d`: `3 sum_r v[r] R_1[r + (s, 0)]` (translation
-    /// invariance along the line). The map triples the constant mode, which a derivative lacks
-    /// but rounding puts back; its left eigenvector is the position at `(t, 0)` (the same
-    /// relation without the factor 3), so the step removes `(sum) position(t)`.
-    fn line_step(&mut self, v: &FanStencil, s: i64, k: i64) -> Result<FanStencil, StencilError> {
-        let mut out = FanStencil::new();
-        for (&p, &w) in v {
-            let (a, b) = BoundaryFan::in_sector_zero(p);
-            let name =
-                self.fan
-                    .canonical(0, (a + s, b))
-                    .ok_or_else(|| StencilError::OutOfDomain {
-                        what: format!("({}, {b}) below the boundary", a + s),
-                    })?;
-            for (q, r) in self.rows.row(1, name) {
-                *out.entry(q).or_insert(0.0) += 3.0 * w * r;
-            }
-        }
-        let sum: f64 = out.values().sum();
-        for (q, w) in self.stencil(0, (k, 0), StencilKind::Position)? {
-            *out.entry(q).or_insert(0.0) -= sum * w;
-        }
-        out.retain(|_, w| *w != 0.0);
-        Ok(out)
+/// The derivative a stencil kind asks of the surface.
+pub fn derivative(kind: StencilKind) -> RegularDerivative {
+    match kind {
+        StencilKind::Position => RegularDerivative::Position,
+        StencilKind::DerivativeU => RegularDerivative::U,
+        StencilKind::DerivativeV => RegularDerivative::V,
     }
+}
 
-    /// The cross-boundary tangent mask at `(k/d, 0)` on the half-plane's line
-    /// ([`BoundaryEvaluator::strip`]): the direction the derivatives `D(t, e)` across the line
-    /// take as `e -> 0` (they grow without bound where a cross mode outgrows the tangent's
-    /// `1/3`, as at an edge's midpoint, and converge where it does not, as at a vertex),
-    /// normalized with the line's own tangent so that on the flat lattice (point `(a, b)` at
-    /// `(a, b)`) it maps to `(0, 1)`, the `x_2` axis, as a derivative would. So `du` (the
-    /// B-spline's derivative) and this mask span the surface's tangent plane there.
-    ///
-    /// The derivatives above the line relate level to level, `D(t, e/3) = 3 sum_r D(t', e)[r]
-    /// R_1[r + (s, 0)]` with `3t = t' + s` (translation invariance along the line); on the
-    /// grid `1/d` the numerators follow `t -> 3t mod d` into a cycle. Starting from the exact
-    /// derivative at `(t_p, 1/d)` above the cycle's first point, the cycle is walked backwards
-    /// level by level, renormalized every turn, until a turn changes the normalized mask by at
-    /// most 1e-12 of its largest weight; the points before the cycle follow by the same step.
-    pub fn cross_mask_on_line(&mut self, k: i64) -> Result<StripStencil, StencilError> {
-        let d = i64::from(self.d);
-        let unsettled = || StencilError::OutOfDomain {
-            what: format!("the cross-boundary direction at ({k}/{d}, 0) did not settle"),
-        };
-        if !self.strip {
-            return Err(StencilError::OutOfDomain {
-                what: "the cross-boundary mask on the line is the half-plane's".to_owned(),
-            });
-        }
-        let (base, start_t) = (k.div_euclid(d), k.rem_euclid(d));
-        // The orbit t -> 3t mod d with each step's shift, until a numerator repeats.
-        let mut orbit: Vec<(i64, i64)> = Vec::new();
-        let mut t = start_t;
-        let start = loop {
-            if let Some(i) = orbit.iter().position(|&(u, _)| u == t) {
-                break i;
-            }
-            orbit.push((t, (3 * t).div_euclid(d)));
-            t = (3 * t).rem_euclid(d);
-        };
-        let normalized = |v: FanStencil| -> FanStencil {
-            let largest = v.values().fold(0.0f64, |m, w| m.max(w.abs()));
-            v.into_iter().map(|(p, w)| (p, w / largest)).collect()
-        };
-        let cycle: Vec<(i64, i64)> = orbit[start..].to_vec();
-        let mut v = normalized(self.stencil(0, (cycle[0].0, 1), StencilKind::DerivativeV)?);
-        let mut levels = 0;
-        loop {
-            let before = v.clone();
-            for &(u, s) in cycle.iter().rev() {
-                v = self.line_step(&v, s, u)?;
-                levels += 1;
-            }
-            v = normalized(v);
-            let change = v
-                .keys()
-                .chain(before.keys())
-                .map(|p| {
-                    (v.get(p).copied().unwrap_or(0.0) - before.get(p).copied().unwrap_or(0.0)).abs()
-                })
-                .fold(0.0f64, f64::max);
-            if change <= SETTLED {
-                break;
-            }
-            if levels > MAX_LINE_LEVELS {
-                return Err(unsettled());
-            }
-        }
-        for &(u, s) in orbit[..start].iter().rev() {
-            v = self.line_step(&v, s, u)?;
-        }
-        // Frame: the flat lattice's image of v is (g_1, g_2); the line's tangent maps it to
-        // (1, 0); so (v - g_1 tangent) / g_2 maps it to (0, 1).
-        let image = v.iter().fold([0.0, 0.0], |acc, (&p, &w)| {
-            let (a, b) = BoundaryFan::in_sector_zero(p);
-            [acc[0] + w * a as f64, acc[1] + w * b as f64]
+impl From<Refused> for StencilError {
+    fn from(refused: Refused) -> Self {
+        StencilError::OutOfDomain { what: refused.0 }
+    }
+}
+
+/// `psi` and its two skew-axis derivatives solved on the grid `1/d`
+/// (`1..=`[`MAX_BASIS_RATE`]).
+fn basis(d: u32) -> Result<RegionBasis<f64>, StencilError> {
+    if d == 0 || d > MAX_BASIS_RATE {
+        return Err(StencilError::RateOutOfRange {
+            n: d,
+            max: MAX_BASIS_RATE,
         });
-        if image[1].abs() < 1e-12 {
-            return Err(unsettled());
-        }
-        let tangent = self.stencil(0, (start_t, 0), StencilKind::DerivativeU)?;
-        let mut mask = v;
-        for (p, w) in tangent {
-            *mask.entry(p).or_insert(0.0) -= image[0] * w;
-        }
-        Ok(mask
-            .into_iter()
-            .filter(|&(_, w)| w != 0.0)
-            .map(|(p, w)| {
-                let (a, b) = BoundaryFan::in_sector_zero(p);
-                ((a + base, b), w / image[1])
-            })
-            .collect())
     }
+    let scheme = TriangleScheme::by_name("sqrt3").ok_or_else(|| StencilError::OutOfDomain {
+        what: "the sqrt3 scheme".to_owned(),
+    })?;
+    let kinds = [
+        StencilKind::Position,
+        StencilKind::DerivativeU,
+        StencilKind::DerivativeV,
+    ];
+    RegionBasis::new(&scheme, d, &kinds)
 }
 
-/// How much one turn of a cycle may change the normalized mask of
-/// [`BoundaryEvaluator::cross_mask_on_line`] (relative to its largest weight) when it stops.
-const SETTLED: f64 = 1e-12;
-
-/// Levels walked at most by [`BoundaryEvaluator::cross_mask_on_line`]: at an edge's midpoint
-/// the rest shrinks by `(1/3) / 0.3722 = 0.896` a level, which reaches [`SETTLED`] within 300.
-const MAX_LINE_LEVELS: usize = 5000;
-
-/// A chart axis along the boundary, with its direction relative to the boundary polygon's.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Axis {
-    U,
-    MinusV,
+/// The half-plane beside a straight boundary, on the grid `1/d`.
+pub fn strip(d: u32) -> Result<BoundaryEvaluator, StencilError> {
+    Ok(BoundarySurface::strip(basis(d)?))
 }
 
-/// Levels tried at most before a point is refused as too close to the boundary or `V` (a
-/// grid point off them is certified within `log_3(4 d) + 1` levels).
-const MAX_LEVEL: u32 = 12;
+/// The fan of `faces` triangles around a boundary vertex, on the grid `1/d`.
+pub fn fan(faces: u32, d: u32) -> Result<BoundaryEvaluator, StencilError> {
+    Ok(BoundarySurface::fan(faces, basis(d)?)?)
+}
 
 #[cfg(test)]
 mod tests {
@@ -441,7 +101,7 @@ mod tests {
     /// (`1/4 -> 3/4 -> 1/4`).
     #[test]
     fn cross_masks_on_the_line() {
-        let mut e = BoundaryEvaluator::strip(4).expect("psi on 1/4");
+        let mut e = strip(4).expect("psi on 1/4");
         for k in [0, 1, 2, 4, 6] {
             let m = e.cross_mask_on_line(k).expect("settles");
             let sum: f64 = m.values().sum();
@@ -458,20 +118,20 @@ mod tests {
 
     #[test]
     fn stencils_are_affine() {
-        let mut e = BoundaryEvaluator::strip(6).expect("psi on 1/6");
+        let mut e = strip(6).expect("psi on 1/6");
         for k in [(0, 0), (3, 0), (1, 1), (2, 3), (5, 1), (0, 6), (4, 2)] {
             for kind in [
-                StencilKind::Position,
-                StencilKind::DerivativeU,
-                StencilKind::DerivativeV,
+                RegularDerivative::Position,
+                RegularDerivative::U,
+                RegularDerivative::V,
             ] {
-                if k.1 == 0 && kind == StencilKind::DerivativeV {
+                if k.1 == 0 && kind == RegularDerivative::V {
                     assert!(e.half_plane_stencil(k, kind).is_err());
                     continue;
                 }
                 let s = e.half_plane_stencil(k, kind).expect("evaluates");
                 let sum: f64 = s.values().sum();
-                let want = if kind == StencilKind::Position {
+                let want = if kind == RegularDerivative::Position {
                     1.0
                 } else {
                     0.0

@@ -3,9 +3,9 @@
 //! rules of `schemes::sqrt3_boundary`) against whole-mesh refinement (`subtess`'s
 //! `sqrt3_refine`) and Kobbelt's limit positions, which share no code with it.
 
+use schemes::loop_regular::RegularDerivative;
 use schemes::BoundaryMode;
-use stencilgen::regular_patch::StencilKind;
-use stencilgen::sqrt3_strip::{BoundaryEvaluator, StripStencil};
+use stencilgen::sqrt3_strip::{self, StripStencil};
 use subtess::mesh::geometry::{add, cross, dot, norm, scale};
 use subtess::mesh::topology::Mesh;
 use subtess::mesh::triangle_topology::neighbours;
@@ -113,7 +113,7 @@ fn limit_position(mesh: &Mesh, v: usize) -> [f64; 3] {
 fn the_strip_is_the_limit_of_whole_mesh_refinement() {
     let m = 12;
     let (coarse, fine, at) = refined_lattice(m, 3);
-    let mut strip = BoundaryEvaluator::strip(27).expect("psi on 1/27");
+    let mut strip = sqrt3_strip::strip(27).expect("psi on 1/27");
     let mut checked = 0;
     for (v, &q) in at.iter().enumerate() {
         if q.0 < 108 || q.0 > 216 || q.1 > 81 {
@@ -122,7 +122,7 @@ fn the_strip_is_the_limit_of_whole_mesh_refinement() {
         let want = limit_position(&fine, v);
         let got = apply(
             &strip
-                .half_plane_stencil(q, StencilKind::Position)
+                .half_plane_stencil(q, RegularDerivative::Position)
                 .expect("evaluates"),
             &coarse,
             m,
@@ -152,7 +152,7 @@ fn strip_derivatives_are_the_positions_slopes() {
     let m = 12;
     let coarse = parallelogram(m);
     let d = 36;
-    let mut strip = BoundaryEvaluator::strip(d).expect("psi on 1/36");
+    let mut strip = sqrt3_strip::strip(d).expect("psi on 1/36");
     let mut at = |k: (i64, i64), kind| {
         apply(
             &strip.half_plane_stencil(k, kind).expect("evaluates"),
@@ -169,14 +169,20 @@ fn strip_derivatives_are_the_positions_slopes() {
         (205, 71),
     ] {
         for (kind, step) in [
-            (StencilKind::DerivativeU, (1, 0)),
-            (StencilKind::DerivativeV, (0, 1)),
+            (RegularDerivative::U, (1, 0)),
+            (RegularDerivative::V, (0, 1)),
         ] {
             let exact = at(k, kind);
             let size = exact.iter().map(|x| x * x).sum::<f64>().sqrt();
-            let error = |at: &mut dyn FnMut((i64, i64), StencilKind) -> [f64; 3], s: i64| {
-                let plus = at((k.0 + s * step.0, k.1 + s * step.1), StencilKind::Position);
-                let minus = at((k.0 - s * step.0, k.1 - s * step.1), StencilKind::Position);
+            let error = |at: &mut dyn FnMut((i64, i64), RegularDerivative) -> [f64; 3], s: i64| {
+                let plus = at(
+                    (k.0 + s * step.0, k.1 + s * step.1),
+                    RegularDerivative::Position,
+                );
+                let minus = at(
+                    (k.0 - s * step.0, k.1 - s * step.1),
+                    RegularDerivative::Position,
+                );
                 let h = s as f64 / f64::from(d);
                 (0..3)
                     .map(|x| ((plus[x] - minus[x]) / (2.0 * h) - exact[x]).abs())
@@ -205,13 +211,13 @@ fn normals_above_the_line_converge_to_the_cross_mask() {
     let m = 12;
     let coarse = parallelogram(m);
     let d = 36i64;
-    let mut strip = BoundaryEvaluator::strip(d as u32).expect("psi on 1/36");
+    let mut strip = sqrt3_strip::strip(d as u32).expect("psi on 1/36");
     let angle =
         |a: [f64; 3], b: [f64; 3]| (dot(a, b) / (norm(a) * norm(b))).clamp(-1.0, 1.0).acos();
     for t in [6 * d, 6 * d + d / 2] {
         let du = apply(
             &strip
-                .half_plane_stencil((t, 0), StencilKind::DerivativeU)
+                .half_plane_stencil((t, 0), RegularDerivative::U)
                 .expect("along the line"),
             &coarse,
             m,
@@ -228,7 +234,7 @@ fn normals_above_the_line_converge_to_the_cross_mask() {
                         m,
                     )
                 };
-                let (u, v) = (at(StencilKind::DerivativeU), at(StencilKind::DerivativeV));
+                let (u, v) = (at(RegularDerivative::U), at(RegularDerivative::V));
                 angle(cross(u, v), limit)
             })
             .collect();

@@ -707,7 +707,7 @@ mod tests {
         assert!(checked > 2000, "{checked} points checked");
     }
 
-    /// The generator's surface on the fan (`stencilgen::sqrt3_strip::BoundaryEvaluator`: the
+    /// The generator's surface on the fan (`stencilgen::sqrt3_strip::fan`: the
     /// regular basis over certified levels, the B-spline on the boundary) is the limit of this
     /// whole-mesh step: for `K = 1..=6`, at every ternary point `(i/9, j/9)` of a sector within
     /// three units of the boundary vertex (`V` and the boundary rays included), the position
@@ -715,8 +715,8 @@ mod tests {
     /// whole-mesh steps put there (to 1e-12).
     #[test]
     fn the_fan_surface_is_the_limit_of_whole_mesh_refinement() {
-        use stencilgen::regular_patch::StencilKind;
-        use stencilgen::sqrt3_strip::BoundaryEvaluator;
+        use schemes::loop_regular::RegularDerivative;
+        use stencilgen::sqrt3_strip;
         let mut checked = 0;
         for k in 1..=6u32 {
             let (names, coarse, chart, corners) = fan_mesh(k, 7);
@@ -724,13 +724,13 @@ mod tests {
             let (corners, chart, _) = refined_corners(&coarse, &one, &corners, &chart);
             let two = sqrt3_refine(&one).expect("refines").mesh;
             let (_, _, located) = refined_corners(&one, &two, &corners, &chart);
-            let mut surface = BoundaryEvaluator::fan(k, 9).expect("psi on 1/9");
+            let mut surface = sqrt3_strip::fan(k, 9).expect("psi on 1/9");
             for (v, &(s, q)) in located.iter().enumerate() {
                 if q.0 + q.1 > 27 {
                     continue;
                 }
                 let stencil = surface
-                    .stencil(s, q, StencilKind::Position)
+                    .stencil(s, q, RegularDerivative::Position)
                     .expect("evaluates");
                 let got = stencil.iter().fold([0.0; 3], |acc, (p, &w)| {
                     let i = names.iter().position(|q| q == p).expect("a coarse vertex");
