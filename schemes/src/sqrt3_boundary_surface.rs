@@ -423,6 +423,251 @@ impl<B: RegularBasis> BoundarySurface<B> {
     }
 }
 
+impl<B: RegularBasis + Clone> BoundarySurface<B> {
+    /// The cross-boundary tangent mask at the boundary point of parameter `tau / d` along the
+    /// boundary polygon (`V` at 0, `E_0` at `d`, `E_K` at `-d`; on the half-plane the line's
+    /// `x_1`), over the fan's level-0 points: the direction into the surface that, with the
+    /// derivative along the boundary, spans the tangent plane there (module docs). Oriented so
+    /// that (along the boundary towards `E_0`, this mask) turns counter-clockwise like the
+    /// charts' axes; scaled so that its largest weight is 1 on a fan (the half-plane's is
+    /// [`BoundarySurface::cross_mask_on_line`]'s).
+    ///
+    /// * On the half-plane: [`BoundarySurface::cross_mask_on_line`].
+    /// * On a fan's ray: the ray is the half-plane's line far from `V`, so the mask at
+    ///   `3^m tau` (the first `m` that puts it and its support [`FAR`] units or more from `V`)
+    ///   is the half-plane's there; walked back `m` levels by the fan's rows
+    ///   (`M_{l-1} = sum_q M_l[q] R_1[q]`, the relation [`BoundarySurface::cross_mask_on_line`]
+    ///   walks on the line, without its translation), the constant mode removed at each level.
+    /// * At `V`: [`BoundarySurface::cross_mask_at_vertex`].
+    pub fn cross_mask(&mut self, tau: i64) -> Result<FanStencil, Refused> {
+        if self.strip {
+            let line = self.cross_mask_on_line(tau)?;
+            return line
+                .into_iter()
+                .map(|(p, w)| {
+                    self.fan
+                        .canonical(0, p)
+                        .map(|name| (name, w))
+                        .ok_or_else(|| Refused(format!("{p:?} is below the line")))
+                })
+                .collect();
+        }
+        if tau == 0 {
+            return self.cross_mask_at_vertex();
+        }
+        let d = self.d;
+        let last = i64::from(self.fan.faces) - 1;
+        // Half-plane point (x, y), x along the boundary parameter, as a point of the ray's
+        // sector chart: sector 0 takes it as is; sector K - 1 runs the boundary along (0, -1)
+        // with the surface on the side of (1, -1), its 60-degree turn.
+        let on_ray = |fan: &BoundaryFan, (x, y): (i64, i64)| -> Option<FanPoint> {
+            if tau > 0 {
+                (x >= 1).then(|| fan.canonical(0, (x, y))).flatten()
+            } else {
+                (x <= -1)
+                    .then(|| fan.canonical(last, (y, -x - y)))
+                    .flatten()
+            }
+        };
+        let mut strip = BoundarySurface::strip(self.basis.clone());
+        let (mut level, mut far) = (0u32, tau);
+        let mut mask = loop {
+            if far.abs() >= FAR * d {
+                let line = strip.cross_mask_on_line(far)?;
+                let named: Option<FanStencil> = line
+                    .iter()
+                    .map(|(&p, &w)| on_ray(&self.fan, p).map(|name| (name, w)))
+                    .collect();
+                if let Some(named) = named {
+                    break named;
+                }
+            }
+            if level >= MAX_LEVEL {
+                return Err(Refused(format!(
+                    "the cross-boundary mask at {tau}/{d} on a ray: no level puts it beside a \
+                     straight boundary"
+                )));
+            }
+            level += 1;
+            far *= 3;
+        };
+        for l in (0..level).rev() {
+            let mut back = FanStencil::new();
+            for (&q, &w) in &mask {
+                for (p, r) in self.rows.row(1, q) {
+                    *back.entry(p).or_insert(0.0) += w * r;
+                }
+            }
+            // The rows are affine, so the sum stays 0 but for rounding, which the step would
+            // triple: remove it with the boundary curve's position there.
+            let sum: f64 = back.values().sum();
+            let here = (3i64.pow(l) * tau) as f64 / d as f64;
+            for (p, w) in self.boundary_curve(here, None) {
+                *back.entry(p).or_insert(0.0) -= sum * w;
+            }
+            mask = normalized(back);
+        }
+        mask.retain(|_, w| *w != 0.0);
+        Ok(mask)
+    }
+}
+
+impl<B: RegularBasis> BoundarySurface<B> {
+    /// The cross-boundary tangent mask at a fan's vertex `V` (`K != 3`; the half-plane's is
+    /// [`BoundarySurface::cross_mask_on_line`] at 0): the left eigenvector `c` of the ternary
+    /// step on the ball of points within three units of `V` (closed under the step) for the
+    /// largest eigenvalue below 1 whose eigenvector is independent of the boundary tangent
+    /// `t = (E_0 - E_K)/2` (docs/algorithms/sqrt3.md, the spectra table), by power iteration:
+    /// at `K >= 4` that mode leads `t`'s `1/3`; at `K = 1, 2` (`1/9`, `2/9`) `t` is deflated
+    /// with its right eigenvector, itself iterated. The constant mode (left: the limit mask
+    /// `(E_K + 4V + E_0)/6`, right: the ones) is removed at every step. Oriented on the
+    /// half-disk net (sector `s`'s `(a, b)` at `a e_s + b e_{s+1}`, `e_i` at angle
+    /// `i pi / max(K, 2)`) so that it points into the surface from the boundary tangent.
+    pub fn cross_mask_at_vertex(&mut self) -> Result<FanStencil, Refused> {
+        if self.strip {
+            return Err(Refused(
+                "the half-plane's vertex mask is cross_mask_on_line(0)".to_owned(),
+            ));
+        }
+        let k = self.fan.faces;
+        let mut ball: Vec<FanPoint> =
+            std::iter::once(V)
+                .chain((0..=k).flat_map(|s| {
+                    (1..=3i64).flat_map(move |a| (0..=3 - a).map(move |b| (s, a, b)))
+                }))
+                .filter(|&(s, a, b)| self.fan.canonical(i64::from(s), (a, b)) == Some((s, a, b)))
+                .collect();
+        ball.sort_unstable();
+        let slot = |p: &FanPoint| ball.binary_search(p).ok();
+        let refuse = |why: String| Refused(format!("the vertex mask of the fan of {k}: {why}"));
+        // A[q][p]: the step's rows of the ball's points over the ball.
+        let mut a = vec![vec![0.0; ball.len()]; ball.len()];
+        for (i, &q) in ball.iter().enumerate() {
+            for (p, w) in self.rows.row(1, q) {
+                let j = slot(&p).ok_or_else(|| refuse(format!("{p:?} leaves the ball")))?;
+                a[i][j] = w;
+            }
+        }
+        let limit: Vec<f64> = ball
+            .iter()
+            .map(|p| {
+                self.boundary_curve(0.0, None)
+                    .get(p)
+                    .copied()
+                    .unwrap_or(0.0)
+            })
+            .collect();
+        let unit = |p: FanPoint| -> Vec<f64> { ball.iter().map(|&q| f64::from(q == p)).collect() };
+        let (e0, ek) = (unit((0, 1, 0)), unit((k, 1, 0)));
+        let tangent: Vec<f64> = e0.iter().zip(&ek).map(|(x, y)| (x - y) / 2.0).collect();
+        let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(a, b)| a * b).sum::<f64>();
+        let scaled = |x: Vec<f64>| -> Vec<f64> {
+            let m = x.iter().fold(0.0f64, |m, w| m.max(w.abs()));
+            x.into_iter().map(|w| w / m).collect()
+        };
+        let settle =
+            |mut x: Vec<f64>, step: &dyn Fn(&[f64]) -> Vec<f64>| -> Result<Vec<f64>, Refused> {
+                for _ in 0..MAX_LINE_LEVELS {
+                    let next = scaled(step(&x));
+                    let change = next
+                        .iter()
+                        .zip(&x)
+                        .map(|(a, b)| (a - b).abs())
+                        .fold(0.0, f64::max);
+                    x = next;
+                    if change <= SETTLED {
+                        return Ok(x);
+                    }
+                }
+                Err(refuse("the power iteration did not settle".to_owned()))
+            };
+        // Right eigenvector of t's 1/3 (K = 1, 2): A r, less its constant part (l . r) 1.
+        let deflate = if k <= 2 {
+            let right = settle(
+                e0.iter().zip(&ek).map(|(x, y)| x - y).collect(),
+                &|r: &[f64]| {
+                    let ar: Vec<f64> = a.iter().map(|row| dot(row, r)).collect();
+                    let c = dot(&limit, &ar);
+                    ar.into_iter().map(|x| x - c).collect()
+                },
+            )?;
+            let norm = dot(&tangent, &right);
+            if norm.abs() < 1e-12 {
+                return Err(refuse(
+                    "the tangent's right eigenvector is degenerate".to_owned(),
+                ));
+            }
+            Some((right, norm))
+        } else {
+            None
+        };
+        // Left iteration from a point inside the middle sector, less the limit mask.
+        let inside = ball
+            .iter()
+            .position(|&p| p == (k.saturating_sub(1) / 2, 1, 1))
+            .ok_or_else(|| refuse("no interior point in the ball".to_owned()))?;
+        let start: Vec<f64> = (0..ball.len())
+            .map(|j| f64::from(j == inside) - limit[j])
+            .collect();
+        let mask = settle(start, &|m: &[f64]| {
+            let mut next: Vec<f64> = (0..ball.len())
+                .map(|j| m.iter().zip(&a).map(|(w, row)| w * row[j]).sum())
+                .collect();
+            let constant: f64 = next.iter().sum();
+            for (x, l) in next.iter_mut().zip(&limit) {
+                *x -= constant * l;
+            }
+            if let Some((right, norm)) = &deflate {
+                let c = dot(&next, right) / norm;
+                for (x, t) in next.iter_mut().zip(&tangent) {
+                    *x -= c * t;
+                }
+            }
+            next
+        })?;
+        // Orientation on the half-disk net: the image of c to the left of t's.
+        let theta = std::f64::consts::PI / f64::from(k.max(2));
+        let at = |&(s, a, b): &FanPoint| -> [f64; 2] {
+            let e = |i: u32| [(f64::from(i) * theta).cos(), (f64::from(i) * theta).sin()];
+            let (x, y) = (e(s), e(s + 1));
+            [
+                a as f64 * x[0] + b as f64 * y[0],
+                a as f64 * x[1] + b as f64 * y[1],
+            ]
+        };
+        let image = |w: &[f64]| {
+            ball.iter().zip(w).fold([0.0, 0.0], |acc, (p, &x)| {
+                let q = at(p);
+                [acc[0] + x * q[0], acc[1] + x * q[1]]
+            })
+        };
+        let (t, c) = (image(&tangent), image(&mask));
+        let turn = t[0] * c[1] - t[1] * c[0];
+        if turn.abs() < 1e-9 {
+            return Err(refuse(
+                "the cross mode is parallel to the tangent on the net".to_owned(),
+            ));
+        }
+        let sign = turn.signum();
+        Ok(ball
+            .iter()
+            .zip(mask)
+            .filter(|(_, w)| *w != 0.0)
+            .map(|(&p, w)| (p, sign * w))
+            .collect())
+    }
+}
+
+/// A stencil scaled so that its largest weight is 1 in magnitude.
+fn normalized(v: FanStencil) -> FanStencil {
+    let largest = v.values().fold(0.0f64, |m, w| m.max(w.abs()));
+    v.into_iter().map(|(p, w)| (p, w / largest)).collect()
+}
+
+/// How far from `V` (in level units, along the ray) a fan's ray is the half-plane's line for
+/// [`BoundarySurface::cross_mask`]: the line's masks reach about five units on either side.
+pub const FAR: i64 = 9;
+
 /// How much one turn of a cycle may change the normalized mask of
 /// [`BoundarySurface::cross_mask_on_line`] (relative to its largest weight) when it stops.
 const SETTLED: f64 = 1e-12;
