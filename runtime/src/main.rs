@@ -251,9 +251,9 @@ struct TessellateArgs {
     /// Output triangle mesh: .obj, .ply (with per-vertex face, u, v), .glb or .gltf.
     #[arg(short = 'o', long = "output")]
     output: PathBuf,
-    /// Subdivision scheme: catmull-clark (any polygons), loop (triangles), butterfly or sqrt3
-    /// (closed triangle meshes); the triangle schemes take --rate, --rates, --tolerance or
-    /// --view.
+    /// Subdivision scheme: catmull-clark (any polygons), loop and sqrt3 (triangles), butterfly
+    /// (closed triangle meshes); the triangle schemes take --rate, --rates, --tolerance (not
+    /// sqrt3 with a boundary) or --view.
     #[arg(long, default_value = "catmull-clark", value_parser = scheme_arg)]
     scheme: Scheme,
     /// Dual points per face side, 1..=24, on every face.

@@ -19,6 +19,7 @@ use crate::scheme::catmull_clark::face_varying::ChannelIsolation;
 use crate::scheme::catmull_clark::isolate::{isolate_with_origins, Isolation};
 use crate::scheme::loop_scheme::isolate::isolate_loop;
 use crate::scheme::region_isolate::isolate_regions;
+use crate::scheme::sqrt3::boundary_grids::Sqrt3BoundaryStencils;
 use crate::scheme::stencil::Stencil;
 use crate::scheme::triangle::isolation::TriangleIsolation;
 use crate::scheme::triangle::region_patch::RegionScheme;
@@ -294,6 +295,16 @@ impl Surface {
                     Isolated::Quad(iso) => {
                         tolerance_rates(&self.table, &iso.mesh, &iso.patches, *t)?
                     }
+                    Isolated::Triangle(iso)
+                        if self.scheme == Scheme::Sqrt3
+                            && iso.patches.iter().any(|p| p.kind.boundary) =>
+                    {
+                        return Err(RuntimeError::Unsupported(
+                            "tolerance rates for √3 on a mesh with boundary (use --rate or \
+                             per-face rates)"
+                                .to_owned(),
+                        ))
+                    }
                     Isolated::Triangle(iso) => triangle_tolerance_rates(&self.table, iso, *t)?,
                 };
                 let unmet = chosen.unmet.len();
@@ -333,6 +344,18 @@ impl Surface {
                     .as_ref()
                     .map(|c| c.mesh.face_vertices.as_slice()),
             )?),
+            Isolated::Triangle(iso)
+                if iso.patches.iter().any(|p| p.kind.boundary) && self.scheme == Scheme::Sqrt3 =>
+            {
+                // √3's boundary patches: their grids are made now, from the table's basis.
+                let stencils = Sqrt3BoundaryStencils::new(&self.table, &iso.patches, &rates)?;
+                Box::new(TriangleDualGrid::new(
+                    &stencils,
+                    &iso.mesh,
+                    &iso.patches,
+                    &rates,
+                )?)
+            }
             Isolated::Triangle(iso) => Box::new(TriangleDualGrid::new(
                 &self.table,
                 &iso.mesh,

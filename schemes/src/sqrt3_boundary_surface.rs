@@ -60,6 +60,20 @@ pub trait RegularBasis {
     fn value(&self, what: RegularDerivative, k: (i64, i64)) -> f64;
 }
 
+impl<T: RegularBasis + ?Sized> RegularBasis for &T {
+    fn denominator(&self) -> i64 {
+        (**self).denominator()
+    }
+
+    fn support_box(&self, what: RegularDerivative) -> ((i64, i64), (i64, i64)) {
+        (**self).support_box(what)
+    }
+
+    fn value(&self, what: RegularDerivative, k: (i64, i64)) -> f64 {
+        (**self).value(what, k)
+    }
+}
+
 /// Why a point has no stencil here: the message names the point and the reason.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Refused(pub String);
@@ -254,6 +268,12 @@ impl<B: RegularBasis> BoundarySurface<B> {
         }
         out.retain(|_, w| *w != 0.0);
         Ok(out)
+    }
+
+    /// The derivative along the boundary polygon (towards `E_0`; on the half-plane along
+    /// `x_1`) at the boundary point of parameter `tau / d`, `V` included: the cubic B-spline's.
+    pub fn boundary_tangent(&self, tau: i64) -> FanStencil {
+        self.boundary_curve(tau as f64 / self.d as f64, Some(1.0))
     }
 
     /// Where `k/d` of sector `s`'s chart lies on the boundary: its parameter along the

@@ -28,7 +28,8 @@ pub enum Scheme {
     Loop,
     /// The modified butterfly (interpolating): closed triangle meshes.
     Butterfly,
-    /// Kobbelt's √3 (two steps as one ternary step): closed triangle meshes.
+    /// Kobbelt's √3 (two steps as one ternary step): triangles, closed or with boundary
+    /// (Kobbelt's boundary rules).
     Sqrt3,
 }
 

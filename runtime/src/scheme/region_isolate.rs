@@ -11,8 +11,9 @@
 use std::collections::BTreeSet;
 
 use crate::mesh::topology::Mesh;
-use crate::mesh::triangle_topology::require_closed_triangles;
+use crate::mesh::triangle_topology::{require_closed_triangles, require_triangles};
 use crate::scheme::butterfly::refine::butterfly_refine;
+use crate::scheme::sqrt3::boundary_patch::gather_boundary_patches;
 use crate::scheme::sqrt3::refine::sqrt3_refine;
 use crate::scheme::stencil::Stencil;
 use crate::scheme::triangle::isolation::{
@@ -65,18 +66,24 @@ impl RegionScheme {
     }
 }
 
-/// Check that `mesh` is a closed triangle mesh, refine it by `scheme` until every triangle is a
-/// table patch, and gather every triangle's patch.
+/// Check that `mesh` is a triangle mesh (closed, for the butterfly, which has no boundary rules
+/// here), refine it by `scheme` until every triangle is a patch, and gather every triangle's
+/// patch: √3's boundary patches ([`gather_boundary_patches`]) first, then the regions.
 pub fn isolate_regions(
     mesh: &Mesh,
     scheme: RegionScheme,
 ) -> Result<TriangleIsolation, RuntimeError> {
-    require_closed_triangles(mesh, scheme.name())?;
+    match scheme {
+        RegionScheme::Butterfly => require_closed_triangles(mesh, scheme.name())?,
+        RegionScheme::Sqrt3 => require_triangles(mesh)?,
+    }
+    // The interior vertices' valences (a boundary vertex's triangles are boundary patches).
     let valences: BTreeSet<u32> = mesh
         .valences()
         .into_iter()
-        .filter(|&k| k != 0)
-        .map(|k| k as u32)
+        .enumerate()
+        .filter(|&(v, k)| k != 0 && !mesh.is_boundary_vertex(v))
+        .map(|(_, k)| k as u32)
         .collect();
     let catalogue = RegionCatalogue::new(scheme, valences)?;
     isolate_by_refinement(
@@ -84,7 +91,16 @@ pub fn isolate_regions(
         scheme.split(),
         scheme.max_steps(),
         |m| scheme.refine_with_stencil(m),
-        |m| Ok((gather_region_patches(m, &catalogue)?, Phantoms::new(m))),
+        |m| {
+            let claimed = match scheme {
+                RegionScheme::Sqrt3 => gather_boundary_patches(m)?,
+                RegionScheme::Butterfly => vec![None; m.faces()],
+            };
+            Ok((
+                gather_region_patches(m, &catalogue, claimed)?,
+                Phantoms::new(m),
+            ))
+        },
     )
 }
 

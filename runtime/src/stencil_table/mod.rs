@@ -15,6 +15,7 @@ use table_format::{AlignedBytes, SectionKey, TableIndex};
 use crate::RuntimeError;
 use quad_expansion::QuadExpansion;
 pub(crate) use region_expansion::cone_regions;
+pub use region_expansion::RateBasis;
 use region_expansion::RegionExpansion;
 use triangle_expansion::TriangleExpansion;
 
@@ -432,6 +433,28 @@ impl StencilTable {
 pub trait TriangleStencils: Sync {
     /// The weights of `key`, or an error naming what the source covers.
     fn triangle_weights(&self, key: &SectionKey) -> Result<&[f32], RuntimeError>;
+}
+
+impl StencilTable {
+    /// The regular basis of a compact √3 (or butterfly) table at rate `n`, on the grid `1/3n`:
+    /// what √3's boundary patches are evaluated from
+    /// (`crate::scheme::sqrt3::boundary_grids`). Refused, naming the table, for a
+    /// table that stores grids only or lacks the rate.
+    pub fn regular_basis(&self, n: u32) -> Result<&RateBasis, RuntimeError> {
+        let missing = || {
+            RuntimeError::Unsupported(format!(
+                "the {} table has no regular basis at rate {n} (boundary patches are evaluated \
+                 from a compact table's basis: regenerate it with stencilgen tables)",
+                self.index.meta.scheme.name()
+            ))
+        };
+        match &self.expansion {
+            Some(Expansion::Region(e)) => e
+                .regular_basis(&self.index, self.bytes(), n)
+                .unwrap_or_else(|| Err(missing())),
+            _ => Err(missing()),
+        }
+    }
 }
 
 impl TriangleStencils for StencilTable {

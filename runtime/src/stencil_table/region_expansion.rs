@@ -64,7 +64,7 @@ use crate::RuntimeError;
 /// outside the open support, as the canonical lookups give (the support is invariant under
 /// the symmetries, so the images of the canonical points are all its points).
 #[derive(Debug)]
-struct RateBasis {
+pub struct RateBasis {
     /// The grid denominator `3n`.
     d: i64,
     /// The box's lowest numerators `(lo_1, lo_2)`.
@@ -150,6 +150,31 @@ impl RateBasis {
             .and_then(|i| self.values.get(i))
             .copied()
             .unwrap_or([0.0; 4])
+    }
+}
+
+/// `psi` and its skew-axis derivatives on the grid `1/3n` as √3's boundary patches read them
+/// (`schemes::sqrt3_boundary_surface`).
+impl schemes::sqrt3_boundary_surface::RegularBasis for RateBasis {
+    fn denominator(&self) -> i64 {
+        self.d
+    }
+
+    fn support_box(&self, _: schemes::loop_regular::RegularDerivative) -> ((i64, i64), (i64, i64)) {
+        (
+            (self.low.0, self.low.0 + self.size.0 - 1),
+            (self.low.1, self.low.1 + self.size.1 - 1),
+        )
+    }
+
+    fn value(&self, what: schemes::loop_regular::RegularDerivative, k: (i64, i64)) -> f64 {
+        use schemes::loop_regular::RegularDerivative;
+        let lanes = self.at(k);
+        match what {
+            RegularDerivative::Position => lanes[0],
+            RegularDerivative::U => lanes[1],
+            RegularDerivative::V => lanes[2],
+        }
     }
 }
 
@@ -509,6 +534,27 @@ impl RegionExpansion {
             })
             .map(|grids| &*grids[usize::from(!primal)]),
         )
+    }
+
+    /// Rate `n`'s regular basis on the grid `1/3n`, spread on first use and kept (what the
+    /// grids of the rate read too); `None` if the table has no basis at `n`.
+    pub(super) fn regular_basis(
+        &self,
+        index: &TableIndex,
+        bytes: &[u8],
+        n: u32,
+    ) -> Option<Result<&RateBasis, RuntimeError>> {
+        let rate = match self.slots.rate_index.get(n as usize) {
+            Some(&i) if i != u32::MAX => i as usize,
+            _ => return None,
+        };
+        let slot = &self.bases[rate];
+        Some(match slot.get() {
+            Some(basis) => Ok(basis),
+            None => self
+                .rate_basis(index, bytes, n)
+                .map(|basis| slot.get_or_init(|| basis)),
+        })
     }
 
     /// Rate `n`'s regular basis spread on its support box from the table's canonical values.

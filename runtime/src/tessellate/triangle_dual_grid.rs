@@ -55,8 +55,9 @@ use crate::RuntimeError;
 
 /// The largest patch (control points) the evaluator takes: an interior vertex of valence `v`
 /// has `v + 6`, a boundary vertex with `k` triangles at most `k + 7`; a butterfly region at
-/// most 33 (`3K + 9` at valence 8).
-const MAX_TRIANGLE_PATCH: usize = 40;
+/// most 33 (`3K + 9` at valence 8); a √3 boundary patch every fan point within four edges of
+/// its corners (`crate::scheme::sqrt3::boundary_patch`).
+const MAX_TRIANGLE_PATCH: usize = 128;
 
 /// The largest rate the evaluator takes.
 pub const MAX_TRIANGLE_RATE: u32 = 64;

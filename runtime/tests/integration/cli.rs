@@ -622,7 +622,7 @@ fn butterfly_scheme_tessellates_closed_triangle_meshes() {
 
 #[test]
 #[cfg(feature = "sqrt3")]
-fn sqrt3_scheme_tessellates_closed_triangle_meshes() {
+fn sqrt3_scheme_tessellates_triangle_meshes() {
     let mesh = temp("octahedron-s.obj");
     std::fs::write(&mesh, OCTAHEDRON).expect("written");
     let out_path = temp("octahedron-sqrt3.obj");
@@ -648,11 +648,20 @@ fn sqrt3_scheme_tessellates_closed_triangle_meshes() {
     assert_eq!(json(&bench)["triangles"], 8 * 81 * 9);
     // Issue 18: the embedded (compact) table covers every rate 1..=24, each one watertight.
     every_rate_is_watertight(&mesh, &out_path, "sqrt3");
-    // A mesh with a boundary: the √3 tables have no boundary patches yet.
+    // A mesh with a boundary (one triangle: three corners with one triangle each, three
+    // ternary steps apart) tessellates with √3's boundary patches; a tolerance is refused there.
     let open = temp("open-triangle-s.obj");
     std::fs::write(&open, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").expect("written");
+    let stats = json(&succeeds(&format!(
+        "tessellate {} -o {} --scheme sqrt3 --rate 2 --stats",
+        open.display(),
+        out_path.display()
+    )));
+    assert_eq!(stats["boundary_loops"], 1);
+    assert_eq!(stats["watertight"], false);
+    assert_eq!(stats["isolation_steps"], 3);
     let err = fails(&format!(
-        "tessellate {} -o {} --scheme sqrt3",
+        "tessellate {} -o {} --scheme sqrt3 --tolerance 0.01",
         open.display(),
         out_path.display()
     ));

@@ -3,6 +3,8 @@
 //! rules of `schemes::sqrt3_boundary`) against whole-mesh refinement (`subtess`'s
 //! `sqrt3_refine`) and Kobbelt's limit positions, which share no code with it.
 
+use crate::common;
+use crate::common::ring_normal;
 use schemes::loop_regular::RegularDerivative;
 use schemes::BoundaryMode;
 use stencilgen::sqrt3_strip::{self, StripStencil};
@@ -244,4 +246,150 @@ fn normals_above_the_line_converge_to_the_cross_mask() {
             "t = {t}/{d}: {angles:?}"
         );
     }
+}
+
+/// The runtime's boundary patches (`subtess::scheme::sqrt3::boundary_patch`, their grids made
+/// from the √3 table's regular basis) on an open mesh: a 4 x 4 lattice parallelogram whose
+/// corners have one and two triangles (fans of `K = 1, 2`) and whose sides are straight
+/// (strip patches). Every output vertex of the tessellation at rate 3 is at a ternary parameter
+/// of an input triangle; its position is the limit position of the vertex that four
+/// whole-mesh ternary steps put there (to 2e-5, the output's f32), and the output is a
+/// manifold with boundary whose normals turn with the reference normals of the refined mesh.
+#[test]
+fn boundary_patches_are_the_limit_of_whole_mesh_refinement() {
+    let m = 4;
+    let (coarse, fine, at) = refined_lattice(m, 4);
+    let surface = subtess::Surface::new(&coarse, subtess::Scheme::Sqrt3).expect("isolates");
+    assert!(
+        surface.isolation_steps() <= 2,
+        "{} steps",
+        surface.isolation_steps()
+    );
+    let mut tessellator = surface
+        .tessellator(&subtess::Rates::Uniform(3))
+        .expect("plans");
+    let frame = tessellator
+        .evaluate(&coarse.positions_f32())
+        .expect("evaluates");
+    let vertex_at: std::collections::HashMap<(i64, i64), usize> =
+        at.iter().enumerate().map(|(v, &q)| (q, v)).collect();
+    let level = 81;
+    let mut worst: f64 = 0.0;
+    let mut worst_normal = [0.0f64; 2];
+    for (i, source) in frame.sources().iter().enumerate() {
+        let t = coarse.face(source.face as usize);
+        let c: Vec<(i64, i64)> = t
+            .iter()
+            .map(|&v| (i64::from(v) % (m + 1), i64::from(v) / (m + 1)))
+            .collect();
+        let den = i64::from(source.denominator);
+        assert_eq!(level % den, 0, "denominator {den}");
+        let (u, v) = (
+            i64::from(source.u) * level / den,
+            i64::from(source.v) * level / den,
+        );
+        let q = (
+            level * c[0].0 + u * (c[1].0 - c[0].0) + v * (c[2].0 - c[0].0),
+            level * c[0].1 + u * (c[1].1 - c[0].1) + v * (c[2].1 - c[0].1),
+        );
+        let w = vertex_at[&q];
+        let want = limit_position(&fine, w);
+        let got = frame.positions()[i];
+        for x in 0..3 {
+            worst = worst.max((f64::from(got[x]) - want[x]).abs());
+        }
+        let n = frame.normals()[i].map(f64::from);
+        let reference = ring_normal(&fine, w);
+        let angle = dot(n, reference).clamp(-1.0, 1.0).acos();
+        let slot = usize::from(fine.is_boundary_vertex(w));
+        worst_normal[slot] = worst_normal[slot].max(angle);
+    }
+    println!(
+        "positions within {worst:.1e}; normals (interior, boundary) within {:.1e}, {:.1e} rad",
+        worst_normal[0], worst_normal[1]
+    );
+    assert!(worst < 2e-5, "worst position error {worst}");
+    assert!(
+        worst_normal[0] < 2e-2 && worst_normal[1] < 0.1,
+        "worst normal angles {worst_normal:?}"
+    );
+    assert!(
+        frame.sources().len() > 500,
+        "{} vertices",
+        frame.sources().len()
+    );
+    common::check_topology(&coarse, &frame.to_triangle_mesh(), "parallelogram");
+}
+
+/// The hand (`../shared/models/odedstein/hand_lowres.obj`: one boundary loop with fans of 2,
+/// 3 and 4 triangles, interior vertices of valence 3 to 8) with √3: two isolation steps, a
+/// manifold output with the input's boundary loop, and every output vertex of the rate-1
+/// tessellation at the limit position of the vertex three whole-mesh ternary steps of the
+/// input put at its parameter (to 1e-6).
+#[test]
+#[cfg_attr(
+    not(shared_models),
+    ignore = "needs ../shared/models beside the repository"
+)]
+fn the_hand_is_the_limit_of_whole_mesh_refinement() {
+    let hand = common::load(&common::models().join("odedstein/hand_lowres.obj"));
+    let surface = subtess::Surface::new(&hand, subtess::Scheme::Sqrt3).expect("isolates");
+    assert_eq!(surface.isolation_steps(), 2);
+    let mut tessellator = surface
+        .tessellator(&subtess::Rates::Uniform(1))
+        .expect("plans");
+    let frame = tessellator
+        .evaluate(&hand.positions_f32())
+        .expect("evaluates");
+    common::check_topology(&hand, &frame.to_triangle_mesh(), "hand");
+    // Three steps, every refined vertex named by (input face, numerators over 27).
+    let level = 27;
+    let mut mesh = hand.clone();
+    let mut corners: Vec<(u32, [(i64, i64); 3])> = (0..hand.faces())
+        .map(|f| (f as u32, [(0, 0), (1, 0), (0, 1)]))
+        .collect();
+    for _ in 0..3 {
+        let fine = sqrt3_refine(&mesh).expect("refines").mesh;
+        corners = (0..fine.faces())
+            .map(|g| {
+                let (origin, c) = corners[g / 9];
+                let child = [(0, 0), (1, 0), (0, 1)].map(|(s, t)| {
+                    let (u, w) = ternary_child_to_parent((g % 9) as u8, s, t, 1);
+                    let (u, w) = (i64::from(u), i64::from(w));
+                    (
+                        3 * c[0].0 + u * (c[1].0 - c[0].0) + w * (c[2].0 - c[0].0),
+                        3 * c[0].1 + u * (c[1].1 - c[0].1) + w * (c[2].1 - c[0].1),
+                    )
+                });
+                (origin, child)
+            })
+            .collect();
+        mesh = fine;
+    }
+    let mut vertex_at = std::collections::HashMap::new();
+    for (g, (origin, c)) in corners.iter().enumerate() {
+        for (i, &q) in c.iter().enumerate() {
+            vertex_at.insert((*origin, q), mesh.face(g)[i] as usize);
+        }
+    }
+    let mut worst: f64 = 0.0;
+    for (i, source) in frame.sources().iter().enumerate() {
+        let den = i64::from(source.denominator);
+        assert_eq!(level % den, 0, "denominator {den}");
+        let q = (
+            i64::from(source.u) * level / den,
+            i64::from(source.v) * level / den,
+        );
+        let w = vertex_at[&(source.face, q)];
+        let want = limit_position(&mesh, w);
+        let got = frame.positions()[i];
+        for x in 0..3 {
+            worst = worst.max((f64::from(got[x]) - want[x]).abs());
+        }
+    }
+    println!(
+        "hand: {} vertices within {worst:.1e}",
+        frame.sources().len()
+    );
+    assert!(worst < 1e-6, "worst position error {worst}");
 }

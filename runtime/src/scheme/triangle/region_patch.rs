@@ -152,20 +152,30 @@ fn gather(
         .collect()
 }
 
-/// The patch of every triangle of a closed triangle mesh, or the first triangle that is not
-/// one yet (see the module docs).
+/// The patch of every triangle of a triangle mesh, or the first triangle that is not one yet
+/// (see the module docs). `claimed` holds the patches found before (√3's boundary patches,
+/// one per triangle, `None` elsewhere); a region may not hold one of them.
 pub fn gather_region_patches(
     mesh: &Mesh,
     catalogue: &RegionCatalogue,
+    claimed: Vec<Option<TrianglePatch>>,
 ) -> Result<Vec<TrianglePatch>, RuntimeError> {
     let valence = mesh.valences();
-    let mut patches: Vec<Option<TrianglePatch>> = vec![None; mesh.faces()];
+    if claimed.len() != mesh.faces() {
+        return Err(RuntimeError::Unsupported(format!(
+            "{} claimed patches for {} triangles",
+            claimed.len(),
+            mesh.faces()
+        )));
+    }
+    let mut patches = claimed;
     // The extraordinary vertex whose region every claimed triangle is.
     let mut owner: Vec<u32> = vec![u32::MAX; mesh.faces()];
     let mut charts = ConeCharts::new(mesh);
     let not_isolated = |face: usize, reason: String| MeshError::NotIsolated { face, reason };
     for v in 0..mesh.positions.len() {
-        if valence[v] == 6 || valence[v] == 0 {
+        // A boundary vertex's triangles are boundary patches (or refused with the boundary).
+        if valence[v] == 6 || valence[v] == 0 || mesh.is_boundary_vertex(v) {
             continue;
         }
         let k = valence[v] as u32;
@@ -203,7 +213,9 @@ pub fn gather_region_patches(
                     })?;
                 let f = mesh.face_of[h] as usize;
                 if patches[f].is_some() {
-                    let reason = if owner[f] == v as u32 {
+                    let reason = if owner[f] == u32::MAX {
+                        format!("it lies in the regions of vertex {v} and beside the boundary")
+                    } else if owner[f] == v as u32 {
                         format!("it is two regions of vertex {v}: the mesh closes on itself there")
                     } else {
                         format!(
