@@ -265,21 +265,22 @@ impl BoundaryRows {
     }
 
     /// The row of the level-`level` point `q` (level-`level` coordinates) over level-0 points.
-    pub fn row(&mut self, level: u32, q: FanPoint) -> FanRow {
-        if level == 0 {
-            return FanRow::from([(q, 1.0)]);
+    pub fn row(&mut self, level: u32, q: FanPoint) -> &FanRow {
+        if !self.memo.contains_key(&(level, q)) {
+            let row = if level == 0 {
+                FanRow::from([(q, 1.0)])
+            } else {
+                let mut row = FanRow::new();
+                for (p, w) in self.fan.level1_row(q) {
+                    let inner = self.row(level - 1, p);
+                    add_scaled(&mut row, inner, w);
+                }
+                row.retain(|_, w| *w != 0.0);
+                row
+            };
+            self.memo.insert((level, q), row);
         }
-        if let Some(row) = self.memo.get(&(level, q)) {
-            return row.clone();
-        }
-        let mut row = FanRow::new();
-        for (p, w) in self.fan.level1_row(q) {
-            let inner = self.row(level - 1, p);
-            add_scaled(&mut row, &inner, w);
-        }
-        row.retain(|_, w| *w != 0.0);
-        self.memo.insert((level, q), row.clone());
-        row
+        &self.memo[&(level, q)]
     }
 }
 

@@ -33,7 +33,7 @@
 //! [`BoundarySurface::cross_mask_on_line`] on the half-plane (the fan's rays and `V` are not
 //! covered here; `V`'s masks are `stencilgen::sqrt3_fan_tangents`').
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 use std::fmt;
 
 use crate::loop_regular::RegularDerivative;
@@ -96,6 +96,11 @@ pub struct BoundarySurface<B> {
     rows: BoundaryRows,
     /// The half-plane: no vertex is special, so only the rows count.
     strip: bool,
+    /// The half-plane's cross masks on its line by `t` in `0..d` (at `(t/d, 0)`; the others
+    /// are their translates).
+    line_masks: HashMap<i64, StripStencil>,
+    /// A fan's half-plane, whose line masks its rays' start from.
+    half_plane: Option<Box<BoundarySurface<B>>>,
 }
 
 /// The uniform cubic B-spline's four basis functions at `u` in `[0, 1]` (for the points
@@ -144,6 +149,8 @@ impl<B: RegularBasis> BoundarySurface<B> {
             fan,
             rows: BoundaryRows::new(fan),
             strip,
+            line_masks: HashMap::new(),
+            half_plane: None,
         }
     }
 
@@ -261,7 +268,7 @@ impl<B: RegularBasis> BoundarySurface<B> {
                         "level-{level} point ({j1}, {j2}) is outside the fan"
                     ))
                 })?;
-                for (p, r) in self.rows.row(level, name) {
+                for (&p, &r) in self.rows.row(level, name) {
                     *out.entry(p).or_insert(0.0) += scale * w * r;
                 }
             }
@@ -338,7 +345,7 @@ impl<B: RegularBasis> BoundarySurface<B> {
                 .fan
                 .canonical(0, (a + s, b))
                 .ok_or_else(|| Refused(format!("({}, {b}) below the boundary", a + s)))?;
-            for (q, r) in self.rows.row(1, name) {
+            for (&q, &r) in self.rows.row(1, name) {
                 *out.entry(q).or_insert(0.0) += 3.0 * w * r;
             }
         }
@@ -365,6 +372,24 @@ impl<B: RegularBasis> BoundarySurface<B> {
     /// level by level, renormalized every turn, until a turn changes the normalized mask by at
     /// most 1e-12 of its largest weight; the points before the cycle follow by the same step.
     pub fn cross_mask_on_line(&mut self, k: i64) -> Result<StripStencil, Refused> {
+        let (base, t) = (k.div_euclid(self.d), k.rem_euclid(self.d));
+        let mask = match self.line_masks.get(&t) {
+            Some(mask) => mask.clone(),
+            None => {
+                let mask = self.walk_the_line(t)?;
+                self.line_masks.insert(t, mask.clone());
+                mask
+            }
+        };
+        // Translation invariance along the line: the mask at k is the one at t moved.
+        Ok(mask
+            .into_iter()
+            .map(|((a, b), w)| ((a + base, b), w))
+            .collect())
+    }
+
+    /// [`BoundarySurface::cross_mask_on_line`] at `(k/d, 0)`, walked (uncached).
+    fn walk_the_line(&mut self, k: i64) -> Result<StripStencil, Refused> {
         let d = self.d;
         let unsettled = || {
             Refused(format!(
@@ -489,7 +514,10 @@ impl<B: RegularBasis + Clone> BoundarySurface<B> {
                     .flatten()
             }
         };
-        let mut strip = BoundarySurface::strip(self.basis.clone());
+        let basis = &self.basis;
+        let strip = self
+            .half_plane
+            .get_or_insert_with(|| Box::new(BoundarySurface::strip(basis.clone())));
         let (mut level, mut far) = (0u32, tau);
         let mut mask = loop {
             if far.abs() >= FAR * d {
@@ -514,7 +542,7 @@ impl<B: RegularBasis + Clone> BoundarySurface<B> {
         for l in (0..level).rev() {
             let mut back = FanStencil::new();
             for (&q, &w) in &mask {
-                for (p, r) in self.rows.row(1, q) {
+                for (&p, &r) in self.rows.row(1, q) {
                     *back.entry(p).or_insert(0.0) += w * r;
                 }
             }
@@ -563,7 +591,7 @@ impl<B: RegularBasis> BoundarySurface<B> {
         // A[q][p]: the step's rows of the ball's points over the ball.
         let mut a = vec![vec![0.0; ball.len()]; ball.len()];
         for (i, &q) in ball.iter().enumerate() {
-            for (p, w) in self.rows.row(1, q) {
+            for (&p, &w) in self.rows.row(1, q) {
                 let j = slot(&p).ok_or_else(|| refuse(format!("{p:?} leaves the ball")))?;
                 a[i][j] = w;
             }

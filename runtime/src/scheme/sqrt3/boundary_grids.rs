@@ -41,17 +41,23 @@ impl<'t> Sqrt3BoundaryStencils<'t> {
         patches: &[TrianglePatch],
         rates: &[u32],
     ) -> Result<Self, RuntimeError> {
-        let mut wanted: Vec<(BoundaryPatch, u32)> = patches
+        // By fan and rate: one surface each, whose memo of the rules' rows its kinds share.
+        let mut wanted: Vec<(u32, u32, BoundaryPatch)> = patches
             .iter()
             .zip(rates)
             .filter(|(p, _)| p.kind.boundary)
-            .map(|(p, &n)| (BoundaryPatch::unpacked(p.kind.faces, p.kind.sector), n))
+            .map(|(p, &n)| {
+                let patch = BoundaryPatch::unpacked(p.kind.faces, p.kind.sector);
+                (patch.faces, n, patch)
+            })
             .collect();
         wanted.sort_unstable();
         wanted.dedup();
-        let made: Vec<Vec<Grid>> = wanted
+        let groups: Vec<&[(u32, u32, BoundaryPatch)]> =
+            wanted.chunk_by(|a, b| (a.0, a.1) == (b.0, b.1)).collect();
+        let made: Vec<Vec<Grid>> = groups
             .par_iter()
-            .map(|&(patch, n)| patch_grids(table, patch, n))
+            .map(|group| fan_grids(table, group))
             .collect::<Result<_, _>>()?;
         Ok(Sqrt3BoundaryStencils {
             table,
@@ -76,20 +82,38 @@ impl TriangleStencils for Sqrt3BoundaryStencils<'_> {
 /// One made grid and its key.
 type Grid = (SectionKey, Box<[f32]>);
 
-/// The six grids (primal and dual, three kinds) of one boundary patch at rate `n`.
-fn patch_grids(
+/// The six grids (primal and dual, three kinds) of every patch of `group` (one fan, one rate).
+fn fan_grids(
     table: &StencilTable,
+    group: &[(u32, u32, BoundaryPatch)],
+) -> Result<Vec<Grid>, RuntimeError> {
+    let Some(&(faces, n, _)) = group.first() else {
+        return Ok(Vec::new());
+    };
+    let basis: &RateBasis = table.regular_basis(n)?;
+    let mut surface = if faces == 3 {
+        BoundarySurface::strip(basis)
+    } else {
+        BoundarySurface::fan(faces, basis).map_err(|e| {
+            RuntimeError::Unsupported(format!("√3 boundary patches of {faces} triangles: {e}"))
+        })?
+    };
+    let mut out = Vec::with_capacity(6 * group.len());
+    for &(_, _, patch) in group {
+        out.extend(patch_grids(&mut surface, patch, n)?);
+    }
+    Ok(out)
+}
+
+/// The six grids (primal and dual, three kinds) of one boundary patch at rate `n`, on its fan's
+/// `surface`.
+fn patch_grids(
+    surface: &mut BoundarySurface<&RateBasis>,
     patch: BoundaryPatch,
     n: u32,
 ) -> Result<Vec<Grid>, RuntimeError> {
-    let basis: &RateBasis = table.regular_basis(n)?;
     let refused = |e: schemes::sqrt3_boundary_surface::Refused| {
         RuntimeError::Unsupported(format!("√3 boundary patch {patch:?} at rate {n}: {e}"))
-    };
-    let mut surface = if patch.is_strip() {
-        BoundarySurface::strip(basis)
-    } else {
-        BoundarySurface::fan(patch.faces, basis).map_err(refused)?
     };
     let layout = patch.layout();
     let column = |p: &FanPoint| layout.binary_search(p).ok();
