@@ -21,8 +21,8 @@
 //!   `T ∩ (j + int S)` nonempty, rows of level-0 layout weights after `L` steps of the true
 //!   rules.
 //!
-//! The rows are built by one memoized implementation ([`RowMemo`]) over the scheme's rules
-//! ([`ConeRules`], kept with the family enum [`ConeFamily`]); reading a level-0 point outside
+//! The rows are built by one memoized implementation (`RowMemo`) over the scheme's rules
+//! (`ConeRules`, kept with the family enum [`ConeFamily`]); reading a level-0 point outside
 //! the layout is an error, which is how every
 //! layout is checked. Every matrix is kept in f64 and, when every weight is rational
 //! (`K = 3, 4, 6` for both schemes), also exactly as [`BigRational`].

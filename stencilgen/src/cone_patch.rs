@@ -521,7 +521,7 @@ impl<S: Scalar> ConeSubstitution<S> {
 
     /// The limit-position mask at the vertex: the left fixed vector `phi(0) = phi(0) A` with
     /// `sum phi(0) = 1`, exactly when `A` is rational, else by an f64 least-squares solve
-    /// ([`limit_mask_f64`]).
+    /// (`limit_mask_f64`).
     pub fn limit_mask(&self) -> Result<Vec<S>, StencilError> {
         let m = &self.matrices;
         let failure = |detail: String| StencilError::Inconsistent {

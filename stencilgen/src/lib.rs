@@ -9,7 +9,7 @@
 //! the tangent masks (section 4).
 //!
 //! The system relates `phi` at `x` only to `phi` at `2x - i`, so it splits along the orbits of
-//! the residues `r -> 2r (mod n)` ([`residue_orbits`]). Only the cycle of each orbit is a real
+//! the residues `r -> 2r (mod n)` ([`orbits::orbits`]). Only the cycle of each orbit is a real
 //! linear solve; every other residue follows by substitution. The exact path solves each cycle
 //! over the rationals ([`exact_solve`]), the f64 path by an SVD least-squares solve
 //! ([`float_solve`]); both share everything else through [`Scalar`].

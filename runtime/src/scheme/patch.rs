@@ -266,7 +266,7 @@ fn sector_at(mesh: &Mesh, face: usize, k: usize) -> Option<CreaseSector> {
 
 /// The crease sector whose boundary patch describes face `face`, when the face lies at an
 /// infinitely sharp crease the tables describe as a boundary: a crease vertex's sectors
-/// subdivide apart ([`crease_edges`]), each exactly as a boundary vertex with as many faces
+/// subdivide apart (`crease_edges`), each exactly as a boundary vertex with as many faces
 /// (the crease rule is the boundary rule, a crease edge's rule the boundary edge's midpoint),
 /// so the table's boundary patch of `faces` faces, sector `sector`, gathered on the face's side
 /// of the crease, is the face's limit.
@@ -276,7 +276,7 @@ fn sector_at(mesh: &Mesh, face: usize, k: usize) -> Option<CreaseSector> {
 /// two faces, if any), the face's sides at `V` sharp exactly where the sector ends, its two
 /// other sides smooth, a corner on the crease a crease vertex with two faces on the face's side
 /// (the crease goes on as a regular boundary), any other corner an interior valence-4 vertex
-/// with nothing sharp at it ([`smooth_regular`]). A one-face sector takes the crease rule, so
+/// with nothing sharp at it (`smooth_regular`). A one-face sector takes the crease rule, so
 /// in "edge and corner" mode, whose table pins one-face boundary vertices, it is not one.
 pub fn crease_sector(mesh: &Mesh, face: usize) -> Option<CreaseSector> {
     if mesh.face(face).len() != 4 {
