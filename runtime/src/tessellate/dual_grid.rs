@@ -75,7 +75,7 @@ struct SeparableBasis {
 
 /// Grid coordinates `(a, b)` (each in -1..=2) of the regular patch's layout entries
 /// `V, E_1..E_4, F_1..F_4, O_1..O_7` (docs/algorithms/extraordinary-stencils.md).
-const REGULAR_LAYOUT: [(i32, i32); 16] = [
+pub(crate) const REGULAR_LAYOUT: [(i32, i32); 16] = [
     (0, 0),
     (1, 0),
     (0, 1),

@@ -33,8 +33,9 @@
 //! ```
 //!
 //! over the dense rational grid `G` = the table's primal and dual points at rate
-//! [`SELECTION_GRID`] (`k/24` and `(2k+1)/48`: 1,201 points a face), evaluated exactly from the
-//! table. Both kinds of distance are at least the distance from the sample to the output mesh,
+//! [`SELECTION_GRID`] (`k/24` and `(2k+1)/48`: 1,201 points a face), evaluated from the table
+//! (a regular face's in closed form: its patch is the bicubic B-spline, whose table stencils are
+//! the same weights rounded to `f32`). Both kinds of distance are at least the distance from the sample to the output mesh,
 //! so `e_f(n)` bounds the geometric error of the uniform tessellation at those samples. The
 //! parametric part also counts tangential distortion (a flat patch whose parameterization is
 //! not affine deviates): what texture coordinates and shading see.
@@ -90,9 +91,10 @@ use table_format::{PointSet, StencilKind};
 use crate::mesh::topology::{Cut, Mesh};
 use crate::mesh::triangle_grid::TriangleGrid;
 use crate::mesh::triangle_mesh::TriangleMesh;
-use crate::scheme::catmull_clark::adaptive::{limit_points, LimitQuery};
+use crate::scheme::catmull_clark::adaptive::{bspline, limit_points, LimitQuery};
 use crate::scheme::patch::{dual_index_in_patch, FacePatch};
 use crate::stencil_table::StencilTable;
+use crate::tessellate::dual_grid::REGULAR_LAYOUT;
 use crate::tessellate::kernel::{table_may_describe, unless_absent};
 use crate::RuntimeError;
 
@@ -276,6 +278,30 @@ impl<'a> PatchPoints<'a> {
             side,
             corner: patch.corner,
         })
+    }
+
+    /// The 4 x 4 B-spline control net (`net[a + 1][b + 1]` at grid offset `(a, b)`, `a` along
+    /// the face's `u`) of a regular interior face whose patch starts at the face's first
+    /// corner: its limit surface is the tensor-product cubic B-spline, which
+    /// [`Samples::new`] evaluates in closed form.
+    fn bspline_net(&self) -> Option<[[[f64; 3]; 4]; 4]> {
+        let PatchPoints::Table { patch, control, .. } = self else {
+            return None;
+        };
+        let kind = &patch.kind;
+        if kind.boundary
+            || kind.feature != table_format::Feature::None
+            || kind.faces != 4
+            || patch.corner != 0
+            || control.len() != REGULAR_LAYOUT.len()
+        {
+            return None;
+        }
+        let mut net = [[[0.0; 3]; 4]; 4];
+        for (&(a, b), &q) in REGULAR_LAYOUT.iter().zip(control) {
+            net[(a + 1) as usize][(b + 1) as usize] = q;
+        }
+        Some(net)
     }
 
     /// The control points of a table face (none for an adaptive one, whose grids hold
@@ -606,6 +632,9 @@ pub fn table_positions(
 struct Samples {
     uv: Vec<[f64; 2]>,
     positions: Vec<[f64; 3]>,
+    /// The parameters along either axis of each grid of samples (primal, then dual), in the
+    /// order of `uv`: grid `g` holds `axes[g].len()^2` samples, `j` outer.
+    axes: Vec<Vec<f64>>,
     /// Where the next early-stopping scan starts: the sample that refuted the last rate. The
     /// next rate's deviation peaks in the same region of the face (where it bends most), so a
     /// scan from there finds a failing rate's first sample beyond the tolerance soonest.
@@ -621,6 +650,7 @@ impl Samples {
         Samples {
             uv: Vec::new(),
             positions: Vec::new(),
+            axes: Vec::new(),
             start: Cell::new(0),
             outside_first: Cell::new(false),
         }
@@ -628,38 +658,80 @@ impl Samples {
 
     /// The primal and dual points of the face at rate `grid`.
     fn new(points: &PatchPoints, grid: u32) -> Result<Self, RuntimeError> {
-        let mut uv = Vec::new();
-        let mut positions = Vec::new();
+        let count = (grid_side(true, grid).pow(2) + grid_side(false, grid).pow(2)) as usize;
+        let mut uv = Vec::with_capacity(count);
+        let mut positions = Vec::with_capacity(count);
+        let mut axes = Vec::with_capacity(2);
         for set in [PointSet::Primal, PointSet::Dual] {
             let g = points.grid(set, grid)?;
             let n = f64::from(grid);
-            for j in 0..g.side() {
-                for i in 0..g.side() {
-                    // `grid` refused the triangle point sets; only the quad ones reach here.
-                    let (u, v) = if set == PointSet::Primal {
-                        (i as f64 / n, j as f64 / n)
+            // `grid` refused the triangle point sets; only the quad ones reach here.
+            let axis: Vec<f64> = (0..g.side())
+                .map(|i| {
+                    if set == PointSet::Primal {
+                        i as f64 / n
                     } else {
-                        (
-                            (2 * i + 1) as f64 / (2.0 * n),
-                            (2 * j + 1) as f64 / (2.0 * n),
-                        )
-                    };
+                        (2 * i + 1) as f64 / (2.0 * n)
+                    }
+                })
+                .collect();
+            for &v in &axis {
+                for &u in &axis {
                     uv.push([u, v]);
                 }
             }
             let side = g.side();
-            points.extend(
-                &g,
-                (0..side * side).map(|p| (p % side, p / side)),
-                &mut positions,
-            );
+            match points.bspline_net() {
+                Some(net) => tensor_product(&net, &axis, &mut positions),
+                None => points.extend(
+                    &g,
+                    (0..side * side).map(|p| (p % side, p / side)),
+                    &mut positions,
+                ),
+            }
+            axes.push(axis);
         }
         Ok(Samples {
             uv,
             positions,
+            axes,
             start: Cell::new(0),
             outside_first: Cell::new(false),
         })
+    }
+}
+
+/// The cubic B-spline surface of `net` ([`PatchPoints::bspline_net`]) at the grid `axis x axis`
+/// (`j` outer), appended to `out`: the curve of each row of the net at every `u`, then per point
+/// the curve through those four, `16 side + 4 side^2` weighted sums where the table's stencils
+/// take `16 side^2`.
+fn tensor_product(net: &[[[f64; 3]; 4]; 4], axis: &[f64], out: &mut Vec<[f64; 3]>) {
+    let basis: Vec<[f64; 4]> = axis.iter().map(|&t| bspline(t).0).collect();
+    // rows[i][b]: net row b (offset b - 1 along v) at u_i.
+    let rows: Vec<[[f64; 3]; 4]> = basis
+        .iter()
+        .map(|w| {
+            std::array::from_fn(|b| {
+                let mut p = [0.0; 3];
+                for (a, column) in net.iter().enumerate() {
+                    for c in 0..3 {
+                        p[c] += w[a] * column[b][c];
+                    }
+                }
+                p
+            })
+        })
+        .collect();
+    for w in &basis {
+        out.extend(rows.iter().map(|row| {
+            let mut p = [0.0; 3];
+            for (b, q) in row.iter().enumerate() {
+                for c in 0..3 {
+                    p[c] += w[b] * q[c];
+                }
+            }
+            p
+        }));
     }
 }
 
@@ -696,10 +768,16 @@ enum Beyond {
 
 /// The uniform-rate tessellation around one face, `L_{f,n}` (module docs): the face's dual
 /// points, what lies beyond each side, and the triangles around each corner.
-struct FaceLocal {
+struct FaceLocal<'p> {
     n: usize,
-    /// `n x n` dual points, `j` outer.
-    dual: Vec<[f64; 3]>,
+    /// The face's points and its dual grid at rate `n`, which `dual` is evaluated from.
+    own: &'p PatchPoints<'p>,
+    grid: Grid<'p>,
+    /// `n x n` dual points, `j` outer, each evaluated when first read ([`FaceLocal::d`]): a rate
+    /// the selection refutes is refuted at a sample or two, which read four points each, and a
+    /// face that reaches rate `n` tries every smaller rate first (`n^3 / 3` points in all, where
+    /// the rate it keeps reads `n^2`).
+    dual: Vec<Cell<Option<[f64; 3]>>>,
     beyond: Vec<Beyond>,
     /// Per corner: the vertex polygon's triangles, the two ends of the adjacent strips, and the
     /// face's corner cell.
@@ -754,13 +832,17 @@ fn strip_triangles(a: &[[f64; 3]], b: &[[f64; 3]], curve: bool) -> Vec<[[f64; 3]
     out
 }
 
-impl FaceLocal {
+impl<'p> FaceLocal<'p> {
     /// The face's own dual points at rate `n`: all that `L_{f,n}` needs in the interior
     /// `[h, 1-h]^2` (see [`FaceLocal::is_interior`]); [`FaceLocal::complete`] adds the rest.
-    fn interior(own: &PatchPoints, n: u32) -> Result<Self, RuntimeError> {
+    fn interior(own: &'p PatchPoints<'p>, n: u32) -> Result<Self, RuntimeError> {
+        let grid = own.grid(PointSet::Dual, n)?;
+        let count = grid.side() * grid.side();
         Ok(FaceLocal {
             n: n as usize,
-            dual: own.all(PointSet::Dual, n)?,
+            own,
+            grid,
+            dual: vec![Cell::new(None); count],
             beyond: Vec::new(),
             corners: Vec::new(),
         })
@@ -768,10 +850,31 @@ impl FaceLocal {
 
     /// `L_{f,n}` around face `f` in full: its interior ([`FaceLocal::interior`]), what lies
     /// beyond each side and the triangles around each corner.
-    fn new(ctx: &Context, f: usize, n: u32) -> Result<Self, RuntimeError> {
+    fn new(ctx: &'p Context, f: usize, n: u32) -> Result<Self, RuntimeError> {
         let mut local = FaceLocal::interior(&ctx.points[f], n)?;
         local.complete(ctx, f)?;
         Ok(local)
+    }
+
+    /// Every dual point, those not read yet evaluated four at a time ([`PatchPoints::extend`]):
+    /// what a scan that is not refuted at once reads anyway.
+    fn filled(&self) -> Vec<[f64; 3]> {
+        let missing: Vec<usize> = (0..self.dual.len())
+            .filter(|&k| self.dual[k].get().is_none())
+            .collect();
+        let mut points = Vec::with_capacity(missing.len());
+        self.own.extend(
+            &self.grid,
+            missing.iter().map(|&k| (k % self.n, k / self.n)),
+            &mut points,
+        );
+        for (&k, p) in missing.iter().zip(points) {
+            self.dual[k].set(Some(p));
+        }
+        self.dual
+            .iter()
+            .map(|c| c.get().unwrap_or_default())
+            .collect()
     }
 
     /// Add the neighbours' rows (or the boundary curves) and the corners' triangles to the
@@ -783,6 +886,18 @@ impl FaceLocal {
         let primal = own.grid(PointSet::Primal, n)?;
         let mesh = ctx.mesh;
         let first = mesh.face_halfedges(f).start;
+        // The neighbours' dual grids at rate n, each looked up once: the rows beyond the sides
+        // and the corners' rings read the same few faces (a lookup in a compact table costs
+        // as much as a dozen points).
+        let mut grids: Vec<(usize, Grid)> = Vec::with_capacity(12);
+        let mut dual_grid = |g: usize| -> Result<Grid, RuntimeError> {
+            if let Some(&(_, grid)) = grids.iter().find(|(h, _)| *h == g) {
+                return Ok(grid);
+            }
+            let grid = ctx.points[g].grid(PointSet::Dual, n)?;
+            grids.push((g, grid));
+            Ok(grid)
+        };
         let mut beyond = Vec::with_capacity(4);
         for side in 0..4 {
             let t = mesh.twin[first + side];
@@ -800,7 +915,7 @@ impl FaceLocal {
                 let other = t - mesh.face_halfedges(g).start;
                 // The neighbour's row runs the other way along the shared edge.
                 let points = &ctx.points[g];
-                let grid = points.grid(PointSet::Dual, n)?;
+                let grid = dual_grid(g)?;
                 let mut row = Vec::with_capacity(m);
                 points.extend(
                     &grid,
@@ -822,13 +937,11 @@ impl FaceLocal {
             })
             .collect();
         // The dual point (i, j) of face g at rate n.
-        let dual_of = |g: usize, (i, j): (usize, usize)| -> Result<[f64; 3], RuntimeError> {
+        let mut dual_of = |g: usize, (i, j): (usize, usize)| -> Result<[f64; 3], RuntimeError> {
             if g == f {
                 return Ok(local.d(i, j));
             }
-            let points = &ctx.points[g];
-            let grid = points.grid(PointSet::Dual, n)?;
-            Ok(points.at(&grid, i, j))
+            Ok(ctx.points[g].at(&dual_grid(g)?, i, j))
         };
         let mut corners = Vec::with_capacity(4);
         for corner in 0..4 {
@@ -870,8 +983,14 @@ impl FaceLocal {
         Ok(())
     }
 
+    /// Dual point `(i, j)`, evaluated the first time it is read.
     fn d(&self, i: usize, j: usize) -> [f64; 3] {
-        self.dual[j * self.n + i]
+        let cell = &self.dual[j * self.n + i];
+        cell.get().unwrap_or_else(|| {
+            let p = self.own.at(&self.grid, i, j);
+            cell.set(Some(p));
+            p
+        })
     }
 
     /// Dual point `t` of the row next to side `side`, in the side's direction.
@@ -910,9 +1029,7 @@ impl FaceLocal {
     /// Whether `(u, v)` lies in the interior `[h, 1-h]^2`, outside the corner squares: there
     /// `L_{f,n}` is made of the face's own dual points alone ([`FaceLocal::interior`]).
     fn is_interior(&self, u: f64, v: f64) -> bool {
-        let h = 0.5 / self.n as f64;
-        let corner = (u <= h || u >= 1.0 - h) && (v <= h || v >= 1.0 - h);
-        self.n >= 2 && !corner && u.min(v).min(1.0 - u).min(1.0 - v) >= h
+        AxisPlace::new(u, self.n).interior_with(&AxisPlace::new(v, self.n), self.n)
     }
 
     /// `L_{f,n}(u, v)` outside the corner squares.
@@ -940,24 +1057,11 @@ impl FaceLocal {
             if self.n == 1 {
                 return self.d(0, 0);
             }
-            let cell = |x: f64| -> (usize, f64) {
-                let t = (x * n - 0.5).clamp(0.0, n - 1.0);
-                // `t >= 0`: truncation is the floor, without a call to `floor`.
-                let i = (t as usize).min(self.n - 2);
-                (i, t - i as f64)
-            };
-            let ((i, a), (j, b)) = (cell(u), cell(v));
-            let (p, q, r, s) = (
-                self.d(i, j),
-                self.d(i + 1, j),
-                self.d(i + 1, j + 1),
-                self.d(i, j + 1),
+            return in_cell(
+                |i, j| self.d(i, j),
+                &AxisPlace::new(u, self.n),
+                &AxisPlace::new(v, self.n),
             );
-            return if a >= b {
-                combine(&[(1.0 - a, p), (a - b, q), (b, r)])
-            } else {
-                combine(&[(1.0 - b, p), (b - a, s), (a, r)])
-            };
         }
         // A side's strip, in scaled side coordinates: the face's row point t at (2t + 1, 1),
         // the curve point t at (2t, 0), the neighbour's row point t at (2t + 1, -1).
@@ -1019,22 +1123,105 @@ impl FaceLocal {
     /// soon as one sample deviates by more than `stop`, that sample's deviation (a lower bound
     /// of `e_f(n)`, enough to reject the rate: the selection tries rates that mostly fail, and
     /// a failing rate usually fails at its first samples).
+    ///
+    /// The sample that refuted the last rate is read first; then the samples grid by grid, row
+    /// by row, with each row's and column's place in the dual grid found once (where the
+    /// interior's samples, most of them, cost one interpolation each).
     fn deviation_up_to(&self, samples: &Samples, stop: f64, keep: impl Fn(bool) -> bool) -> f64 {
         let count = samples.uv.len().min(samples.positions.len());
-        let first = samples.start.get().min(count);
+        let first = samples.start.get();
         let mut worst = 0.0f64;
-        for k in (first..count).chain(0..first) {
-            let ([u, v], p) = (samples.uv[k], samples.positions[k]);
-            if !keep(self.is_interior(u, v)) {
-                continue;
-            }
-            worst = worst.max(self.deviation_at(u, v, p));
-            if worst > stop {
-                samples.start.set(k);
-                break;
+        if first < count {
+            let ([u, v], p) = (samples.uv[first], samples.positions[first]);
+            if keep(self.is_interior(u, v)) {
+                worst = self.deviation_at(u, v, p);
+                if worst > stop {
+                    return worst;
+                }
             }
         }
+        let n = self.n;
+        let wants_interior = n >= 2 && keep(true);
+        let dual = if wants_interior {
+            self.filled()
+        } else {
+            Vec::new()
+        };
+        let mut offset = 0;
+        for axis in &samples.axes {
+            let side = axis.len();
+            let places: Vec<AxisPlace> = axis.iter().map(|&t| AxisPlace::new(t, n)).collect();
+            for (j, row) in places.iter().enumerate() {
+                for (i, column) in places.iter().enumerate() {
+                    let k = offset + j * side + i;
+                    if k >= count {
+                        break;
+                    }
+                    let interior = column.interior_with(row, n);
+                    if !keep(interior) {
+                        continue;
+                    }
+                    let p = samples.positions[k];
+                    let deviation = if interior && wants_interior {
+                        distance(p, in_cell(|i, j| dual[j * n + i], column, row))
+                    } else {
+                        let [u, v] = samples.uv[k];
+                        self.deviation_at(u, v, p)
+                    };
+                    worst = worst.max(deviation);
+                    if worst > stop {
+                        samples.start.set(k);
+                        return worst;
+                    }
+                }
+            }
+            offset += side * side;
+        }
         worst
+    }
+}
+
+/// `L_{f,n}` in the interior: the dual grid's cell that holds the sample with places `u` and `v`,
+/// split along `a = b` (the tessellator's diagonal), the dual point `(i, j)` read by `at`.
+fn in_cell(at: impl Fn(usize, usize) -> [f64; 3], u: &AxisPlace, v: &AxisPlace) -> [f64; 3] {
+    let ((i, a), (j, b)) = ((u.cell, u.fraction), (v.cell, v.fraction));
+    let (p, q, r, s) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+    if a >= b {
+        combine(&[(1.0 - a, p), (a - b, q), (b, r)])
+    } else {
+        combine(&[(1.0 - b, p), (b - a, s), (a, r)])
+    }
+}
+
+/// A sample parameter `t` (along `u` or `v`) against the dual grid at rate `n`: the cell (of
+/// cells `0..n-1` between dual points `(2i+1)/2n`) that [`in_cell`] interpolates in, and the
+/// fraction in it. A scan computes it once per row and column of samples.
+struct AxisPlace {
+    t: f64,
+    cell: usize,
+    fraction: f64,
+}
+
+impl AxisPlace {
+    fn new(t: f64, n: usize) -> Self {
+        let nf = n as f64;
+        let x = (t * nf - 0.5).clamp(0.0, nf - 1.0);
+        // `x >= 0`: truncation is the floor.
+        let cell = (x as usize).min(n.saturating_sub(2));
+        AxisPlace {
+            t,
+            cell,
+            fraction: x - cell as f64,
+        }
+    }
+
+    /// Whether the sample at places `self` (along `u`) and `v` lies in the interior of the rate-`n`
+    /// tessellation, `[h, 1-h]^2` with `h = 1/2n`, outside the corner squares (n >= 2).
+    fn interior_with(&self, v: &AxisPlace, n: usize) -> bool {
+        let h = 0.5 / n as f64;
+        let inside = |t: f64| t >= h && 1.0 - t >= h;
+        let near_side = |t: f64| t <= h || t >= 1.0 - h;
+        n >= 2 && inside(self.t) && inside(v.t) && !(near_side(self.t) && near_side(v.t))
     }
 }
 
@@ -1187,8 +1374,10 @@ pub fn tolerance_rates(
 /// the largest candidate (and the face listed in [`ToleranceRates::unmet`]) when none meets it.
 /// `tolerance` is in the mesh's units; `candidates` must be non-empty, each in `1..=24`.
 ///
-/// Cost: per face, the 1,201 samples once, then for each candidate tried `n^2 + 4(n + 1)` table
-/// points and one interpolation per sample; faces run in parallel.
+/// Cost: per face, the 1,201 samples once (a regular face's in closed form, the tensor-product
+/// B-spline), then for each candidate tried the dual points its scan reads (four for a rate
+/// refuted at its first sample, `n^2 + 4(n + 1)` table points for the rate kept) and one
+/// interpolation per sample read; faces run in parallel.
 /// Faces evaluated adaptively ([module docs](self)) cost a descent per grid, shared by the faces
 /// around one vertex.
 pub fn tolerance_rates_among(
@@ -1511,6 +1700,54 @@ mod tests {
             Ok(rates) => panic!("{text:?} parsed as {rates:?}"),
             Err(e) => e.to_string(),
         }
+    }
+
+    /// On a torus of regular quads, the samples of every face in closed form
+    /// ([`tensor_product`]) are the table's stencils applied to the same control points, to the
+    /// table's `f32` rounding.
+    #[test]
+    #[cfg(feature = "catmull-clark")]
+    fn regular_samples_in_closed_form_are_the_tables() {
+        let (m, n) = (6, 5);
+        let mut positions = Vec::new();
+        for j in 0..n {
+            for i in 0..m {
+                let (a, b) = (
+                    std::f64::consts::TAU * i as f64 / m as f64,
+                    std::f64::consts::TAU * j as f64 / n as f64,
+                );
+                let r = 3.0 + b.cos();
+                positions.push([r * a.cos(), r * a.sin(), b.sin() + 0.1 * a.sin()]);
+            }
+        }
+        let at = |i: usize, j: usize| ((j % n) * m + i % m) as i64;
+        let faces: Vec<Vec<i64>> = (0..m * n)
+            .map(|k| {
+                let (i, j) = (k % m, k / m);
+                vec![at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]
+            })
+            .collect();
+        let mesh = Mesh::new(positions, &faces, &[], schemes::BoundaryMode::EdgeOnly)
+            .expect("a valid torus");
+        let patches = crate::scheme::patch::gather_patches(&mesh).expect("patches");
+        let table = StencilTable::default_catmull_clark().expect("embedded table");
+        let mut closed_form = 0;
+        for patch in &patches {
+            let points = PatchPoints::new(&table, &mesh, patch).expect("table patch");
+            closed_form += usize::from(points.bspline_net().is_some());
+            let samples = Samples::new(&points, SELECTION_GRID).expect("samples");
+            let mut stencils = points
+                .all(PointSet::Primal, SELECTION_GRID)
+                .expect("primal");
+            stencils.extend(points.all(PointSet::Dual, SELECTION_GRID).expect("dual"));
+            assert_eq!(samples.positions.len(), 1201);
+            assert_eq!(stencils.len(), 1201);
+            for (a, b) in samples.positions.iter().zip(&stencils) {
+                assert!(distance(*a, *b) < 2e-6, "{a:?} != {b:?}");
+            }
+        }
+        // Most patches start at the face's first corner; those take the closed form.
+        assert!(closed_form > 0, "no face took the closed form");
     }
 
     #[test]

@@ -58,7 +58,7 @@ pub struct LimitQuery {
 pub type LimitStencil = Vec<(u32, [f64; 3])>;
 
 /// The cubic B-spline basis at `t` and its derivative, for control offsets `-1, 0, 1, 2`.
-fn bspline(t: f64) -> ([f64; 4], [f64; 4]) {
+pub(crate) fn bspline(t: f64) -> ([f64; 4], [f64; 4]) {
     let s = 1.0 - t;
     let (t2, t3) = (t * t, t * t * t);
     (
