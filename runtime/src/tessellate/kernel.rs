@@ -211,6 +211,60 @@ pub(crate) fn gather_relative(
     origin.map(|c| c as f32)
 }
 
+/// The weighted sum `sum_l row[l] control[l]` in f64, its terms added in the order of the
+/// control points.
+pub(crate) fn weighted_sum(control: &[[f64; 3]], row: &[f32]) -> [f64; 3] {
+    weighted_sums(control, [row])[0]
+}
+
+/// The weighted sums of `control` by `M` rows of weights at once: `M` independent chains of
+/// additions, where one sum alone waits on its own additions. Each sum adds its terms in the
+/// order of the control points, so a point comes out bit for bit the same whichever rows it is
+/// computed with ([`weighted_sum`] alone included).
+#[inline]
+pub(crate) fn weighted_sums<const M: usize>(
+    control: &[[f64; 3]],
+    rows: [&[f32]; M],
+) -> [[f64; 3]; M] {
+    let mut out = [[0.0; 3]; M];
+    for (l, q) in control.iter().enumerate() {
+        for (p, row) in out.iter_mut().zip(&rows) {
+            let w = f64::from(row[l]);
+            for c in 0..3 {
+                p[c] += w * q[c];
+            }
+        }
+    }
+    out
+}
+
+/// The weighted sums of `control` by every row of `rows`, appended to `out` in order, four at a
+/// time ([`weighted_sums`]).
+pub(crate) fn extend_weighted_sums<'w>(
+    control: &[[f64; 3]],
+    rows: impl Iterator<Item = &'w [f32]>,
+    out: &mut Vec<[f64; 3]>,
+) {
+    let mut rows = rows.peekable();
+    while let Some(first) = rows.next() {
+        let mut four = [first; 4];
+        let mut m = 1;
+        while m < 4 {
+            match rows.next() {
+                Some(row) => four[m] = row,
+                None => break,
+            }
+            m += 1;
+        }
+        if m == 4 {
+            out.extend_from_slice(&weighted_sums(control, four));
+        } else {
+            // The last few one at a time, rather than sums of repeated rows.
+            out.extend(four[..m].iter().map(|&row| weighted_sum(control, row)));
+        }
+    }
+}
+
 /// Running totals of `counts`: item `i` owns `[ends[i-1], ends[i])`.
 pub(crate) fn prefix_sums(counts: impl Iterator<Item = usize>) -> Vec<usize> {
     let mut total = 0;

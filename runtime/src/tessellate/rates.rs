@@ -95,7 +95,9 @@ use crate::scheme::catmull_clark::adaptive::{bspline, limit_points, LimitQuery};
 use crate::scheme::patch::{dual_index_in_patch, FacePatch};
 use crate::stencil_table::StencilTable;
 use crate::tessellate::dual_grid::REGULAR_LAYOUT;
-use crate::tessellate::kernel::{table_may_describe, unless_absent};
+use crate::tessellate::kernel::{
+    extend_weighted_sums, table_may_describe, unless_absent, weighted_sum,
+};
 use crate::RuntimeError;
 
 /// The largest rate selected: the largest of the default table (`n = 1..=24`).
@@ -326,21 +328,6 @@ impl<'a> PatchPoints<'a> {
         &weights[(pj * side + pi) * k..][..k]
     }
 
-    /// The weighted sums of the control points by `M` rows of weights at once: `M`
-    /// independent chains of additions, where one sum alone waits on its own additions.
-    fn sums<const M: usize>(&self, rows: [&[f32]; M]) -> [[f64; 3]; M] {
-        let mut out = [[0.0; 3]; M];
-        for (l, q) in self.control().iter().enumerate() {
-            for (p, row) in out.iter_mut().zip(&rows) {
-                let w = f64::from(row[l]);
-                for c in 0..3 {
-                    p[c] += w * q[c];
-                }
-            }
-        }
-        out
-    }
-
     /// The limit position at grid point `(i, j)` of `grid`, in the face's own indices.
     fn at(&self, grid: &Grid, i: usize, j: usize) -> [f64; 3] {
         match *grid {
@@ -348,7 +335,7 @@ impl<'a> PatchPoints<'a> {
                 weights,
                 side,
                 corner,
-            } => self.sums([self.row(weights, side, corner, (i, j))])[0],
+            } => weighted_sum(self.control(), self.row(weights, side, corner, (i, j))),
             Grid::Positions { positions, side } => positions[j * side + i],
         }
     }
@@ -361,34 +348,18 @@ impl<'a> PatchPoints<'a> {
         ij: impl Iterator<Item = (usize, usize)>,
         out: &mut Vec<[f64; 3]>,
     ) {
-        let (weights, side, corner) = match *grid {
+        match *grid {
             Grid::Weights {
                 weights,
                 side,
                 corner,
-            } => (weights, side, corner),
+            } => extend_weighted_sums(
+                self.control(),
+                ij.map(|point| self.row(weights, side, corner, point)),
+                out,
+            ),
             Grid::Positions { positions, side } => {
-                out.extend(ij.map(|(i, j)| positions[j * side + i]));
-                return;
-            }
-        };
-        let mut ij = ij.peekable();
-        while let Some(first) = ij.next() {
-            let first = self.row(weights, side, corner, first);
-            let mut rows = [first; 4];
-            let mut m = 1;
-            while m < 4 {
-                match ij.next() {
-                    Some(point) => rows[m] = self.row(weights, side, corner, point),
-                    None => break,
-                }
-                m += 1;
-            }
-            if m == 4 {
-                out.extend_from_slice(&self.sums(rows));
-            } else {
-                // The last few: one at a time, rather than sums of repeated rows.
-                out.extend(rows[..m].iter().map(|&row| self.sums([row])[0]));
+                out.extend(ij.map(|(i, j)| positions[j * side + i]))
             }
         }
     }

@@ -80,7 +80,7 @@ use crate::mesh::triangle_mesh::TriangleMesh;
 use crate::scheme::triangle::isolation::TriangleIsolation;
 use crate::scheme::triangle::patch::{dual_in_patch, dual_index, primal_in_patch, primal_index};
 use crate::stencil_table::StencilTable;
-use crate::tessellate::kernel::merge_rows;
+use crate::tessellate::kernel::{extend_weighted_sums, merge_rows};
 use crate::tessellate::rates::{check_tolerance, select_rates, sorted_candidates, ToleranceRates};
 use crate::tessellate::triangle_dual_grid::{zigzag_cell, TriangleStencils, MAX_TRIANGLE_RATE};
 use crate::RuntimeError;
@@ -172,17 +172,38 @@ impl<'a> Context<'a> {
         })
     }
 
-    /// The limit position of row `row` of `section` of triangle `f`.
-    fn at(&self, f: usize, section: &Section, row: usize) -> [f64; 3] {
-        let weights = &section.weights[row * section.k..][..section.k];
-        let mut p = [0.0; 3];
-        for (&w, &v) in weights.iter().zip(&self.iso.patches[f].points) {
-            let q = self.control[v as usize];
-            for c in 0..3 {
-                p[c] += f64::from(w) * q[c];
+    /// The control points of triangle `f`'s patch, in its layout.
+    fn patch_control(&self, f: usize) -> Vec<[f64; 3]> {
+        self.iso.patches[f]
+            .points
+            .iter()
+            .map(|&v| self.control[v as usize])
+            .collect()
+    }
+
+    /// The limit positions of every point of `section` (triangle `f`'s, its control points
+    /// `control`), in the triangle's own indices and the table's order, appended to `out`.
+    fn extend_grid(
+        &self,
+        control: &[[f64; 3]],
+        section: &Section,
+        points: PointSet,
+        out: &mut Vec<[f64; 3]>,
+    ) {
+        let n = section.n;
+        let mut rows = Vec::with_capacity(points.count(n) as usize);
+        if points == PointSet::TrianglePrimal {
+            for j in 0..=n {
+                for i in 0..=n - j {
+                    rows.push(section.weights_of(section.primal_row(i, j)));
+                }
             }
+        } else {
+            for_each_dual(n, |i, j, down| {
+                rows.push(section.weights_of(section.dual_row(i, j, down)))
+            });
         }
-        p
+        extend_weighted_sums(control, rows.into_iter(), out);
     }
 
     /// Which sides of triangle `f` are on the boundary (bit `s` for side `s`).
@@ -196,17 +217,12 @@ impl<'a> Context<'a> {
     /// The limit samples of triangle `f` on the grid `grid`, in its order.
     fn samples(&self, f: usize, grid: &SampleGrid) -> Result<Vec<[f64; 3]>, RuntimeError> {
         let mut out = Vec::with_capacity(grid.params.len());
+        let control = self.patch_control(f);
         for &n in &grid.rates {
-            let primal = self.section(f, PointSet::TrianglePrimal, n)?;
-            for j in 0..=n {
-                for i in 0..=n - j {
-                    out.push(self.at(f, &primal, primal.primal_row(i, j)));
-                }
+            for points in [PointSet::TrianglePrimal, PointSet::TriangleDual] {
+                let section = self.section(f, points, n)?;
+                self.extend_grid(&control, &section, points, &mut out);
             }
-            let dual = self.section(f, PointSet::TriangleDual, n)?;
-            for_each_dual(n, |i, j, down| {
-                out.push(self.at(f, &dual, dual.dual_row(i, j, down)));
-            });
         }
         Ok(out)
     }
@@ -214,17 +230,14 @@ impl<'a> Context<'a> {
     /// The positions of the points of `L_{f,n}` ([`Ids`]).
     fn local_points(&self, f: usize, n: u32) -> Result<Vec<[f64; 3]>, RuntimeError> {
         let ids = Ids { n };
-        let mut out = vec![[0.0; 3]; ids.count()];
-        let dual = self.section(f, PointSet::TriangleDual, n)?;
-        for_each_dual(n, |i, j, down| {
-            out[ids.dual(i, j, down)] = self.at(f, &dual, dual.dual_row(i, j, down));
-        });
-        let primal = self.section(f, PointSet::TrianglePrimal, n)?;
-        for j in 0..=n {
-            for i in 0..=n - j {
-                out[ids.primal(i, j)] = self.at(f, &primal, primal.primal_row(i, j));
-            }
+        // f's dual points, then its primal points, in the table's order: the first ids.
+        let mut out = Vec::with_capacity(ids.count());
+        let control = self.patch_control(f);
+        for points in [PointSet::TriangleDual, PointSet::TrianglePrimal] {
+            let section = self.section(f, points, n)?;
+            self.extend_grid(&control, &section, points, &mut out);
         }
+        out.resize(ids.count(), [0.0; 3]);
         let mesh = &self.iso.mesh;
         let first = mesh.face_halfedges(f).start;
         for s in 0..3 {
@@ -237,10 +250,14 @@ impl<'a> Context<'a> {
             let side = (t - mesh.face_halfedges(g).start) as u8;
             let theirs = self.section(g, PointSet::TriangleDual, n)?;
             // g's zigzag runs from f's corner s + 1 to corner s: reversed, it runs along f's side.
-            for k in 0..2 * n - 1 {
+            let rows = (0..2 * n - 1).map(|k| {
                 let (i, j, down) = zigzag_cell(n, side, 2 * n - 2 - k);
-                out[ids.beyond(s, k)] = self.at(g, &theirs, theirs.dual_row(i, j, down));
-            }
+                theirs.weights_of(theirs.dual_row(i, j, down))
+            });
+            let mut row = Vec::with_capacity(2 * n as usize - 1);
+            extend_weighted_sums(&self.patch_control(g), rows, &mut row);
+            let first = ids.beyond(s, 0);
+            out[first..first + row.len()].copy_from_slice(&row);
         }
         Ok(out)
     }
@@ -254,7 +271,12 @@ struct Section<'t> {
     n: u32,
 }
 
-impl Section<'_> {
+impl<'t> Section<'t> {
+    /// The weights of table row `row`.
+    fn weights_of(&self, row: usize) -> &'t [f32] {
+        &self.weights[row * self.k..][..self.k]
+    }
+
     fn primal_row(&self, i: u32, j: u32) -> usize {
         let (pi, pj) = primal_in_patch(self.corner, self.n, i, j);
         primal_index(self.n, pi, pj)
@@ -709,17 +731,7 @@ pub fn triangle_table_positions(
     }
     let section = ctx.section(face, points, n)?;
     let mut out = Vec::with_capacity(points.count(n) as usize);
-    if points == PointSet::TrianglePrimal {
-        for j in 0..=n {
-            for i in 0..=n - j {
-                out.push(ctx.at(face, &section, section.primal_row(i, j)));
-            }
-        }
-    } else {
-        for_each_dual(n, |i, j, down| {
-            out.push(ctx.at(face, &section, section.dual_row(i, j, down)));
-        });
-    }
+    ctx.extend_grid(&ctx.patch_control(face), &section, points, &mut out);
     Ok(out)
 }
 
