@@ -54,3 +54,27 @@ pub fn lattice_torus(m: i64, position: impl Fn(i64, i64) -> [f64; 3]) -> Mesh {
     }
     Mesh::new(positions, &faces, &[], BoundaryMode::EdgeOnly).expect("a valid torus")
 }
+
+/// A torus of `m x n` quads, every vertex interior of valence 4 (regular), slightly twisted
+/// out of its symmetry planes so that no coordinate of a patch is constant.
+pub fn quad_torus(m: usize, n: usize) -> Mesh {
+    let mut positions = Vec::new();
+    for j in 0..n {
+        for i in 0..m {
+            let (a, b) = (
+                std::f64::consts::TAU * i as f64 / m as f64,
+                std::f64::consts::TAU * j as f64 / n as f64,
+            );
+            let r = 3.0 + b.cos();
+            positions.push([r * a.cos(), r * a.sin(), b.sin() + 0.1 * a.sin()]);
+        }
+    }
+    let at = |i: usize, j: usize| ((j % n) * m + i % m) as i64;
+    let faces: Vec<Vec<i64>> = (0..m * n)
+        .map(|k| {
+            let (i, j) = (k % m, k / m);
+            vec![at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]
+        })
+        .collect();
+    Mesh::new(positions, &faces, &[], BoundaryMode::EdgeOnly).expect("a valid torus")
+}

@@ -1679,27 +1679,7 @@ mod tests {
     #[test]
     #[cfg(feature = "catmull-clark")]
     fn regular_samples_in_closed_form_are_the_tables() {
-        let (m, n) = (6, 5);
-        let mut positions = Vec::new();
-        for j in 0..n {
-            for i in 0..m {
-                let (a, b) = (
-                    std::f64::consts::TAU * i as f64 / m as f64,
-                    std::f64::consts::TAU * j as f64 / n as f64,
-                );
-                let r = 3.0 + b.cos();
-                positions.push([r * a.cos(), r * a.sin(), b.sin() + 0.1 * a.sin()]);
-            }
-        }
-        let at = |i: usize, j: usize| ((j % n) * m + i % m) as i64;
-        let faces: Vec<Vec<i64>> = (0..m * n)
-            .map(|k| {
-                let (i, j) = (k % m, k / m);
-                vec![at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]
-            })
-            .collect();
-        let mesh = Mesh::new(positions, &faces, &[], schemes::BoundaryMode::EdgeOnly)
-            .expect("a valid torus");
+        let mesh = crate::mesh::test_meshes::quad_torus(6, 5);
         let patches = crate::scheme::patch::gather_patches(&mesh).expect("patches");
         let table = StencilTable::default_catmull_clark().expect("embedded table");
         let mut closed_form = 0;

@@ -256,6 +256,7 @@ fn normals_above_the_line_converge_to_the_cross_mask() {
 /// whole-mesh ternary steps put there (to 2e-5, the output's f32), and the output is a
 /// manifold with boundary whose normals turn with the reference normals of the refined mesh.
 #[test]
+#[cfg(feature = "sqrt3")]
 fn boundary_patches_are_the_limit_of_whole_mesh_refinement() {
     let m = 4;
     let (coarse, fine, at) = refined_lattice(m, 4);
@@ -327,6 +328,7 @@ fn boundary_patches_are_the_limit_of_whole_mesh_refinement() {
 /// tessellation at the limit position of the vertex three whole-mesh ternary steps of the
 /// input put at its parameter (to 1e-6).
 #[test]
+#[cfg(feature = "sqrt3")]
 #[cfg_attr(
     not(shared_models),
     ignore = "needs ../shared/models beside the repository"
