@@ -181,31 +181,6 @@ impl<'a> Context<'a> {
             .collect()
     }
 
-    /// The limit positions of every point of `section` (triangle `f`'s, its control points
-    /// `control`), in the triangle's own indices and the table's order, appended to `out`.
-    fn extend_grid(
-        &self,
-        control: &[[f64; 3]],
-        section: &Section,
-        points: PointSet,
-        out: &mut Vec<[f64; 3]>,
-    ) {
-        let n = section.n;
-        let mut rows = Vec::with_capacity(points.count(n) as usize);
-        if points == PointSet::TrianglePrimal {
-            for j in 0..=n {
-                for i in 0..=n - j {
-                    rows.push(section.weights_of(section.primal_row(i, j)));
-                }
-            }
-        } else {
-            for_each_dual(n, |i, j, down| {
-                rows.push(section.weights_of(section.dual_row(i, j, down)))
-            });
-        }
-        extend_weighted_sums(control, rows.into_iter(), out);
-    }
-
     /// Which sides of triangle `f` are on the boundary (bit `s` for side `s`).
     fn boundary_mask(&self, f: usize) -> u8 {
         let first = self.iso.mesh.face_halfedges(f).start;
@@ -221,7 +196,7 @@ impl<'a> Context<'a> {
         for &n in &grid.rates {
             for points in [PointSet::TrianglePrimal, PointSet::TriangleDual] {
                 let section = self.section(f, points, n)?;
-                self.extend_grid(&control, &section, points, &mut out);
+                section.extend_points(&control, points, &mut out);
             }
         }
         Ok(out)
@@ -235,7 +210,7 @@ impl<'a> Context<'a> {
         let control = self.patch_control(f);
         for points in [PointSet::TriangleDual, PointSet::TrianglePrimal] {
             let section = self.section(f, points, n)?;
-            self.extend_grid(&control, &section, points, &mut out);
+            section.extend_points(&control, points, &mut out);
         }
         out.resize(ids.count(), [0.0; 3]);
         let mesh = &self.iso.mesh;
@@ -275,6 +250,26 @@ impl<'t> Section<'t> {
     /// The weights of table row `row`.
     fn weights_of(&self, row: usize) -> &'t [f32] {
         &self.weights[row * self.k..][..self.k]
+    }
+
+    /// The limit positions of every point of this section (on the grid `points`) of a triangle
+    /// whose patch has the control points `control`, in the triangle's own indices and the
+    /// table's order, appended to `out`.
+    fn extend_points(&self, control: &[[f64; 3]], points: PointSet, out: &mut Vec<[f64; 3]>) {
+        let n = self.n;
+        let mut rows = Vec::with_capacity(points.count(n) as usize);
+        if points == PointSet::TrianglePrimal {
+            for j in 0..=n {
+                for i in 0..=n - j {
+                    rows.push(self.weights_of(self.primal_row(i, j)));
+                }
+            }
+        } else {
+            for_each_dual(n, |i, j, down| {
+                rows.push(self.weights_of(self.dual_row(i, j, down)))
+            });
+        }
+        extend_weighted_sums(control, rows.into_iter(), out);
     }
 
     fn primal_row(&self, i: u32, j: u32) -> usize {
@@ -731,7 +726,7 @@ pub fn triangle_table_positions(
     }
     let section = ctx.section(face, points, n)?;
     let mut out = Vec::with_capacity(points.count(n) as usize);
-    ctx.extend_grid(&ctx.patch_control(face), &section, points, &mut out);
+    section.extend_points(&ctx.patch_control(face), points, &mut out);
     Ok(out)
 }
 
