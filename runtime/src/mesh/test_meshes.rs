@@ -57,6 +57,7 @@ pub fn lattice_torus(m: i64, position: impl Fn(i64, i64) -> [f64; 3]) -> Mesh {
 
 /// A torus of `m x n` quads, every vertex interior of valence 4 (regular), slightly twisted
 /// out of its symmetry planes so that no coordinate of a patch is constant.
+#[cfg(feature = "catmull-clark")]
 pub fn quad_torus(m: usize, n: usize) -> Mesh {
     let mut positions = Vec::new();
     for j in 0..n {

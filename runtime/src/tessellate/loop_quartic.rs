@@ -52,7 +52,11 @@ use crate::tessellate::lane_stencils::{unit_cross, LANES};
 pub(crate) const POINTS: usize = 12;
 
 /// Monomials `u^a v^b` of total degree at most 4, indexed by [`monomial`].
-const MONOMIALS: usize = 15;
+pub(crate) const MONOMIALS: usize = 15;
+
+/// One regular patch as a quartic in a face's parameters: the coefficient of every monomial
+/// ([`monomial`]), per coordinate ([`QuarticBasis::polynomial`]).
+pub(crate) type Polynomial = [[f64; 3]; MONOMIALS];
 
 /// [`MONOMIALS`] padded to a multiple of the vector width.
 const MONOMIAL_LANES: usize = 16;
@@ -150,6 +154,21 @@ impl QuarticBasis {
         Some(QuarticBasis { by_corner, frame })
     }
 
+    /// The regular patch at face corner `corner` over its twelve control points `control` (the
+    /// table's layout) as one quartic in the face's parameters: `c_ab = sum_l C[a, b][l] P_l`.
+    pub(crate) fn polynomial(&self, corner: usize, control: &[[f64; 3]]) -> Polynomial {
+        let c = &self.by_corner[corner % 3];
+        std::array::from_fn(|m| {
+            let mut out = [0.0; 3];
+            for (&w, q) in c[m].iter().zip(control) {
+                for k in 0..3 {
+                    out[k] += w * q[k];
+                }
+            }
+            out
+        })
+    }
+
     /// Whether the patch-frame polynomials reproduce the table's stencils `dual` and `primal`
     /// of the regular patch at rate `n` (position, d/du, d/dv; every point) to `1e-6`.
     pub(crate) fn reproduces(&self, dual: &Stencils, primal: &Stencils, n: u32) -> bool {
@@ -197,6 +216,24 @@ impl QuarticBasis {
             })
         })
     }
+}
+
+/// The value of `p` at `(u, v)`: per power of `u` the quartic in `v` by Horner's rule, then the
+/// quartic in `u`.
+pub(crate) fn polynomial_value(p: &Polynomial, u: f64, v: f64) -> [f64; 3] {
+    let mut out = [0.0; 3];
+    for a in (0..=DEGREE).rev() {
+        let mut row = [0.0; 3];
+        for b in (0..=DEGREE - a).rev() {
+            for k in 0..3 {
+                row[k] = row[k] * v + p[monomial(a, b)][k];
+            }
+        }
+        for k in 0..3 {
+            out[k] = out[k] * u + row[k];
+        }
+    }
+    out
 }
 
 /// Weight of control point `l` and its two derivatives at `(u, v)`, from coefficients `c`.

@@ -750,7 +750,7 @@ pub const MIN_QUARTIC_RATE: u32 = 5;
 
 /// Whether `patch` has the layout of Loop's regular patch (interior, valence 6, twelve points);
 /// whether its table section *is* the quartic box spline is checked against the table.
-fn is_loop_regular(patch: &TrianglePatch) -> bool {
+pub(crate) fn is_loop_regular(patch: &TrianglePatch) -> bool {
     !patch.kind.boundary && patch.kind.faces == 6 && patch.points.len() == LOOP_REGULAR_POINTS
 }
 
