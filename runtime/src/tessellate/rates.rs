@@ -830,9 +830,8 @@ impl<'p> FaceLocal<'p> {
     /// Every dual point, those not read yet evaluated four at a time ([`PatchPoints::extend`]):
     /// what a scan that is not refuted at once reads anyway.
     fn filled(&self) -> Vec<[f64; 3]> {
-        let missing: Vec<usize> = (0..self.dual.len())
-            .filter(|&k| self.dual[k].get().is_none())
-            .collect();
+        let mut missing = Vec::with_capacity(self.dual.len());
+        missing.extend((0..self.dual.len()).filter(|&k| self.dual[k].get().is_none()));
         let mut points = Vec::with_capacity(missing.len());
         self.own.extend(
             &self.grid,
@@ -917,7 +916,7 @@ impl<'p> FaceLocal<'p> {
         let mut corners = Vec::with_capacity(4);
         for corner in 0..4 {
             let (fan, closed) = sector(mesh, first + corner);
-            let mut ring = Vec::new();
+            let mut ring = Vec::with_capacity(fan.len() + 1);
             if !closed {
                 let (i, j) = curve_index(corner, 0, m);
                 ring.push(own.at(&primal, i, j));
@@ -927,9 +926,10 @@ impl<'p> FaceLocal<'p> {
                 let c = h - mesh.face_halfedges(g).start;
                 ring.push(dual_of(g, row_index(c, 0, m))?);
             }
-            let mut triangles: Vec<[[f64; 3]; 3]> = (1..ring.len().saturating_sub(1))
-                .map(|i| [ring[0], ring[i], ring[i + 1]])
-                .collect();
+            // The polygon's fan, two triangles of each strip and the corner cell's two.
+            let mut triangles: Vec<[[f64; 3]; 3]> = Vec::with_capacity(ring.len() + 6);
+            triangles
+                .extend((1..ring.len().saturating_sub(1)).map(|i| [ring[0], ring[i], ring[i + 1]]));
             // Side `corner` starts at this corner, side `corner - 1` ends at it.
             let (starting, ending) = (&strips[corner], &strips[(corner + 3) % 4]);
             triangles.extend(starting.iter().take(2));
