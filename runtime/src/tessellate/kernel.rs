@@ -242,10 +242,9 @@ pub(crate) fn weighted_sums<const M: usize>(
 /// time ([`weighted_sums`]).
 pub(crate) fn extend_weighted_sums<'w>(
     control: &[[f64; 3]],
-    rows: impl Iterator<Item = &'w [f32]>,
+    mut rows: impl Iterator<Item = &'w [f32]>,
     out: &mut Vec<[f64; 3]>,
 ) {
-    let mut rows = rows.peekable();
     while let Some(first) = rows.next() {
         let mut four = [first; 4];
         let mut m = 1;

@@ -1,5 +1,6 @@
 //! Loop's regular patch as one quartic polynomial per triangle, for the triangle dual grid's
-//! regular faces ([`crate::tessellate::triangle_dual_grid`]).
+//! regular faces ([`crate::tessellate::triangle_dual_grid`]) and the tolerance selection's
+//! samples of them ([`crate::tessellate::triangle_rates`]).
 //!
 //! Over a triangle whose three corners have valence 6 Loop's surface is the quartic box spline
 //! (Loop 1987; Schaefer–Warren section 5.1): each of the twelve control points' weights is one
