@@ -490,13 +490,13 @@ fn tessellate_command(args: TessellateArgs) -> Result<(), RuntimeError> {
     let frame = tessellator.evaluate(&input.positions_f32())?;
     let seconds = started.elapsed().as_secs_f64();
     let output = frame.to_triangle_mesh();
-    let writing = Instant::now();
-    write_mesh(&output, &args.output)?;
-    let write_seconds = writing.elapsed().as_secs_f64();
-    if args.stats {
-        let checking = Instant::now();
-        let watertight = surface.boundary_loops() == 0 && output.is_watertight();
-        let check_seconds = checking.elapsed().as_secs_f64();
+    let closed = surface.boundary_loops() == 0;
+    let (write_seconds, check) = write_and_check(
+        args.stats,
+        || write_mesh(&output, &args.output),
+        || closed && output.is_watertight(),
+    )?;
+    if let Some((watertight, check_seconds)) = check {
         let mut stats = plan_stats(&surface, &tessellator);
         stats["write_seconds"] = write_seconds.into();
         stats["check_seconds"] = check_seconds.into();
@@ -510,6 +510,29 @@ fn tessellate_command(args: TessellateArgs) -> Result<(), RuntimeError> {
         out!("{stats}")?;
     }
     Ok(())
+}
+
+/// Write the output (`write`) and, for `--stats`, check that it is watertight (`check`) at the
+/// same time, on the pool's threads: the check reads what the writer reads and costs a fraction
+/// of it (docs/benchmarks.md, "Output"), so it leaves the critical path. The seconds of the
+/// write, and with `stats` the check's answer and seconds.
+fn write_and_check(
+    stats: bool,
+    write: impl FnOnce() -> Result<(), RuntimeError> + Send,
+    check: impl FnOnce() -> bool + Send,
+) -> Result<(f64, Option<(bool, f64)>), RuntimeError> {
+    let writing = || {
+        let started = Instant::now();
+        write().map(|()| started.elapsed().as_secs_f64())
+    };
+    if !stats {
+        return Ok((writing()?, None));
+    }
+    let (written, checked) = rayon::join(writing, || {
+        let started = Instant::now();
+        (check(), started.elapsed().as_secs_f64())
+    });
+    Ok((written?, Some(checked)))
 }
 
 /// The statistics every dual-grid run reports (docs/cli.md), less the timings of frames.
@@ -581,15 +604,22 @@ fn adaptive_command(args: &TessellateArgs, surface: &Surface) -> Result<(), Runt
             stats.leaves_over_tolerance, args.max_depth
         );
     }
-    if MeshFormat::from_path(&args.output)? == MeshFormat::Obj && !args.triangulate {
-        write_obj_polygons(&adaptive, &args.output)?;
-    } else {
-        write_mesh(&adaptive.to_triangle_mesh(), &args.output)?;
-    }
-    if args.stats {
+    let polygons = MeshFormat::from_path(&args.output)? == MeshFormat::Obj && !args.triangulate;
+    let closed = surface.boundary_loops() == 0;
+    let (_, check) = write_and_check(
+        args.stats,
+        || {
+            if polygons {
+                write_obj_polygons(&adaptive, &args.output)
+            } else {
+                write_mesh(&adaptive.to_triangle_mesh(), &args.output)
+            }
+        },
+        || closed && adaptive.is_watertight(),
+    )?;
+    if let Some((watertight, _)) = check {
         let mut report = stats.to_json();
-        report["watertight"] =
-            serde_json::json!(surface.boundary_loops() == 0 && adaptive.is_watertight());
+        report["watertight"] = serde_json::json!(watertight);
         report["isolation_seconds"] = serde_json::json!(surface.isolation_seconds());
         out!("{report}")?;
     }

@@ -567,11 +567,11 @@ fn ev_enclosure(levels: &[EvLevel]) -> Vec<Point> {
 /// A pair is at most `r_a + r_b` apart (`r` the distance from the centroid, the triangle
 /// inequality), with a margin of `1e-12` of the coordinates' and radii's size, far above the
 /// rounding of either side. The farthest point from the outermost one gives a first distance
-/// `d_0`; a point with `r + r_max` below it is in no pair that beats it and is dropped (most of
-/// an enclosure's, `ev_enclosure`, about 170 points clustered near a surface piece); the rest
-/// are visited by decreasing `r`, a pair skipped when `r_a + r_b` is below the best distance
-/// found. A skipped pair's computed distance cannot be the largest, so the result is the full
-/// double loop's, and most of the `n^2 / 2` pairs are never computed.
+/// `d_0`; a point with `r + r_max` below it is in no pair that beats it and is dropped before
+/// the sort (an enclosure, `ev_enclosure`, is about 170 points clustered near a surface piece);
+/// the rest are visited by decreasing `r`, a pair skipped when `r_a + r_b` is below the best
+/// distance found. A skipped pair's computed distance cannot be the largest, so the result is
+/// the full double loop's, and most of the `n^2 / 2` pairs are never computed.
 fn diameter(points: &[Point]) -> f64 {
     if points.is_empty() {
         return 0.0;
