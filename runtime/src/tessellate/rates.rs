@@ -82,7 +82,7 @@
 //! * Between samples of `G`: `e_f` is a maximum over samples, not over the continuum; the tests
 //!   measure the output again on other grids (dual points at rates 23 and 19).
 
-use std::cell::Cell;
+use std::cell::{Cell, OnceCell, RefCell};
 use std::sync::{Mutex, OnceLock};
 
 use rayon::prelude::*;
@@ -739,6 +739,11 @@ enum Beyond {
 
 /// The uniform-rate tessellation around one face, `L_{f,n}` (module docs): the face's dual
 /// points, what lies beyond each side, and the triangles around each corner.
+///
+/// Everything is made when a sample first reads it: a rate the selection refutes is mostly
+/// refuted at the sample that refuted the last one, in one side rectangle or corner square,
+/// and needs that region's rows and triangles only (on Spot at `1e-4`, 21,332 rates got past
+/// the interior, and 2,928 of them were the faces' last: the others were refuted outside it).
 struct FaceLocal<'p> {
     n: usize,
     /// The face's points and its dual grid at rate `n`, which `dual` is evaluated from.
@@ -749,10 +754,20 @@ struct FaceLocal<'p> {
     /// face that reaches rate `n` tries every smaller rate first (`n^3 / 3` points in all, where
     /// the rate it keeps reads `n^2`).
     dual: Vec<Cell<Option<[f64; 3]>>>,
-    beyond: Vec<Beyond>,
+    /// The mesh and every face's points: what the sides and corners are made from.
+    ctx: &'p Context<'p>,
+    /// The face.
+    f: usize,
+    /// The neighbours' dual grids at rate `n`, each looked up once: the rows beyond the sides
+    /// and the corners' rings read the same few faces (a lookup in a compact table costs as
+    /// much as a dozen points).
+    neighbours: RefCell<Vec<(usize, Grid<'p>)>>,
+    /// What lies beyond each side, and the strip between it and the face's row.
+    beyond: [OnceCell<Beyond>; 4],
+    strips: [OnceCell<Vec<[[f64; 3]; 3]>>; 4],
     /// Per corner: the vertex polygon's triangles, the two ends of the adjacent strips, and the
     /// face's corner cell.
-    corners: Vec<Vec<Corner>>,
+    corners: [OnceCell<Vec<Corner>>; 4],
 }
 
 /// A triangle around a corner, with a ball that holds it: `|p - centre| - radius` is a lower
@@ -804,9 +819,11 @@ fn strip_triangles(a: &[[f64; 3]], b: &[[f64; 3]], curve: bool) -> Vec<[[f64; 3]
 }
 
 impl<'p> FaceLocal<'p> {
-    /// The face's own dual points at rate `n`: all that `L_{f,n}` needs in the interior
-    /// `[h, 1-h]^2` (see [`FaceLocal::is_interior`]); [`FaceLocal::complete`] adds the rest.
-    fn interior(own: &'p PatchPoints<'p>, n: u32) -> Result<Self, RuntimeError> {
+    /// `L_{f,n}` around face `f`: the face's own dual points at rate `n` (all it needs in the
+    /// interior `[h, 1-h]^2`, [`FaceLocal::is_interior`]), what lies beyond each side and the
+    /// triangles around each corner, each made when first read.
+    fn new(ctx: &'p Context<'p>, f: usize, n: u32) -> Result<Self, RuntimeError> {
+        let own = &ctx.points[f];
         let grid = own.grid(PointSet::Dual, n)?;
         let count = grid.side() * grid.side();
         Ok(FaceLocal {
@@ -814,17 +831,13 @@ impl<'p> FaceLocal<'p> {
             own,
             grid,
             dual: vec![Cell::new(None); count],
-            beyond: Vec::new(),
-            corners: Vec::new(),
+            ctx,
+            f,
+            neighbours: RefCell::new(Vec::new()),
+            beyond: Default::default(),
+            strips: Default::default(),
+            corners: Default::default(),
         })
-    }
-
-    /// `L_{f,n}` around face `f` in full: its interior ([`FaceLocal::interior`]), what lies
-    /// beyond each side and the triangles around each corner.
-    fn new(ctx: &'p Context, f: usize, n: u32) -> Result<Self, RuntimeError> {
-        let mut local = FaceLocal::interior(&ctx.points[f], n)?;
-        local.complete(ctx, f)?;
-        Ok(local)
     }
 
     /// Every dual point, those not read yet evaluated four at a time ([`PatchPoints::extend`]):
@@ -847,111 +860,110 @@ impl<'p> FaceLocal<'p> {
             .collect()
     }
 
-    /// Add the neighbours' rows (or the boundary curves) and the corners' triangles to the
-    /// interior of face `f`.
-    fn complete(&mut self, ctx: &Context, f: usize) -> Result<(), RuntimeError> {
+    /// The dual grid of face `g` at rate `n`.
+    fn neighbour_grid(&self, g: usize) -> Result<Grid<'p>, RuntimeError> {
+        if let Some(&(_, grid)) = self.neighbours.borrow().iter().find(|(h, _)| *h == g) {
+            return Ok(grid);
+        }
+        let grid = self.ctx.points[g].grid(PointSet::Dual, self.n as u32)?;
+        self.neighbours.borrow_mut().push((g, grid));
+        Ok(grid)
+    }
+
+    /// What lies beyond side `side`: the neighbour's row, or the boundary curve.
+    fn beyond(&self, side: usize) -> Result<&Beyond, RuntimeError> {
+        once(&self.beyond[side], || self.make_beyond(side))
+    }
+
+    /// [`FaceLocal::beyond`], made (apart, so that the scans' loops stay small).
+    #[inline(never)]
+    fn make_beyond(&self, side: usize) -> Result<Beyond, RuntimeError> {
+        let (ctx, f) = (self.ctx, self.f);
         let m = self.n;
-        let n = m as u32;
-        let own = &ctx.points[f];
-        let primal = own.grid(PointSet::Primal, n)?;
         let mesh = ctx.mesh;
-        let first = mesh.face_halfedges(f).start;
-        // The neighbours' dual grids at rate n, each looked up once: the rows beyond the sides
-        // and the corners' rings read the same few faces (a lookup in a compact table costs
-        // as much as a dozen points).
-        let mut grids: Vec<(usize, Grid)> = Vec::with_capacity(12);
-        let mut dual_grid = |g: usize| -> Result<Grid, RuntimeError> {
-            if let Some(&(_, grid)) = grids.iter().find(|(h, _)| *h == g) {
-                return Ok(grid);
-            }
-            let grid = ctx.points[g].grid(PointSet::Dual, n)?;
-            grids.push((g, grid));
-            Ok(grid)
-        };
-        let mut beyond = Vec::with_capacity(4);
-        for side in 0..4 {
-            let t = mesh.twin[first + side];
-            beyond.push(if mesh.cut(first + side, false) != Cut::None {
-                let mut curve = Vec::with_capacity(m + 1);
-                own.extend(
-                    &primal,
-                    (0..=m).map(|t| curve_index(side, t, m)),
-                    &mut curve,
-                );
-                Beyond::Curve(curve)
+        let h = mesh.face_halfedges(f).start + side;
+        if mesh.cut(h, false) != Cut::None {
+            let primal = self.own.grid(PointSet::Primal, m as u32)?;
+            let mut curve = Vec::with_capacity(m + 1);
+            self.own.extend(
+                &primal,
+                (0..=m).map(|t| curve_index(side, t, m)),
+                &mut curve,
+            );
+            return Ok(Beyond::Curve(curve));
+        }
+        let t = mesh.twin[h] as usize;
+        let g = mesh.face_of[t] as usize;
+        let other = t - mesh.face_halfedges(g).start;
+        // The neighbour's row runs the other way along the shared edge.
+        let grid = self.neighbour_grid(g)?;
+        let mut row = Vec::with_capacity(m);
+        ctx.points[g].extend(
+            &grid,
+            (0..m).map(|t| row_index(other, m - 1 - t, m)),
+            &mut row,
+        );
+        Ok(Beyond::Face(row))
+    }
+
+    /// The strip along side `side`, in the tessellator's merge order.
+    fn strip(&self, side: usize) -> Result<&[[[f64; 3]; 3]], RuntimeError> {
+        once(&self.strips[side], || {
+            let row: Vec<[f64; 3]> = (0..self.n).map(|t| self.row(side, t)).collect();
+            Ok(match self.beyond(side)? {
+                Beyond::Face(other) => strip_triangles(&row, other, false),
+                Beyond::Curve(curve) => strip_triangles(&row, curve, true),
+            })
+        })
+        .map(Vec::as_slice)
+    }
+
+    /// The triangles around corner `corner`.
+    fn corner(&self, corner: usize) -> Result<&[Corner], RuntimeError> {
+        once(&self.corners[corner], || self.make_corner(corner)).map(Vec::as_slice)
+    }
+
+    /// [`FaceLocal::corner`], made (apart, so that the scans' loops stay small).
+    #[inline(never)]
+    fn make_corner(&self, corner: usize) -> Result<Vec<Corner>, RuntimeError> {
+        let (ctx, f) = (self.ctx, self.f);
+        let m = self.n;
+        let mesh = ctx.mesh;
+        let (fan, closed) = sector(mesh, mesh.face_halfedges(f).start + corner);
+        let mut ring = Vec::with_capacity(fan.len() + 1);
+        if !closed {
+            let primal = self.own.grid(PointSet::Primal, m as u32)?;
+            let (i, j) = curve_index(corner, 0, m);
+            ring.push(self.own.at(&primal, i, j));
+        }
+        for h in fan {
+            let g = mesh.face_of[h] as usize;
+            let (i, j) = row_index(h - mesh.face_halfedges(g).start, 0, m);
+            ring.push(if g == f {
+                self.d(i, j)
             } else {
-                let t = t as usize;
-                let g = mesh.face_of[t] as usize;
-                let other = t - mesh.face_halfedges(g).start;
-                // The neighbour's row runs the other way along the shared edge.
-                let points = &ctx.points[g];
-                let grid = dual_grid(g)?;
-                let mut row = Vec::with_capacity(m);
-                points.extend(
-                    &grid,
-                    (0..m).map(|t| row_index(other, m - 1 - t, m)),
-                    &mut row,
-                );
-                Beyond::Face(row)
+                ctx.points[g].at(&self.neighbour_grid(g)?, i, j)
             });
         }
-        self.beyond = beyond;
-        let local = &*self;
-        let strips: Vec<Vec<[[f64; 3]; 3]>> = (0..4)
-            .map(|side| {
-                let row: Vec<[f64; 3]> = (0..m).map(|t| local.row(side, t)).collect();
-                match &local.beyond[side] {
-                    Beyond::Face(other) => strip_triangles(&row, other, false),
-                    Beyond::Curve(curve) => strip_triangles(&row, curve, true),
-                }
-            })
-            .collect();
-        // The dual point (i, j) of face g at rate n.
-        let mut dual_of = |g: usize, (i, j): (usize, usize)| -> Result<[f64; 3], RuntimeError> {
-            if g == f {
-                return Ok(local.d(i, j));
-            }
-            Ok(ctx.points[g].at(&dual_grid(g)?, i, j))
-        };
-        let mut corners = Vec::with_capacity(4);
-        for corner in 0..4 {
-            let (fan, closed) = sector(mesh, first + corner);
-            let mut ring = Vec::with_capacity(fan.len() + 1);
-            if !closed {
-                let (i, j) = curve_index(corner, 0, m);
-                ring.push(own.at(&primal, i, j));
-            }
-            for h in fan {
-                let g = mesh.face_of[h] as usize;
-                let c = h - mesh.face_halfedges(g).start;
-                ring.push(dual_of(g, row_index(c, 0, m))?);
-            }
-            // The polygon's fan, two triangles of each strip and the corner cell's two.
-            let mut triangles: Vec<[[f64; 3]; 3]> = Vec::with_capacity(ring.len() + 6);
-            triangles
-                .extend((1..ring.len().saturating_sub(1)).map(|i| [ring[0], ring[i], ring[i + 1]]));
-            // Side `corner` starts at this corner, side `corner - 1` ends at it.
-            let (starting, ending) = (&strips[corner], &strips[(corner + 3) % 4]);
-            triangles.extend(starting.iter().take(2));
-            triangles.extend(ending.iter().rev().take(2));
-            if m >= 2 {
-                let (i, j) = row_index(corner, 0, m);
-                let (i1, j1) = (i.min(m - 2), j.min(m - 2));
-                let (p, q, r, s) = (
-                    local.d(i1, j1),
-                    local.d(i1 + 1, j1),
-                    local.d(i1 + 1, j1 + 1),
-                    local.d(i1, j1 + 1),
-                );
-                triangles.extend([[p, q, r], [p, r, s]]);
-            }
-            corners.push(triangles);
+        // The polygon's fan, two triangles of each strip and the corner cell's two.
+        let mut triangles: Vec<[[f64; 3]; 3]> = Vec::with_capacity(ring.len() + 6);
+        triangles
+            .extend((1..ring.len().saturating_sub(1)).map(|i| [ring[0], ring[i], ring[i + 1]]));
+        // Side `corner` starts at this corner, side `corner - 1` ends at it.
+        triangles.extend(self.strip(corner)?.iter().take(2));
+        triangles.extend(self.strip((corner + 3) % 4)?.iter().rev().take(2));
+        if m >= 2 {
+            let (i, j) = row_index(corner, 0, m);
+            let (i1, j1) = (i.min(m - 2), j.min(m - 2));
+            let (p, q, r, s) = (
+                self.d(i1, j1),
+                self.d(i1 + 1, j1),
+                self.d(i1 + 1, j1 + 1),
+                self.d(i1, j1 + 1),
+            );
+            triangles.extend([[p, q, r], [p, r, s]]);
         }
-        self.corners = corners
-            .into_iter()
-            .map(|triangles| triangles.into_iter().map(Corner::new).collect())
-            .collect();
-        Ok(())
+        Ok(triangles.into_iter().map(Corner::new).collect())
     }
 
     /// Dual point `(i, j)`, evaluated the first time it is read.
@@ -972,7 +984,7 @@ impl<'p> FaceLocal<'p> {
 
     /// The deviation at one sample: `|S - L_{f,n}(u, v)|` in the interior and the side
     /// rectangles, the distance to the nearest triangle around the corner in a corner square.
-    fn deviation_at(&self, u: f64, v: f64, p: [f64; 3]) -> f64 {
+    fn deviation_at(&self, u: f64, v: f64, p: [f64; 3]) -> Result<f64, RuntimeError> {
         let n = self.n as f64;
         let h = 0.5 / n;
         let (low_u, high_u, low_v, high_v) = (u <= h, u >= 1.0 - h, v <= h, v >= 1.0 - h);
@@ -986,25 +998,25 @@ impl<'p> FaceLocal<'p> {
             // The nearest triangle: one whose ball is farther than the nearest so far cannot be
             // nearer (the margin keeps rounding in the bound from skipping a tie).
             let mut nearest = f64::INFINITY;
-            for t in &self.corners[corner] {
+            for t in self.corner(corner)? {
                 let centre = distance(p, t.centre);
                 if centre - t.radius - 1e-12 * (centre + t.radius) <= nearest {
                     nearest = nearest.min(point_triangle_distance(p, &t.triangle));
                 }
             }
-            return nearest;
+            return Ok(nearest);
         }
-        distance(p, self.at(u, v))
+        Ok(distance(p, self.at(u, v)?))
     }
 
     /// Whether `(u, v)` lies in the interior `[h, 1-h]^2`, outside the corner squares: there
-    /// `L_{f,n}` is made of the face's own dual points alone ([`FaceLocal::interior`]).
+    /// `L_{f,n}` is made of the face's own dual points alone.
     fn is_interior(&self, u: f64, v: f64) -> bool {
         AxisPlace::new(u, self.n).interior_with(&AxisPlace::new(v, self.n), self.n)
     }
 
     /// `L_{f,n}(u, v)` outside the corner squares.
-    fn at(&self, u: f64, v: f64) -> [f64; 3] {
+    fn at(&self, u: f64, v: f64) -> Result<[f64; 3], RuntimeError> {
         let n = self.n as f64;
         let h = 0.5 / n;
         let distances = [v, 1.0 - u, 1.0 - v, u];
@@ -1026,13 +1038,13 @@ impl<'p> FaceLocal<'p> {
         if nearest >= h || self.n == 1 {
             // Interior: cell (i, j) of the dual grid, local (a, b) in [0,1]^2, split along a = b.
             if self.n == 1 {
-                return self.d(0, 0);
+                return Ok(self.d(0, 0));
             }
-            return in_cell(
+            return Ok(in_cell(
                 |i, j| self.d(i, j),
                 &AxisPlace::new(u, self.n),
                 &AxisPlace::new(v, self.n),
-            );
+            ));
         }
         // A side's strip, in scaled side coordinates: the face's row point t at (2t + 1, 1),
         // the curve point t at (2t, 0), the neighbour's row point t at (2t + 1, -1).
@@ -1044,7 +1056,7 @@ impl<'p> FaceLocal<'p> {
         };
         let sigma = (2.0 * n * s).clamp(1.0, 2.0 * n - 1.0);
         let delta = (2.0 * n * nearest).clamp(0.0, 1.0);
-        match &self.beyond[side] {
+        Ok(match self.beyond(side)? {
             Beyond::Face(other) => {
                 // Cell i between the rows: quad (F_i, F_i+1, G_i+1, G_i) split as
                 // [G_i, F_i+1, F_i], [G_i, G_i+1, F_i+1]; alpha along, beta from G (0) to F (1).
@@ -1082,11 +1094,11 @@ impl<'p> FaceLocal<'p> {
                     ])
                 }
             }
-        }
+        })
     }
 
     /// `e_f(n)` over the samples.
-    fn deviation(&self, samples: &Samples) -> f64 {
+    fn deviation(&self, samples: &Samples) -> Result<f64, RuntimeError> {
         self.deviation_up_to(samples, f64::INFINITY, |_| true)
     }
 
@@ -1098,16 +1110,21 @@ impl<'p> FaceLocal<'p> {
     /// The sample that refuted the last rate is read first; then the samples grid by grid, row
     /// by row, with each row's and column's place in the dual grid found once (where the
     /// interior's samples, most of them, cost one interpolation each).
-    fn deviation_up_to(&self, samples: &Samples, stop: f64, keep: impl Fn(bool) -> bool) -> f64 {
+    fn deviation_up_to(
+        &self,
+        samples: &Samples,
+        stop: f64,
+        keep: impl Fn(bool) -> bool,
+    ) -> Result<f64, RuntimeError> {
         let count = samples.uv.len().min(samples.positions.len());
         let first = samples.start.get();
         let mut worst = 0.0f64;
         if first < count {
             let ([u, v], p) = (samples.uv[first], samples.positions[first]);
             if keep(self.is_interior(u, v)) {
-                worst = self.deviation_at(u, v, p);
+                worst = self.deviation_at(u, v, p)?;
                 if worst > stop {
-                    return worst;
+                    return Ok(worst);
                 }
             }
         }
@@ -1137,19 +1154,31 @@ impl<'p> FaceLocal<'p> {
                         distance(p, in_cell(|i, j| dual[j * n + i], column, row))
                     } else {
                         let [u, v] = samples.uv[k];
-                        self.deviation_at(u, v, p)
+                        self.deviation_at(u, v, p)?
                     };
                     worst = worst.max(deviation);
                     if worst > stop {
                         samples.start.set(k);
-                        return worst;
+                        return Ok(worst);
                     }
                 }
             }
             offset += side * side;
         }
-        worst
+        Ok(worst)
     }
+}
+
+/// The value of `cell`, made by `make` the first time.
+fn once<T>(
+    cell: &OnceCell<T>,
+    make: impl FnOnce() -> Result<T, RuntimeError>,
+) -> Result<&T, RuntimeError> {
+    if let Some(value) = cell.get() {
+        return Ok(value);
+    }
+    let value = make()?;
+    Ok(cell.get_or_init(|| value))
 }
 
 /// `L_{f,n}` in the interior: the dual grid's cell that holds the sample with places `u` and `v`,
@@ -1327,7 +1356,7 @@ pub fn face_deviation(
             reason: format!("{face} (the mesh has {} faces)", patches.len()),
         })?;
     let samples = Samples::new(points, SELECTION_GRID)?;
-    Ok(FaceLocal::new(&ctx, face, n)?.deviation(&samples))
+    FaceLocal::new(&ctx, face, n)?.deviation(&samples)
 }
 
 /// Per face the smallest rate `n` in `1..=24` with `e_f(n) <= tolerance` (module docs):
@@ -1347,8 +1376,10 @@ pub fn tolerance_rates(
 ///
 /// Cost: per face, the 1,201 samples once (a regular face's in closed form, the tensor-product
 /// B-spline), then for each candidate tried the dual points its scan reads (four for a rate
-/// refuted at its first sample, `n^2 + 4(n + 1)` table points for the rate kept) and one
-/// interpolation per sample read; faces run in parallel.
+/// refuted at its first sample, `n^2 + 4(n + 1)` table points for the rate kept), the rows and
+/// triangles of the side rectangles and corner squares it reads (one region for a rate refuted
+/// there at its first sample, all of them for the rate kept) and one interpolation per sample
+/// read; faces run in parallel.
 /// Faces evaluated adaptively ([module docs](self)) cost a descent per grid, shared by the faces
 /// around one vertex.
 pub fn tolerance_rates_among(
@@ -1387,23 +1418,22 @@ pub fn tolerance_rates_among(
             // Most samples are interior, where the face's own dual points are all of
             // `L_{f,n}`: a failing rate is refuted there before its neighbours' rows and its
             // corners' polygons are evaluated, unless the last rate failed only outside.
-            let mut local = FaceLocal::interior(&ctx.points[f], n)?;
+            let local = FaceLocal::new(&ctx, f, n)?;
             let mut worst = 0.0f64;
             if !samples.outside_first.get() {
-                worst = local.deviation_up_to(samples, stop, |interior| interior);
+                worst = local.deviation_up_to(samples, stop, |interior| interior)?;
                 if worst > stop {
                     return Ok(worst);
                 }
             }
-            local.complete(&ctx, f)?;
-            worst = worst.max(local.deviation_up_to(samples, stop, |interior| !interior));
+            worst = worst.max(local.deviation_up_to(samples, stop, |interior| !interior)?);
             if worst > stop {
                 samples.outside_first.set(true);
                 return Ok(worst);
             }
             if samples.outside_first.get() {
                 samples.outside_first.set(false);
-                worst = worst.max(local.deviation_up_to(samples, stop, |interior| interior));
+                worst = worst.max(local.deviation_up_to(samples, stop, |interior| interior)?);
             }
             Ok(worst)
         },
