@@ -762,6 +762,9 @@ struct FaceLocal<'p> {
     /// and the corners' rings read the same few faces (a lookup in a compact table costs as
     /// much as a dozen points).
     neighbours: RefCell<Vec<(usize, Grid<'p>)>>,
+    /// The face's primal grid at rate `n`: its boundary curves and the limit points that close
+    /// its corners' polygons.
+    primal: OnceCell<Grid<'p>>,
     /// What lies beyond each side, and the strip between it and the face's row.
     beyond: [OnceCell<Beyond>; 4],
     strips: [OnceCell<Vec<[[f64; 3]; 3]>>; 4],
@@ -834,6 +837,7 @@ impl<'p> FaceLocal<'p> {
             ctx,
             f,
             neighbours: RefCell::new(Vec::new()),
+            primal: OnceCell::new(),
             beyond: Default::default(),
             strips: Default::default(),
             corners: Default::default(),
@@ -870,6 +874,14 @@ impl<'p> FaceLocal<'p> {
         Ok(grid)
     }
 
+    /// The face's primal grid at rate `n`, looked up once for all its sides and corners.
+    fn primal(&self) -> Result<Grid<'p>, RuntimeError> {
+        once(&self.primal, || {
+            self.own.grid(PointSet::Primal, self.n as u32)
+        })
+        .copied()
+    }
+
     /// What lies beyond side `side`: the neighbour's row, or the boundary curve.
     fn beyond(&self, side: usize) -> Result<&Beyond, RuntimeError> {
         once(&self.beyond[side], || self.make_beyond(side))
@@ -883,7 +895,7 @@ impl<'p> FaceLocal<'p> {
         let mesh = ctx.mesh;
         let h = mesh.face_halfedges(f).start + side;
         if mesh.cut(h, false) != Cut::None {
-            let primal = self.own.grid(PointSet::Primal, m as u32)?;
+            let primal = self.primal()?;
             let mut curve = Vec::with_capacity(m + 1);
             self.own.extend(
                 &primal,
@@ -932,7 +944,7 @@ impl<'p> FaceLocal<'p> {
         let (fan, closed) = sector(mesh, mesh.face_halfedges(f).start + corner);
         let mut ring = Vec::with_capacity(fan.len() + 1);
         if !closed {
-            let primal = self.own.grid(PointSet::Primal, m as u32)?;
+            let primal = self.primal()?;
             let (i, j) = curve_index(corner, 0, m);
             ring.push(self.own.at(&primal, i, j));
         }
