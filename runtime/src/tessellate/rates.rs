@@ -602,10 +602,8 @@ pub fn table_positions(
 /// Limit-surface samples of one face: parameters and positions.
 struct Samples {
     uv: Vec<[f64; 2]>,
+    /// Grid by grid ([`selection_axes`]), `j` outer.
     positions: Vec<[f64; 3]>,
-    /// The parameters along either axis of each grid of samples (primal, then dual), in the
-    /// order of `uv`: grid `g` holds `axes[g].len()^2` samples, `j` outer.
-    axes: Vec<Vec<f64>>,
     /// Where the next early-stopping scan starts: the sample that refuted the last rate. The
     /// next rate's deviation peaks in the same region of the face (where it bends most), so a
     /// scan from there finds a failing rate's first sample beyond the tolerance soonest.
@@ -621,7 +619,6 @@ impl Samples {
         Samples {
             uv: Vec::new(),
             positions: Vec::new(),
-            axes: Vec::new(),
             start: Cell::new(0),
             outside_first: Cell::new(false),
         }
@@ -632,20 +629,11 @@ impl Samples {
         let count = (grid_side(true, grid).pow(2) + grid_side(false, grid).pow(2)) as usize;
         let mut uv = Vec::with_capacity(count);
         let mut positions = Vec::with_capacity(count);
-        let mut axes = Vec::with_capacity(2);
-        for set in [PointSet::Primal, PointSet::Dual] {
+        for (set, axis) in [PointSet::Primal, PointSet::Dual]
+            .into_iter()
+            .zip(selection_axes(grid))
+        {
             let g = points.grid(set, grid)?;
-            let n = f64::from(grid);
-            // `grid` refused the triangle point sets; only the quad ones reach here.
-            let axis: Vec<f64> = (0..g.side())
-                .map(|i| {
-                    if set == PointSet::Primal {
-                        i as f64 / n
-                    } else {
-                        (2 * i + 1) as f64 / (2.0 * n)
-                    }
-                })
-                .collect();
             for &v in &axis {
                 for &u in &axis {
                     uv.push([u, v]);
@@ -660,16 +648,27 @@ impl Samples {
                     &mut positions,
                 ),
             }
-            axes.push(axis);
         }
         Ok(Samples {
             uv,
             positions,
-            axes,
             start: Cell::new(0),
             outside_first: Cell::new(false),
         })
     }
+}
+
+/// The parameters along either axis of the samples at rate `grid`: the primal grid's `i / grid`,
+/// `i = 0..=grid`, then the dual grid's `(2i + 1) / 2 grid`, `i = 0..grid`. Each grid of samples
+/// is the square of its axis.
+fn selection_axes(grid: u32) -> [Vec<f64>; 2] {
+    let n = f64::from(grid);
+    [
+        (0..=grid).map(|i| f64::from(i) / n).collect(),
+        (0..grid)
+            .map(|i| f64::from(2 * i + 1) / (2.0 * n))
+            .collect(),
+    ]
 }
 
 /// The cubic B-spline surface of `net` ([`PatchPoints::bspline_net`]) at the grid `axis x axis`
@@ -771,6 +770,9 @@ struct FaceLocal<'p> {
     /// Per corner: the vertex polygon's triangles, the two ends of the adjacent strips, and the
     /// face's corner cell.
     corners: [OnceCell<Vec<Corner>>; 4],
+    /// Per corner, the triangle nearest the last sample read there: where a corner square's
+    /// search starts.
+    nearest: [Cell<usize>; 4],
 }
 
 /// A triangle around a corner, with a ball that holds it: `|p - centre| - radius` is a lower
@@ -841,6 +843,7 @@ impl<'p> FaceLocal<'p> {
             beyond: Default::default(),
             strips: Default::default(),
             corners: Default::default(),
+            nearest: Default::default(),
         })
     }
 
@@ -995,8 +998,11 @@ impl<'p> FaceLocal<'p> {
     }
 
     /// The deviation at one sample: `|S - L_{f,n}(u, v)|` in the interior and the side
-    /// rectangles, the distance to the nearest triangle around the corner in a corner square.
-    fn deviation_at(&self, u: f64, v: f64, p: [f64; 3]) -> Result<f64, RuntimeError> {
+    /// rectangles, the distance to the nearest triangle around the corner in a corner square;
+    /// or, where that is at most `floor`, any value at most `floor` (a scan after the largest
+    /// deviation needs no more: a corner square's search stops at the first triangle that
+    /// near).
+    fn deviation_at(&self, u: f64, v: f64, p: [f64; 3], floor: f64) -> Result<f64, RuntimeError> {
         let n = self.n as f64;
         let h = 0.5 / n;
         let (low_u, high_u, low_v, high_v) = (u <= h, u >= 1.0 - h, v <= h, v >= 1.0 - h);
@@ -1007,13 +1013,28 @@ impl<'p> FaceLocal<'p> {
                 (false, false) => 2,
                 (true, false) => 3,
             };
-            // The nearest triangle: one whose ball is farther than the nearest so far cannot be
-            // nearer (the margin keeps rounding in the bound from skipping a tie).
-            let mut nearest = f64::INFINITY;
-            for t in self.corner(corner)? {
+            // The nearest triangle, from the one nearest the last sample here (the next sample
+            // is mostly nearest it too, and then bounds the rest tightest): one whose ball is
+            // farther than the nearest so far cannot be nearer (the margin keeps rounding in the
+            // bound from skipping a tie).
+            let triangles = self.corner(corner)?;
+            let hint = &self.nearest[corner];
+            let first = hint.get().min(triangles.len().saturating_sub(1));
+            let Some(t) = triangles.get(first) else {
+                return Ok(f64::INFINITY);
+            };
+            let mut nearest = point_triangle_distance(p, &t.triangle);
+            for (k, t) in triangles.iter().enumerate() {
+                if nearest <= floor {
+                    break;
+                }
                 let centre = distance(p, t.centre);
-                if centre - t.radius - 1e-12 * (centre + t.radius) <= nearest {
-                    nearest = nearest.min(point_triangle_distance(p, &t.triangle));
+                if k != first && centre - t.radius - 1e-12 * (centre + t.radius) <= nearest {
+                    let d = point_triangle_distance(p, &t.triangle);
+                    if d < nearest {
+                        nearest = d;
+                        hint.set(k);
+                    }
                 }
             }
             return Ok(nearest);
@@ -1134,7 +1155,7 @@ impl<'p> FaceLocal<'p> {
         if first < count {
             let ([u, v], p) = (samples.uv[first], samples.positions[first]);
             if keep(self.is_interior(u, v)) {
-                worst = self.deviation_at(u, v, p)?;
+                worst = self.deviation_at(u, v, p, 0.0)?;
                 if worst > stop {
                     return Ok(worst);
                 }
@@ -1147,31 +1168,55 @@ impl<'p> FaceLocal<'p> {
         } else {
             Vec::new()
         };
+        let mut below = worst * worst * (1.0 - 1e-14);
         let mut offset = 0;
-        for axis in &samples.axes {
-            let side = axis.len();
-            let places: Vec<AxisPlace> = axis.iter().map(|&t| AxisPlace::new(t, n)).collect();
-            for (j, row) in places.iter().enumerate() {
-                for (i, column) in places.iter().enumerate() {
-                    let k = offset + j * side + i;
-                    if k >= count {
-                        break;
+        for axis in self.ctx.places(n)? {
+            let side = axis.places.len();
+            for (j, row) in axis.places.iter().enumerate() {
+                let row_samples = offset + j * side..offset + (j + 1) * side;
+                let (Some(positions), Some(uv)) = (
+                    samples.positions.get(row_samples.clone()),
+                    samples.uv.get(row_samples),
+                ) else {
+                    break;
+                };
+                let interior = axis.interior_columns(row, n);
+                if wants_interior {
+                    for i in interior.clone() {
+                        // The square root only where the sample may be the largest so far:
+                        // `distance` is the root of the same sum.
+                        let d = sub(
+                            positions[i],
+                            in_cell(|i, j| dual[j * n + i], &axis.places[i], row),
+                        );
+                        let squared = dot(d, d);
+                        if squared <= below {
+                            continue;
+                        }
+                        let deviation = squared.sqrt();
+                        if deviation > worst {
+                            worst = deviation;
+                            below = worst * worst * (1.0 - 1e-14);
+                            if worst > stop {
+                                samples.start.set(offset + j * side + i);
+                                return Ok(worst);
+                            }
+                        }
                     }
-                    let interior = column.interior_with(row, n);
-                    if !keep(interior) {
-                        continue;
-                    }
-                    let p = samples.positions[k];
-                    let deviation = if interior && wants_interior {
-                        distance(p, in_cell(|i, j| dual[j * n + i], column, row))
-                    } else {
-                        let [u, v] = samples.uv[k];
-                        self.deviation_at(u, v, p)?
-                    };
-                    worst = worst.max(deviation);
-                    if worst > stop {
-                        samples.start.set(k);
-                        return Ok(worst);
+                }
+                if keep(false) {
+                    for i in (0..interior.start).chain(interior.end..side) {
+                        let [u, v] = uv[i];
+                        let deviation = self.deviation_at(u, v, positions[i], worst)?;
+                        // (A NaN leaves `worst` as it is, as `f64::max` would.)
+                        if deviation > worst {
+                            worst = deviation;
+                            below = worst * worst * (1.0 - 1e-14);
+                            if worst > stop {
+                                samples.start.set(offset + j * side + i);
+                                return Ok(worst);
+                            }
+                        }
                     }
                 }
             }
@@ -1209,9 +1254,11 @@ fn in_cell(at: impl Fn(usize, usize) -> [f64; 3], u: &AxisPlace, v: &AxisPlace) 
 /// cells `0..n-1` between dual points `(2i+1)/2n`) that [`in_cell`] interpolates in, and the
 /// fraction in it. A scan computes it once per row and column of samples.
 struct AxisPlace {
-    t: f64,
     cell: usize,
     fraction: f64,
+    /// Whether `t` lies in `[h, 1-h]` (`h = 1/2n`), and whether in `[0, h]` or `[1-h, 1]`.
+    inside: bool,
+    near_side: bool,
 }
 
 impl AxisPlace {
@@ -1220,20 +1267,64 @@ impl AxisPlace {
         let x = (t * nf - 0.5).clamp(0.0, nf - 1.0);
         // `x >= 0`: truncation is the floor.
         let cell = (x as usize).min(n.saturating_sub(2));
+        let h = 0.5 / nf;
         AxisPlace {
-            t,
             cell,
             fraction: x - cell as f64,
+            inside: t >= h && 1.0 - t >= h,
+            near_side: t <= h || t >= 1.0 - h,
         }
     }
 
     /// Whether the sample at places `self` (along `u`) and `v` lies in the interior of the rate-`n`
     /// tessellation, `[h, 1-h]^2` with `h = 1/2n`, outside the corner squares (n >= 2).
     fn interior_with(&self, v: &AxisPlace, n: usize) -> bool {
-        let h = 0.5 / n as f64;
-        let inside = |t: f64| t >= h && 1.0 - t >= h;
-        let near_side = |t: f64| t <= h || t >= 1.0 - h;
-        n >= 2 && inside(self.t) && inside(v.t) && !(near_side(self.t) && near_side(v.t))
+        n >= 2 && self.inside && v.inside && !(self.near_side && v.near_side)
+    }
+}
+
+/// The samples' parameters along either axis ([`selection_axes`]) placed against the dual grid
+/// at one rate, with the columns whose samples may lie in the interior: the same for every face.
+struct AxisPlaces {
+    places: Vec<AxisPlace>,
+    /// The columns whose parameter lies in `[h, 1-h]`, and those in `(h, 1-h)`: contiguous,
+    /// the parameters ascending.
+    inside: std::ops::Range<usize>,
+    strictly_inside: std::ops::Range<usize>,
+}
+
+impl AxisPlaces {
+    fn new(axis: &[f64], n: usize) -> Self {
+        let places: Vec<AxisPlace> = axis.iter().map(|&t| AxisPlace::new(t, n)).collect();
+        let range = |keep: &dyn Fn(&AxisPlace) -> bool| {
+            let start = places.iter().take_while(|p| !keep(p)).count();
+            let end = places.len()
+                - places[start..]
+                    .iter()
+                    .rev()
+                    .take_while(|p| !keep(p))
+                    .count();
+            start..end
+        };
+        let inside = range(&|p| p.inside);
+        let strictly_inside = range(&|p| p.inside && !p.near_side);
+        AxisPlaces {
+            places,
+            inside,
+            strictly_inside,
+        }
+    }
+
+    /// The columns whose samples in row `row` lie in the interior ([`AxisPlace::interior_with`]):
+    /// beside a corner square (the row within `h` of a side) only those strictly inside.
+    fn interior_columns(&self, row: &AxisPlace, n: usize) -> std::ops::Range<usize> {
+        if n < 2 || !row.inside {
+            0..0
+        } else if row.near_side {
+            self.strictly_inside.clone()
+        } else {
+            self.inside.clone()
+        }
     }
 }
 
@@ -1241,6 +1332,8 @@ impl AxisPlace {
 struct Context<'a> {
     mesh: &'a Mesh,
     points: Vec<PatchPoints<'a>>,
+    /// Per rate `n = 1..=MAX_SELECTED_RATE` (at `n - 1`), the sample grids' axes placed.
+    places: Vec<[AxisPlaces; 2]>,
 }
 
 impl<'a> Context<'a> {
@@ -1257,7 +1350,24 @@ impl<'a> Context<'a> {
             .enumerate()
             .map(|(f, patch)| PatchPoints::of_face(table, mesh, patch, f, adaptive))
             .collect::<Result<Vec<_>, _>>()?;
-        Ok(Context { mesh, points })
+        let places = (1..=MAX_SELECTED_RATE as usize)
+            .map(|n| selection_axes(SELECTION_GRID).map(|axis| AxisPlaces::new(&axis, n)))
+            .collect();
+        Ok(Context {
+            mesh,
+            points,
+            places,
+        })
+    }
+
+    /// The sample grids' axes placed at rate `n`.
+    fn places(&self, n: usize) -> Result<&[AxisPlaces; 2], RuntimeError> {
+        n.checked_sub(1)
+            .and_then(|k| self.places.get(k))
+            .ok_or_else(|| RuntimeError::InvalidParameter {
+                name: "rate".to_owned(),
+                reason: format!("{n} (the selection measures rates 1..={MAX_SELECTED_RATE})"),
+            })
     }
 
     /// Whether face `f` is a hole: it has no surface, no samples and no deviation.
@@ -1741,6 +1851,72 @@ mod tests {
         }
         // Most patches start at the face's first corner; those take the closed form.
         assert!(closed_form > 0, "no face took the closed form");
+    }
+
+    /// The scan's shortcuts (squares before roots, a corner's search from the last nearest
+    /// triangle, stopped once below the largest deviation so far) change no deviation: on the
+    /// Catmull–Clark octahedron (valence-3 and valence-4 corners) and a torus of regular quads
+    /// (whose largest deviations lie in the interior), every corner sample's deviation is the
+    /// nearest of all its triangles by a plain search, below a floor it stays below it, and a
+    /// face's `e_f(n)` is the largest of the samples' deviations one by one.
+    #[test]
+    #[cfg(feature = "catmull-clark")]
+    fn scans_are_the_largest_plain_sample_deviation() {
+        use crate::mesh::test_meshes::{octahedron, quad_torus};
+        let table = StencilTable::default_catmull_clark().expect("embedded table");
+        let (octahedron, octahedron_patches, _) =
+            crate::scheme::catmull_clark::isolate::isolate(&octahedron()).expect("isolates");
+        let torus = quad_torus(6, 5);
+        let torus_patches = crate::scheme::patch::gather_patches(&torus).expect("patches");
+        let mut corner_samples = 0;
+        for (mesh, patches) in [(&octahedron, &octahedron_patches), (&torus, &torus_patches)] {
+            let adaptive = adaptive_faces(&table, mesh, patches).expect("adaptive faces");
+            let ctx = Context::new(&table, mesh, patches, &adaptive).expect("context");
+            for f in [0, 5, 17] {
+                let samples = Samples::new(&ctx.points[f], SELECTION_GRID).expect("samples");
+                for n in [1, 2, 3, 7, 16] {
+                    let local = FaceLocal::new(&ctx, f, n).expect("local");
+                    let mut largest = 0.0f64;
+                    for (&[u, v], &p) in samples.uv.iter().zip(&samples.positions) {
+                        let deviation = local.deviation_at(u, v, p, 0.0).expect("deviation");
+                        largest = largest.max(deviation);
+                        let h = 0.5 / f64::from(n);
+                        let near = |t: f64| t <= h || t >= 1.0 - h;
+                        if !(near(u) && near(v)) {
+                            continue;
+                        }
+                        corner_samples += 1;
+                        let corner = match (u <= h, v <= h) {
+                            (true, true) => 0,
+                            (false, true) => 1,
+                            (false, false) => 2,
+                            (true, false) => 3,
+                        };
+                        let plain = local
+                            .corner(corner)
+                            .expect("corner")
+                            .iter()
+                            .map(|t| point_triangle_distance(p, &t.triangle))
+                            .fold(f64::INFINITY, f64::min);
+                        assert_eq!(deviation, plain, "face {f} n = {n} at ({u}, {v})");
+                        for floor in [0.5 * plain, plain, 2.0 * plain] {
+                            let d = local.deviation_at(u, v, p, floor).expect("deviation");
+                            if plain <= floor {
+                                assert!(d <= floor, "face {f} n = {n}: {d} above {floor}");
+                            } else {
+                                assert_eq!(d, plain, "face {f} n = {n} floor {floor}");
+                            }
+                        }
+                    }
+                    let scanned = FaceLocal::new(&ctx, f, n)
+                        .expect("local")
+                        .deviation(&samples)
+                        .expect("scan");
+                    assert_eq!(scanned, largest, "face {f} n = {n}");
+                }
+            }
+        }
+        assert!(corner_samples > 1000, "{corner_samples} corner samples");
     }
 
     #[test]
