@@ -620,6 +620,7 @@ impl Template {
     /// `e_f(n)`, or, as soon as one sample deviates by more than `stop`, that sample's
     /// deviation (a lower bound, enough to reject the rate; as the quad selection does).
     fn deviation_up_to(&self, points: &[[f64; 3]], samples: &[[f64; 3]], stop: f64) -> f64 {
+        // The largest square, rooted once: the root is monotone, so that is the largest root.
         let mut worst = 0.0f64;
         for ((t, w), s) in self.triangles.iter().zip(&self.weights).zip(samples) {
             let mut d = 0.0;
@@ -627,12 +628,14 @@ impl Template {
                 let l: f64 = (0..3).map(|k| w[k] * points[t[k] as usize][c]).sum();
                 d += (s[c] - l) * (s[c] - l);
             }
-            worst = worst.max(d.sqrt());
-            if worst > stop {
-                break;
+            if d > worst {
+                worst = d;
+                if worst.sqrt() > stop {
+                    break;
+                }
             }
         }
-        worst
+        worst.sqrt()
     }
 }
 
