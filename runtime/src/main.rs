@@ -606,7 +606,7 @@ fn adaptive_command(args: &TessellateArgs, surface: &Surface) -> Result<(), Runt
     }
     let polygons = MeshFormat::from_path(&args.output)? == MeshFormat::Obj && !args.triangulate;
     let closed = surface.boundary_loops() == 0;
-    let (_, check) = write_and_check(
+    let (write_seconds, check) = write_and_check(
         args.stats,
         || {
             if polygons {
@@ -617,9 +617,11 @@ fn adaptive_command(args: &TessellateArgs, surface: &Surface) -> Result<(), Runt
         },
         || closed && adaptive.is_watertight(),
     )?;
-    if let Some((watertight, _)) = check {
+    if let Some((watertight, check_seconds)) = check {
         let mut report = stats.to_json();
         report["watertight"] = serde_json::json!(watertight);
+        report["write_seconds"] = serde_json::json!(write_seconds);
+        report["check_seconds"] = serde_json::json!(check_seconds);
         report["isolation_seconds"] = serde_json::json!(surface.isolation_seconds());
         out!("{report}")?;
     }

@@ -11,7 +11,7 @@ pub mod topology;
 pub mod triangle_grid;
 pub mod triangle_mesh;
 pub mod triangle_topology;
-mod watertight;
+pub(crate) mod watertight;
 
 pub use source::VertexSource;
 pub use topology::{Mesh, NONE};

@@ -379,6 +379,9 @@ fn adaptive_method_from_the_command_line() {
     ));
     let stats = json(&out);
     assert_eq!(stats["watertight"], true);
+    for key in ["write_seconds", "check_seconds"] {
+        assert!(stats[key].as_f64().is_some(), "{key} missing: {stats}");
+    }
     assert_eq!(stats["leaves_over_tolerance"], 0);
     assert!(stats["max_bound"].as_f64().is_some_and(|b| b <= 0.02));
     let polygons = stats["polygons"].as_u64().expect("a count");

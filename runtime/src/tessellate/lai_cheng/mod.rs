@@ -66,6 +66,7 @@ use table_format::{PointSet, StencilKind};
 
 use crate::mesh::topology::Mesh;
 use crate::mesh::triangle_mesh::{TriangleMesh, VertexSource};
+use crate::mesh::watertight::DirectedEdges;
 use crate::scheme::catmull_clark::adaptive::{limit_of, limit_stencils, LimitQuery};
 use crate::scheme::patch::{is_table_patch, FacePatch, PatchKind};
 use crate::stencil_table::StencilTable;
@@ -206,18 +207,21 @@ impl AdaptiveMesh {
     }
 
     /// Whether every polygon edge is shared by exactly two polygons traversing it in opposite
-    /// directions (closed inputs).
+    /// directions (closed inputs): every directed edge used once, and its reverse once, grouped
+    /// by tail with the triangle meshes' counting sort ([`DirectedEdges`]). `false` also when a
+    /// polygon names a vertex beyond `positions`.
     pub fn is_watertight(&self) -> bool {
-        let mut directed = std::collections::HashSet::new();
-        for p in &self.polygons {
-            let n = p.vertices.len();
-            for k in 0..n {
-                if !directed.insert((p.vertices[k], p.vertices[(k + 1) % n])) {
-                    return false;
-                }
-            }
+        let vertices = self.positions.len();
+        let edges = || {
+            self.polygons.iter().flat_map(|p| {
+                let around = p.vertices.iter().zip(p.vertices.iter().cycle().skip(1));
+                around.map(|(&a, &b)| (a, b))
+            })
+        };
+        if edges().any(|(a, _)| a as usize >= vertices) {
+            return false;
         }
-        directed.iter().all(|&(a, b)| directed.contains(&(b, a)))
+        DirectedEdges::new(vertices, edges).is_some_and(|d| d.all_paired())
     }
 }
 
@@ -981,6 +985,59 @@ fn statistics(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A mesh of the quads `faces` over 8 vertices (positions unused by the check).
+    fn quads(faces: &[[u32; 4]]) -> AdaptiveMesh {
+        let region = PolygonRegion {
+            face: 0,
+            u0: 0,
+            v0: 0,
+            size: 1,
+            denominator: 1,
+            depth: 0,
+            extraordinary: false,
+            bound: 0.0,
+            tolerance: 0.0,
+            diagonal: 0.0,
+        };
+        AdaptiveMesh {
+            positions: vec![[0.0; 3]; 8],
+            polygons: faces
+                .iter()
+                .map(|f| AdaptivePolygon {
+                    vertices: f.to_vec(),
+                    triangles: Vec::new(),
+                    region,
+                })
+                .collect(),
+            ..AdaptiveMesh::default()
+        }
+    }
+
+    /// The polygons' check against the definition on a cube (vertex `x + 2y + 4z`, faces
+    /// outward): closed; a face missing, reversed or doubled, or a vertex beyond the positions,
+    /// is not.
+    #[test]
+    fn polygon_watertightness_is_every_edge_once_each_way() {
+        let cube = [
+            [0, 2, 3, 1],
+            [4, 5, 7, 6],
+            [0, 1, 5, 4],
+            [2, 6, 7, 3],
+            [0, 4, 6, 2],
+            [1, 3, 7, 5],
+        ];
+        assert!(quads(&cube).is_watertight());
+        assert!(!quads(&cube[1..]).is_watertight(), "a face missing");
+        let mut reversed = cube;
+        reversed[2].reverse();
+        assert!(!quads(&reversed).is_watertight(), "a face reversed");
+        let doubled: Vec<[u32; 4]> = cube.iter().chain(&cube[..1]).copied().collect();
+        assert!(!quads(&doubled).is_watertight(), "a face twice");
+        let mut beyond = quads(&cube);
+        beyond.positions.truncate(7);
+        assert!(!beyond.is_watertight(), "vertex 7 beyond the positions");
+    }
 
     /// Every pair's distance, the largest: what `diameter` must return to the bit.
     fn all_pairs(points: &[Point]) -> f64 {
