@@ -219,19 +219,26 @@ impl QuarticBasis {
     }
 }
 
-/// The value of `p` at `(u, v)`: per power of `u` the quartic in `v` by Horner's rule, then the
-/// quartic in `u`.
-pub(crate) fn polynomial_value(p: &Polynomial, u: f64, v: f64) -> [f64; 3] {
-    let mut out = [0.0; 3];
-    for a in (0..=DEGREE).rev() {
+/// `p` on the line `v`: the coefficient of each power `u^a`, its quartic in `v` by Horner's
+/// rule. The value at `(u, v)` is [`row_value`] of it, so samples along one row share it.
+pub(crate) fn polynomial_row(p: &Polynomial, v: f64) -> [[f64; 3]; DEGREE + 1] {
+    std::array::from_fn(|a| {
         let mut row = [0.0; 3];
         for b in (0..=DEGREE - a).rev() {
             for k in 0..3 {
                 row[k] = row[k] * v + p[monomial(a, b)][k];
             }
         }
+        row
+    })
+}
+
+/// The quartic in `u` with coefficients `row` ([`polynomial_row`]), by Horner's rule.
+pub(crate) fn row_value(row: &[[f64; 3]; DEGREE + 1], u: f64) -> [f64; 3] {
+    let mut out = [0.0; 3];
+    for coefficient in row.iter().rev() {
         for k in 0..3 {
-            out[k] = out[k] * u + row[k];
+            out[k] = out[k] * u + coefficient[k];
         }
     }
     out

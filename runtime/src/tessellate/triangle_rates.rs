@@ -83,7 +83,7 @@ use crate::scheme::triangle::isolation::TriangleIsolation;
 use crate::scheme::triangle::patch::{dual_in_patch, dual_index, primal_in_patch, primal_index};
 use crate::stencil_table::StencilTable;
 use crate::tessellate::kernel::{extend_weighted_sums, merge_rows, Stencils};
-use crate::tessellate::loop_quartic::{polynomial_value, QuarticBasis};
+use crate::tessellate::loop_quartic::{polynomial_row, row_value, QuarticBasis};
 use crate::tessellate::rates::{check_tolerance, select_rates, sorted_candidates, ToleranceRates};
 use crate::tessellate::triangle_dual_grid::{
     is_loop_regular, zigzag_cell, TriangleStencils, MAX_TRIANGLE_RATE,
@@ -200,10 +200,17 @@ impl<'a> Context<'a> {
         let control = self.patch_control(f);
         if let (Some(quartic), true) = (grid.quartic, is_loop_regular(patch)) {
             let polynomial = quartic.polynomial(patch.corner, &control);
+            // Each line `v` of the grid once: the quartic in `u` there, then every sample on it.
+            let rows: Vec<_> = grid
+                .lines
+                .iter()
+                .map(|&v| polynomial_row(&polynomial, v))
+                .collect();
             return Ok(grid
                 .params
                 .iter()
-                .map(|&[u, v]| polynomial_value(&polynomial, u, v))
+                .zip(&grid.line_of)
+                .map(|(&[u, _], &line)| row_value(&rows[line as usize], u))
                 .collect());
         }
         let mut out = Vec::with_capacity(grid.params.len());
@@ -324,6 +331,10 @@ fn centroid(n: u32, i: u32, j: u32, down: bool) -> [f64; 2] {
 struct SampleGrid {
     rates: Vec<u32>,
     params: Vec<[f64; 2]>,
+    /// The distinct values of `v` among `params`, and per point the index of its own: a
+    /// regular triangle's quartic is contracted to a quartic in `u` once per line.
+    lines: Vec<f64>,
+    line_of: Vec<u32>,
     /// Loop's regular patch as quartics, where the table's regular patch is the quartic box
     /// spline at every rate of the grid ([`SampleGrid::with_closed_form`]): a regular triangle's
     /// samples are then the polynomial's values.
@@ -341,9 +352,23 @@ impl SampleGrid {
             }
             for_each_dual(n, |i, j, down| params.push(centroid(n, i, j, down)));
         }
+        let mut lines: Vec<f64> = Vec::new();
+        let line_of = params
+            .iter()
+            .map(|&[_, v]| {
+                // A dual row alternates between two lines: search from the last one made.
+                let found = lines.iter().rposition(|&w| w == v);
+                found.unwrap_or_else(|| {
+                    lines.push(v);
+                    lines.len() - 1
+                }) as u32
+            })
+            .collect();
         SampleGrid {
             rates,
             params,
+            lines,
+            line_of,
             quartic: None,
         }
     }
