@@ -1501,7 +1501,9 @@ pub fn tolerance_rates(
 /// refuted at its first sample, `n^2 + 4(n + 1)` table points for the rate kept), the rows and
 /// triangles of the side rectangles and corner squares it reads (one region for a rate refuted
 /// there at its first sample, all of them for the rate kept) and one interpolation per sample
-/// read; faces run in parallel.
+/// read (in a corner square, mostly one triangle's distance: the search starts at the last
+/// sample's nearest triangle and stops below the largest deviation so far); faces run in
+/// parallel.
 /// Faces evaluated adaptively ([module docs](self)) cost a descent per grid, shared by the faces
 /// around one vertex.
 pub fn tolerance_rates_among(
