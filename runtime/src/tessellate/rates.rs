@@ -1168,7 +1168,7 @@ impl<'p> FaceLocal<'p> {
         } else {
             Vec::new()
         };
-        let mut below = worst * worst * (1.0 - 1e-14);
+        let mut largest = Largest::new(worst);
         let mut offset = 0;
         for axis in self.ctx.places(n)? {
             let side = axis.places.len();
@@ -1190,39 +1190,56 @@ impl<'p> FaceLocal<'p> {
                             in_cell(|i, j| dual[j * n + i], &axis.places[i], row),
                         );
                         let squared = dot(d, d);
-                        if squared <= below {
-                            continue;
-                        }
-                        let deviation = squared.sqrt();
-                        if deviation > worst {
-                            worst = deviation;
-                            below = worst * worst * (1.0 - 1e-14);
-                            if worst > stop {
-                                samples.start.set(offset + j * side + i);
-                                return Ok(worst);
-                            }
+                        if squared > largest.below
+                            && largest.raise(squared.sqrt())
+                            && largest.value > stop
+                        {
+                            samples.start.set(offset + j * side + i);
+                            return Ok(largest.value);
                         }
                     }
                 }
                 if keep(false) {
                     for i in (0..interior.start).chain(interior.end..side) {
                         let [u, v] = uv[i];
-                        let deviation = self.deviation_at(u, v, positions[i], worst)?;
-                        // (A NaN leaves `worst` as it is, as `f64::max` would.)
-                        if deviation > worst {
-                            worst = deviation;
-                            below = worst * worst * (1.0 - 1e-14);
-                            if worst > stop {
-                                samples.start.set(offset + j * side + i);
-                                return Ok(worst);
-                            }
+                        let deviation = self.deviation_at(u, v, positions[i], largest.value)?;
+                        if largest.raise(deviation) && largest.value > stop {
+                            samples.start.set(offset + j * side + i);
+                            return Ok(largest.value);
                         }
                     }
                 }
             }
             offset += side * side;
         }
-        Ok(worst)
+        Ok(largest.value)
+    }
+}
+
+/// The largest deviation of a scan so far, and the squared distances certainly below it.
+struct Largest {
+    value: f64,
+    /// `value^2` less a margin of a few ulps of its rounding: a square at most this has a root
+    /// at most `value`.
+    below: f64,
+}
+
+impl Largest {
+    fn new(value: f64) -> Self {
+        Largest {
+            value,
+            below: value * value * (1.0 - 1e-14),
+        }
+    }
+
+    /// Keep `deviation` if it is larger (a NaN is not: it leaves the value as `f64::max`
+    /// would), and say whether it was.
+    fn raise(&mut self, deviation: f64) -> bool {
+        let larger = deviation > self.value;
+        if larger {
+            *self = Largest::new(deviation);
+        }
+        larger
     }
 }
 
