@@ -1349,7 +1349,8 @@ impl AxisPlaces {
 struct Context<'a> {
     mesh: &'a Mesh,
     points: Vec<PatchPoints<'a>>,
-    /// Per rate `n = 1..=MAX_SELECTED_RATE` (at `n - 1`), the sample grids' axes placed.
+    /// Per rate `n = 1..=MAX_SELECTED_RATE` (at `n - 1`), the axes of the samples at rate
+    /// [`SELECTION_GRID`] placed: what every scan reads its samples by.
     places: Vec<[AxisPlaces; 2]>,
 }
 
