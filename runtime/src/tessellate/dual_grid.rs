@@ -913,7 +913,7 @@ impl DualGrid {
     }
 
     /// Every dual point of face `f`, from its control points relative to one of them
-    /// ([`gather_relative`]).
+    /// ([`gather_relative`](crate::tessellate::kernel::gather_relative)).
     fn evaluate_face(
         &self,
         f: usize,
@@ -1133,7 +1133,7 @@ fn reflect_phantoms(g: &mut [[[f32; 3]; 4]; 4], phantoms: u8) {
 
 /// The tensor-product evaluation of a regular face: per row `j`, contract the 4 x 4 grid with the
 /// row's weights into four points (and their `v` derivatives), then every point of the row is a
-/// 4-term combination of those. `g` is relative to `origin` ([`gather_relative`]), where every
+/// 4-term combination of those. `g` is relative to `origin` ([`gather_relative`](crate::tessellate::kernel::gather_relative)), where every
 /// position's sum starts.
 ///
 /// In vectors of [`LANES`] columns: a row's contraction is made once, the four points `a` in

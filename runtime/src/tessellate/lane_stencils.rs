@@ -328,7 +328,7 @@ fn sums(weights: &[LaneWeights], q: &[[f32; 3]], origin: [f32; 3]) -> LaneSums {
     [p, du, dv]
 }
 
-/// `unit(cross(a, b))` lane by lane, with [`cross`] and [`unit`]'s operations in their order
+/// `unit(cross(a, b))` lane by lane, with [`cross`] and [`unit`](fn@unit)'s operations in their order
 /// (bit-identical), the square root and division vectorized where every lane's squared length
 /// is a normal float.
 #[inline(always)]

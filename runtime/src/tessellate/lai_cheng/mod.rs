@@ -208,8 +208,8 @@ impl AdaptiveMesh {
 
     /// Whether every polygon edge is shared by exactly two polygons traversing it in opposite
     /// directions (closed inputs): every directed edge used once, and its reverse once, grouped
-    /// by tail with the triangle meshes' counting sort ([`DirectedEdges`]). `false` also when a
-    /// polygon names a vertex beyond `positions`.
+    /// by tail with the triangle meshes' counting sort (`mesh::watertight::DirectedEdges`).
+    /// `false` also when a polygon names a vertex beyond `positions`.
     pub fn is_watertight(&self) -> bool {
         let vertices = self.positions.len();
         let edges = || {
