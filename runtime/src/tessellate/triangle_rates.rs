@@ -648,9 +648,10 @@ impl Template {
         // The largest square, rooted once: the root is monotone, so that is the largest root.
         let mut worst = 0.0f64;
         for ((t, w), s) in self.triangles.iter().zip(&self.weights).zip(samples) {
+            let corners = t.map(|k| points[k as usize]);
             let mut d = 0.0;
             for c in 0..3 {
-                let l: f64 = (0..3).map(|k| w[k] * points[t[k] as usize][c]).sum();
+                let l: f64 = (0..3).map(|k| w[k] * corners[k][c]).sum();
                 d += (s[c] - l) * (s[c] - l);
             }
             if d > worst {
