@@ -241,15 +241,18 @@ pub(crate) struct DirectedEdges {
 }
 
 impl DirectedEdges {
-    /// Group `edges` (between vertices below `vertices`) by tail, by a counting sort: linear,
-    /// where hashing took seconds for millions of edges. `None` when an edge is listed twice.
-    /// `edges` is called twice (count, then place), for the same edges each time.
+    /// Group `edges` by tail, by a counting sort: linear, where hashing took seconds for
+    /// millions of edges. `None` when an edge is listed twice or names a vertex not below
+    /// `vertices`. `edges` is called twice (count, then place), for the same edges each time.
     pub(crate) fn new<I: Iterator<Item = (u32, u32)>>(
         vertices: usize,
         edges: impl Fn() -> I,
     ) -> Option<DirectedEdges> {
         let mut start = vec![0u32; vertices + 1];
-        for (a, _) in edges() {
+        for (a, b) in edges() {
+            if a as usize >= vertices || b as usize >= vertices {
+                return None;
+            }
             start[a as usize + 1] += 1;
         }
         for v in 0..vertices {

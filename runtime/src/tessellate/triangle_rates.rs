@@ -646,7 +646,7 @@ impl Template {
     /// deviation (a lower bound, enough to reject the rate; as the quad selection does).
     fn deviation_up_to(&self, points: &[[f64; 3]], samples: &[[f64; 3]], stop: f64) -> f64 {
         // The largest square, rooted once: the root is monotone, so that is the largest root.
-        let mut worst = 0.0f64;
+        let mut worst_squared = 0.0f64;
         for ((t, w), s) in self.triangles.iter().zip(&self.weights).zip(samples) {
             let corners = t.map(|k| points[k as usize]);
             let mut d = 0.0;
@@ -654,14 +654,14 @@ impl Template {
                 let l: f64 = (0..3).map(|k| w[k] * corners[k][c]).sum();
                 d += (s[c] - l) * (s[c] - l);
             }
-            if d > worst {
-                worst = d;
-                if worst.sqrt() > stop {
+            if d > worst_squared {
+                worst_squared = d;
+                if worst_squared.sqrt() > stop {
                     break;
                 }
             }
         }
-        worst.sqrt()
+        worst_squared.sqrt()
     }
 }
 

@@ -211,17 +211,13 @@ impl AdaptiveMesh {
     /// by tail with the triangle meshes' counting sort (`mesh::watertight::DirectedEdges`).
     /// `false` also when a polygon names a vertex beyond `positions`.
     pub fn is_watertight(&self) -> bool {
-        let vertices = self.positions.len();
         let edges = || {
             self.polygons.iter().flat_map(|p| {
                 let around = p.vertices.iter().zip(p.vertices.iter().cycle().skip(1));
                 around.map(|(&a, &b)| (a, b))
             })
         };
-        if edges().any(|(a, _)| a as usize >= vertices) {
-            return false;
-        }
-        DirectedEdges::new(vertices, edges).is_some_and(|d| d.all_paired())
+        DirectedEdges::new(self.positions.len(), edges).is_some_and(|d| d.all_paired())
     }
 }
 
