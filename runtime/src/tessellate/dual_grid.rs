@@ -24,7 +24,7 @@
 //! isolated mesh, are evaluated as tensor products: their table stencils factor into the cubic
 //! B-spline weights of the two directions (checked when the plan is built), so a point costs 12
 //! multiply-adds per coordinate for position, d/du and d/dv together instead of 48, four points
-//! (four rows) in each vector operation. The other faces' stencils are interleaved four points a
+//! (four columns) in each vector operation. The other faces' stencils are interleaved four points a
 //! group (`tessellate::lane_stencils`).
 
 use std::collections::HashMap;
@@ -1131,18 +1131,23 @@ fn reflect_phantoms(g: &mut [[[f32; 3]; 4]; 4], phantoms: u8) {
     }
 }
 
-/// The tensor-product evaluation of a regular face: per row `j`, contract the 4 x 4 grid with the
-/// row's weights into four points (and their `v` derivatives), then every point of the row is a
-/// 4-term combination of those. `g` is relative to `origin` ([`gather_relative`](crate::tessellate::kernel::gather_relative)), where every
-/// position's sum starts.
+/// The tensor-product evaluation of a regular face, a group of [`LANES`] columns at a time: the
+/// 4 x 4 grid contracted along `u` with the group's weights into four points `q[b]` per
+/// control row (and `dq[b]` with the derivative's weights), the group's columns in the lanes;
+/// then every row `j` of the group is a 4-term combination of those with the row's weights
+/// (broadcast in the basis). `g` is relative to `origin`
+/// ([`gather_relative`](crate::tessellate::kernel::gather_relative)), where every position's sum
+/// starts.
 ///
-/// In vectors of [`LANES`] columns: a row's contraction is made once, the four points `a` in
-/// the lanes, and broadcast; each group of columns `i..i + 4` then gives the points
-/// `(i..i + 4, j)` with the weights of those columns in the lanes (precomputed in the basis), so
-/// a group's points are consecutive in the output and leave in whole vectors. Every lane makes
-/// its sums in the order of the scalar formulas (`r[a] = sum_b y_b g[a][b]`, then
-/// `P = O + sum_a x_a r[a]`, `P_u = sum_a x'_a r[a]`, `P_v = sum_a x_a s[a]`, each over
-/// `b, a = 0..4` from zero or `O`), so the output is bit-identical to one point at a time
+/// Why this order: the contraction along `u` is made once per group of columns and serves
+/// every row, where contracting along `v` first (once per row) needed its four results
+/// broadcast into 24 vectors that spilled: a rate-4 frame took 14% more instructions that way
+/// (docs/benchmarks.md).
+///
+/// Every lane makes its sums in the order of the scalar formulas (`q[b] = sum_a x_a g[a][b]`,
+/// `q'[b] = sum_a x'_a g[a][b]`, then `P = O + sum_b y_b q[b]`, `P_u = sum_b y_b q'[b]`,
+/// `P_v = sum_b y'_b q[b]`, each over `a, b = 0..4`: `q` and `q'` from zero, `P` from `O`,
+/// `P_u` and `P_v` from their first term), so the output is bit-identical to one point at a time
 /// (`separable_lanes_are_the_scalar_sums_bit_for_bit`).
 ///
 /// Inlined into both of its callers (regular faces and those with phantom rows): called, it cost
@@ -1158,45 +1163,38 @@ fn evaluate_separable(
 ) {
     let (positions, normals) = (&mut positions[..n * n], &mut normals[..n * n]);
     let origin = origin.map(f32x4::splat);
-    // The grid with the four points `a` of each `(b, c)` in the lanes.
-    let columns: [[f32x4; 3]; 4] = std::array::from_fn(|b| {
-        std::array::from_fn(|c| f32x4::new(std::array::from_fn(|a| g[a][b][c])))
-    });
-    let rows = positions
-        .chunks_exact_mut(n)
-        .zip(normals.chunks_exact_mut(n));
-    for ((y, dy), (row_positions, row_normals)) in
-        basis.y_splat.iter().zip(&basis.dy_splat).zip(rows)
-    {
-        // r[a][c] = sum_b y_b g[a][b][c], s the same with dy: `a` in the lanes, then broadcast.
-        let mut r = [f32x4::ZERO; 3];
-        let mut s = [f32x4::ZERO; 3];
+    for (k, (x, dx)) in basis.x_lanes.iter().zip(&basis.dx_lanes).enumerate() {
+        // q[b][c] = sum_a x_a g[a][b][c], dq the same with dx: the group's columns in the lanes.
+        let mut q = [[f32x4::ZERO; 3]; 4];
+        let mut dq = [[f32x4::ZERO; 3]; 4];
         for b in 0..4 {
             for c in 0..3 {
-                r[c] += y[b] * columns[b][c];
-                s[c] += dy[b] * columns[b][c];
-            }
-        }
-        let splat = |v: [f32x4; 3]| -> [[f32x4; 3]; 4] {
-            let v = v.map(f32x4::to_array);
-            std::array::from_fn(|a| std::array::from_fn(|c| f32x4::splat(v[c][a])))
-        };
-        let (r, s) = (splat(r), splat(s));
-        for (k, (x, dx)) in basis.x_lanes.iter().zip(&basis.dx_lanes).enumerate() {
-            let mut p = origin;
-            let mut du = [f32x4::ZERO; 3];
-            let mut dv = [f32x4::ZERO; 3];
-            for a in 0..4 {
-                for c in 0..3 {
-                    p[c] += x[a] * r[a][c];
-                    du[c] += dx[a] * r[a][c];
-                    dv[c] += x[a] * s[a][c];
+                for a in 0..4 {
+                    let point = f32x4::splat(g[a][b][c]);
+                    q[b][c] += x[a] * point;
+                    dq[b][c] += dx[a] * point;
                 }
             }
-            let at = k * LANES;
-            let end = n.min(at + LANES);
-            store_points(p, &mut row_positions[at..end]);
-            store_points(unit_cross_x4(du, dv), &mut row_normals[at..end]);
+        }
+        let at = k * LANES;
+        let end = n.min(at + LANES);
+        for (j, (y, dy)) in basis.y_splat.iter().zip(&basis.dy_splat).enumerate() {
+            let mut p = origin;
+            let mut du: [f32x4; 3] = std::array::from_fn(|c| y[0] * dq[0][c]);
+            let mut dv: [f32x4; 3] = std::array::from_fn(|c| dy[0] * q[0][c]);
+            for c in 0..3 {
+                p[c] += y[0] * q[0][c];
+            }
+            for b in 1..4 {
+                for c in 0..3 {
+                    p[c] += y[b] * q[b][c];
+                    du[c] += y[b] * dq[b][c];
+                    dv[c] += dy[b] * q[b][c];
+                }
+            }
+            let row = j * n;
+            store_points(p, &mut positions[row + at..row + end]);
+            store_points(unit_cross_x4(du, dv), &mut normals[row + at..row + end]);
         }
     }
 }
@@ -1255,27 +1253,24 @@ mod tests {
             let mut normals = vec![[0.0f32; 3]; n * n];
             evaluate_separable(&g, origin, &basis, n, &mut positions, &mut normals);
             for j in 0..n {
-                let mut r = [[0.0f32; 3]; 4];
-                let mut s = [[0.0f32; 3]; 4];
-                for a in 0..4 {
-                    for b in 0..4 {
-                        for c in 0..3 {
-                            r[a][c] += y[b][j] * g[a][b][c];
-                            s[a][c] += dy[b][j] * g[a][b][c];
-                        }
-                    }
-                }
                 for i in 0..n {
-                    let mut p = origin;
-                    let mut du = [0.0f32; 3];
-                    let mut dv = [0.0f32; 3];
-                    for a in 0..4 {
-                        for c in 0..3 {
-                            p[c] += x[a][i] * r[a][c];
-                            du[c] += dx[a][i] * r[a][c];
-                            dv[c] += x[a][i] * s[a][c];
-                        }
-                    }
+                    // The derivatives' last sums from their first term, as the lanes make them
+                    // (a sum from zero differs where every term is -0).
+                    let q: [[f32; 3]; 4] = std::array::from_fn(|b| {
+                        std::array::from_fn(|c| (0..4).fold(0.0, |s, a| s + x[a][i] * g[a][b][c]))
+                    });
+                    let dq: [[f32; 3]; 4] = std::array::from_fn(|b| {
+                        std::array::from_fn(|c| (0..4).fold(0.0, |s, a| s + dx[a][i] * g[a][b][c]))
+                    });
+                    let p: [f32; 3] = std::array::from_fn(|c| {
+                        (0..4).fold(origin[c], |s, b| s + y[b][j] * q[b][c])
+                    });
+                    let du: [f32; 3] = std::array::from_fn(|c| {
+                        (1..4).fold(y[0][j] * dq[0][c], |s, b| s + y[b][j] * dq[b][c])
+                    });
+                    let dv: [f32; 3] = std::array::from_fn(|c| {
+                        (1..4).fold(dy[0][j] * q[0][c], |s, b| s + dy[b][j] * q[b][c])
+                    });
                     let at = j * n + i;
                     assert_eq!(
                         positions[at].map(f32::to_bits),
