@@ -66,6 +66,32 @@ fn a_fin_on_a_grid_edge_is_not_closed() {
     assert!(!agreed(&mesh, "fin"));
 }
 
+/// Tessellations long enough that the grid scan runs in pieces (65,536 triangles and more
+/// each), a face's grid cut between two of them, with and without texture seams (whose grids go
+/// to the general check, from every piece): closed by both checks, and broken by both where a
+/// piece ends.
+#[test]
+#[cfg(feature = "catmull-clark")]
+fn tessellations_scanned_in_pieces_agree() {
+    for file in ["cube.obj", "cube_uv.obj"] {
+        let mesh = tessellated(file, Rates::Uniform(64));
+        assert!(
+            mesh.triangles.len() > 2 * 65_536,
+            "{}",
+            mesh.triangles.len()
+        );
+        assert!(agreed(&mesh, file));
+        for t in [65_535, 65_536, 65_537, 131_071, 131_072] {
+            let mut removed = mesh.clone();
+            removed.triangles.remove(t);
+            assert!(!agreed(&removed, file));
+            let mut reversed = mesh.clone();
+            reversed.triangles[t].swap(1, 2);
+            assert!(!agreed(&reversed, file));
+        }
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
