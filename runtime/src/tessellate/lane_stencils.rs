@@ -34,8 +34,12 @@ use crate::RuntimeError;
 pub(crate) const LANES: usize = 4;
 
 /// One step `l` of a group of points: the weights of control point `l` for position, d/du and
-/// d/dv, one lane per point.
-type LaneWeights = [[f32; LANES]; 3];
+/// d/dv, one lane per point (aligned vectors: a multiply takes its weights from memory).
+type LaneWeights = [f32x4; 3];
+
+/// A control point's coordinates, each broadcast to every lane once per face (not once per
+/// group of points).
+type Splat = [f32x4; 3];
 
 /// The stencils of every point of one kind of face (table section, face corner, rate) in the
 /// face's output order, `LANES` points a group.
@@ -78,6 +82,7 @@ impl LaneStencils {
                 }
             }
         }
+        let weights = weights.into_iter().map(|w| w.map(f32x4::new)).collect();
         Some(LaneStencils { k, points, weights })
     }
 
@@ -137,9 +142,8 @@ impl LaneStencils {
         positions: &mut [[f32; 3]],
         normals: &mut [[f32; 3]],
     ) {
-        let mut q = [[0.0f32; 3]; K];
-        q.copy_from_slice(&local[..K]);
-        let mut sums = [[[[0.0f32; LANES]; 3]; 3]; CHUNK];
+        let q: [Splat; K] = std::array::from_fn(|l| local[l].map(f32x4::splat));
+        let mut sums = [[[f32x4::ZERO; 3]; 3]; CHUNK];
         for (c, weights) in self.weights.chunks(K * CHUNK).enumerate() {
             chunk_sums_fixed::<K>(weights, &q, origin, &mut sums);
             self.write(c * CHUNK, &sums[..weights.len() / K], positions, normals);
@@ -153,8 +157,18 @@ impl LaneStencils {
         positions: &mut [[f32; 3]],
         normals: &mut [[f32; 3]],
     ) {
-        let q = &local[..self.k];
-        let mut sums = [[[[0.0f32; LANES]; 3]; 3]; CHUNK];
+        let mut fixed = [[f32x4::ZERO; 3]; MAX_PATCH];
+        let mut wide = Vec::new();
+        let q = if self.k <= MAX_PATCH {
+            &mut fixed[..self.k]
+        } else {
+            wide.resize(self.k, [f32x4::ZERO; 3]);
+            &mut wide[..]
+        };
+        for (q, p) in q.iter_mut().zip(local) {
+            *q = p.map(f32x4::splat);
+        }
+        let mut sums = [[[f32x4::ZERO; 3]; 3]; CHUNK];
         for (c, weights) in self.weights.chunks(self.k * CHUNK).enumerate() {
             chunk_sums_any(self.k, weights, q, origin, &mut sums);
             self.write(
@@ -175,11 +189,11 @@ impl LaneStencils {
         positions: &mut [[f32; 3]],
         normals: &mut [[f32; 3]],
     ) {
-        for (g, [p, du, dv]) in sums.iter().enumerate() {
-            let normal = unit_cross_x4(du.map(f32x4::new), dv.map(f32x4::new));
+        for (g, &[p, du, dv]) in sums.iter().enumerate() {
+            let normal = unit_cross_x4(du, dv);
             let start = (first + g) * LANES;
             let end = self.points.min(start + LANES);
-            store_points(p.map(f32x4::new), &mut positions[start..end]);
+            store_points(p, &mut positions[start..end]);
             store_points(normal, &mut normals[start..end]);
         }
     }
@@ -264,8 +278,8 @@ impl PointGroups {
     }
 }
 
-/// One group's sums: `[position, d/du, d/dv][coordinate][lane]`.
-type LaneSums = [[[f32; LANES]; 3]; 3];
+/// One group's sums: `[position, d/du, d/dv][coordinate]`, a point per lane.
+type LaneSums = [[f32x4; 3]; 3];
 
 /// Groups whose sums are made by one call of [`chunk_sums_fixed`] or [`chunk_sums_any`].
 const CHUNK: usize = 8;
@@ -280,7 +294,7 @@ const CHUNK: usize = 8;
 #[inline(never)]
 fn chunk_sums_fixed<const K: usize>(
     weights: &[LaneWeights],
-    q: &[[f32; 3]; K],
+    q: &[Splat; K],
     origin: [f32; 3],
     out: &mut [LaneSums; CHUNK],
 ) {
@@ -294,7 +308,7 @@ fn chunk_sums_fixed<const K: usize>(
 fn chunk_sums_any(
     k: usize,
     weights: &[LaneWeights],
-    q: &[[f32; 3]],
+    q: &[Splat],
     origin: [f32; 3],
     out: &mut [LaneSums; CHUNK],
 ) {
@@ -303,26 +317,18 @@ fn chunk_sums_any(
     }
 }
 
-/// `acc + w q` lane by lane.
-#[inline(always)]
-fn multiply_add(acc: &mut [f32; LANES], w: &[f32; LANES], q: f32) {
-    for lane in 0..LANES {
-        acc[lane] += w[lane] * q;
-    }
-}
-
 /// One group's sums over the control points `q`, the position's started at `origin`, each in
 /// the order of `q`.
 #[inline(always)]
-fn sums(weights: &[LaneWeights], q: &[[f32; 3]], origin: [f32; 3]) -> LaneSums {
-    let mut p = origin.map(|c| [c; LANES]);
-    let mut du = [[0.0f32; LANES]; 3];
-    let mut dv = [[0.0f32; LANES]; 3];
+fn sums(weights: &[LaneWeights], q: &[Splat], origin: [f32; 3]) -> LaneSums {
+    let mut p = origin.map(f32x4::splat);
+    let mut du = [f32x4::ZERO; 3];
+    let mut dv = [f32x4::ZERO; 3];
     for (w, q) in weights.iter().zip(q) {
         for x in 0..3 {
-            multiply_add(&mut p[x], &w[0], q[x]);
-            multiply_add(&mut du[x], &w[1], q[x]);
-            multiply_add(&mut dv[x], &w[2], q[x]);
+            p[x] += w[0] * q[x];
+            du[x] += w[1] * q[x];
+            dv[x] += w[2] * q[x];
         }
     }
     [p, du, dv]
