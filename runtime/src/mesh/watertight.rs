@@ -141,7 +141,8 @@ fn find_blocks(triangles: &[[u32; 3]]) -> (Vec<GridBlock>, Vec<usize>) {
     (blocks, others)
 }
 
-/// The largest grid side a block may have.
+/// The largest grid side a block may have: a block's index arithmetic (`first + j w + i`,
+/// `w + 1`) then stays far from `u32`'s end.
 const MAX_BLOCK_SIDE: u32 = u16::MAX as u32;
 
 /// No block holds the vertex.
@@ -211,9 +212,11 @@ pub(crate) fn is_closed(triangles: &[[u32; 3]], vertices: usize, of: &[u32]) -> 
     let (mut found, mut others) = find_blocks_in_parallel(triangles);
     // A block over a seam copy or its original would pair edges by index where the positions
     // pair them differently: its triangles go to the general check.
-    let mut merged: Vec<u64> = (0..of.len() as u32)
-        .filter(|&v| of[v as usize] != v)
-        .flat_map(|v| [u64::from(v), u64::from(of[v as usize])])
+    let mut merged: Vec<u64> = of
+        .iter()
+        .enumerate()
+        .filter(|&(v, &o)| o as usize != v)
+        .flat_map(|(v, &o)| [v as u64, u64::from(o)])
         .collect();
     merged.sort_unstable();
     let holds_merged = |range: &Range<u64>| {
@@ -267,12 +270,18 @@ pub(crate) fn is_closed(triangles: &[[u32; 3]], vertices: usize, of: &[u32]) -> 
     }
     // Position vertices, then numbered densely in the order met: the grouping's arrays then
     // span the vertices these edges touch (a quarter of all at rate 16), not every vertex.
+    // Every number stays below `vertices`, so below `u32::MAX`, the unnumbered mark (more
+    // vertices than that are taken by position as they are).
+    let position = |v: u32| if of.is_empty() { v } else { of[v as usize] };
+    if u32::try_from(vertices).map_or(true, |n| n == u32::MAX) {
+        let edges = || edges.iter().map(|&(a, b)| (position(a), position(b)));
+        return DirectedEdges::new(vertices, edges).is_some_and(|d| d.all_paired());
+    }
     let mut dense = vec![u32::MAX; vertices];
     let mut touched = 0u32;
     for e in &mut edges {
         for v in [&mut e.0, &mut e.1] {
-            let position = if of.is_empty() { *v } else { of[*v as usize] };
-            let slot = &mut dense[position as usize];
+            let slot = &mut dense[position(*v) as usize];
             if *slot == u32::MAX {
                 *slot = touched;
                 touched += 1;

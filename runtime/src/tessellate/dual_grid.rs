@@ -24,8 +24,8 @@
 //! isolated mesh, are evaluated as tensor products: their table stencils factor into the cubic
 //! B-spline weights of the two directions (checked when the plan is built), so a point costs 12
 //! multiply-adds per coordinate for position, d/du and d/dv together instead of 48, four points
-//! (four columns) in each vector operation. The other faces' stencils are interleaved four points a
-//! group (`tessellate::lane_stencils`).
+//! (four columns) in each vector operation. The other faces' stencils are interleaved four
+//! points a group (`tessellate::lane_stencils`).
 
 use std::collections::HashMap;
 use std::ops::Range;
