@@ -71,9 +71,7 @@ use crate::scheme::catmull_clark::adaptive::{limit_of, limit_stencils, LimitQuer
 use crate::scheme::patch::{is_table_patch, FacePatch, PatchKind};
 use crate::stencil_table::StencilTable;
 use crate::RuntimeError;
-use bezier_net::{
-    corner_normals, corners, cross, flatness_bound, longer_diagonal, unit, Net, Point,
-};
+use bezier_net::{corner_normals, corners, cross, longer_diagonal, unit, Deviation, Net, Point};
 use operators::Operators;
 pub use polygons::write_obj_polygons;
 
@@ -315,6 +313,51 @@ struct FaceWork<'a> {
     polygons: &'a AtomicUsize,
 }
 
+/// A thread's buffers for the faces' leaves and marks, each sized by the face before: a face
+/// then grows its vectors rarely, where they grew by doubling from empty (a tenth of the
+/// adaptive pass's instructions went to `realloc` and its copies; docs/benchmarks.md).
+type Scratch = (Vec<Leaf>, Vec<Marked>);
+
+impl<'a> FaceWork<'a> {
+    /// The work on a face whose patch has its `(0,0)` at face corner `corner`, growing its
+    /// leaves and marks in `scratch`'s buffers.
+    fn new(
+        options: &'a AdaptiveOptions,
+        corner: usize,
+        scratch: &mut Scratch,
+        polygons: &'a AtomicUsize,
+    ) -> Self {
+        let (mut leaves, mut marked) = std::mem::take(scratch);
+        leaves.clear();
+        marked.clear();
+        FaceWork {
+            options,
+            corner,
+            leaves,
+            marked,
+            polygons,
+        }
+    }
+
+    /// The face's leaves and marks (none when the polygon budget is spent), their buffers
+    /// shrunk to their length (in place, not copied); `scratch` gets new buffers of that
+    /// length, about what the next face needs.
+    fn finish(self, scratch: &mut Scratch) -> (Vec<Leaf>, Vec<Marked>) {
+        if self.over_budget() {
+            *scratch = (self.leaves, self.marked);
+            return (Vec::new(), Vec::new());
+        }
+        let (mut leaves, mut marked) = (self.leaves, self.marked);
+        *scratch = (
+            Vec::with_capacity(leaves.len()),
+            Vec::with_capacity(marked.len()),
+        );
+        leaves.shrink_to_fit();
+        marked.shrink_to_fit();
+        (leaves, marked)
+    }
+}
+
 impl FaceWork<'_> {
     /// Face grid coordinates of patch grid coordinates (the inverse of [`crate::scheme::patch::to_patch`]).
     fn to_face(&self, p: u32, q: u32) -> (u32, u32) {
@@ -419,24 +462,50 @@ impl FaceWork<'_> {
 
     /// A regular square with Bézier net `net` at patch coordinates `(p0, q0)`, depth `depth`.
     fn regular(&mut self, net: &Net, p0: u32, q0: u32, depth: u32) {
+        self.regular_below(net, (p0, q0, depth), f64::INFINITY);
+    }
+
+    /// [`FaceWork::regular`] for a square whose parent's bound was at least `parent` (a lower
+    /// bound of it, or the bound itself).
+    ///
+    /// A square that is split needs no exact bound (only leaves record theirs): where the
+    /// corner pairs' lower bound ([`Deviation::corner_bound`]) already exceeds the tolerance,
+    /// `done` would say no whatever the other pairs give, and the square is split after 28 of
+    /// the bound's 182 pairs. That lower bound is only tried where the square is likely to be
+    /// split, its parent's bound above four times the tolerance (a bound falls about fourfold
+    /// per level on a smooth patch): most squares are leaves, for which it would be wasted.
+    /// Either way the leaves, their bounds and every split are the full test's.
+    fn regular_below(&mut self, net: &Net, (p0, q0, depth): (u32, u32, u32), parent: f64) {
         let points = corners(net);
-        let bound = flatness_bound(net);
+        let deviation = Deviation::new(net);
         let tolerance = self.tolerance(longer_diagonal(&points));
-        if self.done(depth, bound, tolerance) {
-            self.leaf(
-                (p0, q0, depth),
-                points,
-                corner_normals(net),
-                bound,
-                tolerance,
-                false,
-            );
-            return;
+        let mut lower = if depth < self.options.max_depth && parent > 4.0 * tolerance {
+            deviation.corner_bound()
+        } else {
+            0.0
+        };
+        let split = depth < self.options.max_depth
+            && (depth < self.options.min_depth || lower > tolerance)
+            && !self.over_budget();
+        if !split {
+            let bound = deviation.bound();
+            lower = bound;
+            if self.done(depth, bound, tolerance) {
+                self.leaf(
+                    (p0, q0, depth),
+                    points,
+                    corner_normals(net),
+                    bound,
+                    tolerance,
+                    false,
+                );
+                return;
+            }
         }
         let half = (GRID >> depth) / 2;
         let origins = [(0, 0), (half, 0), (half, half), (0, half)];
         for (child, (dp, dq)) in bezier_net::split(net).iter().zip(origins) {
-            self.regular(child, p0 + dp, q0 + dq, depth + 1);
+            self.regular_below(child, (p0 + dp, q0 + dq, depth + 1), lower);
         }
     }
 
@@ -764,25 +833,17 @@ pub fn tessellate_adaptive(
     let mut work: Vec<(Vec<Leaf>, Vec<Marked>)> = patches
         .par_iter()
         .enumerate()
-        .map(
-            |(f, patch)| -> Result<(Vec<Leaf>, Vec<Marked>), RuntimeError> {
+        .map_init(
+            Scratch::default,
+            |scratch, (f, patch)| -> Result<(Vec<Leaf>, Vec<Marked>), RuntimeError> {
                 match path[f] {
                     Path::Hole => return Ok((Vec::new(), Vec::new())),
                     Path::Feature => {
-                        let mut face = FaceWork {
-                            options,
-                            corner: 0,
-                            leaves: Vec::new(),
-                            marked: Vec::new(),
-                            polygons: &polygons,
-                        };
+                        let mut face = FaceWork::new(options, 0, scratch, &polygons);
                         let (level, g) = feature::root(mesh, f);
                         let frame = [(0, 0), (GRID, 0), (GRID, GRID), (0, GRID)];
                         face.feature(&level, g, frame, 0, true, root_diagonal[f]);
-                        if face.over_budget() {
-                            return Ok((Vec::new(), Vec::new()));
-                        }
-                        return Ok((face.leaves, face.marked));
+                        return Ok(face.finish(scratch));
                     }
                     Path::Table => {}
                 }
@@ -802,13 +863,7 @@ pub fn tessellate_adaptive(
                     .iter()
                     .map(|&v| mesh.positions[v as usize])
                     .collect();
-                let mut face = FaceWork {
-                    options,
-                    corner: patch.corner,
-                    leaves: Vec::new(),
-                    marked: Vec::new(),
-                    polygons: &polygons,
-                };
+                let mut face = FaceWork::new(options, patch.corner, scratch, &polygons);
                 match ops.regular_patch(&points) {
                     Some(net) => face.regular(&net, 0, 0, 0),
                     None => {
@@ -816,10 +871,7 @@ pub fn tessellate_adaptive(
                         face.extraordinary(ops, points, normal);
                     }
                 }
-                if face.over_budget() {
-                    return Ok((Vec::new(), Vec::new()));
-                }
-                Ok((face.leaves, face.marked))
+                Ok(face.finish(scratch))
             },
         )
         .collect::<Result<_, _>>()?;
@@ -900,41 +952,41 @@ pub fn tessellate_adaptive(
         .enumerate()
         .map(
             |(face, (leaves, _))| -> Result<Vec<AdaptivePolygon>, RuntimeError> {
-                // One set of buffers per face, not per polygon.
+                // One set of buffers per face, not per polygon: a polygon allocates its own two
+                // vectors at their final length and nothing else.
                 let mut ring = Vec::new();
                 let mut params = Vec::new();
                 let mut positions = Vec::new();
-                leaves
-                    .iter()
-                    .map(|leaf| {
-                        ids.leaf_ring(mesh, face, leaf, &mut ring)?;
-                        let vertices: Vec<u32> = ring.iter().map(|&(_, id)| id).collect();
-                        params.clear();
-                        params.extend(ring.iter().map(|&((u, v), _)| (i64::from(u), i64::from(v))));
-                        positions.clear();
-                        positions.extend(vertices.iter().map(|&i| out.positions[i as usize]));
-                        let triangles = polygons::triangulate(&params, &positions)
-                            .into_iter()
-                            .map(|t| t.map(|k| vertices[k]))
-                            .collect();
-                        Ok(AdaptivePolygon {
-                            vertices,
-                            triangles,
-                            region: PolygonRegion {
-                                face: face as u32,
-                                u0: leaf.u0,
-                                v0: leaf.v0,
-                                size: leaf.size,
-                                denominator: GRID,
-                                depth: leaf.depth,
-                                extraordinary: leaf.extraordinary,
-                                bound: leaf.bound,
-                                tolerance: leaf.tolerance,
-                                diagonal: leaf.diagonal,
-                            },
-                        })
-                    })
-                    .collect()
+                let mut corners = Vec::new();
+                let mut local = Vec::new();
+                let mut face_polygons = Vec::with_capacity(leaves.len());
+                for leaf in leaves {
+                    ids.leaf_ring(mesh, face, leaf, &mut ring)?;
+                    let vertices: Vec<u32> = ring.iter().map(|&(_, id)| id).collect();
+                    params.clear();
+                    params.extend(ring.iter().map(|&((u, v), _)| (i64::from(u), i64::from(v))));
+                    positions.clear();
+                    positions.extend(vertices.iter().map(|&i| out.positions[i as usize]));
+                    polygons::triangulate(&params, &positions, &mut corners, &mut local);
+                    let triangles = local.iter().map(|t| t.map(|k| vertices[k])).collect();
+                    face_polygons.push(AdaptivePolygon {
+                        vertices,
+                        triangles,
+                        region: PolygonRegion {
+                            face: face as u32,
+                            u0: leaf.u0,
+                            v0: leaf.v0,
+                            size: leaf.size,
+                            denominator: GRID,
+                            depth: leaf.depth,
+                            extraordinary: leaf.extraordinary,
+                            bound: leaf.bound,
+                            tolerance: leaf.tolerance,
+                            diagonal: leaf.diagonal,
+                        },
+                    });
+                }
+                Ok(face_polygons)
             },
         )
         .collect::<Result<_, _>>()?;

@@ -29,10 +29,18 @@ fn collinear(mut points: impl Iterator<Item = (i64, i64)>) -> bool {
 /// triangle has positive parameter area and the triangles tile the square. Among the
 /// admissible ears the one with the shortest new diagonal in space (`positions`) is cut first.
 ///
-/// Returns index triples into `params`, counter-clockwise in parameter space.
-pub(crate) fn triangulate(params: &[(i64, i64)], positions: &[Point]) -> Vec<[usize; 3]> {
-    let mut ring: Vec<usize> = (0..params.len()).collect();
-    let mut out = Vec::with_capacity(params.len().saturating_sub(2));
+/// Writes index triples into `params` to `out` (cleared first), counter-clockwise in parameter
+/// space; `ring` is scratch (both are kept by the caller from polygon to polygon, so that a
+/// polygon allocates nothing here).
+pub(crate) fn triangulate(
+    params: &[(i64, i64)],
+    positions: &[Point],
+    ring: &mut Vec<usize>,
+    out: &mut Vec<[usize; 3]>,
+) {
+    ring.clear();
+    ring.extend(0..params.len());
+    out.clear();
     while ring.len() > 3 {
         let m = ring.len();
         let mut best: Option<(f64, usize)> = None;
@@ -58,7 +66,7 @@ pub(crate) fn triangulate(params: &[(i64, i64)], positions: &[Point]) -> Vec<[us
             for w in 1..m - 1 {
                 out.push([ring[0], ring[w], ring[w + 1]]);
             }
-            return out;
+            return;
         };
         out.push([ring[(k + m - 1) % m], ring[k], ring[(k + 1) % m]]);
         ring.remove(k);
@@ -66,7 +74,6 @@ pub(crate) fn triangulate(params: &[(i64, i64)], positions: &[Point]) -> Vec<[us
     if ring.len() == 3 {
         out.push([ring[0], ring[1], ring[2]]);
     }
-    out
 }
 
 /// Write the polygons (not triangulated) as OBJ: `v`, `vn`, then one `f a//a b//b ...` line
@@ -129,7 +136,8 @@ mod tests {
                 .iter()
                 .map(|&(u, v)| [u as f64, v as f64, 0.0])
                 .collect();
-            let triangles = triangulate(params, &positions);
+            let mut triangles = Vec::new();
+            triangulate(params, &positions, &mut Vec::new(), &mut triangles);
             assert_eq!(triangles.len(), params.len() - 2);
             let mut area = 0;
             for t in &triangles {
