@@ -990,7 +990,12 @@ pub fn tessellate_adaptive(
             },
         )
         .collect::<Result<_, _>>()?;
-    out.polygons = polygons.into_par_iter().flatten().collect();
+    // One allocation and one copy (rayon's flattening collect went through a list of vectors:
+    // 30 ms for Spot's 356,467 polygons at `8.248e-5`, on one thread or two).
+    out.polygons = Vec::with_capacity(polygons.iter().map(Vec::len).sum());
+    for face in polygons {
+        out.polygons.extend(face);
+    }
     let stats = statistics(&out, mesh.faces(), options, started);
     Ok((out, stats))
 }
@@ -1001,33 +1006,36 @@ fn statistics(
     options: &AdaptiveOptions,
     started: Instant,
 ) -> AdaptiveStats {
-    let regions = || out.polygons.iter().map(|p| &p.region);
-    let max_depth = regions().map(|r| r.depth).max().unwrap_or(0);
-    let triangles = out.triangle_count();
-    let uniform_polygons = faces as f64 * 4f64.powi(max_depth as i32);
-    let primitives = if options.triangulate {
-        triangles
-    } else {
-        out.polygons.len()
-    };
-    AdaptiveStats {
+    // One pass over the polygons (a pass per statistic took 9–13 ms on Spot's 356,467 polygons
+    // at `8.248e-5`, serial, a twentieth of the whole on one thread).
+    let mut stats = AdaptiveStats {
         polygons: out.polygons.len(),
-        triangles,
         vertices: out.positions.len(),
         triangulated: options.triangulate,
-        max_depth,
-        uniform_depth: max_depth,
-        uniform_polygons,
-        au_ratio: primitives as f64 / uniform_polygons,
-        leaves_over_tolerance: regions().filter(|r| r.bound > r.tolerance).count(),
-        max_bound: regions().map(|r| r.bound).fold(0.0, f64::max),
-        max_relative_bound: regions()
-            .filter(|r| !r.extraordinary)
-            .map(|r| r.bound / r.diagonal)
-            .fold(0.0, f64::max),
-        extraordinary_leaves: regions().filter(|r| r.extraordinary).count(),
-        seconds: started.elapsed().as_secs_f64(),
+        ..AdaptiveStats::default()
+    };
+    for polygon in &out.polygons {
+        let r = &polygon.region;
+        stats.triangles += polygon.triangles.len();
+        stats.max_depth = stats.max_depth.max(r.depth);
+        stats.leaves_over_tolerance += usize::from(r.bound > r.tolerance);
+        stats.max_bound = stats.max_bound.max(r.bound);
+        if r.extraordinary {
+            stats.extraordinary_leaves += 1;
+        } else {
+            stats.max_relative_bound = stats.max_relative_bound.max(r.bound / r.diagonal);
+        }
     }
+    stats.uniform_depth = stats.max_depth;
+    stats.uniform_polygons = faces as f64 * 4f64.powi(stats.max_depth as i32);
+    let primitives = if options.triangulate {
+        stats.triangles
+    } else {
+        stats.polygons
+    };
+    stats.au_ratio = primitives as f64 / stats.uniform_polygons;
+    stats.seconds = started.elapsed().as_secs_f64();
+    stats
 }
 
 #[cfg(test)]
