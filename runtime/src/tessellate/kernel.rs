@@ -147,6 +147,15 @@ impl<A, B> SplitSlices for (&mut [A], &mut [B]) {
     }
 }
 
+impl<A, B, C> SplitSlices for (&mut [A], &mut [B], &mut [C]) {
+    fn split_at(self, mid: usize) -> (Self, Self) {
+        let (a0, a1) = self.0.split_at_mut(mid);
+        let (b0, b1) = self.1.split_at_mut(mid);
+        let (c0, c1) = self.2.split_at_mut(mid);
+        ((a0, b0, c0), (a1, b1, c1))
+    }
+}
+
 /// Merge two rows running along an edge into triangles, in order of their parameters
 /// `param_a(i) / den_a` and `param_b(j) / den_b`; `b` lies to the right of the edge.
 pub(crate) fn merge_rows(

@@ -16,6 +16,7 @@ use rayon::prelude::*;
 use super::{Leaf, Marked, GRID};
 use crate::mesh::topology::{Mesh, NONE};
 use crate::mesh::triangle_mesh::VertexSource;
+use crate::tessellate::kernel::for_each_range;
 use crate::RuntimeError;
 
 /// Where a point of a face's grid lies.
@@ -113,6 +114,15 @@ fn face_points(marked: &[Marked], edges: &[SideEdge; 4]) -> FacePoints {
         list.sort_unstable();
     }
     FacePoints { first, sides }
+}
+
+/// `more` after `list`'s items: `more` itself when `list` is empty (no copy).
+fn append<T: Copy>(list: &mut Vec<T>, more: Vec<T>) {
+    if list.is_empty() {
+        *list = more;
+    } else {
+        list.extend_from_slice(&more);
+    }
 }
 
 /// A sorted list's pairs `(key, id)` with keys strictly between `lo` and `hi`.
@@ -222,7 +232,8 @@ pub(super) fn assign(
         base.push(total);
         total += r.iter().filter(|&&x| x != NONE).count() as u32;
     }
-    let owned: Vec<Vec<(Marked, u32)>> = (0..work.len())
+    // Per face, the points it owns: the index of the first mark of each and its id.
+    let owned: Vec<Vec<(u32, u32)>> = (0..work.len())
         .into_par_iter()
         .map(|f| {
             points[f]
@@ -230,29 +241,54 @@ pub(super) fn assign(
                 .iter()
                 .zip(&ranks[f])
                 .filter(|(_, &r)| r != NONE)
-                .map(|(&i, &r)| (work[f].1[i as usize], base[f] + r))
+                .map(|(&i, &r)| (i, base[f] + r))
                 .collect()
         })
         .collect();
-    for (f, list) in owned.iter().enumerate() {
-        for (m, _) in list {
-            positions.push(m.position);
-            normals.push(m.normal);
+    // The owned points' vertices, face by face in parallel into their places (ids are
+    // consecutive within a face): the output's pages are first written on both threads, where
+    // pushing them one by one took 15 ms on one (Spot at `8.248e-5`, 359,558 points).
+    let start = positions.len();
+    let count = (total as usize).saturating_sub(start);
+    let mut new_positions = vec![[0.0; 3]; count];
+    let mut new_normals = vec![[0.0; 3]; count];
+    let mut new_sources = vec![VertexSource::default(); count];
+    let ends: Vec<usize> = owned
+        .iter()
+        .scan(0, |end, list| {
+            *end += list.len();
+            Some(*end)
+        })
+        .collect();
+    let out = (
+        &mut new_positions[..],
+        &mut new_normals[..],
+        &mut new_sources[..],
+    );
+    for_each_range(&ends, out, |f, (p, n, s)| {
+        for (k, &(i, _)) in owned[f].iter().enumerate() {
+            let m = &work[f].1[i as usize];
+            p[k] = m.position;
+            n[k] = m.normal;
             let shift = (m.u | m.v | GRID).trailing_zeros();
-            sources.push(VertexSource {
+            s[k] = VertexSource {
                 face: f as u32,
                 u: m.u >> shift,
                 v: m.v >> shift,
                 denominator: GRID >> shift,
                 subface: 0,
-            });
+            };
         }
-    }
+    });
+    append(positions, new_positions);
+    append(normals, new_normals);
+    append(sources, new_sources);
     let mut vertices = vec![NONE; mesh.positions.len()];
     for (f, list) in owned.iter().enumerate() {
-        for (m, id) in list {
+        for &(i, id) in list {
+            let m = &work[f].1[i as usize];
             if let Place::Corner(k) = place(m.u, m.v) {
-                vertices[mesh.face(f)[k] as usize] = *id;
+                vertices[mesh.face(f)[k] as usize] = id;
             }
         }
     }
@@ -260,11 +296,13 @@ pub(super) fn assign(
     let owned_sides: Vec<[Vec<(u32, u32)>; 4]> = owned
         .par_iter()
         .zip(&edges)
-        .map(|(list, edges)| {
+        .enumerate()
+        .map(|(f, (list, edges))| {
             let mut sides: [Vec<(u32, u32)>; 4] = Default::default();
-            for (m, id) in list {
+            for &(i, id) in list {
+                let m = &work[f].1[i as usize];
                 if let Place::Side(s, t) = place(m.u, m.v) {
-                    sides[s].push((edges[s].canonical(t), *id));
+                    sides[s].push((edges[s].canonical(t), id));
                 }
             }
             for side in &mut sides {
