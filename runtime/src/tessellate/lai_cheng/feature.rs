@@ -25,7 +25,7 @@ use std::collections::BTreeSet;
 use std::iter::once;
 
 use super::bezier_net::{bspline_to_bezier, Net, Point};
-use super::{diameter, FaceWork};
+use super::{diameter_above, FaceWork};
 use crate::mesh::topology::Mesh;
 use crate::scheme::catmull_clark::adaptive::{bspline_patch, neighbourhood, submesh, RINGS};
 use crate::scheme::catmull_clark::refine::refine;
@@ -126,12 +126,19 @@ impl FaceWork<'_> {
             self.regular(&net, u0, v0, depth);
             return;
         }
-        let bound = if nonnegative {
-            diameter(&one_ring(level, g))
+        let tolerance = self.tolerance(root_diagonal);
+        // A square that may be split only asks whether the diameter exceeds the tolerance
+        // (`diameter_above`); a leaf gets it exact.
+        let floor = if depth < self.options.max_depth && !self.over_budget() {
+            tolerance
         } else {
             f64::INFINITY
         };
-        let tolerance = self.tolerance(root_diagonal);
+        let bound = if nonnegative {
+            diameter_above(&one_ring(level, g), floor)
+        } else {
+            f64::INFINITY
+        };
         if self.done(depth, bound, tolerance) {
             self.pending_leaf(&frame, depth, bound, tolerance);
             return;

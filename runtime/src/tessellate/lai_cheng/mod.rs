@@ -546,12 +546,22 @@ impl FaceWork<'_> {
             if depth == 0 {
                 root_diagonal = diagonal;
             }
-            let bound = if ops.nonnegative {
-                diameter(&level.points).min(diameter(&ev_enclosure(levels)))
+            let tolerance = self.tolerance(root_diagonal);
+            // A level that may be split needs to know only whether both diameters exceed the
+            // tolerance, which their first pairs often show ([`diameter_above`]); where one of
+            // them does not, it is exact and below the other, so the smaller is exact too, as
+            // the leaf records it.
+            let floor = if depth < self.options.max_depth && !self.over_budget() {
+                tolerance
             } else {
                 f64::INFINITY
             };
-            let tolerance = self.tolerance(root_diagonal);
+            let bound = if ops.nonnegative {
+                diameter_above(&level.points, floor)
+                    .min(diameter_above(&ev_enclosure(levels), floor))
+            } else {
+                f64::INFINITY
+            };
             if self.done(depth, bound, tolerance) {
                 let normals = [
                     vertex_normal,
@@ -631,7 +641,7 @@ fn ev_enclosure(levels: &[EvLevel]) -> Vec<Point> {
 }
 
 /// The largest distance between two of the points (the diameter of their convex hull), to the
-/// last bit the largest `norm(a - b)` over all pairs.
+/// last bit the largest `norm(a - b)` over all pairs (but see `floor` below).
 ///
 /// A pair is at most `r_a + r_b` apart (`r` the distance from the centroid, the triangle
 /// inequality), with a margin of `1e-12` of the coordinates' and radii's size, far above the
@@ -641,7 +651,12 @@ fn ev_enclosure(levels: &[EvLevel]) -> Vec<Point> {
 /// the rest are visited by decreasing `r`, a pair skipped when `r_a + r_b` is below the best
 /// distance found. A skipped pair's computed distance cannot be the largest, so the result is
 /// the full double loop's, and most of the `n^2 / 2` pairs are never computed.
-fn diameter(points: &[Point]) -> f64 {
+///
+/// Except when `d_0` (a pair's distance, so at most the diameter) is above `floor`: then it is
+/// returned, enough for a caller that only asks whether the diameter exceeds `floor` (the sort
+/// and the pairs, most of the cost, are skipped). `floor = f64::INFINITY` always gets the
+/// diameter.
+fn diameter_above(points: &[Point], floor: f64) -> f64 {
     if points.is_empty() {
         return 0.0;
     }
@@ -674,6 +689,9 @@ fn diameter(points: &[Point]) -> f64 {
         .map(|&p| squared(outermost, p))
         .fold(0.0, f64::max);
     let mut best = best_squared.sqrt();
+    if best > floor {
+        return best;
+    }
     let mut by_radius: Vec<(f64, Point)> = points
         .iter()
         .map(|&p| (radius(p), p))
@@ -1134,13 +1152,24 @@ mod tests {
                 let copy = points[0];
                 points.push(copy);
             }
+            let exact = all_pairs(&points);
             assert_eq!(
-                diameter(&points).to_bits(),
-                all_pairs(&points).to_bits(),
+                diameter_above(&points, f64::INFINITY).to_bits(),
+                exact.to_bits(),
                 "case {case}"
             );
+            // Below a floor under the diameter a caller learns only that it is above; at or
+            // over it, the diameter itself.
+            for floor in [0.0, 0.5 * exact, 0.999 * exact, exact] {
+                let d = diameter_above(&points, floor);
+                assert!(d <= exact, "case {case}");
+                assert_eq!(d > floor, exact > floor, "case {case}, floor {floor}");
+                if d <= floor {
+                    assert_eq!(d.to_bits(), exact.to_bits(), "case {case}, floor {floor}");
+                }
+            }
         }
-        assert_eq!(diameter(&[]), 0.0);
-        assert_eq!(diameter(&[[1.0, 2.0, 3.0]]), 0.0);
+        assert_eq!(diameter_above(&[], f64::INFINITY), 0.0);
+        assert_eq!(diameter_above(&[[1.0, 2.0, 3.0]], f64::INFINITY), 0.0);
     }
 }
