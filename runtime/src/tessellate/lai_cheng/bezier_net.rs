@@ -151,7 +151,7 @@ const DISTINCT: usize = 13;
 /// ([`ENTRIES`]): the bound visits 13 x 14 pairs instead of 16 x 16, and every value it drops
 /// is one that it computes.
 #[derive(Clone, Copy)]
-pub struct Deviation {
+pub(crate) struct Deviation {
     x: [f64; 14],
     y: [f64; 14],
     z: [f64; 14],
@@ -160,7 +160,7 @@ pub struct Deviation {
 
 impl Deviation {
     /// The coefficients of the patch with Bézier net `net`.
-    pub fn new(net: &Net) -> Self {
+    pub(crate) fn new(net: &Net) -> Self {
         let [v1, v2, v3, v4] = corners(net);
         let bilinear = |s: f64, t: f64| -> Point {
             std::array::from_fn(|k| {
@@ -197,7 +197,7 @@ impl Deviation {
     }
 
     /// [`flatness_bound`].
-    pub fn bound(&self) -> f64 {
+    pub(crate) fn bound(&self) -> f64 {
         // Squared lengths (`norm` is the square root of `dot`), one square root at the end:
         // `sqrt` is correctly rounded, hence monotone, so the square root of the largest square
         // is the largest length to the last bit. Every ordered pair with `+w` covers the
@@ -239,7 +239,7 @@ impl Deviation {
     /// Why: a square that is split anyway needs no exact bound (only leaves record theirs), and
     /// on a curved square the largest pair usually has a corner in it (the control points bulge
     /// to one side of `Q`), so this decides most splits with 28 pairs instead of 182.
-    pub fn corner_bound(&self) -> f64 {
+    pub(crate) fn corner_bound(&self) -> f64 {
         // Lane-wise maxima first (the pairs vectorize), then over the lanes.
         let mut largest = [0.0f64; 14];
         for (k, largest) in largest.iter_mut().enumerate() {
