@@ -127,15 +127,10 @@ impl FaceWork<'_> {
             return;
         }
         let tolerance = self.tolerance(root_diagonal);
-        // A square that may be split only asks whether the diameter exceeds the tolerance
-        // (`diameter_above`); a leaf gets it exact.
-        let floor = if depth < self.options.max_depth && !self.over_budget() {
-            tolerance
-        } else {
-            f64::INFINITY
-        };
+        // A square that may be split only asks whether the diameter exceeds the tolerance; a
+        // leaf gets it exact.
         let bound = if nonnegative {
-            diameter_above(&one_ring(level, g), floor)
+            diameter_above(&one_ring(level, g), self.diameter_floor(depth, tolerance))
         } else {
             f64::INFINITY
         };

@@ -226,11 +226,15 @@ pub(super) fn assign(
                 .collect()
         })
         .collect();
+    // Ids are `u32`: the count is checked (the polygon budget keeps it far below).
+    let too_many = || internal("more than u32::MAX marked points".to_owned());
     let mut base = Vec::with_capacity(work.len());
-    let mut total = positions.len() as u32;
+    let mut total = u32::try_from(positions.len()).map_err(|_| too_many())?;
     for r in &ranks {
         base.push(total);
-        total += r.iter().filter(|&&x| x != NONE).count() as u32;
+        let owned =
+            u32::try_from(r.iter().filter(|&&x| x != NONE).count()).map_err(|_| too_many())?;
+        total = total.checked_add(owned).ok_or_else(too_many)?;
     }
     // Per face, the points it owns: the index of the first mark of each and its id.
     let owned: Vec<Vec<(u32, u32)>> = (0..work.len())
@@ -248,11 +252,6 @@ pub(super) fn assign(
     // The owned points' vertices, face by face in parallel into their places (ids are
     // consecutive within a face): the output's pages are first written on both threads, where
     // pushing them one by one took 15 ms on one (Spot at `8.248e-5`, 359,558 points).
-    let start = positions.len();
-    let count = (total as usize).saturating_sub(start);
-    let mut new_positions = vec![[0.0; 3]; count];
-    let mut new_normals = vec![[0.0; 3]; count];
-    let mut new_sources = vec![VertexSource::default(); count];
     let ends: Vec<usize> = owned
         .iter()
         .scan(0, |end, list| {
@@ -260,6 +259,10 @@ pub(super) fn assign(
             Some(*end)
         })
         .collect();
+    let count = ends.last().copied().unwrap_or(0);
+    let mut new_positions = vec![[0.0; 3]; count];
+    let mut new_normals = vec![[0.0; 3]; count];
+    let mut new_sources = vec![VertexSource::default(); count];
     let out = (
         &mut new_positions[..],
         &mut new_normals[..],

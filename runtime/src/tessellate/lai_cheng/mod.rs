@@ -390,6 +390,23 @@ impl FaceWork<'_> {
         self.polygons.load(Ordering::Relaxed) > self.options.max_polygons
     }
 
+    /// Whether a square at `depth` may still be split (below `max_depth`, budget left): then
+    /// whether its bound exceeds the tolerance is all [`FaceWork::done`] asks of it, and a
+    /// lower bound above the tolerance answers that.
+    fn may_split(&self, depth: u32) -> bool {
+        depth < self.options.max_depth && !self.over_budget()
+    }
+
+    /// The `floor` of [`diameter_above`] for a square at `depth`: the tolerance where the
+    /// square may be split (a first distance above it settles the split), else none.
+    fn diameter_floor(&self, depth: u32, tolerance: f64) -> f64 {
+        if self.may_split(depth) {
+            tolerance
+        } else {
+            f64::INFINITY
+        }
+    }
+
     /// Record the leaf `[p0, p0 + size] x [q0, q0 + size]` (patch coordinates) and mark its
     /// corners (`MarkBlack`).
     #[allow(clippy::too_many_arguments)]
@@ -480,14 +497,13 @@ impl FaceWork<'_> {
         let points = corners(net);
         let deviation = Deviation::new(net);
         let tolerance = self.tolerance(longer_diagonal(&points));
-        let mut lower = if depth < self.options.max_depth && parent > 4.0 * tolerance {
+        let may_split = self.may_split(depth);
+        let mut lower = if may_split && parent > 4.0 * tolerance {
             deviation.corner_bound()
         } else {
             0.0
         };
-        let split = depth < self.options.max_depth
-            && (depth < self.options.min_depth || lower > tolerance)
-            && !self.over_budget();
+        let split = may_split && (depth < self.options.min_depth || lower > tolerance);
         if !split {
             let bound = deviation.bound();
             lower = bound;
@@ -552,11 +568,7 @@ impl FaceWork<'_> {
             // tolerance, which their first pairs often show ([`diameter_above`]); where one of
             // them does not, it is exact and below the other, so the smaller is exact too, as
             // the leaf records it.
-            let floor = if depth < self.options.max_depth && !self.over_budget() {
-                tolerance
-            } else {
-                f64::INFINITY
-            };
+            let floor = self.diameter_floor(depth, tolerance);
             let bound = if ops.nonnegative {
                 diameter_above(&level.points, floor)
                     .min(diameter_above(&ev_enclosure(levels), floor))

@@ -22,7 +22,6 @@ use crate::RuntimeError;
 /// `-0` only when both terms are), and `x + (+-0) = x` for any other `x`.
 #[derive(Clone, Debug)]
 pub(crate) struct Matrix {
-    rows: usize,
     data: Vec<f64>,
     /// Row `r`'s non-zero entries, `(column, weight)` in column order:
     /// `entries[starts[r]..starts[r + 1]]`.
@@ -32,33 +31,32 @@ pub(crate) struct Matrix {
 
 impl Matrix {
     fn from_exact(m: &[Vec<BigRational>]) -> Result<Self, RuntimeError> {
-        let rows = m.len();
         let cols = m.first().map_or(0, Vec::len);
-        let mut data = Vec::with_capacity(rows * cols);
-        for row in m {
-            for x in row {
-                data.push(x.to_f64().ok_or_else(|| {
-                    RuntimeError::Unsupported(format!("a subdivision weight {x} has no f64 value"))
-                })?);
-            }
-        }
+        let mut data = Vec::with_capacity(m.len() * cols);
         let mut entries = Vec::new();
         let mut starts = vec![0];
-        for row in data.chunks(cols.max(1)).take(rows) {
-            entries.extend(
-                row.iter()
-                    .enumerate()
-                    .filter(|(_, &w)| w != 0.0)
-                    .map(|(c, &w)| (c, w)),
-            );
+        for row in m {
+            for (c, x) in row.iter().enumerate() {
+                let w = x.to_f64().ok_or_else(|| {
+                    RuntimeError::Unsupported(format!("a subdivision weight {x} has no f64 value"))
+                })?;
+                data.push(w);
+                if w != 0.0 {
+                    entries.push((c, w));
+                }
+            }
             starts.push(entries.len());
         }
         Ok(Matrix {
-            rows,
             data,
             entries,
             starts,
         })
+    }
+
+    /// Rows.
+    fn rows(&self) -> usize {
+        self.starts.len() - 1
     }
 
     /// Row `r` of `M P`.
@@ -80,13 +78,15 @@ impl Matrix {
 
     /// `M P` for a column of points.
     pub(crate) fn apply(&self, points: &[Point]) -> Vec<Point> {
-        (0..self.rows).map(|r| self.row_times(r, points)).collect()
+        (0..self.rows())
+            .map(|r| self.row_times(r, points))
+            .collect()
     }
 
     /// `M P` as a 4 x 4 net (`M` has 16 rows).
     fn apply_net(&self, points: &[Point]) -> Net {
         std::array::from_fn(|k| {
-            if k < self.rows {
+            if k < self.rows() {
                 self.row_times(k, points)
             } else {
                 [0.0; 3]
