@@ -90,8 +90,8 @@ fn dense_check(
     out: &AdaptiveMesh,
     slack: f64,
 ) -> Result<Dense, subtess::RuntimeError> {
-    let mut by_face: Vec<Vec<&AdaptivePolygon>> = vec![Vec::new(); iso.mesh.faces()];
-    for p in &out.polygons {
+    let mut by_face: Vec<Vec<AdaptivePolygon>> = vec![Vec::new(); iso.mesh.faces()];
+    for p in out.polygons() {
         by_face[p.region.face as usize].push(p);
     }
     let mut dense = Dense {

@@ -88,8 +88,8 @@ fn contains(polygon: &AdaptivePolygon, u: f64, v: f64) -> bool {
 /// square contains it (its own triangles only). Asserts `distance <= bound + slack`.
 fn check_with_table(iso: &Isolation, out: &AdaptiveMesh, slack: f64) -> (f64, f64) {
     let table = table();
-    let mut by_face: Vec<Vec<&AdaptivePolygon>> = vec![Vec::new(); iso.mesh.faces()];
-    for p in &out.polygons {
+    let mut by_face: Vec<Vec<AdaptivePolygon>> = vec![Vec::new(); iso.mesh.faces()];
+    for p in out.polygons() {
         by_face[p.region.face as usize].push(p);
     }
     let (mut worst_ratio, mut worst): (f64, f64) = (0.0, 0.0);
@@ -131,11 +131,7 @@ fn rational(numerator: u64, denominator: u64) -> BigRational {
 fn check_exactly(iso: &Isolation, out: &AdaptiveMesh, faces: &[u32], scale: f64) -> f64 {
     let exact = ExactEvaluator::new(&iso.mesh);
     let mut worst: f64 = 0.0;
-    for polygon in out
-        .polygons
-        .iter()
-        .filter(|p| faces.contains(&p.region.face))
-    {
+    for polygon in out.polygons().filter(|p| faces.contains(&p.region.face)) {
         let r = polygon.region;
         let d = u64::from(r.denominator) * 8;
         for a in 0..4u64 {
@@ -146,7 +142,7 @@ fn check_exactly(iso: &Isolation, out: &AdaptiveMesh, faces: &[u32], scale: f64)
                     .evaluate(r.face as usize, &u, &v)
                     .expect("exact evaluation")
                     .position;
-                let dist = distance_to_polygon(out, polygon, s);
+                let dist = distance_to_polygon(out, &polygon, s);
                 assert!(
                     dist <= r.bound + 1e-12 * scale,
                     "face {} at ({u}, {v}): {dist} > {}",
@@ -172,8 +168,7 @@ fn check_extraordinary_exactly(
     let exact = ExactEvaluator::new(&iso.mesh);
     let mut worst: f64 = 0.0;
     for polygon in out
-        .polygons
-        .iter()
+        .polygons()
         .filter(|p| p.region.extraordinary && faces.contains(&p.region.face))
     {
         let r = polygon.region;
@@ -186,7 +181,7 @@ fn check_extraordinary_exactly(
                     .evaluate(r.face as usize, &u, &v)
                     .expect("exact evaluation")
                     .position;
-                let dist = distance_to_polygon(out, polygon, s);
+                let dist = distance_to_polygon(out, &polygon, s);
                 assert!(
                     dist <= r.bound + 1e-12 * scale,
                     "face {} at ({u}, {v}): {dist} > {}",
@@ -247,13 +242,11 @@ fn spot_meets_the_tolerance_everywhere_sampled() {
     let (ratio, worst) = check_with_table(&iso, &out, 2e-6 * scale);
     // A face at an extraordinary vertex and a regular one, exactly.
     let ev = out
-        .polygons
-        .iter()
+        .polygons()
         .find(|p| p.region.extraordinary)
         .map_or(0, |p| p.region.face);
     let regular = out
-        .polygons
-        .iter()
+        .polygons()
         .find(|p| p.region.depth > 1 && !p.region.extraordinary)
         .map_or(1, |p| p.region.face);
     let exact = check_exactly(&iso, &out, &[ev, regular], scale);
@@ -286,8 +279,7 @@ fn the_penguin_meets_the_extraordinary_bound() {
     assert!(stats.max_bound <= t);
     let (ratio, worst) = check_with_table(&iso, &out, 2e-6 * scale);
     let mut ev: Vec<(u32, u32)> = out
-        .polygons
-        .iter()
+        .polygons()
         .filter(|p| p.region.extraordinary)
         .map(|p| (p.region.depth, p.region.face))
         .collect();
@@ -347,9 +339,20 @@ fn check_watertight(name: &str, mesh: &Mesh) {
             "{name} T = {t}"
         );
         assert_eq!(stats.triangles, triangles.triangles.len());
-        // A polygon with m vertices gives m - 2 triangles.
-        let expected: usize = out.polygons.iter().map(|p| p.vertices.len() - 2).sum();
+        // A polygon with m vertices gives m - 2 triangles, over its own vertices (every one
+        // used: no point is added inside), whether read in order or one by one.
+        let expected: usize = out.polygons().map(|p| p.vertices.len() - 2).sum();
         assert_eq!(stats.triangles, expected);
+        assert_eq!(out.polygons().len(), out.polygon_count());
+        for (i, p) in out.polygons().enumerate() {
+            assert_eq!(out.polygon(i), Some(p), "{name} T = {t}: polygon {i}");
+            assert_eq!(p.triangles.len() + 2, p.vertices.len());
+            let used: std::collections::BTreeSet<u32> =
+                p.triangles.iter().flatten().copied().collect();
+            let own: std::collections::BTreeSet<u32> = p.vertices.iter().copied().collect();
+            assert_eq!(used, own, "{name} T = {t}: polygon {i}'s triangles");
+        }
+        assert_eq!(out.polygon(out.polygon_count()), None);
     }
 }
 
@@ -405,7 +408,7 @@ fn relative_flatness_is_scale_invariant_and_bounded_by_the_diagonal() {
     let (large, l_stats) = run(&iso_big, &relative);
     assert_eq!(s_stats.polygons, l_stats.polygons);
     assert_eq!(small.positions.len(), large.positions.len());
-    for p in &small.polygons {
+    for p in small.polygons() {
         assert!(p.region.bound <= p.region.tolerance);
         if !p.region.extraordinary {
             assert!(p.region.bound <= t * p.region.diagonal * (1.0 + 1e-12));
@@ -413,9 +416,9 @@ fn relative_flatness_is_scale_invariant_and_bounded_by_the_diagonal() {
     }
     let (abs_small, _) = run(&iso, &options(0.01));
     let (abs_large, _) = run(&iso_big, &options(0.01));
-    assert!(abs_large.polygons.len() > abs_small.polygons.len());
+    assert!(abs_large.polygon_count() > abs_small.polygon_count());
     let (abs_large_scaled, _) = run(&iso_big, &options(0.08));
-    assert_eq!(abs_large_scaled.polygons.len(), abs_small.polygons.len());
+    assert_eq!(abs_large_scaled.polygon_count(), abs_small.polygon_count());
 }
 
 fn grid(n: i64, mode: BoundaryMode) -> Mesh {
@@ -451,7 +454,7 @@ fn a_flat_region_needs_depth_zero() {
     let (out2, _) =
         tessellate_adaptive(&table(), &iso.mesh, &iso.patches, &options(1e-6)).expect("ok");
     let mut per_face = vec![0; iso.mesh.faces()];
-    for p in &out2.polygons {
+    for p in out2.polygons() {
         per_face[p.region.face as usize] += 1;
     }
     let single = per_face.iter().filter(|&&c| c == 1).count();
@@ -461,7 +464,7 @@ fn a_flat_region_needs_depth_zero() {
         .filter(|p| p.kind.boundary && p.kind.faces == 1)
         .count();
     assert_eq!(single, iso.mesh.faces() - corner_faces);
-    assert!(out.polygons.iter().all(|p| p.region.depth == 0));
+    assert!(out.polygons().all(|p| p.region.depth == 0));
 }
 
 #[test]
@@ -499,9 +502,9 @@ fn uniform_depth_gives_the_uniform_count() {
         ..options(1.0)
     };
     let (out, stats) = tessellate_adaptive(&table(), &iso.mesh, &iso.patches, &o).expect("ok");
-    assert_eq!(out.polygons.len(), iso.mesh.faces() * 16);
-    assert_eq!(stats.uniform_polygons, out.polygons.len() as f64);
-    assert!(out.polygons.iter().all(|p| p.vertices.len() == 4));
+    assert_eq!(out.polygon_count(), iso.mesh.faces() * 16);
+    assert_eq!(stats.uniform_polygons, out.polygon_count() as f64);
+    assert!(out.polygons().all(|p| p.vertices.len() == 4));
 }
 
 /// A tagged OpenSubdiv shape from `../shared/models/opensubdiv`.
@@ -526,8 +529,8 @@ fn sample_parameters() -> Vec<f64> {
 /// largest distance / bound at hull squares).
 fn check_with_limit_stencils(iso: &Isolation, out: &AdaptiveMesh, slack: f64) -> (usize, f64, f64) {
     let mesh = &iso.mesh;
-    let mut by_face: Vec<Vec<&AdaptivePolygon>> = vec![Vec::new(); mesh.faces()];
-    for p in &out.polygons {
+    let mut by_face: Vec<Vec<AdaptivePolygon>> = vec![Vec::new(); mesh.faces()];
+    for p in out.polygons() {
         by_face[p.region.face as usize].push(p);
     }
     let ts = sample_parameters();
@@ -583,7 +586,7 @@ fn check_with_limit_stencils(iso: &Isolation, out: &AdaptiveMesh, slack: f64) ->
 fn output_boundary_loops(out: &AdaptiveMesh) -> usize {
     use std::collections::{HashMap, HashSet};
     let mut directed = HashSet::new();
-    for p in &out.polygons {
+    for p in out.polygons() {
         let n = p.vertices.len();
         for k in 0..n {
             directed.insert((p.vertices[k], p.vertices[(k + 1) % n]));
@@ -690,7 +693,7 @@ fn relative_flatness_on_a_tagged_shape() {
     };
     let (out, stats) = tessellate_adaptive(&table(), &iso.mesh, &iso.patches, &opts).expect("ok");
     assert_eq!(stats.leaves_over_tolerance, 0);
-    for p in &out.polygons {
+    for p in out.polygons() {
         assert!(p.region.bound <= p.region.tolerance, "{:?}", p.region);
         assert!(p.region.diagonal > 0.0, "{:?}", p.region);
     }

@@ -58,7 +58,6 @@ mod polygons;
 
 use std::collections::{HashMap, VecDeque};
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Mutex;
 use std::time::Instant;
 
 use rayon::prelude::*;
@@ -83,8 +82,8 @@ pub const MAX_DEPTH: u32 = 24;
 const GRID: u32 = 1 << MAX_DEPTH;
 
 /// The default [`AdaptiveOptions::max_polygons`]: 20 million. The adaptive tessellation peaked
-/// at 738 MB for 986,496 polygons (the cube at tolerance 1e-5), about 750 bytes per polygon, so
-/// the largest output allowed takes about 15 GB and a 24 GiB machine survives it.
+/// at 412 MB for 986,496 polygons (the cube at tolerance 1e-5), about 420 bytes per polygon, so
+/// the largest output allowed takes about 8.4 GB and a 24 GiB machine survives it.
 pub const DEFAULT_MAX_POLYGONS: usize = 20_000_000;
 
 /// How to tessellate.
@@ -158,19 +157,29 @@ pub struct PolygonRegion {
     pub diagonal: f64,
 }
 
-/// One output polygon: the base quadrilateral with every marked point on its sides.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct AdaptivePolygon {
-    /// Global vertex ids, counter-clockwise in the face's parameters.
-    pub vertices: Vec<u32>,
-    /// Its triangulation (ids), every triangle of positive area in parameter space.
-    pub triangles: Vec<[u32; 3]>,
+/// One output polygon, borrowed from its [`AdaptiveMesh`]: the base quadrilateral with every
+/// marked point on its sides.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AdaptivePolygon<'a> {
+    /// Global vertex ids, counter-clockwise in the face's parameters (at least the square's
+    /// four corners).
+    pub vertices: &'a [u32],
+    /// Its triangulation (ids), every triangle of positive area in parameter space: a polygon
+    /// of `k` vertices has `k - 2` (no point inside the square is marked).
+    pub triangles: &'a [[u32; 3]],
     /// The parameter square it replaces, with its bound.
-    pub region: PolygonRegion,
+    pub region: &'a PolygonRegion,
 }
 
-/// The adaptive tessellation: one vertex per global id, and the polygons.
-#[derive(Clone, Debug, Default, PartialEq)]
+/// The adaptive tessellation: one vertex per global id, and the polygons, face by face.
+///
+/// The polygons lie in three flat arrays rather than in a vector each (two allocations per
+/// polygon cost Spot's 109,176 polygons at `2.749e-4` about a tenth of the run, and 80 bytes
+/// a polygon of heap): polygon `i`'s vertices are `vertices[starts[i]..starts[i + 1]]` and,
+/// since a polygon of `k` vertices has `k - 2` triangles, its triangles are
+/// `triangles[starts[i] - 2i..starts[i + 1] - 2(i + 1)]`. [`AdaptiveMesh::polygons`] hands them
+/// out as [`AdaptivePolygon`]s.
+#[derive(Clone, Debug, PartialEq)]
 pub struct AdaptiveMesh {
     /// Limit positions.
     pub positions: Vec<[f64; 3]>,
@@ -179,11 +188,79 @@ pub struct AdaptiveMesh {
     /// Where each vertex was evaluated (faces of the tessellated mesh; map them to the input
     /// with [`crate::scheme::catmull_clark::isolate::Isolation::input_source`]).
     pub sources: Vec<VertexSource>,
-    /// The polygons, face by face.
-    pub polygons: Vec<AdaptivePolygon>,
+    /// Where each polygon's vertices start in `vertices`, and their end (`polygons + 1`
+    /// entries).
+    starts: Vec<u32>,
+    /// Every polygon's vertex ids, polygon after polygon.
+    vertices: Vec<u32>,
+    /// Every polygon's triangles, polygon after polygon.
+    triangles: Vec<[u32; 3]>,
+    /// Every polygon's parameter square.
+    regions: Vec<PolygonRegion>,
+}
+
+impl Default for AdaptiveMesh {
+    fn default() -> Self {
+        AdaptiveMesh {
+            positions: Vec::new(),
+            normals: Vec::new(),
+            sources: Vec::new(),
+            starts: vec![0],
+            vertices: Vec::new(),
+            triangles: Vec::new(),
+            regions: Vec::new(),
+        }
+    }
 }
 
 impl AdaptiveMesh {
+    /// How many polygons.
+    pub fn polygon_count(&self) -> usize {
+        self.regions.len()
+    }
+
+    /// Polygon `i` (`< polygon_count()`), or `None`.
+    pub fn polygon(&self, i: usize) -> Option<AdaptivePolygon<'_>> {
+        let (start, end) = (
+            *self.starts.get(i)? as usize,
+            *self.starts.get(i + 1)? as usize,
+        );
+        Some(AdaptivePolygon {
+            vertices: self.vertices.get(start..end)?,
+            triangles: self.triangles.get(start - 2 * i..end - 2 * (i + 1))?,
+            region: self.regions.get(i)?,
+        })
+    }
+
+    /// The polygons in order (face by face).
+    pub fn polygons(&self) -> impl ExactSizeIterator<Item = AdaptivePolygon<'_>> + '_ {
+        let mut triangles = &self.triangles[..];
+        self.starts
+            .windows(2)
+            .zip(&self.regions)
+            .map(move |(ends, region)| {
+                let vertices = &self.vertices[ends[0] as usize..ends[1] as usize];
+                let count = vertices.len().saturating_sub(2).min(triangles.len());
+                let (mine, rest) = triangles.split_at(count);
+                triangles = rest;
+                AdaptivePolygon {
+                    vertices,
+                    triangles: mine,
+                    region,
+                }
+            })
+    }
+
+    /// Every polygon's parameter square, in polygon order.
+    pub fn regions(&self) -> &[PolygonRegion] {
+        &self.regions
+    }
+
+    /// Every polygon's triangles, polygon after polygon: the triangulated output.
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
+
     /// The triangulated output as the runtime's triangle mesh (f32).
     pub fn to_triangle_mesh(&self) -> TriangleMesh {
         let f32s = |p: &[f64; 3]| p.map(|c| c as f32);
@@ -191,18 +268,14 @@ impl AdaptiveMesh {
             positions: self.positions.iter().map(f32s).collect(),
             normals: self.normals.iter().map(f32s).collect(),
             sources: self.sources.clone(),
-            triangles: self
-                .polygons
-                .iter()
-                .flat_map(|p| p.triangles.iter().copied())
-                .collect(),
+            triangles: self.triangles.clone(),
             ..TriangleMesh::default()
         }
     }
 
     /// Number of triangles of the triangulated output.
     pub fn triangle_count(&self) -> usize {
-        self.polygons.iter().map(|p| p.triangles.len()).sum()
+        self.triangles.len()
     }
 
     /// Whether every polygon edge is shared by exactly two polygons traversing it in opposite
@@ -211,7 +284,7 @@ impl AdaptiveMesh {
     /// `false` also when a polygon names a vertex beyond `positions`.
     pub fn is_watertight(&self) -> bool {
         let edges = || {
-            self.polygons.iter().flat_map(|p| {
+            self.polygons().flat_map(|p| {
                 let around = p.vertices.iter().zip(p.vertices.iter().cycle().skip(1));
                 around.map(|(&a, &b)| (a, b))
             })
@@ -606,8 +679,7 @@ impl FaceWork<'_> {
     }
 }
 
-/// A thread's buffers for pass 3, kept from polygon to polygon: a polygon allocates its own two
-/// vectors, at their length, and nothing else.
+/// A thread's buffers for pass 3, kept from polygon to polygon.
 #[derive(Default)]
 struct PolygonBuffers {
     ring: Vec<((u32, u32), u32)>,
@@ -617,9 +689,22 @@ struct PolygonBuffers {
     triangles: Vec<[usize; 3]>,
 }
 
+/// The polygons of a run of leaves, flat as in [`AdaptiveMesh`]: each polygon's vertex count,
+/// then all their vertices and all their triangles.
+#[derive(Default)]
+struct PolygonRun {
+    counts: Vec<u32>,
+    vertices: Vec<u32>,
+    triangles: Vec<[u32; 3]>,
+}
+
+/// Leaves per job of pass 3: enough that a job's three vectors grow a few times only, few
+/// enough that Spot's 109,176 polygons at `2.749e-4` make about a hundred jobs for two threads.
+const LEAVES_PER_RUN: usize = 1024;
+
 impl PolygonBuffers {
-    /// The polygon of `leaf` of `face`: its ring of marked points (section 5) and the ring's
-    /// triangulation.
+    /// Append to `run` the polygon of `leaf` of `face`: its ring of marked points (section 5)
+    /// and the ring's triangulation (`k - 2` triangles for `k` points).
     fn polygon(
         &mut self,
         ids: &global_ids::GlobalIds,
@@ -627,17 +712,15 @@ impl PolygonBuffers {
         positions: &[Point],
         face: usize,
         leaf: &Leaf,
-    ) -> Result<AdaptivePolygon, RuntimeError> {
+        run: &mut PolygonRun,
+    ) -> Result<(), RuntimeError> {
         ids.leaf_ring(mesh, face, leaf, &mut self.ring)?;
-        let vertices: Vec<u32> = self.ring.iter().map(|&(_, id)| id).collect();
+        let count = u32::try_from(self.ring.len())
+            .map_err(|_| RuntimeError::Unsupported("a polygon of 2^32 vertices".to_owned()))?;
         self.params.clear();
-        self.params.extend(
-            self.ring
-                .iter()
-                .map(|&((u, v), _)| (i64::from(u), i64::from(v))),
-        );
         self.positions.clear();
-        for &i in &vertices {
+        for &((u, v), i) in &self.ring {
+            self.params.push((i64::from(u), i64::from(v)));
             let p = positions
                 .get(i as usize)
                 .ok_or_else(|| RuntimeError::Unsupported(format!("vertex {i} has no position")))?;
@@ -649,27 +732,31 @@ impl PolygonBuffers {
             &mut self.corners,
             &mut self.triangles,
         );
-        let triangles = self
-            .triangles
-            .iter()
-            .map(|t| t.map(|k| vertices[k]))
-            .collect();
-        Ok(AdaptivePolygon {
-            vertices,
-            triangles,
-            region: PolygonRegion {
-                face: face as u32,
-                u0: leaf.u0,
-                v0: leaf.v0,
-                size: leaf.size,
-                denominator: GRID,
-                depth: leaf.depth,
-                extraordinary: leaf.extraordinary,
-                bound: leaf.bound,
-                tolerance: leaf.tolerance,
-                diagonal: leaf.diagonal,
-            },
-        })
+        let first = run.vertices.len();
+        run.counts.push(count);
+        run.vertices.extend(self.ring.iter().map(|&(_, id)| id));
+        let vertices = &run.vertices[first..];
+        run.triangles
+            .extend(self.triangles.iter().map(|t| t.map(|k| vertices[k])));
+        Ok(())
+    }
+}
+
+impl Leaf {
+    /// The parameter square of this leaf of `face`, with its bound.
+    fn region(&self, face: usize) -> PolygonRegion {
+        PolygonRegion {
+            face: face as u32,
+            u0: self.u0,
+            v0: self.v0,
+            size: self.size,
+            denominator: GRID,
+            depth: self.depth,
+            extraordinary: self.extraordinary,
+            bound: self.bound,
+            tolerance: self.tolerance,
+            diagonal: self.diagonal,
+        }
     }
 }
 
@@ -1044,35 +1131,82 @@ pub fn tessellate_adaptive(
         &mut out.normals,
         &mut out.sources,
     )?;
+    // The marks (four a leaf, 64 bytes each) are not read again: their memory goes before the
+    // polygons take theirs.
+    for (_, marked) in &mut work {
+        *marked = Vec::new();
+    }
     // Pass 3 (parallel): the polygons (base quadrilateral replacement) and their triangles,
-    // every leaf a job, collected straight into the output in face order: its pages are first
-    // written on every thread (gathering per-face vectors into it afterwards was a serial copy
-    // of 36 MB, 23 ms for Spot's 356,467 polygons at `8.248e-5`).
+    // in runs of leaves, then copied into the output's flat arrays run by run in parallel
+    // (gathering them on one thread was a serial copy of 36 MB, 23 ms for Spot's 356,467
+    // polygons at `8.248e-5`).
     let jobs: Vec<(usize, &Leaf)> = work
         .iter()
         .enumerate()
         .flat_map(|(face, (leaves, _))| leaves.iter().map(move |leaf| (face, leaf)))
         .collect();
-    let failure = Mutex::new(None);
     jobs.par_iter()
-        .map_init(PolygonBuffers::default, |buffers, &(face, leaf)| {
-            buffers
-                .polygon(&ids, mesh, &out.positions, face, leaf)
-                .unwrap_or_else(|e| {
-                    // Kept (the first one) and returned once every job has stopped; the
-                    // polygon in its place is never seen.
-                    if let Ok(mut first) = failure.lock() {
-                        first.get_or_insert(e);
-                    }
-                    AdaptivePolygon::default()
-                })
+        .map(|&(face, leaf)| leaf.region(face))
+        .collect_into_vec(&mut out.regions);
+    let runs = jobs
+        .par_chunks(LEAVES_PER_RUN)
+        .map_init(PolygonBuffers::default, |buffers, leaves| {
+            let mut run = PolygonRun::default();
+            for &(face, leaf) in leaves {
+                buffers.polygon(&ids, mesh, &out.positions, face, leaf, &mut run)?;
+            }
+            Ok(run)
         })
-        .collect_into_vec(&mut out.polygons);
-    if let Some(e) = failure.into_inner().unwrap_or_else(|p| p.into_inner()) {
-        return Err(e);
-    }
+        .collect::<Result<Vec<PolygonRun>, RuntimeError>>()?;
+    gather_polygons(&runs, &mut out)?;
     let stats = statistics(&out, mesh.faces(), options, started);
     Ok((out, stats))
+}
+
+/// Copy the runs of pass 3 into `out`'s flat arrays, each run into its own ranges, in parallel.
+fn gather_polygons(runs: &[PolygonRun], out: &mut AdaptiveMesh) -> Result<(), RuntimeError> {
+    let too_many = || RuntimeError::Unsupported("more than 2^32 polygon vertices".to_owned());
+    let polygons: usize = runs.iter().map(|r| r.counts.len()).sum();
+    let vertices: usize = runs.iter().map(|r| r.vertices.len()).sum();
+    let triangles: usize = runs.iter().map(|r| r.triangles.len()).sum();
+    u32::try_from(vertices).map_err(|_| too_many())?;
+    if triangles + 2 * polygons != vertices {
+        return Err(RuntimeError::Unsupported(format!(
+            "{polygons} polygons of {vertices} vertices triangulated into {triangles} triangles"
+        )));
+    }
+    out.starts = vec![0; polygons + 1];
+    out.vertices = vec![0; vertices];
+    out.triangles = vec![[0; 3]; triangles];
+    // Each run's ranges of the three arrays, split off in order.
+    let mut pieces = Vec::with_capacity(runs.len());
+    let (mut starts, mut ids, mut triples) = (
+        &mut out.starts[1..],
+        &mut out.vertices[..],
+        &mut out.triangles[..],
+    );
+    let mut first = 0u32;
+    for run in runs {
+        let (s, s_rest) = std::mem::take(&mut starts).split_at_mut(run.counts.len());
+        let (v, v_rest) = std::mem::take(&mut ids).split_at_mut(run.vertices.len());
+        let (t, t_rest) = std::mem::take(&mut triples).split_at_mut(run.triangles.len());
+        (starts, ids, triples) = (s_rest, v_rest, t_rest);
+        pieces.push((run, first, s, v, t));
+        // In range: the total was checked above.
+        first += run.vertices.len() as u32;
+    }
+    pieces
+        .into_par_iter()
+        .for_each(|(run, first, starts, vertices, triangles)| {
+            let mut end = first;
+            for (start, &count) in starts.iter_mut().zip(&run.counts) {
+                end += count;
+                *start = end;
+            }
+            vertices.copy_from_slice(&run.vertices);
+            triangles.copy_from_slice(&run.triangles);
+        });
+    Ok(())
 }
 
 fn statistics(
@@ -1084,14 +1218,13 @@ fn statistics(
     // One pass over the polygons (a pass per statistic took 9–13 ms on Spot's 356,467 polygons
     // at `8.248e-5`, serial, a twentieth of the whole on one thread).
     let mut stats = AdaptiveStats {
-        polygons: out.polygons.len(),
+        polygons: out.polygon_count(),
         vertices: out.positions.len(),
+        triangles: out.triangle_count(),
         triangulated: options.triangulate,
         ..AdaptiveStats::default()
     };
-    for polygon in &out.polygons {
-        let r = &polygon.region;
-        stats.triangles += polygon.triangles.len();
+    for r in &out.regions {
         stats.max_depth = stats.max_depth.max(r.depth);
         stats.leaves_over_tolerance += usize::from(r.bound > r.tolerance);
         stats.max_bound = stats.max_bound.max(r.bound);
@@ -1131,16 +1264,18 @@ mod tests {
             tolerance: 0.0,
             diagonal: 0.0,
         };
+        // Each quad's two triangles (unused by the check), to keep the arrays' invariant.
+        let mut starts = vec![0];
+        starts.extend((1..=faces.len()).map(|i| 4 * i as u32));
         AdaptiveMesh {
             positions: vec![[0.0; 3]; 8],
-            polygons: faces
+            starts,
+            vertices: faces.concat(),
+            triangles: faces
                 .iter()
-                .map(|f| AdaptivePolygon {
-                    vertices: f.to_vec(),
-                    triangles: Vec::new(),
-                    region,
-                })
+                .flat_map(|f| [[f[0], f[1], f[2]], [f[0], f[2], f[3]]])
                 .collect(),
+            regions: vec![region; faces.len()],
             ..AdaptiveMesh::default()
         }
     }

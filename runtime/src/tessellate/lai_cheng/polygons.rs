@@ -88,7 +88,7 @@ pub fn write_obj_polygons(mesh: &AdaptiveMesh, path: &Path) -> Result<(), Runtim
             w,
             "# subtess Lai-Cheng adaptive tessellation: {} vertices, {} polygons",
             mesh.positions.len(),
-            mesh.polygons.len()
+            mesh.polygon_count()
         )
         .map_err(io)?;
         for p in &mesh.positions {
@@ -97,9 +97,9 @@ pub fn write_obj_polygons(mesh: &AdaptiveMesh, path: &Path) -> Result<(), Runtim
         for n in &mesh.normals {
             writeln!(w, "vn {} {} {}", n[0], n[1], n[2]).map_err(io)?;
         }
-        for polygon in &mesh.polygons {
+        for polygon in mesh.polygons() {
             write!(w, "f").map_err(io)?;
-            for &i in &polygon.vertices {
+            for &i in polygon.vertices {
                 write!(w, " {0}//{0}", i + 1).map_err(io)?;
             }
             writeln!(w).map_err(io)?;
