@@ -141,8 +141,14 @@ impl FaceVarying {
     /// next edge's midpoint, centroid, previous edge's midpoint, the Ptex convention of
     /// [`crate::VertexSource`]): the channel under [`FaceVaryingMode::All`].
     pub fn bilinear(&self, corners: Range<usize>, subface: usize, u: f64, v: f64) -> [f64; 2] {
+        bilinear_in(&self.quad(corners, subface), u, v)
+    }
+
+    /// The four values [`FaceVarying::bilinear`] interpolates on a face (or sub-face): made once
+    /// for all the points of a face.
+    pub fn quad(&self, corners: Range<usize>, subface: usize) -> [[f64; 2]; 4] {
         let value = |h: usize| self.values[self.corners[h] as usize];
-        let quad: [[f64; 2]; 4] = if corners.len() == 4 {
+        if corners.len() == 4 {
             [0, 1, 2, 3].map(|k| value(corners.start + k))
         } else {
             let n = corners.len();
@@ -160,13 +166,17 @@ impl FaceVarying {
                 centroid,
                 mid(at(k + n - 1), at(k)),
             ]
-        };
-        let w = [(1.0 - u) * (1.0 - v), u * (1.0 - v), u * v, (1.0 - u) * v];
-        let mut out = [0.0; 2];
-        for (p, w) in quad.iter().zip(w) {
-            out[0] += w * p[0];
-            out[1] += w * p[1];
         }
-        out
     }
+}
+
+/// The bilinear interpolation at `(u, v)` of `quad`'s values (counter-clockwise from `(0, 0)`).
+pub fn bilinear_in(quad: &[[f64; 2]; 4], u: f64, v: f64) -> [f64; 2] {
+    let w = [(1.0 - u) * (1.0 - v), u * (1.0 - v), u * v, (1.0 - u) * v];
+    let mut out = [0.0; 2];
+    for (p, w) in quad.iter().zip(w) {
+        out[0] += w * p[0];
+        out[1] += w * p[1];
+    }
+    out
 }

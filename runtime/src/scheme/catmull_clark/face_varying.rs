@@ -11,10 +11,11 @@
 //! ([`FaceVaryingMode::All`]) is the bilinear interpolation of the input face's corner values,
 //! in closed form.
 
+use rayon::prelude::*;
 use schemes::crease::{is_infinite, INFINITE};
 use schemes::BoundaryMode;
 
-use crate::mesh::face_varying::{FaceVarying, FaceVaryingMode};
+use crate::mesh::face_varying::{bilinear_in, FaceVarying, FaceVaryingMode};
 use crate::mesh::{Mesh, VertexSource, NONE};
 use crate::scheme::catmull_clark::adaptive::{limit_stencils, LimitQuery};
 use crate::scheme::catmull_clark::isolate::Isolation;
@@ -63,27 +64,41 @@ impl ChannelIsolation {
         self.input.mode
     }
 
-    /// The channel's limit values at `sources` (points of the isolated mesh's faces); `input`
-    /// maps each to its input face, sub-face and parameters (the linear mode's closed form
-    /// takes those).
-    pub fn values(
-        &self,
-        sources: &[VertexSource],
-        input: impl Fn(VertexSource) -> VertexSource,
-    ) -> Result<Vec<[f32; 2]>, MeshError> {
-        if self.input.mode == FaceVaryingMode::All {
-            return Ok(sources
-                .iter()
-                .map(|&s| {
-                    let s = input(s);
+    /// The linear mode's values ([`FaceVaryingMode::All`]: bilinear over each input face, or
+    /// over the sub-face of a non-quad) at `input_sources`, points given on their input faces,
+    /// sub-faces and parameters (`Isolation::input_source`); in parallel, in the points' order.
+    pub fn linear_values(&self, input_sources: &[VertexSource]) -> Vec<[f32; 2]> {
+        // A face's (or sub-face's) four values are looked up once for its run of points.
+        type Quad = Option<((u32, u8), [[f64; 2]; 4])>;
+        input_sources
+            .par_iter()
+            .map_init(
+                || None,
+                |last: &mut Quad, s| {
+                    let key = (s.face, s.subface);
+                    let quad = match *last {
+                        Some((k, quad)) if k == key => quad,
+                        _ => {
+                            let f = s.face as usize;
+                            let corners =
+                                self.input_faces[f] as usize..self.input_faces[f + 1] as usize;
+                            let quad = self.input.quad(corners, usize::from(s.subface));
+                            *last = Some((key, quad));
+                            quad
+                        }
+                    };
                     let (u, v) = s.uv();
-                    let f = s.face as usize;
-                    let corners = self.input_faces[f] as usize..self.input_faces[f + 1] as usize;
-                    let [x, y] = self.input.bilinear(corners, usize::from(s.subface), u, v);
+                    let [x, y] = bilinear_in(&quad, u, v);
                     [x as f32, y as f32]
-                })
-                .collect());
-        }
+                },
+            )
+            .collect()
+    }
+
+    /// The channel's limit values at `sources`, points of the isolated mesh's faces, for the
+    /// modes other than the linear one (which [`ChannelIsolation::linear_values`] gives in
+    /// closed form): the channel mesh's limit stencils.
+    pub fn limit_values(&self, sources: &[VertexSource]) -> Result<Vec<[f32; 2]>, MeshError> {
         let queries: Vec<LimitQuery> = sources
             .iter()
             .map(|s| {

@@ -5,6 +5,8 @@
 //! irregular vertices); rates then apply to the faces of the refined mesh, and every refined face
 //! remembers the input face it lies in ([`Isolation::origin`]).
 
+use rayon::prelude::*;
+
 use crate::mesh::topology::Mesh;
 use crate::mesh::VertexSource;
 use crate::scheme::catmull_clark::refine::refine;
@@ -40,36 +42,94 @@ pub struct Isolation {
 
 impl Isolation {
     /// The input face and its own parameters of a point given on face `source.face` of the
-    /// isolated mesh, exactly. Child `c` of a quad covers the quarter at its corner `c` and runs
-    /// from that corner (`refine.rs`): its `(s, t)` is the parent's
-    /// `(s/2, t/2)`, `(1 - t/2, s/2)`, `(1 - s/2, 1 - t/2)`, `(t/2, 1 - s/2)` for `c = 0..3`, so
-    /// the denominator doubles per step. A non-quad input face has no parameterization of its
-    /// own: the point is left in the parameters of the sub-face (the quad of the first step at
-    /// its corner `subface`), the Ptex / OpenSubdiv convention.
+    /// isolated mesh, exactly ([`Isolation::input_map`]).
     pub fn input_source(&self, source: VertexSource) -> VertexSource {
-        let face = source.face as usize;
-        let (mut u, mut v, mut d) = (source.u, source.v, source.denominator);
+        self.input_map(source.face as usize).apply(source)
+    }
+
+    /// Every point of `sources` (given on faces of the isolated mesh) on its input face, in
+    /// place and in parallel, one [`InputMap`] per run of points on the same face (a dual grid
+    /// lists each face's points together).
+    pub fn map_to_input(&self, sources: &mut [VertexSource]) {
+        sources
+            .par_chunk_by_mut(|a, b| a.face == b.face)
+            .for_each(|run| {
+                let map = self.input_map(run[0].face as usize);
+                for source in run {
+                    *source = map.apply(*source);
+                }
+            });
+    }
+
+    /// How the points of isolated face `face` map to its input face. Child `c` of a quad covers
+    /// the quarter at its corner `c` and runs from that corner (`refine.rs`): its `(s, t)` is
+    /// the parent's `(s/2, t/2)`, `(1 - t/2, s/2)`, `(1 - s/2, 1 - t/2)`, `(t/2, 1 - s/2)` for
+    /// `c = 0..3`, so the denominator doubles per step: on numerators `(u, v)` over `d`, a step
+    /// is linear in `(u, v, d)`, and so are the steps composed. A non-quad input face has no
+    /// parameterization of its own: the point is left in the parameters of the sub-face (the
+    /// quad of the first step at its corner `subface`), the Ptex / OpenSubdiv convention. A face
+    /// beyond the isolated mesh maps to itself.
+    pub fn input_map(&self, face: usize) -> InputMap {
+        // Rows of the map on (u, v, d), from the identity; each step multiplies from the left.
+        let mut rows = [[1i64, 0, 0], [0, 1, 0], [0, 0, 1]];
         let mut subface = 0;
-        for level in (0..self.steps).rev() {
-            let c = self.corners[face][level];
-            if level == 0 && self.input_sides[self.origin[face] as usize] != 4 {
+        let (Some(corners), Some(&origin)) = (self.corners.get(face), self.origin.get(face)) else {
+            return InputMap {
+                face: face as u32,
+                subface,
+                rows,
+            };
+        };
+        let quad = self.input_sides.get(origin as usize) == Some(&4);
+        for level in (0..self.steps.min(MAX_STEPS)).rev() {
+            let c = corners[level];
+            if level == 0 && !quad {
                 subface = c;
                 break;
             }
-            (u, v) = match c {
-                0 => (u, v),
-                1 => (2 * d - v, u),
-                2 => (2 * d - u, 2 * d - v),
-                _ => (v, 2 * d - u),
+            let [u, v, d] = rows;
+            let twice = |r: [i64; 3]| r.map(|x| 2 * x);
+            let minus = |a: [i64; 3], b: [i64; 3]| std::array::from_fn(|k| a[k] - b[k]);
+            rows = match c {
+                0 => [u, v, twice(d)],
+                1 => [minus(twice(d), v), u, twice(d)],
+                2 => [minus(twice(d), u), minus(twice(d), v), twice(d)],
+                _ => [v, minus(twice(d), u), twice(d)],
             };
-            d *= 2;
         }
-        VertexSource {
-            face: self.origin[face],
-            u,
-            v,
-            denominator: d,
+        InputMap {
+            face: origin,
             subface,
+            rows,
+        }
+    }
+}
+
+/// The map from the points of one isolated face to its input face ([`Isolation::input_map`]):
+/// the input face, the sub-face of a non-quad, and the integer linear map on `(u, v, d)`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct InputMap {
+    face: u32,
+    subface: u8,
+    rows: [[i64; 3]; 3],
+}
+
+impl InputMap {
+    /// `source` on the input face. The numerators stay in `0..=d'` (the maps are the corner
+    /// quarters' affine maps), so they fit in `u32` whenever the denominator `d'` does.
+    pub fn apply(&self, source: VertexSource) -> VertexSource {
+        let x = [
+            i64::from(source.u),
+            i64::from(source.v),
+            i64::from(source.denominator),
+        ];
+        let row = |r: [i64; 3]| (r[0] * x[0] + r[1] * x[1] + r[2] * x[2]) as u32;
+        VertexSource {
+            face: self.face,
+            u: row(self.rows[0]),
+            v: row(self.rows[1]),
+            denominator: row(self.rows[2]),
+            subface: self.subface,
         }
     }
 }
@@ -155,5 +215,116 @@ mod tests {
         assert_eq!(iso.origin.len(), quads);
         let fives = iso.origin.iter().filter(|&&f| f == 0).count();
         assert_eq!(fives * 3, (quads - fives) * 5);
+    }
+
+    /// The corner steps one at a time, from the last step to the first: what
+    /// [`Isolation::input_map`] composes (the implementation before the maps).
+    fn step_by_step(iso: &Isolation, source: VertexSource) -> VertexSource {
+        let face = source.face as usize;
+        let (mut u, mut v, mut d) = (source.u, source.v, source.denominator);
+        let mut subface = 0;
+        for level in (0..iso.steps).rev() {
+            let c = iso.corners[face][level];
+            if level == 0 && iso.input_sides[iso.origin[face] as usize] != 4 {
+                subface = c;
+                break;
+            }
+            (u, v) = match c {
+                0 => (u, v),
+                1 => (2 * d - v, u),
+                2 => (2 * d - u, 2 * d - v),
+                _ => (v, 2 * d - u),
+            };
+            d *= 2;
+        }
+        VertexSource {
+            face: iso.origin[face],
+            u,
+            v,
+            denominator: d,
+            subface,
+        }
+    }
+
+    /// Every face's map gives the steps' point for points across the face (corners, sides,
+    /// inside; denominators up to Lai–Cheng's `2^24`), on a cube (two steps, every input face a
+    /// quad) and on a pentagon beside a triangle (sub-faces); and the maps by runs give the
+    /// points one by one, whatever the order of the faces.
+    #[test]
+    fn input_maps_are_the_corner_steps_composed() {
+        let cube = Mesh::new(
+            vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [1.0, 1.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.0, 0.0, 1.0],
+                [1.0, 0.0, 1.0],
+                [1.0, 1.0, 1.0],
+                [0.0, 1.0, 1.0],
+            ],
+            &[
+                vec![0, 3, 2, 1],
+                vec![4, 5, 6, 7],
+                vec![0, 1, 5, 4],
+                vec![1, 2, 6, 5],
+                vec![2, 3, 7, 6],
+                vec![3, 0, 4, 7],
+            ],
+            &[],
+            schemes::BoundaryMode::EdgeOnly,
+        )
+        .expect("valid");
+        let mixed = Mesh::new(
+            vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [1.5, 1.0, 0.0],
+                [0.5, 1.5, 0.0],
+                [-0.5, 1.0, 0.0],
+                [0.5, -1.0, 0.0],
+            ],
+            &[vec![0, 1, 2, 3, 4], vec![1, 0, 5]],
+            &[],
+            schemes::BoundaryMode::EdgeOnly,
+        )
+        .expect("valid");
+        for mesh in [cube, mixed] {
+            let iso = isolate_with_origins(&mesh).expect("isolates");
+            assert!(iso.steps >= 1);
+            let mut all = Vec::new();
+            for face in 0..iso.mesh.faces() as u32 {
+                for d in [1u32, 2, 6, 48, 1 << 24] {
+                    for (u, v) in [
+                        (0, 0),
+                        (d, 0),
+                        (d, d),
+                        (0, d),
+                        (d / 2, 0),
+                        (d / 3, d - d / 5),
+                    ] {
+                        let source = VertexSource {
+                            face,
+                            u,
+                            v,
+                            denominator: d,
+                            subface: 0,
+                        };
+                        assert_eq!(iso.input_source(source), step_by_step(&iso, source));
+                        all.push(source);
+                    }
+                }
+            }
+            // Runs of one face, then the faces interleaved point by point.
+            let interleaved: Vec<VertexSource> = (0..30)
+                .flat_map(|k| all.iter().skip(k).step_by(30).copied())
+                .collect();
+            for mut sources in [all.clone(), interleaved] {
+                let expected: Vec<VertexSource> =
+                    sources.iter().map(|&s| step_by_step(&iso, s)).collect();
+                iso.map_to_input(&mut sources);
+                assert_eq!(sources, expected);
+            }
+        }
     }
 }
