@@ -27,6 +27,30 @@ pub fn octahedron() -> Mesh {
     Mesh::new(p, &f, &[], BoundaryMode::EdgeOnly).expect("a valid octahedron")
 }
 
+/// The unit cube `[0, 1]^3`, vertices `(0,0,0), (1,0,0), (1,1,0), (0,1,0)` and then the same at
+/// `z = 1`, faces outward, every vertex of valence 3.
+pub fn cube() -> Mesh {
+    let p = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [1.0, 0.0, 1.0],
+        [1.0, 1.0, 1.0],
+        [0.0, 1.0, 1.0],
+    ];
+    let f = vec![
+        vec![0, 3, 2, 1],
+        vec![4, 5, 6, 7],
+        vec![0, 1, 5, 4],
+        vec![1, 2, 6, 5],
+        vec![2, 3, 7, 6],
+        vec![3, 0, 4, 7],
+    ];
+    Mesh::new(p, &f, &[], BoundaryMode::EdgeOnly).expect("a valid cube")
+}
+
 /// The regular tetrahedron, every vertex of valence 3.
 pub fn tetrahedron() -> Mesh {
     let p = vec![

@@ -195,10 +195,10 @@ pub fn isolate(mesh: &Mesh) -> Result<(Mesh, Vec<FacePatch>, usize), MeshError> 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::test_meshes::cube;
 
-    /// A pentagon and a triangle sharing an edge: one step, five quads then three.
-    #[test]
-    fn origins_follow_the_half_edges() {
+    /// A pentagon and a triangle sharing an edge.
+    fn pentagon_and_triangle() -> Mesh {
         let p = vec![
             [0.0, 0.0, 0.0],
             [1.0, 0.0, 0.0],
@@ -208,8 +208,13 @@ mod tests {
             [0.5, -1.0, 0.0],
         ];
         let faces = vec![vec![0, 1, 2, 3, 4], vec![1, 0, 5]];
-        let mesh = Mesh::new(p, &faces, &[], schemes::BoundaryMode::EdgeOnly).expect("valid");
-        let iso = isolate_with_origins(&mesh).expect("isolates");
+        Mesh::new(p, &faces, &[], schemes::BoundaryMode::EdgeOnly).expect("valid")
+    }
+
+    /// One step makes five quads of the pentagon, then three of the triangle.
+    #[test]
+    fn origins_follow_the_half_edges() {
+        let iso = isolate_with_origins(&pentagon_and_triangle()).expect("isolates");
         assert!(iso.steps >= 1);
         let quads = 8 * 4usize.pow(iso.steps as u32 - 1);
         assert_eq!(iso.origin.len(), quads);
@@ -252,44 +257,7 @@ mod tests {
     /// points one by one, whatever the order of the faces.
     #[test]
     fn input_maps_are_the_corner_steps_composed() {
-        let cube = Mesh::new(
-            vec![
-                [0.0, 0.0, 0.0],
-                [1.0, 0.0, 0.0],
-                [1.0, 1.0, 0.0],
-                [0.0, 1.0, 0.0],
-                [0.0, 0.0, 1.0],
-                [1.0, 0.0, 1.0],
-                [1.0, 1.0, 1.0],
-                [0.0, 1.0, 1.0],
-            ],
-            &[
-                vec![0, 3, 2, 1],
-                vec![4, 5, 6, 7],
-                vec![0, 1, 5, 4],
-                vec![1, 2, 6, 5],
-                vec![2, 3, 7, 6],
-                vec![3, 0, 4, 7],
-            ],
-            &[],
-            schemes::BoundaryMode::EdgeOnly,
-        )
-        .expect("valid");
-        let mixed = Mesh::new(
-            vec![
-                [0.0, 0.0, 0.0],
-                [1.0, 0.0, 0.0],
-                [1.5, 1.0, 0.0],
-                [0.5, 1.5, 0.0],
-                [-0.5, 1.0, 0.0],
-                [0.5, -1.0, 0.0],
-            ],
-            &[vec![0, 1, 2, 3, 4], vec![1, 0, 5]],
-            &[],
-            schemes::BoundaryMode::EdgeOnly,
-        )
-        .expect("valid");
-        for mesh in [cube, mixed] {
+        for mesh in [cube(), pentagon_and_triangle()] {
             let iso = isolate_with_origins(&mesh).expect("isolates");
             assert!(iso.steps >= 1);
             let mut all = Vec::new();

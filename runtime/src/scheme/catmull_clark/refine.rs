@@ -324,30 +324,11 @@ pub fn refine(mesh: &Mesh) -> Refinement {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use schemes::BoundaryMode;
+    use crate::mesh::test_meshes::cube;
 
     #[test]
     fn a_cube_refines_to_the_textbook_counts_and_stays_closed() {
-        let p = vec![
-            [0.0, 0.0, 0.0],
-            [1.0, 0.0, 0.0],
-            [1.0, 1.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [0.0, 0.0, 1.0],
-            [1.0, 0.0, 1.0],
-            [1.0, 1.0, 1.0],
-            [0.0, 1.0, 1.0],
-        ];
-        let f = vec![
-            vec![0, 3, 2, 1],
-            vec![4, 5, 6, 7],
-            vec![0, 1, 5, 4],
-            vec![1, 2, 6, 5],
-            vec![2, 3, 7, 6],
-            vec![3, 0, 4, 7],
-        ];
-        let cube = Mesh::new(p, &f, &[], BoundaryMode::EdgeOnly).expect("valid cube");
-        let r = refine(&cube);
+        let r = refine(&cube());
         assert_eq!((r.mesh.positions.len(), r.mesh.faces()), (26, 24));
         assert_eq!(r.mesh.euler_characteristic(), 2);
         // Vertex point of corner 0 (valence 3): Q = (1/3)(1,1,1) (mean of the three face
