@@ -243,6 +243,9 @@ pub struct DualGrid {
     rates: Vec<u32>,
     /// First dual vertex of every face, and the total after the last.
     first: Vec<u32>,
+    /// `first[1..]` as `usize`: where each face's dual points end, the ranges a frame hands to
+    /// its faces (made once, not per frame).
+    face_ends: Vec<usize>,
     faces: Vec<FaceEval>,
     /// Separable factors by rate (index `n`).
     bases: Vec<Option<SeparableBasis>>,
@@ -407,9 +410,11 @@ impl DualGrid {
             // A hole makes no surface: no points of its own.
             first.push(first[first.len() - 1] + if hole { 0 } else { n * n });
         }
+        let face_ends = first[1..].iter().map(|&x| x as usize).collect();
         let mut grid = DualGrid {
             rates: rates.to_vec(),
             first,
+            face_ends,
             faces: Vec::with_capacity(patches.len()),
             bases: vec![None; MAX_RATE as usize + 1],
             lanes: Vec::new(),
@@ -1017,9 +1022,8 @@ impl GridPlan for DualGrid {
         let dual = self.first[self.rates.len()] as usize;
         let (face_positions, curve_positions) = positions.split_at_mut(dual);
         let (face_normals, curve_normals) = normals.split_at_mut(dual);
-        let vertex_offsets: Vec<usize> = self.first[1..].iter().map(|&x| x as usize).collect();
         for_each_range(
-            &vertex_offsets,
+            &self.face_ends,
             (face_positions, face_normals),
             |f, (p, q)| self.evaluate_face(f, control, p, q),
         );
