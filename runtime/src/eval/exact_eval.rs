@@ -334,7 +334,7 @@ impl ExactEvaluator {
         let mut levels = vec![mesh.clone()];
         let mut edges = Vec::new();
         let valence_two = (0..mesh.positions.len())
-            .any(|v| !mesh.is_boundary_vertex(v) && mesh.fan(v).len() == 2);
+            .any(|v| !mesh.is_boundary_vertex(v) && mesh.fan_iter(v).count() == 2);
         let tagged = mesh.has_sharp_features() || valence_two;
         while !tagged && levels.len() <= MAX_STEPS {
             let last = &levels[levels.len() - 1];

@@ -69,7 +69,7 @@ pub fn ring_from(mesh: &Mesh, h: usize) -> Vec<u32> {
 /// Whether vertex `v` is regular for Loop: interior of valence 6, or on the boundary with three
 /// triangles (where the surface is the quartic box spline, or its boundary restriction).
 pub fn is_regular(mesh: &Mesh, v: usize) -> bool {
-    let faces = mesh.fan(v).len();
+    let faces = mesh.fan_iter(v).count();
     if mesh.is_boundary_vertex(v) {
         faces == 3
     } else {

@@ -89,7 +89,7 @@ pub fn gather_patches(mesh: &Mesh) -> Result<Vec<FacePatch>, MeshError> {
 /// Whether vertex `v` is irregular: interior valence other than 4, or a boundary vertex with
 /// other than two faces.
 pub fn is_irregular(mesh: &Mesh, v: usize) -> bool {
-    let faces = mesh.fan(v).len();
+    let faces = mesh.fan_iter(v).count();
     if mesh.is_boundary_vertex(v) {
         faces != 2
     } else {
@@ -108,12 +108,12 @@ pub fn is_irregular(mesh: &Mesh, v: usize) -> bool {
 pub fn is_smooth_patch(mesh: &Mesh, face: usize) -> bool {
     mesh.face(face).iter().all(|&v| {
         let v = v as usize;
-        if !mesh.is_boundary_vertex(v) && mesh.fan(v).len() == 2 {
+        if !mesh.is_boundary_vertex(v) && mesh.fan_iter(v).count() == 2 {
             return false;
         }
         let pinned = mesh.boundary == schemes::BoundaryMode::EdgeAndCorner
             && mesh.is_boundary_vertex(v)
-            && mesh.fan(v).len() == 1;
+            && mesh.fan_iter(v).count() == 1;
         (mesh.vertex_sharpness[v] == 0.0 || pinned)
             && mesh
                 .vertex_edges(v)
@@ -140,7 +140,7 @@ fn infinitely_sharp(mesh: &Mesh, h: usize) -> bool {
 /// of its own: a regular corner of a smooth patch.
 fn smooth_regular(mesh: &Mesh, v: usize) -> bool {
     !mesh.is_boundary_vertex(v)
-        && mesh.fan(v).len() == 4
+        && mesh.fan_iter(v).count() == 4
         && mesh.vertex_sharpness[v] == 0.0
         && mesh
             .vertex_edges(v)

@@ -134,7 +134,7 @@ pub(crate) fn bspline_patch<W: Weight>(mesh: &Mesh, g: usize) -> Option<[[Combo<
         let reflect = |a: u32, b: u32| vec![(a, int(2)), (b, int(-1))];
         match (in_sharp, out_sharp, rule) {
             (false, false, CreaseRule::Smooth) => {
-                if mesh.fan(v).len() != 4 {
+                if mesh.fan_iter(v).count() != 4 {
                     return None;
                 }
                 let n1 = mesh.twin[mesh.prev(h)] as usize;

@@ -315,7 +315,7 @@ pub fn gather_boundary_patches(mesh: &Mesh) -> Result<Vec<Option<TrianglePatch>>
     let irregular: Vec<u32> = boundary
         .iter()
         .copied()
-        .filter(|&v| mesh.fan(v as usize).len() != 3)
+        .filter(|&v| mesh.fan_iter(v as usize).count() != 3)
         .collect();
     let (to_boundary, nearest) = distances(mesh, &boundary, REGULAR_ROW as u32);
     let (to_irregular, nearest_irregular) = distances(mesh, &irregular, FAN_REACH);
@@ -406,7 +406,7 @@ fn patch_in(
                 ));
             }
         }
-        let faces = mesh.fan(v as usize).len();
+        let faces = mesh.fan_iter(v as usize).count();
         let on = chart.fan.on_boundary(p);
         let want = if p == V {
             chart.fan.faces as usize
