@@ -732,6 +732,14 @@ impl PolygonBuffers {
             &mut self.corners,
             &mut self.triangles,
         );
+        // The flat arrays place a polygon's triangles by this count (`AdaptiveMesh`).
+        if self.triangles.len() + 2 != self.ring.len() {
+            return Err(RuntimeError::Unsupported(format!(
+                "internal: a polygon of {} vertices triangulated into {} triangles",
+                self.ring.len(),
+                self.triangles.len()
+            )));
+        }
         let first = run.vertices.len();
         run.counts.push(count);
         run.vertices.extend(self.ring.iter().map(|&(_, id)| id));
@@ -1172,11 +1180,6 @@ fn gather_polygons(runs: &[PolygonRun], out: &mut AdaptiveMesh) -> Result<(), Ru
     let vertices: usize = runs.iter().map(|r| r.vertices.len()).sum();
     let triangles: usize = runs.iter().map(|r| r.triangles.len()).sum();
     u32::try_from(vertices).map_err(|_| too_many())?;
-    if triangles + 2 * polygons != vertices {
-        return Err(RuntimeError::Unsupported(format!(
-            "{polygons} polygons of {vertices} vertices triangulated into {triangles} triangles"
-        )));
-    }
     out.starts = vec![0; polygons + 1];
     out.vertices = vec![0; vertices];
     out.triangles = vec![[0; 3]; triangles];
