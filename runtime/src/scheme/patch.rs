@@ -155,13 +155,12 @@ fn dart_edge(mesh: &Mesh, v: usize) -> Option<usize> {
     if mesh.is_boundary_vertex(v) || mesh.vertex_sharpness[v] != 0.0 {
         return None;
     }
-    let fan = mesh.fan(v);
-    let mut sharp = fan
-        .iter()
+    let mut sharp = mesh
+        .fan_iter(v)
         .enumerate()
-        .filter(|(_, &h)| mesh.edge_sharpness[h] != 0.0);
+        .filter(|&(_, h)| mesh.edge_sharpness[h] != 0.0);
     match (sharp.next(), sharp.next()) {
-        (Some((d, &h)), None) if infinitely_sharp(mesh, h) => Some(d),
+        (Some((d, h)), None) if infinitely_sharp(mesh, h) => Some(d),
         _ => None,
     }
 }
@@ -399,7 +398,9 @@ pub fn face_patch(mesh: &Mesh, face: usize) -> Result<FacePatch, MeshError> {
             Err(not_isolated(format!("face {f} next to it is not a quad")))
         }
     };
-    let mut points = vec![centre as u32];
+    // The layout's 2N + 8 points (one more on a boundary), in one allocation.
+    let mut points = Vec::with_capacity(2 * fan.len() + 9);
+    points.push(centre as u32);
     for &h in &fan {
         points.push(mesh.head(quad(h)?));
     }
