@@ -115,8 +115,10 @@ pub struct InputMap {
 }
 
 impl InputMap {
-    /// `source` on the input face. The numerators stay in `0..=d'` (the maps are the corner
-    /// quarters' affine maps), so they fit in `u32` whenever the denominator `d'` does.
+    /// `source` on the input face. For a point of the face (`u, v <= d`) the numerators stay in
+    /// `0..=d'` (the maps are the corner quarters' affine maps), so they fit in `u32` whenever
+    /// the denominator `d'` does; a point beyond the face wraps, as the steps' `u32` arithmetic
+    /// did.
     pub fn apply(&self, source: VertexSource) -> VertexSource {
         let x = [
             i64::from(source.u),

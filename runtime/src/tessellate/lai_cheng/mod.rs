@@ -234,18 +234,15 @@ impl AdaptiveMesh {
 
     /// The polygons in order (face by face).
     pub fn polygons(&self) -> impl ExactSizeIterator<Item = AdaptivePolygon<'_>> + '_ {
-        let mut triangles = &self.triangles[..];
         self.starts
             .windows(2)
             .zip(&self.regions)
-            .map(move |(ends, region)| {
-                let vertices = &self.vertices[ends[0] as usize..ends[1] as usize];
-                let count = vertices.len().saturating_sub(2).min(triangles.len());
-                let (mine, rest) = triangles.split_at(count);
-                triangles = rest;
+            .enumerate()
+            .map(move |(i, (ends, region))| {
+                let (start, end) = (ends[0] as usize, ends[1] as usize);
                 AdaptivePolygon {
-                    vertices,
-                    triangles: mine,
+                    vertices: &self.vertices[start..end],
+                    triangles: &self.triangles[start - 2 * i..end - 2 * (i + 1)],
                     region,
                 }
             })
