@@ -29,15 +29,10 @@ impl TriangleMesh {
     /// directions (a closed, consistently oriented, edge-manifold surface), in positions: a
     /// vertex split along a texture seam counts as its original ([`TriangleMesh::seam_copies`]).
     ///
-    /// Exact, and linear but for a sort of the edges outside the faces' grids
-    /// (`mesh::watertight`).
+    /// Exact, and linear but for a sort of the edges outside the faces' grids and the strips
+    /// between them (`mesh::watertight`).
     pub fn is_watertight(&self) -> bool {
-        let of = if self.seam_copies.is_empty() {
-            Vec::new()
-        } else {
-            self.position_vertices()
-        };
-        crate::mesh::watertight::is_closed(&self.triangles, self.positions.len(), &of)
+        crate::mesh::watertight::is_closed(&self.triangles, self.positions.len(), &self.seam_copies)
     }
 
     /// The boundary edges (directed edges without an opposite one), or `None` when some directed

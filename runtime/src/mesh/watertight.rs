@@ -1,29 +1,45 @@
 //! Whether a triangle mesh is closed: every directed edge used exactly once, and its reverse
 //! exactly once (a closed, consistently oriented, edge-manifold surface).
 //!
-//! The general check ([`DirectedEdges`]) groups every directed edge by its tail, `3T` of them.
-//! A dual grid's output is mostly its faces' grids (`(n-1)^2` quads of two triangles each),
-//! whose inner edges pair up by construction. So the check first looks for such grids
-//! in the triangle list itself, trusting nothing the tessellator says: a *grid block* is a run
-//! of triangles `[a, b, c], [a, c, d]` over quads `(a, b, c, d) = (r+i, r+i+1, r+w+i+1, r+w+i)`,
-//! `i` in `0..w-1`, for rows `r = first + j w`, `j` in `0..rows`: complete rows only. Every
-//! inner edge of a block (not on its border) is used once each way by the block's own
-//! triangles, and by nothing else when
+//! The general check looks at every directed edge, `3T` of them ([`DirectedEdges`] groups them
+//! by tail; [`is_closed`] sorts the few it is left with). A dual grid's output is mostly its faces' grids (`(n-1)^2` quads of two triangles each) and
+//! the strips between neighbouring grids (`n - 1` quads each at equal rates), whose inner edges
+//! pair up by construction. So the check first looks for both in the triangle list itself,
+//! trusting nothing the tessellator says:
 //!
-//! * the blocks' vertex ranges are disjoint (a block's edges join its own vertices), and
-//! * no other triangle uses an inner edge of a block (checked edge by edge).
+//! * a *grid block* is a run of triangles `[a, b, c], [a, c, d]` over quads
+//!   `(a, b, c, d) = (r+i, r+i+1, r+w+i+1, r+w+i)`, `i` in `0..w-1`, for rows `r = first + j w`,
+//!   `j` in `0..rows`: complete rows only;
+//! * a *strip* is a run of triangles `[b_k, a_(k+1), a_k], [b_k, b_(k+1), a_(k+1)]` over two
+//!   rows of vertices in arithmetic progression, `a_k = a_0 + k s`, `b_k = b_0 + k t`, `k` in
+//!   `0..=m`, `m >= 2`, whose two sides are whole sides of two different blocks, run the
+//!   other way (the sides' edges then pair with those blocks' border edges).
 //!
-//! What is left, the blocks' border edges and every edge of the other triangles, takes the
-//! general check. The answer is the general check's on the whole mesh, exactly; only the cost
-//! differs: a block's triangle costs a comparison with the pattern instead of three edges
-//! grouped and searched.
+//! Every inner edge of a block or strip (a block's edges off its border; a strip's rungs
+//! `a_k b_k`, `0 < k < m`, and diagonals `b_k a_(k+1)`) is used once each way by its own
+//! triangles, and a strip's sides pair with the blocks' sides it was matched with, and by
+//! nothing else when
 //!
-//! The scan for blocks runs in pieces of the triangle list in parallel (a block cut between two
-//! pieces is two blocks, as valid as one), and so does the test of the other triangles against
-//! the blocks' inner edges; the blocks' disjointness is checked on their ranges sorted by first
-//! vertex, and the general check numbers the vertices its edges touch densely (at rate 16 about
-//! a quarter of all), so its passes over vertices skip the blocks' interiors.
+//! * the blocks' vertex ranges are disjoint (a block's edges join its own vertices; a strip's
+//!   inner edges join two blocks' vertices, one of them inside a side no other strip matched),
+//! * no block side is matched by two strips, and
+//! * no other triangle uses an inner edge of a block or strip or an edge of a matched side
+//!   (checked edge by edge).
+//!
+//! What is left, the unmatched sides' border edges, the strips' end rungs (`a_0 -> b_0`,
+//! `b_m -> a_m`) and every edge of the other triangles, takes the general check. The answer is
+//! the general check's on the whole mesh, exactly; only the cost differs: a block's or strip's
+//! triangle costs a comparison with the pattern instead of three edges grouped and searched.
+//!
+//! The scan for blocks and strips runs in pieces of the triangle list in parallel (a block cut
+//! between two pieces is two blocks, as valid as one; a strip cut there matches no side and goes
+//! to the general check), and so does the test of the other triangles against the inner and
+//! matched edges. The blocks' disjointness is checked on their ranges sorted by first vertex,
+//! and a vertex's block is found from those ranges ([`BlockIndex`]): nothing is allocated per
+//! vertex, since the first writes to such arrays (fresh pages) cost more than the rest of the
+//! check at rate 16.
 
+use std::cmp::Ordering;
 use std::ops::Range;
 
 use rayon::prelude::*;
@@ -49,19 +65,65 @@ impl GridBlock {
         first..first + (u64::from(self.rows) + 1) * u64::from(self.width)
     }
 
-    /// The border's directed edges, as the block's triangles run them: the first row's
-    /// bottoms, the last row's tops, the first quads' left sides, the last quads' right sides.
-    fn border_edges(&self, out: &mut Vec<(u32, u32)>) {
-        let (w, first) = (self.width, self.first);
-        let top = first + (self.rows - 1) * w;
-        for i in 0..w - 1 {
-            out.push((first + i, first + i + 1));
-            out.push((top + w + i + 1, top + w + i));
+    /// Side `side` of the border (0: the first row, 1: the last column, 2: the last row, 3: the
+    /// first column) as the block's triangles run it: the directed edges `x_k -> x_k + d`,
+    /// `x_k = x_0 + k d`, `k` in `0..m`, as `(x_0, d, m)`. Every side runs counterclockwise
+    /// around the block (`x_0` a corner), so a neighbour's matching edges run `(x_m, -d, m)`.
+    fn side_run(&self, side: u8) -> (u32, i64, u32) {
+        let (w, first, rows) = (self.width, self.first, self.rows);
+        let top = first + rows * w;
+        match side {
+            0 => (first, 1, w - 1),
+            1 => (first + w - 1, i64::from(w), rows),
+            2 => (top + w - 1, -1, w - 1),
+            _ => (top, -i64::from(w), rows),
         }
-        for j in 0..self.rows {
-            let r = first + j * w;
-            out.push((r + w, r));
-            out.push((r + w - 1, r + 2 * w - 1));
+    }
+
+    /// The side whose run is `run` ([`GridBlock::side_run`]), if any.
+    fn side_of_run(&self, run: (u32, i64, u32)) -> Option<u8> {
+        (0..4).find(|&side| self.side_run(side) == run)
+    }
+
+    /// The directed edges of side `side`, as the block's triangles run them.
+    fn side_edges(&self, side: u8, out: &mut Vec<(u32, u32)>) {
+        let (x, d, m) = self.side_run(side);
+        // Inside the block's vertex range: every `x + k d` fits.
+        let at = |k: u32| (i64::from(x) + i64::from(k) * d) as u32;
+        out.extend((0..m).map(|k| (at(k), at(k + 1))));
+    }
+
+    /// The block coordinates `(i, j)` of its vertex `v`.
+    fn cell(&self, v: u32) -> (u32, u32) {
+        let local = v - self.first;
+        (local % self.width, local / self.width)
+    }
+
+    /// The side that holds the block's vertex `v` strictly between the side's two corners, if
+    /// any (a corner or an inner vertex has none).
+    fn side_inside(&self, v: u32) -> Option<u8> {
+        let (i, j) = self.cell(v);
+        let along_row = i > 0 && i + 1 < self.width;
+        let along_column = j > 0 && j < self.rows;
+        match (i, j) {
+            (_, 0) if along_row => Some(0),
+            (i, _) if i + 1 == self.width && along_column => Some(1),
+            (_, j) if j == self.rows && along_row => Some(2),
+            (0, _) if along_column => Some(3),
+            _ => None,
+        }
+    }
+
+    /// The side that the edge between the block's vertices `p` and `q` lies on, if any.
+    fn side_of_edge(&self, p: u32, q: u32) -> Option<u8> {
+        let (low, high) = (p.min(q), p.max(q));
+        let (i, j) = self.cell(low);
+        match high - low {
+            1 if i + 1 < self.width && j == 0 => Some(0),
+            1 if i + 1 < self.width && j == self.rows => Some(2),
+            s if s == self.width && i + 1 == self.width => Some(1),
+            s if s == self.width && i == 0 => Some(3),
+            _ => None,
         }
     }
 }
@@ -106,13 +168,114 @@ fn is_grid_row(row: &[[u32; 3]], r: u32, w: u32) -> bool {
     })
 }
 
-/// The grid blocks of `triangles` and the triangles outside them. A block starts at a
-/// triangle `[a, a + 1, a + w + 1]` (`w >= 2`) and runs for as many complete rows as follow; a
-/// triangle that starts no complete row is left to the general check. Linear: a failed start
-/// is passed over, never rescanned.
-fn find_blocks(triangles: &[[u32; 3]]) -> (Vec<GridBlock>, Vec<usize>) {
-    let mut blocks = Vec::new();
-    let mut others = Vec::new();
+/// A strip found in the triangle list: `quads` quads `(a_k, a_(k+1), b_(k+1), b_k)` over
+/// `a_k = a + k s`, `b_k = b + k t` (the module's pattern).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct GridStrip {
+    /// The strip's first triangle.
+    start: usize,
+    a: u32,
+    s: i64,
+    b: u32,
+    t: i64,
+    quads: u32,
+}
+
+impl GridStrip {
+    fn triangles(&self) -> Range<usize> {
+        self.start..self.start + 2 * self.quads as usize
+    }
+
+    fn a_at(&self, k: u32) -> i64 {
+        i64::from(self.a) + i64::from(k) * self.s
+    }
+
+    fn b_at(&self, k: u32) -> i64 {
+        i64::from(self.b) + i64::from(k) * self.t
+    }
+
+    /// The side `a_(k+1) -> a_k` reversed, `a_0 -> a_m`, and the side `b_k -> b_(k+1)`
+    /// reversed, `b_m -> b_0`, as runs `(x_0, d, m)`: what a block's side must run for the
+    /// strip's sides to pair with it.
+    fn matching_runs(&self) -> [(i64, i64, u32); 2] {
+        let m = self.quads;
+        [(self.a_at(0), self.s, m), (self.b_at(m), -self.t, m)]
+    }
+
+    /// Whether `{v, w}` is one of the strip's inner edges, `v` being `a_k` (`on_a`) or `b_k`
+    /// for some `0 < k < m`: the rung `a_k b_k` and the diagonals `b_(k-1) a_k`, `b_k a_(k+1)`.
+    fn inner_edge_at(&self, v: u32, on_a: bool, w: u32) -> bool {
+        let w = i64::from(w);
+        if on_a {
+            let k = ((i64::from(v) - i64::from(self.a)) / self.s) as u32;
+            w == self.b_at(k) || w == self.b_at(k - 1)
+        } else {
+            let k = ((i64::from(v) - i64::from(self.b)) / self.t) as u32;
+            w == self.a_at(k) || w == self.a_at(k + 1)
+        }
+    }
+
+    /// The end rungs `a_0 -> b_0` and `b_m -> a_m`, the strip's edges that pair outside it.
+    fn end_rungs(&self) -> [(u32, u32); 2] {
+        let m = self.quads;
+        // A matched strip's vertices are blocks' vertices: they fit.
+        let v = |x: i64| x as u32;
+        [
+            (v(self.a_at(0)), v(self.b_at(0))),
+            (v(self.b_at(m)), v(self.a_at(m))),
+        ]
+    }
+}
+
+/// The strip that starts at `triangles[0]`, if its pattern holds for at least two quads.
+fn strip_at(triangles: &[[u32; 3]]) -> Option<GridStrip> {
+    let [[b0, a1, a0], [b0_, b1, a1_], ..] = *triangles else {
+        return None;
+    };
+    if b0_ != b0 || a1_ != a1 {
+        return None;
+    }
+    let (s, t) = (i64::from(a1) - i64::from(a0), i64::from(b1) - i64::from(b0));
+    // `a_k`, `b_k` for `k = quads`: within `u32` after every match, so `+ s` cannot overflow.
+    let (mut a, mut b) = (i64::from(a1), i64::from(b1));
+    let mut quads = 1u32;
+    for quad in triangles[2..].chunks_exact(2) {
+        let (next_a, next_b) = (a + s, b + t);
+        let wide = |t: [u32; 3]| t.map(i64::from);
+        if quads == u32::MAX
+            || wide(quad[0]) != [b, next_a, a]
+            || wide(quad[1]) != [b, next_b, next_a]
+        {
+            break;
+        }
+        (a, b) = (next_a, next_b);
+        quads += 1;
+    }
+    (quads >= 2).then_some(GridStrip {
+        start: 0,
+        a: a0,
+        s,
+        b: b0,
+        t,
+        quads,
+    })
+}
+
+/// What the scan finds: grid blocks, strips, and the triangles outside both (by index).
+#[derive(Debug, Default)]
+struct Found {
+    blocks: Vec<GridBlock>,
+    strips: Vec<GridStrip>,
+    others: Vec<usize>,
+}
+
+/// The grid blocks and strips of `triangles` and the triangles outside them. A block starts at
+/// a triangle `[a, a + 1, a + w + 1]` (`w >= 2`) and runs for as many complete rows as follow;
+/// where none starts, a strip may, for as many quads as follow its pattern; a triangle that
+/// starts neither is left to the general check. Linear: a failed start is passed over, never
+/// rescanned.
+fn scan_grids(triangles: &[[u32; 3]]) -> Found {
+    let mut found = Found::default();
     let mut t = 0;
     while t < triangles.len() {
         let [a, b, c] = triangles[t];
@@ -130,23 +293,27 @@ fn find_blocks(triangles: &[[u32; 3]]) -> (Vec<GridBlock>, Vec<usize>) {
                     rows,
                 };
                 t = block.triangles().end;
-                blocks.push(block);
+                found.blocks.push(block);
             }
-            _ => {
-                others.push(t);
-                t += 1;
-            }
+            _ => match strip_at(&triangles[t..]) {
+                Some(strip) => {
+                    let strip = GridStrip { start: t, ..strip };
+                    t = strip.triangles().end;
+                    found.strips.push(strip);
+                }
+                None => {
+                    found.others.push(t);
+                    t += 1;
+                }
+            },
         }
     }
-    (blocks, others)
+    found
 }
 
 /// The largest grid side a block may have: a block's index arithmetic (`first + j w + i`,
 /// `w + 1`) then stays far from `u32`'s end.
 const MAX_BLOCK_SIDE: u32 = u16::MAX as u32;
-
-/// No block holds the vertex.
-const NO_BLOCK: u32 = u32::MAX;
 
 impl GridBlock {
     /// Whether the edge between the block's vertices `p` and `q` is a quad edge or diagonal of
@@ -174,60 +341,207 @@ impl GridBlock {
 /// two blocks, which the check takes as well).
 const SCAN_CHUNK: usize = 1 << 16;
 
-/// [`find_blocks`] over pieces of `triangles` in parallel, in the order of the triangles.
-fn find_blocks_in_parallel(triangles: &[[u32; 3]]) -> (Vec<GridBlock>, Vec<usize>) {
+/// [`scan_grids`] over pieces of `triangles` in parallel, in the order of the triangles.
+fn scan_grids_in_parallel(triangles: &[[u32; 3]]) -> Found {
     let pieces = rayon::current_num_threads().max(1) * 4;
     let chunk = triangles.len().div_ceil(pieces).max(SCAN_CHUNK);
     let found: Vec<_> = triangles
         .par_chunks(chunk)
         .enumerate()
         .map(|(c, piece)| {
-            let (mut blocks, mut others) = find_blocks(piece);
+            let mut found = scan_grids(piece);
             let offset = c * chunk;
-            for b in &mut blocks {
+            for b in &mut found.blocks {
                 b.start += offset;
             }
-            for t in &mut others {
+            for s in &mut found.strips {
+                s.start += offset;
+            }
+            for t in &mut found.others {
                 *t += offset;
             }
-            (blocks, others)
+            found
         })
         .collect();
-    let mut blocks = Vec::new();
-    let mut others = Vec::new();
-    for (b, o) in found {
-        blocks.extend(b);
-        others.extend(o);
+    let mut all = Found::default();
+    for piece in found {
+        all.blocks.extend(piece.blocks);
+        all.strips.extend(piece.strips);
+        all.others.extend(piece.others);
     }
-    (blocks, others)
+    all
 }
 
-/// Whether `triangles`, over `vertices` vertices where vertex `v` stands for `of[v]` (a seam
-/// copy for its original; `of` empty for the identity), use every directed edge once and its
-/// reverse once. `false` also when a triangle names a vertex beyond `vertices`.
-pub(crate) fn is_closed(triangles: &[[u32; 3]], vertices: usize, of: &[u32]) -> bool {
-    if of.iter().any(|&o| o as usize >= vertices) {
-        return false;
+/// No strip matched the side.
+const NO_STRIP: u32 = u32::MAX;
+
+/// Which block holds a vertex, for blocks with sorted, disjoint vertex ranges: the vertices in
+/// buckets of `2^shift`, about one block each, a bucket's candidates found by their first
+/// index.
+struct BlockIndex<'a> {
+    blocks: &'a [GridBlock],
+    shift: u32,
+    /// `starts[c]`: the first block whose range ends after bucket `c` begins.
+    starts: Vec<u32>,
+}
+
+impl<'a> BlockIndex<'a> {
+    fn new(blocks: &'a [GridBlock], vertices: usize) -> BlockIndex<'a> {
+        let shift = (vertices / blocks.len().max(1)).max(1).ilog2();
+        let buckets = (vertices >> shift) + 1;
+        let mut starts = Vec::with_capacity(buckets + 1);
+        let mut k = 0;
+        for c in 0..=buckets as u64 {
+            while blocks
+                .get(k)
+                .is_some_and(|b| b.vertices().end <= c << shift)
+            {
+                k += 1;
+            }
+            starts.push(k as u32);
+        }
+        BlockIndex {
+            blocks,
+            shift,
+            starts,
+        }
     }
-    let (mut found, mut others) = find_blocks_in_parallel(triangles);
-    // A block over a seam copy or its original would pair edges by index where the positions
-    // pair them differently: its triangles go to the general check.
-    let mut merged: Vec<u64> = of
-        .iter()
-        .enumerate()
-        .filter(|&(v, &o)| o as usize != v)
-        .flat_map(|(v, &o)| [v as u64, u64::from(o)])
-        .collect();
-    merged.sort_unstable();
-    let holds_merged = |range: &Range<u64>| {
-        let k = merged.partition_point(|&m| m < range.start);
-        merged.get(k).is_some_and(|&m| m < range.end)
+
+    /// The block that holds vertex `v`, by its number.
+    fn holding(&self, v: u32) -> Option<usize> {
+        // A block that holds `v` ends after its bucket begins, and begins before the next one
+        // does: it is the last candidate at most.
+        let c = (v >> self.shift) as usize;
+        let (low, high) = (
+            *self.starts.get(c)? as usize,
+            *self.starts.get(c + 1)? as usize,
+        );
+        let candidates = &self.blocks[low..(high + 1).min(self.blocks.len())];
+        let k = low
+            + candidates
+                .partition_point(|b| b.first <= v)
+                .checked_sub(1)?;
+        (u64::from(v) < self.blocks[k].vertices().end).then_some(k)
+    }
+}
+
+/// Seam copies and their originals: vertex `copy` stands for the position vertex `original`.
+#[derive(Debug, Default)]
+struct Seams {
+    /// `(copy, original)` by copy, one each, no copy its own original.
+    copies: Vec<(u32, u32)>,
+}
+
+impl Seams {
+    /// The pairs `[copy, original]` as a mesh lists them, a later pair for the same copy
+    /// replacing an earlier one; a copy not below `vertices` is no vertex and ignored. `None`
+    /// when an original is not below `vertices`.
+    fn new(pairs: &[[u32; 2]], vertices: usize) -> Option<Seams> {
+        let mut copies: Vec<(u32, usize, u32)> = pairs
+            .iter()
+            .enumerate()
+            .filter(|(_, &[copy, _])| (copy as usize) < vertices)
+            .map(|(k, &[copy, original])| (copy, k, original))
+            .collect();
+        copies.sort_unstable();
+        // The last pair of each copy.
+        let mut last: Vec<(u32, u32)> = Vec::with_capacity(copies.len());
+        for (copy, _, original) in copies {
+            match last.last_mut() {
+                Some(entry) if entry.0 == copy => entry.1 = original,
+                _ => last.push((copy, original)),
+            }
+        }
+        if last
+            .iter()
+            .any(|&(_, original)| original as usize >= vertices)
+        {
+            return None;
+        }
+        last.retain(|&(copy, original)| copy != original);
+        Some(Seams { copies: last })
+    }
+
+    /// The position vertex that `v` stands for.
+    fn position(&self, v: u32) -> u32 {
+        // Copies follow the vertices they copy in a tessellation: most vertices are below all.
+        if self.copies.first().map_or(true, |&(first, _)| v < first) {
+            return v;
+        }
+        match self.copies.binary_search_by_key(&v, |&(copy, _)| copy) {
+            Ok(k) => self.copies[k].1,
+            Err(_) => v,
+        }
+    }
+
+    /// Whether a seam copy lies in `range`.
+    fn any_copy_in(&self, range: &Range<u64>) -> bool {
+        let k = self
+            .copies
+            .partition_point(|&(c, _)| u64::from(c) < range.start);
+        self.copies
+            .get(k)
+            .is_some_and(|&(c, _)| u64::from(c) < range.end)
+    }
+}
+
+/// Whether `triangles`, over `vertices` vertices of which the seam copies `seams` (pairs
+/// `[copy, original]`) stand for their originals, use every directed edge between position
+/// vertices once and its reverse once. `false` also when a triangle names a vertex beyond
+/// `vertices`.
+///
+/// The edges left to the general check are few (at rate 16 a strip's end rungs and the
+/// vertex polygons' edges: 2% of all), so they are sorted rather than grouped by tail in arrays
+/// over every vertex, whose first writes (fresh pages) cost more than the sorts: the edges
+/// `a -> b` with `a < b` as `(a, b)`, those with `a > b` reversed, as `(b, a)`; every directed
+/// edge is used once and its reverse once exactly when the two sorted lists are equal and
+/// neither repeats a pair. An edge from a vertex to itself is its own reverse, as in the
+/// general check: it may appear once.
+pub(crate) fn is_closed(triangles: &[[u32; 3]], vertices: usize, seams: &[[u32; 2]]) -> bool {
+    let Some(seams) = Seams::new(seams, vertices) else {
+        return false;
     };
+    let Some(edges) = general_edges(triangles, vertices, &seams) else {
+        return false;
+    };
+    let key = |a: u32, b: u32| u64::from(a) << 32 | u64::from(b);
+    let (mut forward, mut backward, mut loops) = (Vec::new(), Vec::new(), Vec::new());
+    for (a, b) in edges {
+        match a.cmp(&b) {
+            Ordering::Less => forward.push(key(a, b)),
+            Ordering::Greater => backward.push(key(b, a)),
+            Ordering::Equal => loops.push(a),
+        }
+    }
+    forward.sort_unstable();
+    backward.sort_unstable();
+    loops.sort_unstable();
+    forward == backward
+        && forward.windows(2).all(|w| w[0] != w[1])
+        && loops.windows(2).all(|w| w[0] != w[1])
+}
+
+/// The directed edges between position vertices left to the general check once the blocks and
+/// strips have paired theirs (the module's conditions), or `None` when the mesh is already
+/// known not to be closed: an index beyond `vertices`, or another triangle on an edge a block
+/// or strip pairs.
+fn general_edges(
+    triangles: &[[u32; 3]],
+    vertices: usize,
+    seams: &Seams,
+) -> Option<Vec<(u32, u32)>> {
+    let Found {
+        blocks: mut found,
+        strips,
+        mut others,
+    } = scan_grids_in_parallel(triangles);
     // Disjoint vertex ranges, a block's edges joining its own vertices only: by first vertex,
-    // a block that starts before the last kept one ends goes to the general check.
+    // a block that starts before the last kept one ends goes to the general check. So does a
+    // block over a seam copy, which would pair edges by index where the positions pair them
+    // differently: the blocks kept hold position vertices only, and the other triangles are
+    // tested by position.
     found.sort_unstable_by_key(|b| b.first);
     let mut blocks = Vec::with_capacity(found.len());
-    let mut block_of = vec![NO_BLOCK; vertices];
     let mut kept_end = 0;
     for b in found {
         let range = b.vertices();
@@ -235,61 +549,86 @@ pub(crate) fn is_closed(triangles: &[[u32; 3]], vertices: usize, of: &[u32]) -> 
             && b.rows < MAX_BLOCK_SIDE
             && range.start >= kept_end
             && range.end <= vertices as u64
-            && !holds_merged(&range);
+            && !seams.any_copy_in(&range);
         if !usable {
             others.extend(b.triangles());
             continue;
         }
         kept_end = range.end;
-        block_of[range.start as usize..range.end as usize].fill(blocks.len() as u32);
         blocks.push(b);
     }
-    // The other triangles name vertices that exist, and none uses a block's inner edge, which
-    // the block already uses both ways.
-    let inner = |p: u32, q: u32| {
-        let b = block_of[p as usize];
-        b != NO_BLOCK && b == block_of[q as usize] && blocks[b as usize].inner_edge(p, q)
+    let index = BlockIndex::new(&blocks, vertices);
+    let block_of = |v: u32| index.holding(v);
+    // A strip pairs its sides with two sides of two different blocks, each side with one strip
+    // only; `matched[4 k + side]` is the strip (twice its number, plus one on its side `b`).
+    let mut matched = vec![NO_STRIP; 4 * blocks.len()];
+    let mut kept: Vec<GridStrip> = Vec::new();
+    let side_of = |(x, d, m): (i64, i64, u32)| {
+        let x = u32::try_from(x).ok()?;
+        let k = block_of(x)?;
+        let side = blocks[k].side_of_run((x, d, m))?;
+        Some((k, 4 * k + usize::from(side)))
     };
-    let others_valid = others.par_iter().all(|&t| {
-        let [a, b, c] = triangles[t];
-        [a, b, c].iter().all(|&v| (v as usize) < vertices)
-            && !inner(a, b)
-            && !inner(b, c)
-            && !inner(c, a)
-    });
-    if !others_valid {
-        return false;
-    }
-    let mut edges: Vec<(u32, u32)> = Vec::with_capacity(3 * others.len());
-    for &t in &others {
-        let [a, b, c] = triangles[t];
-        edges.extend([(a, b), (b, c), (c, a)]);
-    }
-    for b in &blocks {
-        b.border_edges(&mut edges);
-    }
-    // Position vertices, then numbered densely in the order met: the grouping's arrays then
-    // span the vertices these edges touch (a quarter of all at rate 16), not every vertex.
-    // Every number stays below `vertices`, so below `u32::MAX`, the unnumbered mark (more
-    // vertices than that are taken by position as they are).
-    let position = |v: u32| if of.is_empty() { v } else { of[v as usize] };
-    if u32::try_from(vertices).map_or(true, |n| n == u32::MAX) {
-        let edges = || edges.iter().map(|&(a, b)| (position(a), position(b)));
-        return DirectedEdges::new(vertices, edges).is_some_and(|d| d.all_paired());
-    }
-    let mut dense = vec![u32::MAX; vertices];
-    let mut touched = 0u32;
-    for e in &mut edges {
-        for v in [&mut e.0, &mut e.1] {
-            let slot = &mut dense[position(*v) as usize];
-            if *slot == u32::MAX {
-                *slot = touched;
-                touched += 1;
+    for strip in strips {
+        let [a, b] = strip.matching_runs();
+        match (side_of(a), side_of(b)) {
+            (Some((ka, sa)), Some((kb, sb)))
+                if ka != kb && matched[sa] == NO_STRIP && matched[sb] == NO_STRIP =>
+            {
+                let number = 2 * kept.len() as u32;
+                (matched[sa], matched[sb]) = (number, number + 1);
+                kept.push(strip);
             }
-            *v = *slot;
+            _ => others.extend(strip.triangles()),
         }
     }
-    DirectedEdges::new(touched as usize, || edges.iter().copied()).is_some_and(|d| d.all_paired())
+    // Whether the edge `v w`, `v` inside a side of block `k` that a strip matched, is an inner
+    // edge of that strip.
+    let strip_edge = |k: Option<usize>, v: u32, w: u32| {
+        let Some((k, side)) = k.and_then(|k| Some((k, blocks[k].side_inside(v)?))) else {
+            return false;
+        };
+        let m = matched[4 * k + usize::from(side)];
+        m != NO_STRIP && kept[(m / 2) as usize].inner_edge_at(v, m % 2 == 0, w)
+    };
+    // Whether a block or strip pairs the edge `p q` already.
+    let paired = |p: u32, q: u32| match (block_of(p), block_of(q)) {
+        (Some(k), Some(l)) if k == l => {
+            let block = &blocks[k];
+            block.inner_edge(p, q)
+                || block
+                    .side_of_edge(p, q)
+                    .is_some_and(|side| matched[4 * k + usize::from(side)] != NO_STRIP)
+        }
+        (k, l) => strip_edge(k, p, q) || strip_edge(l, q, p),
+    };
+    // The other triangles name vertices that exist, and none uses an edge (between positions)
+    // that a block or strip pairs already.
+    let others: Vec<[(u32, u32); 3]> = others
+        .par_iter()
+        .map(|&t| {
+            let corners = triangles[t];
+            if corners.iter().any(|&v| v as usize >= vertices) {
+                return None;
+            }
+            let [a, b, c] = corners.map(|v| seams.position(v));
+            let edges = [(a, b), (b, c), (c, a)];
+            edges.iter().all(|&(p, q)| !paired(p, q)).then_some(edges)
+        })
+        .collect::<Option<_>>()?;
+    let mut edges: Vec<(u32, u32)> = others.into_iter().flatten().collect();
+    // The blocks and strips kept hold position vertices only.
+    for (k, b) in blocks.iter().enumerate() {
+        for side in 0..4u8 {
+            if matched[4 * k + usize::from(side)] == NO_STRIP {
+                b.side_edges(side, &mut edges);
+            }
+        }
+    }
+    for strip in &kept {
+        edges.extend(strip.end_rungs());
+    }
+    Some(edges)
 }
 
 /// Up to this many edges leaving a vertex (a tessellation's vertices have about six) are
@@ -381,26 +720,44 @@ impl DirectedEdges {
 mod tests {
     use super::*;
 
-    /// Two grids of quads, long enough to be scanned in several pieces, and stray triangles
-    /// between them: every triangle is in exactly one block or among the others, and every
-    /// block's triangles are its pattern, whichever piece found it.
+    /// The triangles of a grid block of `rows` rows of `w` vertices from `first`.
+    fn grid(first: u32, w: u32, rows: u32, out: &mut Vec<[u32; 3]>) {
+        for j in 0..rows {
+            for i in 0..w - 1 {
+                let a = first + j * w + i;
+                out.push([a, a + 1, a + w + 1]);
+                out.push([a, a + w + 1, a + w]);
+            }
+        }
+    }
+
+    /// The triangles of the strip over `a_k = a + k s`, `b_k = b + k t`, `k` in `0..=m`.
+    fn strip(a: i64, s: i64, b: i64, t: i64, m: i64, out: &mut Vec<[u32; 3]>) {
+        for k in 0..m {
+            let v = |x: i64| x as u32;
+            let (a0, a1, b0, b1) = (a + k * s, a + (k + 1) * s, b + k * t, b + (k + 1) * t);
+            out.push([v(b0), v(a1), v(a0)]);
+            out.push([v(b0), v(b1), v(a1)]);
+        }
+    }
+
+    /// Two grids of quads, long enough to be scanned in several pieces, a strip and stray
+    /// triangles between them: every triangle is in exactly one block or strip or among the
+    /// others, and every block's and strip's triangles are its pattern, whichever piece found
+    /// it.
     #[test]
     fn pieces_cover_every_triangle_once() {
         let mut triangles = Vec::new();
-        let grid = |first: u32, w: u32, rows: u32, out: &mut Vec<[u32; 3]>| {
-            for j in 0..rows {
-                for i in 0..w - 1 {
-                    let a = first + j * w + i;
-                    out.push([a, a + 1, a + w + 1]);
-                    out.push([a, a + w + 1, a + w]);
-                }
-            }
-        };
         grid(0, 300, 250, &mut triangles);
         triangles.extend([[7, 3, 5], [1, 1, 1], [90_000, 4, 2]]);
+        strip(75_299, -1, 100_096, -1, 96, &mut triangles);
         grid(100_000, 97, 400, &mut triangles);
         assert!(triangles.len() > 3 * SCAN_CHUNK);
-        let (blocks, others) = find_blocks_in_parallel(&triangles);
+        let Found {
+            blocks,
+            strips,
+            others,
+        } = scan_grids_in_parallel(&triangles);
         let mut seen = vec![0u8; triangles.len()];
         for b in &blocks {
             for (k, t) in b.triangles().enumerate() {
@@ -417,10 +774,89 @@ mod tests {
                 assert_eq!(triangles[t], expected, "block {b:?}, triangle {t}");
             }
         }
+        assert_eq!(strips.len(), 1);
+        let found = strips[0];
+        let mut expected = Vec::new();
+        strip(
+            found.a.into(),
+            found.s,
+            found.b.into(),
+            found.t,
+            found.quads.into(),
+            &mut expected,
+        );
+        assert_eq!(&triangles[found.triangles()], &expected[..]);
+        assert_eq!(
+            (found.a, found.s, found.b, found.t, found.quads),
+            (75_299, -1, 100_096, -1, 96)
+        );
+        for t in found.triangles() {
+            seen[t] += 1;
+        }
         for &t in &others {
             seen[t] += 1;
         }
         assert!(seen.iter().all(|&s| s == 1));
         assert!(blocks.len() >= 4, "{} blocks", blocks.len());
+    }
+
+    /// A block of 4 rows of 5 vertices (`0..20`), one of 3 rows from 100, and the strip from
+    /// the first one's last row to the second one's first row, both walked from their right
+    /// ends; a vertex 200 for fins.
+    fn two_blocks_and_a_strip() -> Vec<[u32; 3]> {
+        let mut triangles = Vec::new();
+        grid(0, 5, 3, &mut triangles);
+        strip(19, -1, 104, -1, 4, &mut triangles);
+        grid(100, 5, 2, &mut triangles);
+        triangles
+    }
+
+    /// The strip's sides pair with the blocks' sides it runs along: what is left to the
+    /// general check is the blocks' other sides and the strip's two end rungs.
+    #[test]
+    fn a_strip_pairs_its_sides_with_the_blocks() {
+        let triangles = two_blocks_and_a_strip();
+        let mut edges =
+            general_edges(&triangles, 201, &Seams::default()).expect("no edge used twice");
+        edges.sort_unstable();
+        let mut expected = Vec::new();
+        let path = |vertices: &[u32], out: &mut Vec<(u32, u32)>| {
+            out.extend(vertices.windows(2).map(|e| (e[0], e[1])));
+        };
+        // The first block: its first row, last column and first column.
+        path(&[0, 1, 2, 3, 4], &mut expected);
+        path(&[4, 9, 14, 19], &mut expected);
+        path(&[15, 10, 5, 0], &mut expected);
+        // The second block: its last column, last row and first column.
+        path(&[104, 109, 114], &mut expected);
+        path(&[114, 113, 112, 111, 110], &mut expected);
+        path(&[110, 105, 100], &mut expected);
+        // The strip's end rungs: a_0 -> b_0, b_m -> a_m.
+        expected.extend([(19, 104), (100, 15)]);
+        expected.sort_unstable();
+        assert_eq!(edges, expected);
+    }
+
+    /// Another triangle on an edge the strip pairs (a rung, a diagonal at either end, a side),
+    /// or a second copy of the strip: not closed, whatever the general check would say of the
+    /// rest.
+    #[test]
+    fn edges_a_strip_pairs_are_not_used_again() {
+        // a_k = 19 - k, b_k = 104 - k.
+        for (p, q) in [(17, 102), (104, 18), (101, 15), (101, 16), (16, 17)] {
+            let mut triangles = two_blocks_and_a_strip();
+            triangles.extend([[p, q, 200], [q, p, 200]]);
+            assert_eq!(
+                general_edges(&triangles, 201, &Seams::default()),
+                None,
+                "a fin on {p} {q}"
+            );
+        }
+        let mut twice = two_blocks_and_a_strip();
+        strip(19, -1, 104, -1, 4, &mut twice);
+        // The second copy matches no side (the first took both), so its triangles are others,
+        // on the first copy's rungs.
+        assert_eq!(general_edges(&twice, 201, &Seams::default()), None);
+        assert!(!is_closed(&twice, 201, &[]));
     }
 }

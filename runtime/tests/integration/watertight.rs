@@ -1,5 +1,5 @@
-//! `TriangleMesh::is_watertight` pairs the inner edges of the faces' grids by their pattern and
-//! sorts only the rest (`mesh/watertight.rs`). The reference is the general check on every
+//! `TriangleMesh::is_watertight` pairs the inner edges of the faces' grids and of the strips
+//! between them by their patterns and sorts only the rest (`mesh/watertight.rs`). The reference is the general check on every
 //! directed edge, `boundary_edges` (closed: no directed edge used twice, none without its
 //! reverse), on the tessellators' outputs and on those outputs broken in the ways a grid
 //! shortcut could miss.
@@ -66,6 +66,34 @@ fn a_fin_on_a_grid_edge_is_not_closed() {
     assert!(!agreed(&mesh, "fin"));
 }
 
+/// An inner edge of a strip between two faces' grids (a rung or a diagonal) used by two more
+/// triangles: the strip pairs its own two uses; only the test of the other triangles against
+/// the strips' inner edges sees the fin.
+#[test]
+#[cfg(feature = "catmull-clark")]
+fn a_fin_on_a_strip_edge_is_not_closed() {
+    let clean = tessellated("cube.obj", Rates::Uniform(6));
+    // A strip's first quad is `[b_0, a_1, a_0], [b_0, b_1, a_1]`: `b_0 a_1` is a diagonal and
+    // `a_1 b_1` a rung (inside the strip, which has two quads at least at this rate). A grid's
+    // quads `[a, a + 1, c], [a, c, c - 1]` share their first vertex too, but not `a + 1`.
+    let first_strip = (0..clean.triangles.len() - 1)
+        .find(|&t| {
+            let (x, y) = (clean.triangles[t], clean.triangles[t + 1]);
+            x[0] == y[0] && x[1] == y[2]
+        })
+        .expect("a strip");
+    let [b0, a1, _] = clean.triangles[first_strip];
+    let [_, b1, _] = clean.triangles[first_strip + 1];
+    for (p, q) in [(b0, a1), (a1, b1)] {
+        let mut mesh = clean.clone();
+        let x = mesh.positions.len() as u32;
+        mesh.positions.push([9.0, 9.0, 9.0]);
+        mesh.triangles.push([p, q, x]);
+        mesh.triangles.push([q, p, x]);
+        assert!(!agreed(&mesh, "fin on a strip"));
+    }
+}
+
 /// Tessellations long enough that the grid scan runs in pieces (65,536 triangles and more
 /// each), a face's grid cut between two of them, with and without texture seams (whose grids go
 /// to the general check, from every piece): closed by both checks, and broken by both where a
@@ -95,12 +123,18 @@ fn tessellations_scanned_in_pieces_agree() {
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
-    /// One triangle removed, reversed, duplicated or moved to other vertices: both checks say
-    /// the same.
+    /// One triangle removed, reversed, duplicated or moved to other vertices, with and without
+    /// texture seams: both checks say the same.
     #[test]
     #[cfg(feature = "catmull-clark")]
-    fn broken_tessellations_agree(rate in 2u32..7, pick in 0usize..10_000, how in 0u8..4) {
-        let mut mesh = tessellated("cube.obj", Rates::Uniform(rate));
+    fn broken_tessellations_agree(
+        rate in 2u32..7,
+        pick in 0usize..10_000,
+        how in 0u8..4,
+        seams in any::<bool>(),
+    ) {
+        let file = if seams { "cube_uv.obj" } else { "cube.obj" };
+        let mut mesh = tessellated(file, Rates::Uniform(rate));
         let t = pick % mesh.triangles.len();
         match how {
             0 => {
