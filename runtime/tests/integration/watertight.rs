@@ -128,7 +128,7 @@ proptest! {
     #[test]
     #[cfg(feature = "catmull-clark")]
     fn broken_tessellations_agree(
-        rate in 2u32..7,
+        rate in 2u32..13,
         pick in 0usize..10_000,
         how in 0u8..4,
         seams in any::<bool>(),
