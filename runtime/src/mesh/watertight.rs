@@ -1,10 +1,11 @@
 //! Whether a triangle mesh is closed: every directed edge used exactly once, and its reverse
 //! exactly once (a closed, consistently oriented, edge-manifold surface).
 //!
-//! The general check looks at every directed edge, `3T` of them ([`DirectedEdges`] groups them
-//! by tail; [`is_closed`] sorts the few it is left with). A dual grid's output is mostly its faces' grids (`(n-1)^2` quads of two triangles each) and
-//! the strips between neighbouring grids (`n - 1` quads each at equal rates), whose inner edges
-//! pair up by construction. So the check first looks for both in the triangle list itself,
+//! The general check looks at every directed edge, `3T` of them, and pairs each with its
+//! reverse ([`DirectedEdges`] groups them by tail; few are sorted instead). A dual grid's output
+//! is mostly its faces' grids (`(n-1)^2` quads of two triangles each) and the strips between
+//! neighbouring grids (`n - 1` quads each at equal rates), whose inner edges pair up by
+//! construction. So the check first looks for both in the triangle list itself,
 //! trusting nothing the tessellator says:
 //!
 //! * a *grid block* is a run of triangles `[a, b, c], [a, c, d]` over quads
@@ -241,7 +242,7 @@ fn strip_at(triangles: &[[u32; 3]]) -> Option<GridStrip> {
     let mut quads = 1u32;
     for quad in triangles[2..].chunks_exact(2) {
         let (next_a, next_b) = (a + s, b + t);
-        let wide = |t: [u32; 3]| t.map(i64::from);
+        let wide = |triangle: [u32; 3]| triangle.map(i64::from);
         if quads == u32::MAX
             || wide(quad[0]) != [b, next_a, a]
             || wide(quad[1]) != [b, next_b, next_a]
@@ -261,12 +262,44 @@ fn strip_at(triangles: &[[u32; 3]]) -> Option<GridStrip> {
     })
 }
 
-/// What the scan finds: grid blocks, strips, and the triangles outside both (by index).
+/// What the scan finds: grid blocks, strips, and the triangles outside both.
 #[derive(Debug, Default)]
 struct Found {
     blocks: Vec<GridBlock>,
     strips: Vec<GridStrip>,
-    others: Vec<usize>,
+    others: Others,
+}
+
+/// Triangles left to the general check, as runs of consecutive indices (a mesh without grids
+/// is one run, not an index per triangle).
+#[derive(Debug, Default)]
+struct Others {
+    runs: Vec<Range<usize>>,
+}
+
+impl Others {
+    /// Add the triangles `run`, after every other.
+    fn push(&mut self, run: Range<usize>) {
+        match self.runs.last_mut() {
+            Some(last) if last.end == run.start => last.end = run.end,
+            _ => self.runs.push(run),
+        }
+    }
+
+    fn len(&self) -> usize {
+        self.runs.iter().map(|r| r.len()).sum()
+    }
+
+    /// The runs cut into pieces of at most `size` triangles, for the threads.
+    fn pieces(&self, size: usize) -> Vec<Range<usize>> {
+        let cut = |run: &Range<usize>| {
+            let end = run.end;
+            run.clone()
+                .step_by(size)
+                .map(move |start| start..end.min(start + size))
+        };
+        self.runs.iter().flat_map(cut).collect()
+    }
 }
 
 /// The grid blocks and strips of `triangles` and the triangles outside them. A block starts at
@@ -302,7 +335,7 @@ fn scan_grids(triangles: &[[u32; 3]]) -> Found {
                     found.strips.push(strip);
                 }
                 None => {
-                    found.others.push(t);
+                    found.others.push(t..t + 1);
                     t += 1;
                 }
             },
@@ -357,8 +390,8 @@ fn scan_grids_in_parallel(triangles: &[[u32; 3]]) -> Found {
             for s in &mut found.strips {
                 s.start += offset;
             }
-            for t in &mut found.others {
-                *t += offset;
+            for run in &mut found.others.runs {
+                *run = run.start + offset..run.end + offset;
             }
             found
         })
@@ -367,7 +400,9 @@ fn scan_grids_in_parallel(triangles: &[[u32; 3]]) -> Found {
     for piece in found {
         all.blocks.extend(piece.blocks);
         all.strips.extend(piece.strips);
-        all.others.extend(piece.others);
+        for run in piece.others.runs {
+            all.others.push(run);
+        }
     }
     all
 }
@@ -497,11 +532,11 @@ pub(crate) fn is_closed(triangles: &[[u32; 3]], vertices: usize, seams: &[[u32; 
         return false;
     };
     // A dual grid of quads leaves few edges (1–2% of Spot's at rate 16), one of triangles most
-    // of them (its grids are not paired by pattern).
+    // of them (its grids are not paired by pattern): those are grouped by tail, in linear time.
     if edges.len() < vertices / 4 {
-        sorted_in_pairs(edges)
+        sorted_in_pairs(&edges)
     } else {
-        grouped_in_pairs(edges, vertices)
+        DirectedEdges::new(vertices, || edges.iter().copied()).is_some_and(|d| d.all_paired())
     }
 }
 
@@ -512,10 +547,10 @@ pub(crate) fn is_closed(triangles: &[[u32; 3]], vertices: usize, seams: &[[u32; 
 ///
 /// For few edges: nothing is allocated per vertex, where the first writes to arrays over every
 /// vertex (fresh pages) cost more than the sorts.
-fn sorted_in_pairs(edges: Vec<(u32, u32)>) -> bool {
+fn sorted_in_pairs(edges: &[(u32, u32)]) -> bool {
     let key = |a: u32, b: u32| u64::from(a) << 32 | u64::from(b);
     let (mut forward, mut backward, mut loops) = (Vec::new(), Vec::new(), Vec::new());
-    for (a, b) in edges {
+    for &(a, b) in edges {
         match a.cmp(&b) {
             Ordering::Less => forward.push(key(a, b)),
             Ordering::Greater => backward.push(key(b, a)),
@@ -528,30 +563,6 @@ fn sorted_in_pairs(edges: Vec<(u32, u32)>) -> bool {
     forward == backward
         && forward.windows(2).all(|w| w[0] != w[1])
         && loops.windows(2).all(|w| w[0] != w[1])
-}
-
-/// [`sorted_in_pairs`]' answer for many edges over `vertices` vertices, in linear time: the
-/// edges grouped by tail ([`DirectedEdges`]) over the vertices they touch, numbered densely in
-/// the order met (every number stays below `vertices`, so below `u32::MAX`, the unnumbered
-/// mark; more vertices than that are taken as they are).
-fn grouped_in_pairs(mut edges: Vec<(u32, u32)>, vertices: usize) -> bool {
-    if u32::try_from(vertices).map_or(true, |n| n == u32::MAX) {
-        return DirectedEdges::new(vertices, || edges.iter().copied())
-            .is_some_and(|d| d.all_paired());
-    }
-    let mut dense = vec![u32::MAX; vertices];
-    let mut touched = 0u32;
-    for e in &mut edges {
-        for v in [&mut e.0, &mut e.1] {
-            let slot = &mut dense[*v as usize];
-            if *slot == u32::MAX {
-                *slot = touched;
-                touched += 1;
-            }
-            *v = *slot;
-        }
-    }
-    DirectedEdges::new(touched as usize, || edges.iter().copied()).is_some_and(|d| d.all_paired())
 }
 
 /// The directed edges between position vertices left to the general check once the blocks and
@@ -584,7 +595,7 @@ fn general_edges(
             && range.end <= vertices as u64
             && !seams.any_copy_in(&range);
         if !usable {
-            others.extend(b.triangles());
+            others.push(b.triangles());
             continue;
         }
         kept_end = range.end;
@@ -612,7 +623,7 @@ fn general_edges(
                 (matched[sa], matched[sb]) = (number, number + 1);
                 kept.push(strip);
             }
-            _ => others.extend(strip.triangles()),
+            _ => others.push(strip.triangles()),
         }
     }
     // Whether the edge `v w`, `v` inside a side of block `k` that a strip matched, is an inner
@@ -638,19 +649,31 @@ fn general_edges(
     // The other triangles name vertices that exist, and none uses an edge (between positions)
     // that a block or strip pairs already (none does when there are no blocks: a grid of
     // triangles).
-    let others: Vec<[(u32, u32); 3]> = others
-        .par_iter()
-        .map(|&t| {
+    // The other triangles' edges between positions, written in place by pieces in parallel.
+    let pieces = others.pieces(SCAN_CHUNK);
+    let count = others.len();
+    let mut edges = vec![(0, 0); 3 * count];
+    let mut outputs = Vec::with_capacity(pieces.len());
+    let mut rest = edges.as_mut_slice();
+    for piece in &pieces {
+        let (output, after) = rest.split_at_mut(3 * piece.len());
+        outputs.push(output);
+        rest = after;
+    }
+    let valid = pieces.into_par_iter().zip(outputs).all(|(piece, output)| {
+        piece.zip(output.chunks_exact_mut(3)).all(|(t, out)| {
             let corners = triangles[t];
             if corners.iter().any(|&v| v as usize >= vertices) {
-                return None;
+                return false;
             }
             let [a, b, c] = corners.map(|v| seams.position(v));
-            let edges = [(a, b), (b, c), (c, a)];
-            (blocks.is_empty() || edges.iter().all(|&(p, q)| !paired(p, q))).then_some(edges)
+            out.copy_from_slice(&[(a, b), (b, c), (c, a)]);
+            blocks.is_empty() || !(paired(a, b) || paired(b, c) || paired(c, a))
         })
-        .collect::<Option<_>>()?;
-    let mut edges: Vec<(u32, u32)> = others.into_iter().flatten().collect();
+    });
+    if !valid {
+        return None;
+    }
     // The blocks and strips kept hold position vertices only.
     for (k, b) in blocks.iter().enumerate() {
         for side in 0..4u8 {
@@ -740,9 +763,9 @@ impl DirectedEdges {
             .flat_map(move |a| self.leaving(a).iter().map(move |&b| (a, b)))
     }
 
-    /// Whether every edge's reverse is an edge too.
+    /// Whether every edge's reverse is an edge too (the tails in parallel).
     pub(crate) fn all_paired(&self) -> bool {
-        self.start.windows(2).enumerate().all(|(a, range)| {
+        self.start.par_windows(2).enumerate().all(|(a, range)| {
             self.heads[range[0] as usize..range[1] as usize]
                 .iter()
                 .all(|&b| self.contains(b, a as u32))
@@ -827,7 +850,7 @@ mod tests {
         for t in found.triangles() {
             seen[t] += 1;
         }
-        for &t in &others {
+        for t in others.runs.iter().flat_map(|r| r.clone()) {
             seen[t] += 1;
         }
         assert!(seen.iter().all(|&s| s == 1));
@@ -880,17 +903,14 @@ mod tests {
         for (p, q) in [(17, 102), (104, 18), (101, 15), (101, 16), (16, 17)] {
             let mut triangles = two_blocks_and_a_strip();
             triangles.extend([[p, q, 200], [q, p, 200]]);
-            assert_eq!(
-                general_edges(&triangles, 201, &Seams::default()),
-                None,
-                "a fin on {p} {q}"
-            );
+            let left = general_edges(&triangles, 201, &Seams::default());
+            assert!(left.is_none(), "a fin on {p} {q}");
         }
         let mut twice = two_blocks_and_a_strip();
         strip(19, -1, 104, -1, 4, &mut twice);
         // The second copy matches no side (the first took both), so its triangles are others,
         // on the first copy's rungs.
-        assert_eq!(general_edges(&twice, 201, &Seams::default()), None);
+        assert!(general_edges(&twice, 201, &Seams::default()).is_none());
         assert!(!is_closed(&twice, 201, &[]));
     }
 
@@ -908,8 +928,8 @@ mod tests {
                 edges.extend(reverses);
             }
             proptest::prop_assert_eq!(
-                sorted_in_pairs(edges.clone()),
-                grouped_in_pairs(edges, 6)
+                sorted_in_pairs(&edges),
+                DirectedEdges::new(6, || edges.iter().copied()).is_some_and(|d| d.all_paired())
             );
         }
     }
