@@ -61,7 +61,7 @@ struct BlockIndex<'a> {
     blocks: &'a [GridBlock],
     shift: u32,
     /// `starts[c]`: the first block whose range ends after bucket `c` begins.
-    starts: Vec<u32>,
+    starts: Vec<usize>,
 }
 
 impl<'a> BlockIndex<'a> {
@@ -77,7 +77,7 @@ impl<'a> BlockIndex<'a> {
             {
                 k += 1;
             }
-            starts.push(k as u32);
+            starts.push(k);
         }
         BlockIndex {
             blocks,
@@ -91,10 +91,7 @@ impl<'a> BlockIndex<'a> {
         // A block that holds `v` ends after its bucket begins, and begins before the next one
         // does: it is the last candidate at most.
         let c = (v >> self.shift) as usize;
-        let (low, high) = (
-            *self.starts.get(c)? as usize,
-            *self.starts.get(c + 1)? as usize,
-        );
+        let (low, high) = (*self.starts.get(c)?, *self.starts.get(c + 1)?);
         let candidates = &self.blocks[low..(high + 1).min(self.blocks.len())];
         let k = low
             + candidates
@@ -259,11 +256,14 @@ fn general_edges(
     };
     for strip in strips {
         let [a, b] = strip.matching_runs();
-        match (side_of(a), side_of(b)) {
-            (Some((ka, sa)), Some((kb, sb)))
+        // Numbers below `NO_STRIP` only: past them a strip takes the general check.
+        let number = u32::try_from(2 * kept.len())
+            .ok()
+            .filter(|&n| n < NO_STRIP - 1);
+        match (side_of(a), side_of(b), number) {
+            (Some((ka, sa)), Some((kb, sb)), Some(number))
                 if ka != kb && matched[sa] == NO_STRIP && matched[sb] == NO_STRIP =>
             {
-                let number = 2 * kept.len() as u32;
                 (matched[sa], matched[sb]) = (number, number + 1);
                 kept.push(strip);
             }
