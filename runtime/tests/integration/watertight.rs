@@ -1,5 +1,6 @@
-//! `TriangleMesh::is_watertight` pairs the inner edges of the faces' grids and of the strips
-//! between them by their patterns and sorts only the rest (`mesh/watertight.rs`). The reference is the general check on every
+//! `TriangleMesh::is_watertight` pairs the inner edges of the faces' grids (quads, or a triangle
+//! face's hexagon fans) and of the strips between them by their patterns and groups only the
+//! rest (`mesh/watertight/`). The reference is the general check on every
 //! directed edge, `boundary_edges` (closed: no directed edge used twice, none without its
 //! reverse), on the tessellators' outputs and on those outputs broken in the ways a grid
 //! shortcut could miss.
@@ -13,9 +14,13 @@ fn closed_by_every_edge(mesh: &TriangleMesh) -> bool {
 }
 
 fn tessellated(file: &str, rates: Rates) -> TriangleMesh {
+    tessellated_by(Scheme::CatmullClark, file, rates)
+}
+
+fn tessellated_by(scheme: Scheme, file: &str, rates: Rates) -> TriangleMesh {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/data/").to_owned() + file;
     let mesh = Mesh::read_obj(&path).expect("readable");
-    let surface = Surface::new(&mesh, Scheme::CatmullClark).expect("surface");
+    let surface = Surface::new(&mesh, scheme).expect("surface");
     let mut tessellator = surface.tessellator(&rates).expect("plan");
     let frame = tessellator.evaluate(&mesh.positions_f32()).expect("frame");
     frame.to_triangle_mesh()
@@ -94,6 +99,47 @@ fn a_fin_on_a_strip_edge_is_not_closed() {
     }
 }
 
+/// Loop's dual grids (hexagon fans in the faces, found as fan blocks), uniform and mixed
+/// rates: closed by both checks.
+#[test]
+#[cfg(feature = "loop")]
+fn triangle_tessellations_are_closed_by_both_checks() {
+    for n in [1, 2, 3, 4, 8, 13] {
+        let mesh = tessellated_by(Scheme::Loop, "octahedron.obj", Rates::Uniform(n));
+        assert!(agreed(&mesh, "octahedron"));
+    }
+    let mixed = Rates::PerFace(vec![1, 3, 4, 5, 8, 13, 2, 6]);
+    let mesh = tessellated_by(Scheme::Loop, "octahedron.obj", mixed);
+    assert!(agreed(&mesh, "octahedron, mixed rates"));
+}
+
+/// A fan block's inner edges, a spoke and a rim between two interior points' hexagons, used
+/// by two more triangles: the block pairs its own two uses; only the test of the other
+/// triangles against the fan blocks' deep vertices and inner edges sees the fin.
+#[test]
+#[cfg(feature = "loop")]
+fn a_fin_on_a_fan_edge_is_not_closed() {
+    let clean = tessellated_by(Scheme::Loop, "octahedron.obj", Rates::Uniform(6));
+    // A fan is six triangles `[c, x_r, x_(r+1)]`; the first fan of a face (around its primal
+    // point (1, 1)) has the hexagons of (1, 2) and (2, 1) across its rims 0 and 5, inner at
+    // this rate.
+    let t = (0..clean.triangles.len() - 6)
+        .find(|&t| {
+            let fan = &clean.triangles[t..t + 6];
+            (0..6).all(|r| fan[r][0] == fan[0][0] && fan[r][2] == fan[(r + 1) % 6][1])
+        })
+        .expect("a fan");
+    let [c, x0, x1] = clean.triangles[t];
+    for (p, q) in [(c, x0), (x0, x1)] {
+        let mut mesh = clean.clone();
+        let x = mesh.positions.len() as u32;
+        mesh.positions.push([9.0, 9.0, 9.0]);
+        mesh.triangles.push([p, q, x]);
+        mesh.triangles.push([q, p, x]);
+        assert!(!agreed(&mesh, "fin on a fan"));
+    }
+}
+
 /// Tessellations long enough that the grid scan runs in pieces (65,536 triangles and more
 /// each), a face's grid cut between two of them, with and without texture seams (whose grids go
 /// to the general check, from every piece): closed by both checks, and broken by both where a
@@ -135,6 +181,33 @@ proptest! {
     ) {
         let file = if seams { "cube_uv.obj" } else { "cube.obj" };
         let mut mesh = tessellated(file, Rates::Uniform(rate));
+        let t = pick % mesh.triangles.len();
+        match how {
+            0 => {
+                mesh.triangles.remove(t);
+            }
+            1 => mesh.triangles[t].swap(1, 2),
+            2 => {
+                let copy = mesh.triangles[t];
+                mesh.triangles.push(copy);
+            }
+            _ => {
+                let v = mesh.positions.len() as u32;
+                mesh.triangles[t][0] = (mesh.triangles[t][0] + 1) % v;
+            }
+        }
+        agreed(&mesh, "broken");
+    }
+
+    /// The same breakages of Loop's dual grids, whose faces' fans the check pairs in place.
+    #[test]
+    #[cfg(feature = "loop")]
+    fn broken_triangle_tessellations_agree(
+        rate in 2u32..13,
+        pick in 0usize..10_000,
+        how in 0u8..4,
+    ) {
+        let mut mesh = tessellated_by(Scheme::Loop, "octahedron.obj", Rates::Uniform(rate));
         let t = pick % mesh.triangles.len();
         match how {
             0 => {

@@ -6,6 +6,8 @@ use std::ops::Range;
 
 use rayon::prelude::*;
 
+use super::fans::{fan_block_at, FanBlock};
+
 /// A run of grid quads found in the triangle list: `rows` rows of `width - 1` quads over the
 /// vertices `first..first + (rows + 1) * width`, row-major.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -223,10 +225,11 @@ fn strip_at(triangles: &[[u32; 3]]) -> Option<GridStrip> {
     })
 }
 
-/// What the scan finds: grid blocks, strips, and the triangles outside both.
+/// What the scan finds: grid blocks, fan blocks, strips, and the triangles outside them.
 #[derive(Debug, Default)]
 pub(super) struct Found {
     pub(super) blocks: Vec<GridBlock>,
+    pub(super) fans: Vec<FanBlock>,
     pub(super) strips: Vec<GridStrip>,
     pub(super) others: Others,
 }
@@ -263,10 +266,11 @@ impl Others {
     }
 }
 
-/// The grid blocks and strips of `triangles` and the triangles outside them. A block starts at
-/// a triangle `[a, a + 1, a + w + 1]` (`w >= 2`) and runs for as many complete rows as follow;
-/// where none starts, a strip may, for as many quads as follow its pattern; a triangle that
-/// starts neither is left to the general check. Linear: a failed start is passed over, never
+/// The grid blocks, fan blocks and strips of `triangles` and the triangles outside them. A
+/// block starts at a triangle `[a, a + 1, a + w + 1]` (`w >= 2`) and runs for as many complete
+/// rows as follow; where none starts, a whole fan block may ([`fan_block_at`]), else a strip,
+/// for as many quads as follow its pattern; a triangle that starts none is left to the general
+/// check. Linear: a failed start is passed over, never
 /// rescanned.
 fn scan_grids(triangles: &[[u32; 3]]) -> Found {
     let mut found = Found::default();
@@ -289,17 +293,20 @@ fn scan_grids(triangles: &[[u32; 3]]) -> Found {
                 t = block.triangles().end;
                 found.blocks.push(block);
             }
-            _ => match strip_at(&triangles[t..]) {
-                Some(strip) => {
+            _ => {
+                if let Some(fans) = fan_block_at(&triangles[t..]) {
+                    let fans = FanBlock { start: t, ..fans };
+                    t = fans.triangles().end;
+                    found.fans.push(fans);
+                } else if let Some(strip) = strip_at(&triangles[t..]) {
                     let strip = GridStrip { start: t, ..strip };
                     t = strip.triangles().end;
                     found.strips.push(strip);
-                }
-                None => {
+                } else {
                     found.others.push(t..t + 1);
                     t += 1;
                 }
-            },
+            }
         }
     }
     found
@@ -348,6 +355,9 @@ pub(super) fn scan_grids_in_parallel(triangles: &[[u32; 3]]) -> Found {
             for b in &mut found.blocks {
                 b.start += offset;
             }
+            for f in &mut found.fans {
+                f.start += offset;
+            }
             for s in &mut found.strips {
                 s.start += offset;
             }
@@ -360,6 +370,7 @@ pub(super) fn scan_grids_in_parallel(triangles: &[[u32; 3]]) -> Found {
     let mut all = Found::default();
     for piece in found {
         all.blocks.extend(piece.blocks);
+        all.fans.extend(piece.fans);
         all.strips.extend(piece.strips);
         for run in piece.others.runs {
             all.others.push(run);
@@ -370,6 +381,7 @@ pub(super) fn scan_grids_in_parallel(triangles: &[[u32; 3]]) -> Found {
 
 #[cfg(test)]
 pub(super) mod tests {
+    use super::super::fans::tests::fans;
     use super::*;
 
     /// The triangles of a grid block of `rows` rows of `w` vertices from `first`.
@@ -406,7 +418,7 @@ pub(super) mod tests {
     }
 
     /// Two grids of quads, long enough to be scanned in several pieces, a strip and stray
-    /// triangles between them: every triangle is in exactly one block or strip or among the
+    /// triangles between them, three fan blocks after them: every triangle is in exactly one block or strip or among the
     /// others, and every block's and strip's triangles are its pattern, whichever piece found
     /// it.
     #[test]
@@ -416,13 +428,28 @@ pub(super) mod tests {
         triangles.extend([[7, 3, 5], [1, 1, 1], [90_000, 4, 2]]);
         strip(75_299, -1, 100_096, -1, 96, &mut triangles);
         grid(100_000, 97, 400, &mut triangles);
+        let before_fans = triangles.len();
+        for k in 0..3 {
+            fans(200_000 + 1_000 * k, 7 + k, &mut triangles);
+        }
+        let fan_triangles = triangles[before_fans..].to_vec();
         assert!(triangles.len() > 3 * SCAN_CHUNK);
         let Found {
             blocks,
+            fans: fan_blocks,
             strips,
             others,
         } = scan_grids_in_parallel(&triangles);
         let mut seen = vec![0u8; triangles.len()];
+        assert_eq!(fan_blocks.len(), 3);
+        let mut scanned = Vec::new();
+        for f in &fan_blocks {
+            scanned.extend_from_slice(&triangles[f.triangles()]);
+            for t in f.triangles() {
+                seen[t] += 1;
+            }
+        }
+        assert_eq!(scanned, fan_triangles);
         for b in &blocks {
             for (k, t) in b.triangles().enumerate() {
                 seen[t] += 1;

@@ -11,6 +11,9 @@
 //! * a *grid block* is a run of triangles `[a, b, c], [a, c, d]` over quads
 //!   `(a, b, c, d) = (r+i, r+i+1, r+w+i+1, r+w+i)`, `i` in `0..w-1`, for rows `r = first + j w`,
 //!   `j` in `0..rows`: complete rows only;
+//! * a *fan block* is a triangle face's grid in a triangle dual grid: the hexagons around the
+//!   face's interior primal points, each fanned at its point, in the order and numbering of
+//!   [`fans`]'s documentation, whole faces only;
 //! * a *strip* is a run of triangles `[b_k, a_(k+1), a_k], [b_k, b_(k+1), a_(k+1)]` over two
 //!   rows of vertices in arithmetic progression, `a_k = a_0 + k s`, `b_k = b_0 + k t`, `k` in
 //!   `0..=m`, `m >= 2`, whose two sides are whole sides of two different blocks, run the
@@ -26,6 +29,12 @@
 //! * no block side is matched by two strips, and
 //! * no other triangle uses an inner edge of a block or strip or an edge of a matched side
 //!   (checked edge by edge).
+//!
+//! A fan block is matched with no strip (its sides are not arithmetic runs): its border edges
+//! all take the general check. Its inner edges each have a *deep* end (an interior point, or a
+//! dual point whose three corners are interior points), which no other triangle of a dual
+//! grid uses: where no grid block was kept, only the other triangles with a deep vertex
+//! (a bit per vertex) are tested edge by edge.
 //!
 //! What is left, the unmatched sides' border edges, the strips' end rungs (`a_0 -> b_0`,
 //! `b_m -> a_m`) and every edge of the other triangles, takes the general check. The answer is
@@ -46,26 +55,95 @@ use std::ops::Range;
 use rayon::prelude::*;
 
 mod directed_edges;
+mod fans;
 mod grids;
 
 pub(crate) use directed_edges::DirectedEdges;
+use fans::FanBlock;
 use grids::{scan_grids_in_parallel, Found, GridBlock, GridStrip, MAX_BLOCK_SIDE, SCAN_CHUNK};
 
 /// No strip matched the side.
 const NO_STRIP: u32 = u32::MAX;
 
+/// A block whose inner edges pair in place: a quad face's grid, or a triangle face's hexagon
+/// fans (which no strip is matched with: all their border edges take the general check).
+#[derive(Clone, Copy, Debug)]
+enum Block {
+    Grid(GridBlock),
+    Fans(FanBlock),
+}
+
+impl Block {
+    fn first(&self) -> u32 {
+        match self {
+            Block::Grid(b) => b.first,
+            Block::Fans(b) => b.first,
+        }
+    }
+
+    fn vertices(&self) -> Range<u64> {
+        match self {
+            Block::Grid(b) => b.vertices(),
+            Block::Fans(b) => b.vertices(),
+        }
+    }
+
+    fn triangles(&self) -> Range<usize> {
+        match self {
+            Block::Grid(b) => b.triangles(),
+            Block::Fans(b) => b.triangles(),
+        }
+    }
+
+    /// Whether its index arithmetic stays within `u32` (a fan block's scan checks its rate).
+    fn fits(&self) -> bool {
+        match self {
+            Block::Grid(b) => b.width <= MAX_BLOCK_SIDE && b.rows < MAX_BLOCK_SIDE,
+            Block::Fans(_) => true,
+        }
+    }
+
+    fn grid(&self) -> Option<&GridBlock> {
+        match self {
+            Block::Grid(b) => Some(b),
+            Block::Fans(_) => None,
+        }
+    }
+
+    fn inner_edge(&self, p: u32, q: u32) -> bool {
+        match self {
+            Block::Grid(b) => b.inner_edge(p, q),
+            Block::Fans(b) => b.inner_edge(p, q),
+        }
+    }
+
+    /// The border edges that no strip pairs (`matched`: the strip on each grid side).
+    fn unpaired_border(&self, matched: &[u32], out: &mut Vec<(u32, u32)>) {
+        match self {
+            Block::Grid(b) => {
+                for side in 0..4u8 {
+                    if matched[usize::from(side)] == NO_STRIP {
+                        b.side_edges(side, out);
+                    }
+                }
+            }
+            Block::Fans(b) => b.border_edges(out),
+        }
+    }
+}
+
 /// Which block holds a vertex, for blocks with sorted, disjoint vertex ranges: the vertices in
 /// buckets of `2^shift`, about one block each, a bucket's candidates found by their first
 /// index.
 struct BlockIndex<'a> {
-    blocks: &'a [GridBlock],
+    blocks: &'a [Block],
     shift: u32,
     /// `starts[c]`: the first block whose range ends after bucket `c` begins.
     starts: Vec<usize>,
 }
 
 impl<'a> BlockIndex<'a> {
-    fn new(blocks: &'a [GridBlock], vertices: usize) -> BlockIndex<'a> {
+    fn new(blocks: &'a [Block], vertices: usize) -> BlockIndex<'a> {
         let shift = (vertices / blocks.len().max(1)).max(1).ilog2();
         let buckets = (vertices >> shift) + 1;
         let mut starts = Vec::with_capacity(buckets + 1);
@@ -95,9 +173,42 @@ impl<'a> BlockIndex<'a> {
         let candidates = &self.blocks[low..(high + 1).min(self.blocks.len())];
         let k = low
             + candidates
-                .partition_point(|b| b.first <= v)
+                .partition_point(|b| b.first() <= v)
                 .checked_sub(1)?;
         (u64::from(v) < self.blocks[k].vertices().end).then_some(k)
+    }
+}
+
+/// The fan blocks' deep vertices ([`FanBlock::deep_ranges`]), a bit each: every inner edge of a
+/// fan block has a deep end, so another triangle without a deep vertex uses none of them. A bit
+/// a vertex is 256 KB for two million vertices, where the per-vertex arrays this module avoids
+/// are 32 times that.
+struct DeepVertices {
+    bits: Vec<u64>,
+}
+
+impl DeepVertices {
+    fn new(blocks: &[Block], vertices: usize) -> DeepVertices {
+        let mut bits = Vec::new();
+        for block in blocks {
+            let Block::Fans(fans) = block else { continue };
+            if bits.is_empty() {
+                bits = vec![0u64; vertices.div_ceil(64)];
+            }
+            // A kept block lies below `vertices`.
+            for range in fans.deep_ranges() {
+                for v in range {
+                    bits[(v / 64) as usize] |= 1 << (v % 64);
+                }
+            }
+        }
+        DeepVertices { bits }
+    }
+
+    fn holds(&self, v: u32) -> bool {
+        self.bits
+            .get((v / 64) as usize)
+            .is_some_and(|word| word & 1 << (v % 64) != 0)
     }
 }
 
@@ -216,22 +327,24 @@ fn general_edges(
     seams: &Seams,
 ) -> Option<Vec<(u32, u32)>> {
     let Found {
-        blocks: mut found,
+        blocks: grids,
+        fans,
         strips,
         mut others,
     } = scan_grids_in_parallel(triangles);
+    let mut found: Vec<Block> = grids.into_iter().map(Block::Grid).collect();
+    found.extend(fans.into_iter().map(Block::Fans));
     // Disjoint vertex ranges, a block's edges joining its own vertices only: by first vertex,
     // a block that starts before the last kept one ends goes to the general check. So does a
     // block over a seam copy, which would pair edges by index where the positions pair them
     // differently: the blocks kept hold position vertices only, and the other triangles are
     // tested by position.
-    found.sort_unstable_by_key(|b| b.first);
+    found.sort_unstable_by_key(Block::first);
     let mut blocks = Vec::with_capacity(found.len());
     let mut kept_end = 0;
     for b in found {
         let range = b.vertices();
-        let usable = b.width <= MAX_BLOCK_SIDE
-            && b.rows < MAX_BLOCK_SIDE
+        let usable = b.fits()
             && range.start >= kept_end
             && range.end <= vertices as u64
             && !seams.any_copy_in(&range);
@@ -243,6 +356,8 @@ fn general_edges(
         blocks.push(b);
     }
     let index = BlockIndex::new(&blocks, vertices);
+    let deep = DeepVertices::new(&blocks, vertices);
+    let grids_kept = blocks.iter().any(|b| b.grid().is_some());
     let block_of = |v: u32| index.holding(v);
     // A strip pairs its sides with two sides of two different blocks, each side with one strip
     // only; `matched[4 k + side]` is the strip (twice its number, plus one on its side `b`).
@@ -251,7 +366,7 @@ fn general_edges(
     let side_of = |(x, d, m): (i64, i64, u32)| {
         let x = u32::try_from(x).ok()?;
         let k = block_of(x)?;
-        let side = blocks[k].side_of_run((x, d, m))?;
+        let side = blocks[k].grid()?.side_of_run((x, d, m))?;
         Some((k, 4 * k + usize::from(side)))
     };
     for strip in strips {
@@ -273,19 +388,20 @@ fn general_edges(
     // Whether the edge `v w`, `v` inside a side of block `k` that a strip matched, is an inner
     // edge of that strip.
     let strip_edge = |k: Option<usize>, v: u32, w: u32| {
-        let Some((k, side)) = k.and_then(|k| Some((k, blocks[k].side_inside(v)?))) else {
+        let Some((k, side)) = k.and_then(|k| Some((k, blocks[k].grid()?.side_inside(v)?))) else {
             return false;
         };
         let m = matched[4 * k + usize::from(side)];
         m != NO_STRIP && kept[(m / 2) as usize].inner_edge_at(v, m % 2 == 0, w)
     };
-    // Whether a block or strip pairs the edge `p q` already.
-    let paired = |p: u32, q: u32| match (block_of(p), block_of(q)) {
+    // Whether a block or strip pairs the edge `p q` already, `k` and `l` their blocks.
+    let paired = |(p, k): (u32, Option<usize>), (q, l): (u32, Option<usize>)| match (k, l) {
         (Some(k), Some(l)) if k == l => {
             let block = &blocks[k];
             block.inner_edge(p, q)
                 || block
-                    .side_of_edge(p, q)
+                    .grid()
+                    .and_then(|grid| grid.side_of_edge(p, q))
                     .is_some_and(|side| matched[4 * k + usize::from(side)] != NO_STRIP)
         }
         (k, l) => strip_edge(k, p, q) || strip_edge(l, q, p),
@@ -312,7 +428,11 @@ fn general_edges(
             }
             let [a, b, c] = corners.map(|v| seams.position(v));
             out.copy_from_slice(&[(a, b), (b, c), (c, a)]);
-            blocks.is_empty() || !(paired(a, b) || paired(b, c) || paired(c, a))
+            if blocks.is_empty() || !(grids_kept || [a, b, c].iter().any(|&v| deep.holds(v))) {
+                return true;
+            }
+            let [a, b, c] = [a, b, c].map(|v| (v, block_of(v)));
+            !(paired(a, b) || paired(b, c) || paired(c, a))
         })
     });
     if !valid {
@@ -320,11 +440,7 @@ fn general_edges(
     }
     // The blocks and strips kept hold position vertices only.
     for (k, b) in blocks.iter().enumerate() {
-        for side in 0..4u8 {
-            if matched[4 * k + usize::from(side)] == NO_STRIP {
-                b.side_edges(side, &mut edges);
-            }
-        }
+        b.unpaired_border(&matched[4 * k..4 * k + 4], &mut edges);
     }
     for strip in &kept {
         edges.extend(strip.end_rungs());
