@@ -140,6 +140,53 @@ fn a_fin_on_a_fan_edge_is_not_closed() {
     }
 }
 
+/// A merge strip between two faces' fans (Loop's strips, whatever the two rates): a rung inside
+/// it and an edge of its row (paired with the face's border) used by two more triangles; and
+/// a closed pair of triangles on a vertex the strip claims, which leaves the mesh closed (by
+/// edges) and sends the check to every edge.
+#[test]
+#[cfg(feature = "loop")]
+fn a_fin_on_a_merge_strip_is_not_closed() {
+    for rates in [
+        Rates::Uniform(6),
+        Rates::PerFace(vec![5, 7, 6, 9, 5, 8, 6, 7]),
+    ] {
+        let clean = tessellated_by(Scheme::Loop, "octahedron.obj", rates);
+        // Consecutive triangles of a strip: the next begins and ends with the first and middle
+        // vertices of the last (its row `a` advanced) or with its middle and last.
+        let zigzag = |t: usize| {
+            let ([x, y, z], next) = (clean.triangles[t], clean.triangles[t + 1]);
+            (next[0], next[2]) == (x, y) || (next[0], next[2]) == (y, z)
+        };
+        let t = (0..clean.triangles.len() - 12)
+            .find(|&t| (t..t + 12).all(zigzag))
+            .expect("a strip")
+            + 6;
+        let [x, y, z] = clean.triangles[t];
+        let next = clean.triangles[t + 1];
+        let rung = if (next[0], next[2]) == (x, y) {
+            (x, y)
+        } else {
+            (y, z)
+        };
+        for (p, q) in [rung, (y, z), (z, x)] {
+            let mut mesh = clean.clone();
+            let w = mesh.positions.len() as u32;
+            mesh.positions.push([9.0, 9.0, 9.0]);
+            mesh.triangles.push([p, q, w]);
+            mesh.triangles.push([q, p, w]);
+            assert!(!agreed(&mesh, "fin on a merge strip"));
+        }
+        let mut pinched = clean.clone();
+        let w = pinched.positions.len() as u32;
+        pinched.positions.push([9.0, 9.0, 9.0]);
+        pinched.positions.push([9.0, 9.0, 8.0]);
+        pinched.triangles.push([y, w, w + 1]);
+        pinched.triangles.push([w + 1, w, y]);
+        assert!(agreed(&pinched, "two triangles on a strip's vertex"));
+    }
+}
+
 /// Tessellations long enough that the grid scan runs in pieces (65,536 triangles and more
 /// each), a face's grid cut between two of them, with and without texture seams (whose grids go
 /// to the general check, from every piece): closed by both checks, and broken by both where a

@@ -91,21 +91,6 @@ impl FanBlock {
         ]
     }
 
-    /// The primal points across the rims of the hexagon around `(i, j)`: the rim
-    /// `x_r -> x_(r+1)` lies on the primal edge from `(i, j)` to the `r`-th (`i - 1` or `j - 1`
-    /// may wrap: such a point is not interior).
-    fn across(i: u32, j: u32) -> [(u32, u32); 6] {
-        let (left, down) = (i.wrapping_sub(1), j.wrapping_sub(1));
-        [
-            (i, j + 1),
-            (left, j + 1),
-            (left, j),
-            (i, down),
-            (i + 1, down),
-            (i + 1, j),
-        ]
-    }
-
     fn interior(&self, (i, j): (u32, u32)) -> bool {
         i >= 1 && j >= 1 && u64::from(i) + u64::from(j) < u64::from(self.n)
     }
@@ -200,23 +185,57 @@ impl FanBlock {
             .chain(std::iter::once(centres))
     }
 
-    /// The block's border edges as its triangles run them: the rims whose primal point across
-    /// is not interior, on the fans along the face's three sides.
-    pub(super) fn border_edges(&self, out: &mut Vec<(u32, u32)>) {
+    /// Side `side`'s dual points in the order the block's border runs them (counterclockwise
+    /// around the face): the `2n - 1` dual points of the small triangles on that side of the
+    /// face, from the corner point before it to the one after. Side 0 is `j = 0`, side 1
+    /// `i + j = n`, side 2 `i = 0`. The border edges along the side join its points `1..=2n-3`
+    /// (the corner points' segments `0 1` and `2n-3 2n-2` are no block edges); a strip along
+    /// the side runs all of them the other way.
+    pub(super) fn side_point(&self, side: u8, k: u32) -> u32 {
+        let (n, t) = (self.n, k / 2);
+        let down = k % 2 == 1;
+        let (i, j) = match side {
+            0 => return self.first + k,
+            1 if down => (n - 2 - t, t),
+            1 => (n - 1 - t, t),
+            _ if down => (0, n - 2 - t),
+            _ => (0, n - 1 - t),
+        };
+        self.up(i, j) + u32::from(down)
+    }
+
+    /// Points `2..=2n-4` of a side belong to that side alone (the others are its corner
+    /// points and their neighbours, on two sides each): the side and the place of the block's
+    /// vertex `v` when it is one of them.
+    pub(super) fn side_inside(&self, v: u32) -> Option<(u8, u32)> {
         let n = self.n;
-        for j in 1..n - 1 {
-            let last = n - 1 - j;
-            for i in 1..=last {
-                if !(i == 1 || j == 1 || i == last) {
-                    continue;
-                }
-                let ring = self.ring(i, j);
-                for (r, &q) in Self::across(i, j).iter().enumerate() {
-                    if !self.interior(q) {
-                        out.push((ring[r], ring[(r + 1) % 6]));
-                    }
-                }
-            }
+        let FanVertex::Dual { i, j, down } = self.vertex(v) else {
+            return None;
+        };
+        let d = u32::from(down);
+        let place = if j == 0 {
+            (0, 2 * i + d)
+        } else if i == 0 {
+            (2, 2 * (n - 1 - j) - d)
+        } else if i + j + 1 + d == n {
+            (1, 2 * j + d)
+        } else {
+            return None;
+        };
+        (2..=2 * n - 4).contains(&place.1).then_some(place)
+    }
+
+    /// The border edges along side `side`, as the block's triangles run them: between its
+    /// points `1..=2n-3` ([`FanBlock::side_point`]).
+    pub(super) fn side_edges(&self, side: u8, out: &mut Vec<(u32, u32)>) {
+        let point = |k| self.side_point(side, k);
+        out.extend((1..2 * self.n - 3).map(|k| (point(k), point(k + 1))));
+    }
+
+    /// The block's border edges, as its triangles run them.
+    pub(super) fn border_edges(&self, out: &mut Vec<(u32, u32)>) {
+        for side in 0..3 {
+            self.side_edges(side, out);
         }
     }
 }
@@ -357,8 +376,9 @@ pub(super) mod tests {
     }
 
     /// Every edge the block's triangles use both ways is inner and has a deep end, every one
-    /// used once is a border edge as the triangles run it, nothing else is an edge, and the
-    /// deep ranges are the deep vertices.
+    /// used once is a border edge as the triangles run it (so the sides' points `1..=2n-3` are
+    /// right), nothing else is an edge, the sides close around the face, and the deep ranges
+    /// are the deep vertices.
     #[test]
     fn inner_and_border_edges_are_the_triangles() {
         for n in 3..10 {
@@ -387,6 +407,24 @@ pub(super) mod tests {
                     assert_eq!(block.inner_edge(p, q), both, "rate {n}, {p} {q}");
                     assert!(!both || block.deep(p) || block.deep(q), "rate {n}, {p} {q}");
                 }
+            }
+            // The sides run around the face: each ends at the next one's first point, and
+            // their points 2..=2n-4 are theirs alone, as `side_inside` finds them.
+            for side in 0..3u8 {
+                let last = block.side_point(side, 2 * n - 2);
+                assert_eq!(last, block.side_point((side + 1) % 3, 0), "rate {n}");
+            }
+            for v in 0..count {
+                let places: Vec<(u8, u32)> = (0..3u8)
+                    .flat_map(|side| (2..=2 * n - 4).map(move |k| (side, k)))
+                    .filter(|&(side, k)| block.side_point(side, k) == v)
+                    .collect();
+                assert!(places.len() <= 1, "rate {n}, vertex {v}: {places:?}");
+                assert_eq!(
+                    block.side_inside(v),
+                    places.first().copied(),
+                    "rate {n}, {v}"
+                );
             }
             let mut deep: Vec<u32> = block.deep_ranges().flatten().collect();
             deep.sort_unstable();

@@ -238,7 +238,7 @@ pub(super) struct Found {
 /// is one run, not an index per triangle).
 #[derive(Debug, Default)]
 pub(super) struct Others {
-    runs: Vec<Range<usize>>,
+    pub(super) runs: Vec<Range<usize>>,
 }
 
 impl Others {
@@ -248,6 +248,18 @@ impl Others {
             Some(last) if last.end == run.start => last.end = run.end,
             _ => self.runs.push(run),
         }
+    }
+
+    /// The same triangles in runs by first triangle, adjacent runs joined (strips that matched
+    /// no side were added after every other run).
+    pub(super) fn sorted(&self) -> Others {
+        let mut runs = self.runs.clone();
+        runs.sort_unstable_by_key(|r| r.start);
+        let mut sorted = Others::default();
+        for run in runs {
+            sorted.push(run);
+        }
+        sorted
     }
 
     pub(super) fn len(&self) -> usize {

@@ -1,0 +1,288 @@
+//! The pairing of a triangle dual grid's output: fan blocks (the faces' hexagon fans,
+//! [`super::fans`]) and the *merge strips* between two of them, where no quad grid was found.
+//!
+//! A merge strip is a run of triangles, each `[b_j, a_(i+1), a_i]` (the row `a` advances) or
+//! `[b_j, b_(j+1), a_i]` (the row `b` does), from `(i, j) = (0, 0)` to the rows' ends: two rows
+//! merged in order of their parameters, whatever their lengths (`kernel::merge_rows`). Its rung
+//! `a_i b_j` between two consecutive triangles is used by both, once each way. It is kept when
+//! its row `a` is a whole side of a fan block as the block's border runs it and its row `b`
+//! one of another block's run backwards ([`super::fans::FanBlock::side_point`]), each side matched once.
+//!
+//! Why the answer is the general check's: call a vertex *claimed* when it is deep in its block
+//! (an interior point, or a dual point with three interior corners) or one of a matched side's
+//! points `2..=2n-4`, which lie on that side alone. An edge and its reverse have the same ends,
+//! so the mesh is closed exactly when both the edges with a claimed end and the others are. The
+//! edges at a claimed vertex come from its block and, on a matched side, its strip (a strip's
+//! triangles use its rows only, and no other strip's rows hold such a point): the fans pair
+//! theirs, the strip's rungs pair inside it, and the side's border edges pair with the strip's
+//! row edges, all once each way. So where no other triangle touches a claimed vertex (checked,
+//! a bit per vertex) the edges with a claimed end pair, and the rest go to the general check:
+//! the other triangles', and the blocks' and strips' edges without a claimed end (the corner
+//! points' segments, the strips' end rungs, the border of sides no strip matched). Where
+//! another triangle does touch one, every edge goes to the general check.
+
+use std::ops::Range;
+
+use rayon::prelude::*;
+
+use super::grids::{Others, SCAN_CHUNK};
+use super::{Block, BlockIndex, Seams};
+
+/// A merge strip kept: its triangles, and the block and side of its rows `a` and `b`.
+struct MergeStrip {
+    triangles: Range<usize>,
+    sides: [(usize, u8); 2],
+}
+
+/// The rows of the merge strip that starts at `triangles[0]` (at least two triangles), into
+/// `a` and `b`, but for its last triangle's middle vertex, which ends one row or the other:
+/// returns the strip's length and that vertex.
+fn zigzag_at(triangles: &[[u32; 3]], a: &mut Vec<u32>, b: &mut Vec<u32>) -> Option<(usize, u32)> {
+    let [[x, y, z], second, ..] = *triangles else {
+        return None;
+    };
+    a.clear();
+    b.clear();
+    a.push(z);
+    b.push(x);
+    // The pairs `(b_j, a_i)` that the next triangle must begin and end with.
+    let advance = |[x, y, z]: [u32; 3], next: [u32; 3]| {
+        if (next[0], next[2]) == (x, y) {
+            Some(true)
+        } else if (next[0], next[2]) == (y, z) {
+            Some(false)
+        } else {
+            None
+        }
+    };
+    advance([x, y, z], second)?;
+    let mut length = 1;
+    while let Some(&next) = triangles.get(length) {
+        let this = triangles[length - 1];
+        match advance(this, next) {
+            Some(true) => a.push(this[1]),
+            Some(false) => b.push(this[1]),
+            None => break,
+        }
+        length += 1;
+    }
+    Some((length, triangles[length - 1][1]))
+}
+
+/// The fan block and side whose border runs `row` (`backwards`: runs it reversed), if any.
+fn side_of_row(
+    row: &[u32],
+    backwards: bool,
+    blocks: &[Block],
+    index: &BlockIndex,
+) -> Option<(usize, u8)> {
+    // A fan block's side has `2n - 1 >= 5` points.
+    if row.len() < 5 {
+        return None;
+    }
+    let at = |k: usize| {
+        if backwards {
+            row[row.len() - 1 - k]
+        } else {
+            row[k]
+        }
+    };
+    let v = at(2);
+    let k = index.holding(v)?;
+    let Block::Fans(block) = &blocks[k] else {
+        return None;
+    };
+    let (side, place) = block.side_inside(v)?;
+    let length = 2 * block.n as usize - 1;
+    (place == 2
+        && row.len() == length
+        && (0..length).all(|p| at(p) == block.side_point(side, p as u32)))
+    .then_some((k, side))
+}
+
+/// The merge strips in the runs of `others` whose rows are two different fan blocks' sides
+/// (not yet each side once), and the triangles left.
+fn find_strips(
+    triangles: &[[u32; 3]],
+    others: &Others,
+    blocks: &[Block],
+    index: &BlockIndex,
+) -> (Vec<MergeStrip>, Vec<Range<usize>>) {
+    let found: Vec<_> = others
+        .pieces(SCAN_CHUNK)
+        .into_par_iter()
+        .map(|piece| {
+            let (mut a, mut b) = (Vec::new(), Vec::new());
+            let (mut strips, mut left) = (Vec::new(), Vec::new());
+            let mut t = piece.start;
+            while t < piece.end {
+                let strip = zigzag_at(&triangles[t..piece.end], &mut a, &mut b).and_then(
+                    |(length, last)| {
+                        let sides = |a: &[u32], b: &[u32]| {
+                            let sa = side_of_row(a, false, blocks, index)?;
+                            let sb = side_of_row(b, true, blocks, index)?;
+                            (sa.0 != sb.0).then_some([sa, sb])
+                        };
+                        a.push(last);
+                        let on_a = sides(&a, &b);
+                        a.pop();
+                        b.push(last);
+                        let sides = on_a.or_else(|| sides(&a, &b))?;
+                        Some(MergeStrip {
+                            triangles: t..t + length,
+                            sides,
+                        })
+                    },
+                );
+                match strip {
+                    Some(strip) => {
+                        t = strip.triangles.end;
+                        strips.push(strip);
+                    }
+                    None => {
+                        left.push(t..t + 1);
+                        t += 1;
+                    }
+                }
+            }
+            (strips, left)
+        })
+        .collect();
+    let mut strips = Vec::new();
+    let mut left = Others::default();
+    for (s, l) in found {
+        strips.extend(s);
+        for run in l {
+            left.push(run);
+        }
+    }
+    (strips, left.runs)
+}
+
+/// The fan blocks' claimed vertices (the module's documentation), a bit each.
+struct Claimed {
+    bits: Vec<u64>,
+}
+
+impl Claimed {
+    fn set(&mut self, v: u32) {
+        self.bits[(v / 64) as usize] |= 1 << (v % 64);
+    }
+
+    fn holds(&self, v: u32) -> bool {
+        self.bits
+            .get((v / 64) as usize)
+            .is_some_and(|word| word & 1 << (v % 64) != 0)
+    }
+}
+
+/// The directed edges left to the general check of a mesh whose kept blocks are all fan blocks
+/// (`blocks`, sorted, disjoint, below `vertices`, no seam copies), `others` the triangles
+/// outside them; `None` when a triangle names a vertex beyond `vertices`.
+pub(super) fn fan_grid_edges(
+    triangles: &[[u32; 3]],
+    vertices: usize,
+    seams: &Seams,
+    blocks: &[Block],
+    index: &BlockIndex,
+    others: &Others,
+) -> Option<Vec<(u32, u32)>> {
+    let fans = |k: usize| match &blocks[k] {
+        Block::Fans(block) => Some(block),
+        Block::Grid(_) => None,
+    };
+    let (found, mut left) = find_strips(triangles, others, blocks, index);
+    // Each side with one strip at most.
+    let mut matched = vec![false; 3 * blocks.len()];
+    let mut strips = Vec::with_capacity(found.len());
+    for strip in found {
+        let [(ka, sa), (kb, sb)] = strip.sides;
+        let (a, b) = (3 * ka + usize::from(sa), 3 * kb + usize::from(sb));
+        if matched[a] || matched[b] {
+            left.push(strip.triangles);
+            continue;
+        }
+        (matched[a], matched[b]) = (true, true);
+        strips.push(strip);
+    }
+    let mut claimed = Claimed {
+        bits: vec![0; vertices.div_ceil(64)],
+    };
+    for (k, block) in (0..blocks.len()).filter_map(|k| Some((k, fans(k)?))) {
+        for range in block.deep_ranges() {
+            for v in range {
+                claimed.set(v);
+            }
+        }
+        for side in 0..3u8 {
+            if matched[3 * k + usize::from(side)] {
+                for p in 2..=2 * block.n - 4 {
+                    claimed.set(block.side_point(side, p));
+                }
+            }
+        }
+    }
+    // The other triangles: every edge, by position; none may touch a claimed vertex.
+    let count = left.iter().map(|run| run.len()).sum::<usize>();
+    let mut edges: Vec<(u32, u32)> = Vec::with_capacity(3 * count);
+    let mut touched = false;
+    for run in &left {
+        for &corners in &triangles[run.clone()] {
+            if corners.iter().any(|&v| v as usize >= vertices) {
+                return None;
+            }
+            let [a, b, c] = corners.map(|v| seams.position(v));
+            touched |= claimed.holds(a) || claimed.holds(b) || claimed.holds(c);
+            edges.extend([(a, b), (b, c), (c, a)]);
+        }
+    }
+    if touched {
+        return all_edges(triangles, vertices, seams);
+    }
+    // The strips' edges without a claimed end (near the strips' ends), by pieces in parallel.
+    let pieces: Vec<Vec<(u32, u32)>> = strips
+        .par_chunks(1024)
+        .map(|strips| {
+            let mut out = Vec::new();
+            for strip in strips {
+                for &[a, b, c] in &triangles[strip.triangles.clone()] {
+                    let [x, y, z] = [a, b, c].map(|v| claimed.holds(v));
+                    if !(x || y) {
+                        out.push((a, b));
+                    }
+                    if !(y || z) {
+                        out.push((b, c));
+                    }
+                    if !(z || x) {
+                        out.push((c, a));
+                    }
+                }
+            }
+            out
+        })
+        .collect();
+    for piece in pieces {
+        edges.extend(piece);
+    }
+    // The border of the sides no strip matched.
+    for (k, block) in (0..blocks.len()).filter_map(|k| Some((k, fans(k)?))) {
+        for side in 0..3u8 {
+            if !matched[3 * k + usize::from(side)] {
+                block.side_edges(side, &mut edges);
+            }
+        }
+    }
+    Some(edges)
+}
+
+/// Every triangle's edges, by position (`None` for a vertex beyond `vertices`).
+fn all_edges(triangles: &[[u32; 3]], vertices: usize, seams: &Seams) -> Option<Vec<(u32, u32)>> {
+    triangles
+        .par_iter()
+        .flat_map_iter(|&corners| {
+            let valid = corners.iter().all(|&v| (v as usize) < vertices);
+            let [a, b, c] = corners.map(|v| seams.position(v));
+            [(a, b), (b, c), (c, a)].map(|e| valid.then_some(e))
+        })
+        .collect()
+}
