@@ -14,8 +14,10 @@
 //!   refined four times by Loop.
 //!
 //! Group "watertightness check": `TriangleMesh::is_watertight` on Spot's control mesh at rate
-//! 16 (1,508,326 triangles; the cube refined three times without `../shared/models`) beside
-//! the general check on every directed edge (`boundary_edges`) and the frame it checks.
+//! 16 (1,508,326 triangles; the cube refined three times without `../shared/models`) and on
+//! Loop's triangulated Spot at rate 8 (4,005,504 triangles; the icosahedron refined four times
+//! without), beside the general check on every directed edge (`boundary_edges`) and the frame
+//! it checks.
 #![allow(missing_docs)] // criterion_group! generates an undocumented function
 
 // The integration tests' meshes; the benchmark uses a few of them.
@@ -132,44 +134,52 @@ fn bench(c: &mut Criterion) {
     }
 }
 
-/// The watertightness check against the frame it checks, one and two threads.
+/// The watertightness check against the frame it checks, one and two threads: a quad dual
+/// grid and Loop's.
 fn check(c: &mut Criterion) {
-    let mesh = shared("crane/spot_control_mesh.obj").unwrap_or_else(|| {
+    let quads = shared("crane/spot_control_mesh.obj").unwrap_or_else(|| {
         let cube = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/cube.obj");
         let cube = Mesh::read_obj(&cube).unwrap_or_else(|e| panic!("{e}"));
         refined(cube, Scheme::CatmullClark, 3)
     });
-    let surface = Surface::new(&mesh, Scheme::CatmullClark).unwrap_or_else(|e| panic!("{e}"));
-    let control = mesh.positions_f32();
-    let mut tessellator = surface
-        .tessellator(&Rates::Uniform(16))
-        .unwrap_or_else(|e| panic!("{e}"));
-    let output = tessellator
-        .evaluate(&control)
-        .unwrap_or_else(|e| panic!("{e}"))
-        .to_triangle_mesh();
-    assert!(output.is_watertight());
-    for threads in [1, 2] {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
+    let triangles = shared("crane/spot_triangulated.obj")
+        .unwrap_or_else(|| refined(common::icosahedron(), Scheme::Loop, 4));
+    for (mesh, scheme, rate) in [
+        (quads, Scheme::CatmullClark, 16),
+        (triangles, Scheme::Loop, 8),
+    ] {
+        let surface = Surface::new(&mesh, scheme).unwrap_or_else(|e| panic!("{e}"));
+        let control = mesh.positions_f32();
+        let mut tessellator = surface
+            .tessellator(&Rates::Uniform(rate))
             .unwrap_or_else(|e| panic!("{e}"));
-        let mut group = c.benchmark_group(format!(
-            "watertightness check, {} triangles, {threads} thread(s)",
-            output.triangles.len()
-        ));
-        group.sample_size(10);
-        group.throughput(Throughput::Elements(output.triangles.len() as u64));
-        group.bench_function("is_watertight", |b| {
-            pool.install(|| b.iter(|| output.is_watertight()))
-        });
-        group.bench_function("general check (boundary_edges)", |b| {
-            pool.install(|| b.iter(|| output.boundary_edges().map(|e| e.len())))
-        });
-        group.bench_function("the frame (evaluate)", |b| {
-            pool.install(|| b.iter(|| frame(&mut tessellator, &control)))
-        });
-        group.finish();
+        let output = tessellator
+            .evaluate(&control)
+            .unwrap_or_else(|e| panic!("{e}"))
+            .to_triangle_mesh();
+        assert!(output.is_watertight());
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap_or_else(|e| panic!("{e}"));
+            let mut group = c.benchmark_group(format!(
+                "watertightness check, {scheme:?} rate {rate}, {} triangles, {threads} thread(s)",
+                output.triangles.len()
+            ));
+            group.sample_size(10);
+            group.throughput(Throughput::Elements(output.triangles.len() as u64));
+            group.bench_function("is_watertight", |b| {
+                pool.install(|| b.iter(|| output.is_watertight()))
+            });
+            group.bench_function("general check (boundary_edges)", |b| {
+                pool.install(|| b.iter(|| output.boundary_edges().map(|e| e.len())))
+            });
+            group.bench_function("the frame (evaluate)", |b| {
+                pool.install(|| b.iter(|| frame(&mut tessellator, &control)))
+            });
+            group.finish();
+        }
     }
 }
 

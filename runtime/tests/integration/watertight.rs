@@ -140,10 +140,11 @@ fn a_fin_on_a_fan_edge_is_not_closed() {
     }
 }
 
-/// A merge strip between two faces' fans (Loop's strips, whatever the two rates): a rung inside
-/// it and an edge of its row (paired with the face's border) used by two more triangles; and
-/// a closed pair of triangles on a vertex the strip claims, which leaves the mesh closed (by
-/// edges) and sends the check to every edge.
+/// A merge strip between two faces' fans (Loop's strips, whatever the two rates): each edge of
+/// its first triangles and of one inside it (rungs, row edges paired with the faces' borders,
+/// the corner segment, the end rung) used by two more triangles; and a closed pair of
+/// triangles on a vertex the strip claims, which leaves the mesh closed (by edges) and sends
+/// the check to every edge.
 #[test]
 #[cfg(feature = "loop")]
 fn a_fin_on_a_merge_strip_is_not_closed() {
@@ -158,25 +159,23 @@ fn a_fin_on_a_merge_strip_is_not_closed() {
             let ([x, y, z], next) = (clean.triangles[t], clean.triangles[t + 1]);
             (next[0], next[2]) == (x, y) || (next[0], next[2]) == (y, z)
         };
-        let t = (0..clean.triangles.len() - 12)
-            .find(|&t| (t..t + 12).all(zigzag))
-            .expect("a strip")
-            + 6;
-        let [x, y, z] = clean.triangles[t];
-        let next = clean.triangles[t + 1];
-        let rung = if (next[0], next[2]) == (x, y) {
-            (x, y)
-        } else {
-            (y, z)
-        };
-        for (p, q) in [rung, (y, z), (z, x)] {
-            let mut mesh = clean.clone();
-            let w = mesh.positions.len() as u32;
-            mesh.positions.push([9.0, 9.0, 9.0]);
-            mesh.triangles.push([p, q, w]);
-            mesh.triangles.push([q, p, w]);
-            assert!(!agreed(&mesh, "fin on a merge strip"));
+        // A strip's first triangles (its end rung, the corner segment, the point next to the
+        // corner) and one inside it: every edge of them, finned, breaks the mesh.
+        let t = (1..clean.triangles.len() - 12)
+            .find(|&t| !zigzag(t - 1) && (t..t + 12).all(zigzag))
+            .expect("a strip");
+        for t in [t, t + 1, t + 2, t + 6] {
+            let [x, y, z] = clean.triangles[t];
+            for (p, q) in [(x, y), (y, z), (z, x)] {
+                let mut mesh = clean.clone();
+                let w = mesh.positions.len() as u32;
+                mesh.positions.push([9.0, 9.0, 9.0]);
+                mesh.triangles.push([p, q, w]);
+                mesh.triangles.push([q, p, w]);
+                assert!(!agreed(&mesh, "fin on a merge strip"));
+            }
         }
+        let [_, y, _] = clean.triangles[t + 6];
         let mut pinched = clean.clone();
         let w = pinched.positions.len() as u32;
         pinched.positions.push([9.0, 9.0, 9.0]);

@@ -9,16 +9,20 @@
 //! one of another block's run backwards ([`super::fans::FanBlock::side_point`]), each side matched once.
 //!
 //! Why the answer is the general check's: call a vertex *claimed* when it is deep in its block
-//! (an interior point, or a dual point with three interior corners) or one of a matched side's
-//! points `2..=2n-4`, which lie on that side alone. An edge and its reverse have the same ends,
-//! so the mesh is closed exactly when both the edges with a claimed end and the others are. The
-//! edges at a claimed vertex come from its block and, on a matched side, its strip (a strip's
-//! triangles use its rows only, and no other strip's rows hold such a point): the fans pair
-//! theirs, the strip's rungs pair inside it, and the side's border edges pair with the strip's
-//! row edges, all once each way. So where no other triangle touches a claimed vertex (checked,
+//! (an interior point, or a dual point with three interior corners), one of a matched side's
+//! points `2..=2n-4`, which lie on that side alone, or the point next to a block's corner (point
+//! 1 of one side, `2n - 3` of the one before) when both sides are matched, by strips from two
+//! different blocks. An edge and its reverse have the same ends, so the mesh is closed exactly
+//! when both the edges with a claimed end and the others are. The edges at a claimed vertex
+//! come from its block and the strips along its sides (a strip's triangles use its rows only,
+//! and no other strip's rows hold such a point): the fans pair theirs, a strip's rungs pair
+//! inside it (its end rungs join unclaimed corner points), the sides' border edges pair with the
+//! strips' row edges, and the segment from a corner to the point next to it is run once by each
+//! of the two strips that meet there; the rungs of those two strips at that point end in two
+//! different blocks, so none is used by both. So where no other triangle touches a claimed vertex (checked,
 //! a bit per vertex) the edges with a claimed end pair, and the rest go to the general check:
-//! the other triangles', and the blocks' and strips' edges without a claimed end (the corner
-//! points' segments, the strips' end rungs, the border of sides no strip matched). Where
+//! the other triangles', and the blocks' and strips' edges without a claimed end (the strips'
+//! end rungs, what is next to a side no strip matched, that side's border). Where
 //! another triangle does touch one, every edge goes to the general check.
 
 use std::ops::Range;
@@ -35,8 +39,8 @@ struct MergeStrip {
 }
 
 /// The rows of the merge strip that starts at `triangles[0]` (at least two triangles), into
-/// `a` and `b`, but for its last triangle's middle vertex, which ends one row or the other:
-/// returns the strip's length and that vertex.
+/// `a` and `b`, but for its last triangle's middle vertex, which ends one row or the other
+/// (the triangle alone does not say which): returns the strip's length and that vertex.
 fn zigzag_at(triangles: &[[u32; 3]], a: &mut Vec<u32>, b: &mut Vec<u32>) -> Option<(usize, u32)> {
     let [[x, y, z], second, ..] = *triangles else {
         return None;
@@ -123,11 +127,14 @@ fn find_strips(
                             let sb = side_of_row(b, true, blocks, index)?;
                             (sa.0 != sb.0).then_some([sa, sb])
                         };
-                        a.push(last);
-                        let on_a = sides(&a, &b);
-                        a.pop();
-                        b.push(last);
-                        let sides = on_a.or_else(|| sides(&a, &b))?;
+                        // Both rows have an odd length (a side's `2n - 1` points): the last
+                        // point ends the row that is one short.
+                        if a.len() % 2 == 0 {
+                            a.push(last);
+                        } else {
+                            b.push(last);
+                        }
+                        let sides = sides(&a, &b)?;
                         Some(MergeStrip {
                             triangles: t..t + length,
                             sides,
@@ -193,18 +200,20 @@ pub(super) fn fan_grid_edges(
     };
     let (found, mut left) = find_strips(triangles, others, blocks, index);
     // Each side with one strip at most.
-    let mut matched = vec![false; 3 * blocks.len()];
+    // `across[3 k + side]`: the block across a matched side.
+    let mut across: Vec<Option<usize>> = vec![None; 3 * blocks.len()];
     let mut strips = Vec::with_capacity(found.len());
     for strip in found {
         let [(ka, sa), (kb, sb)] = strip.sides;
         let (a, b) = (3 * ka + usize::from(sa), 3 * kb + usize::from(sb));
-        if matched[a] || matched[b] {
+        if across[a].is_some() || across[b].is_some() {
             left.push(strip.triangles);
             continue;
         }
-        (matched[a], matched[b]) = (true, true);
+        (across[a], across[b]) = (Some(kb), Some(ka));
         strips.push(strip);
     }
+    let matched = |k: usize, side: u8| across[3 * k + usize::from(side)].is_some();
     let mut claimed = Claimed {
         bits: vec![0; vertices.div_ceil(64)],
     };
@@ -215,10 +224,20 @@ pub(super) fn fan_grid_edges(
             }
         }
         for side in 0..3u8 {
-            if matched[3 * k + usize::from(side)] {
+            if matched(k, side) {
                 for p in 2..=2 * block.n - 4 {
                     claimed.set(block.side_point(side, p));
                 }
+            }
+            // The point next to the corner before the side, on this side and the one before:
+            // claimed when both strips are there, from two different blocks.
+            let before = (side + 2) % 3;
+            let (this, that) = (
+                across[3 * k + usize::from(side)],
+                across[3 * k + usize::from(before)],
+            );
+            if this.is_some() && that.is_some() && this != that {
+                claimed.set(block.side_point(side, 1));
             }
         }
     }
@@ -267,7 +286,7 @@ pub(super) fn fan_grid_edges(
     // The border of the sides no strip matched.
     for (k, block) in (0..blocks.len()).filter_map(|k| Some((k, fans(k)?))) {
         for side in 0..3u8 {
-            if !matched[3 * k + usize::from(side)] {
+            if !matched(k, side) {
                 block.side_edges(side, &mut edges);
             }
         }
