@@ -25,7 +25,7 @@
 //! end rungs, what is next to a side no strip matched, that side's border). Where
 //! another triangle does touch one, every edge goes to the general check.
 
-use std::ops::Range;
+use std::ops::{Range, RangeInclusive};
 
 use rayon::prelude::*;
 
@@ -176,6 +176,24 @@ impl Claimed {
         self.bits[(v / 64) as usize] |= 1 << (v % 64);
     }
 
+    /// Every vertex of `range` (a block's, below the vertex count), a word at a time.
+    fn set_range(&mut self, range: RangeInclusive<u32>) {
+        let (first, last) = (*range.start() as usize, *range.end() as usize);
+        if first > last {
+            return;
+        }
+        let (low, high) = (first / 64, last / 64);
+        let head = !0u64 << (first % 64);
+        let tail = !0u64 >> (63 - last % 64);
+        if low == high {
+            self.bits[low] |= head & tail;
+        } else {
+            self.bits[low] |= head;
+            self.bits[low + 1..high].fill(!0);
+            self.bits[high] |= tail;
+        }
+    }
+
     fn holds(&self, v: u32) -> bool {
         self.bits
             .get((v / 64) as usize)
@@ -219,9 +237,7 @@ pub(super) fn fan_grid_edges(
     };
     for (k, block) in (0..blocks.len()).filter_map(|k| Some((k, fans(k)?))) {
         for range in block.deep_ranges() {
-            for v in range {
-                claimed.set(v);
-            }
+            claimed.set_range(range);
         }
         for side in 0..3u8 {
             if matched(k, side) {
@@ -304,4 +320,31 @@ fn all_edges(triangles: &[[u32; 3]], vertices: usize, seams: &Seams) -> Option<V
             [(a, b), (b, c), (c, a)].map(|e| valid.then_some(e))
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Ranges set a word at a time are the vertices set one by one.
+    #[test]
+    fn ranges_are_claimed_vertex_by_vertex() {
+        for (first, last) in [
+            (0, 0),
+            (3, 70),
+            (64, 127),
+            (63, 64),
+            (5, 4),
+            (100, 300),
+            (0, 255),
+        ] {
+            let mut words = Claimed { bits: vec![0; 5] };
+            words.set_range(first..=last);
+            let mut single = Claimed { bits: vec![0; 5] };
+            for v in first..=last {
+                single.set(v);
+            }
+            assert_eq!(words.bits, single.bits, "{first}..={last}");
+        }
+    }
 }

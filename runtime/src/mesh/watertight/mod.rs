@@ -253,21 +253,24 @@ pub(crate) fn is_closed(triangles: &[[u32; 3]], vertices: usize, seams: &[[u32; 
     // A dual grid leaves few edges (1–2% of Spot's quads at rate 16, 6% of Loop's triangles at
     // rate 8): those are sorted; many are grouped by tail, in linear time.
     if edges.len() < vertices / 2 {
-        sorted_in_pairs(&edges)
+        sorted_in_pairs(&edges, vertices)
     } else {
         DirectedEdges::new(vertices, || edges.iter().copied()).is_some_and(|d| d.all_paired())
     }
 }
 
-/// Whether every directed edge of `edges` is listed once and its reverse once, by sorting: the
-/// edges `a -> b` with `a < b` as `(a, b)`, those with `a > b` reversed, as `(b, a)`; closed
-/// exactly when the two sorted lists are equal and neither repeats a pair. An edge from a vertex
-/// to itself is its own reverse, as in [`DirectedEdges`]: it may be listed once.
+/// Whether every directed edge of `edges` (between vertices below `vertices`) is listed once
+/// and its reverse once, by sorting: the edges `a -> b` with `a < b` as `(a, b)`, those with
+/// `a > b` reversed, as `(b, a)`; closed exactly when the two sorted lists are equal and neither
+/// repeats a pair. An edge from a vertex to itself is its own reverse, as in [`DirectedEdges`]:
+/// it may be listed once.
 ///
 /// For few edges: nothing is allocated per vertex, where the first writes to arrays over every
 /// vertex (fresh pages) cost more than the sorts.
-fn sorted_in_pairs(edges: &[(u32, u32)]) -> bool {
-    let key = |a: u32, b: u32| u64::from(a) << 32 | u64::from(b);
+fn sorted_in_pairs(edges: &[(u32, u32)], vertices: usize) -> bool {
+    // `a V + b` is below `V^2`: four passes of a radix sort for two million vertices.
+    let v = vertices as u64;
+    let key = |a: u32, b: u32| u64::from(a) * v + u64::from(b);
     let (mut forward, mut backward, mut loops) = (Vec::new(), Vec::new(), Vec::new());
     for &(a, b) in edges {
         match a.cmp(&b) {
@@ -276,21 +279,48 @@ fn sorted_in_pairs(edges: &[(u32, u32)]) -> bool {
             Ordering::Equal => loops.push(a),
         }
     }
-    // In parallel where they are many (a triangle dual grid leaves 0.7 M edges at rate 8, a
-    // quad one 30,000 at rate 16, whose sorts a pool would only slow).
-    if edges.len() > 1 << 18 {
-        rayon::join(
-            || forward.par_sort_unstable(),
-            || backward.par_sort_unstable(),
-        );
-    } else {
-        forward.sort_unstable();
-        backward.sort_unstable();
-    }
+    // At most 64 bits: `a V + b < V^2 <= 2^64` for indices below `V <= 2^32`.
+    let bits = 128 - (u128::from(v) * u128::from(v)).leading_zeros();
+    rayon::join(
+        || sort_keys(&mut forward, bits),
+        || sort_keys(&mut backward, bits),
+    );
     loops.sort_unstable();
     forward == backward
         && forward.windows(2).all(|w| w[0] != w[1])
         && loops.windows(2).all(|w| w[0] != w[1])
+}
+
+/// Radix digits of this many bits.
+const DIGIT: u32 = 11;
+
+/// Sort `keys` (below `2^bits`): by radix where they are many (a triangle dual grid leaves
+/// 280,000 edges at rate 8, which a comparison sort took 8 ms to order), else by comparison.
+fn sort_keys(keys: &mut Vec<u64>, bits: u32) {
+    if keys.len() < 1 << 14 {
+        keys.sort_unstable();
+        return;
+    }
+    let mut other = vec![0u64; keys.len()];
+    let mut shift = 0;
+    while shift < bits {
+        let digit = |k: u64| ((k >> shift) & ((1 << DIGIT) - 1)) as usize;
+        let mut start = vec![0usize; 1 << DIGIT];
+        for &k in keys.iter() {
+            start[digit(k)] += 1;
+        }
+        let mut total = 0;
+        for s in &mut start {
+            (*s, total) = (total, total + *s);
+        }
+        for &k in keys.iter() {
+            let d = digit(k);
+            other[start[d]] = k;
+            start[d] += 1;
+        }
+        std::mem::swap(keys, &mut other);
+        shift += DIGIT;
+    }
 }
 
 /// The directed edges between position vertices left to the general check once the blocks and
@@ -498,6 +528,21 @@ mod tests {
     }
 
     proptest::proptest! {
+        /// The radix sort orders keys as the comparison sort does (lists long enough to take
+        /// it, with repeats).
+        #[test]
+        fn radix_and_comparison_sorts_agree(
+            keys in proptest::collection::vec(0u64..1 << 12, 0..40_000),
+        ) {
+            // Spread over all 40 bits, repeats kept.
+            let keys: Vec<u64> = keys.iter().map(|k| k * 0x9E37_79B1 % (1 << 40)).collect();
+            let mut radix = keys.clone();
+            sort_keys(&mut radix, 40);
+            let mut expected = keys;
+            expected.sort_unstable();
+            proptest::prop_assert_eq!(radix, expected);
+        }
+
         /// The two general checks agree on edge lists with repeats, loops and missing
         /// reverses, and on the same lists closed by their reverses.
         #[test]
@@ -511,7 +556,7 @@ mod tests {
                 edges.extend(reverses);
             }
             proptest::prop_assert_eq!(
-                sorted_in_pairs(&edges),
+                sorted_in_pairs(&edges, 6),
                 DirectedEdges::new(6, || edges.iter().copied()).is_some_and(|d| d.all_paired())
             );
         }
