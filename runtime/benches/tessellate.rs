@@ -48,6 +48,14 @@ fn refined(mut mesh: Mesh, scheme: Scheme, steps: usize) -> Mesh {
     mesh
 }
 
+/// A rayon pool of `threads` threads, for the groups of one and two threads.
+fn pool(threads: usize) -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap_or_else(|e| panic!("{e}"))
+}
+
 /// One frame from the input control points; its vertex count keeps it from being optimized away.
 fn frame(tessellator: &mut Tessellator<'_>, control: &[[f32; 3]]) -> usize {
     tessellator
@@ -106,10 +114,7 @@ fn bench(c: &mut Criterion) {
             .map(|f| [3, 5, 8, 12, 7, 16][f % 6])
             .collect();
         for threads in [1, 2] {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap_or_else(|e| panic!("{e}"));
+            let pool = pool(threads);
             let mut group = c.benchmark_group(format!(
                 "{name}, {} faces, {threads} thread(s)",
                 surface.faces()
@@ -159,10 +164,7 @@ fn check(c: &mut Criterion) {
             .to_triangle_mesh();
         assert!(output.is_watertight());
         for threads in [1, 2] {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap_or_else(|e| panic!("{e}"));
+            let pool = pool(threads);
             let mut group = c.benchmark_group(format!(
                 "watertightness check, {scheme:?} rate {rate}, {} triangles, {threads} thread(s)",
                 output.triangles.len()

@@ -33,6 +33,17 @@ fn agreed(mesh: &TriangleMesh, what: &str) -> bool {
     expected
 }
 
+/// `mesh` with a fin on the edge `p q`: two more triangles over it, one each way, to a new
+/// vertex (four uses of the edge, closed in themselves).
+fn finned(mesh: &TriangleMesh, p: u32, q: u32) -> TriangleMesh {
+    let mut mesh = mesh.clone();
+    let x = mesh.positions.len() as u32;
+    mesh.positions.push([9.0, 9.0, 9.0]);
+    mesh.triangles.push([p, q, x]);
+    mesh.triangles.push([q, p, x]);
+    mesh
+}
+
 #[test]
 #[cfg(feature = "catmull-clark")]
 fn tessellations_are_closed_by_both_checks() {
@@ -60,15 +71,11 @@ fn tessellations_are_closed_by_both_checks() {
 #[test]
 #[cfg(feature = "catmull-clark")]
 fn a_fin_on_a_grid_edge_is_not_closed() {
-    let mut mesh = tessellated("cube.obj", Rates::Uniform(6));
+    let mesh = tessellated("cube.obj", Rates::Uniform(6));
     // The second triangle of the first face's first quad: [a, c, d]; its diagonal a-c is
     // inner to the face's grid.
     let [a, c, _] = mesh.triangles[1];
-    let x = mesh.positions.len() as u32;
-    mesh.positions.push([9.0, 9.0, 9.0]);
-    mesh.triangles.push([a, c, x]);
-    mesh.triangles.push([c, a, x]);
-    assert!(!agreed(&mesh, "fin"));
+    assert!(!agreed(&finned(&mesh, a, c), "fin"));
 }
 
 /// An inner edge of a strip between two faces' grids (a rung or a diagonal) used by two more
@@ -90,12 +97,7 @@ fn a_fin_on_a_strip_edge_is_not_closed() {
     let [b0, a1, _] = clean.triangles[first_strip];
     let [_, b1, _] = clean.triangles[first_strip + 1];
     for (p, q) in [(b0, a1), (a1, b1)] {
-        let mut mesh = clean.clone();
-        let x = mesh.positions.len() as u32;
-        mesh.positions.push([9.0, 9.0, 9.0]);
-        mesh.triangles.push([p, q, x]);
-        mesh.triangles.push([q, p, x]);
-        assert!(!agreed(&mesh, "fin on a strip"));
+        assert!(!agreed(&finned(&clean, p, q), "fin on a strip"));
     }
 }
 
@@ -131,12 +133,7 @@ fn a_fin_on_a_fan_edge_is_not_closed() {
         .expect("a fan");
     let [c, x0, x1] = clean.triangles[t];
     for (p, q) in [(c, x0), (x0, x1)] {
-        let mut mesh = clean.clone();
-        let x = mesh.positions.len() as u32;
-        mesh.positions.push([9.0, 9.0, 9.0]);
-        mesh.triangles.push([p, q, x]);
-        mesh.triangles.push([q, p, x]);
-        assert!(!agreed(&mesh, "fin on a fan"));
+        assert!(!agreed(&finned(&clean, p, q), "fin on a fan"));
     }
 }
 
@@ -167,12 +164,7 @@ fn a_fin_on_a_merge_strip_is_not_closed() {
         for t in [t, t + 1, t + 2, t + 6] {
             let [x, y, z] = clean.triangles[t];
             for (p, q) in [(x, y), (y, z), (z, x)] {
-                let mut mesh = clean.clone();
-                let w = mesh.positions.len() as u32;
-                mesh.positions.push([9.0, 9.0, 9.0]);
-                mesh.triangles.push([p, q, w]);
-                mesh.triangles.push([q, p, w]);
-                assert!(!agreed(&mesh, "fin on a merge strip"));
+                assert!(!agreed(&finned(&clean, p, q), "fin on a merge strip"));
             }
         }
         let [_, y, _] = clean.triangles[t + 6];
