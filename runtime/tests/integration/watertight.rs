@@ -204,6 +204,27 @@ fn tessellations_scanned_in_pieces_agree() {
     }
 }
 
+/// `mesh` with its triangle `pick` (modulo the count) removed (`how` 0), reversed (1),
+/// duplicated (2) or moved to other vertices (3).
+fn broken(mut mesh: TriangleMesh, pick: usize, how: u8) -> TriangleMesh {
+    let t = pick % mesh.triangles.len();
+    match how {
+        0 => {
+            mesh.triangles.remove(t);
+        }
+        1 => mesh.triangles[t].swap(1, 2),
+        2 => {
+            let copy = mesh.triangles[t];
+            mesh.triangles.push(copy);
+        }
+        _ => {
+            let v = mesh.positions.len() as u32;
+            mesh.triangles[t][0] = (mesh.triangles[t][0] + 1) % v;
+        }
+    }
+    mesh
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
@@ -218,23 +239,8 @@ proptest! {
         seams in any::<bool>(),
     ) {
         let file = if seams { "cube_uv.obj" } else { "cube.obj" };
-        let mut mesh = tessellated(file, Rates::Uniform(rate));
-        let t = pick % mesh.triangles.len();
-        match how {
-            0 => {
-                mesh.triangles.remove(t);
-            }
-            1 => mesh.triangles[t].swap(1, 2),
-            2 => {
-                let copy = mesh.triangles[t];
-                mesh.triangles.push(copy);
-            }
-            _ => {
-                let v = mesh.positions.len() as u32;
-                mesh.triangles[t][0] = (mesh.triangles[t][0] + 1) % v;
-            }
-        }
-        agreed(&mesh, "broken");
+        let mesh = tessellated(file, Rates::Uniform(rate));
+        agreed(&broken(mesh, pick, how), "broken");
     }
 
     /// The same breakages of Loop's dual grids, whose faces' fans the check pairs in place.
@@ -245,22 +251,7 @@ proptest! {
         pick in 0usize..10_000,
         how in 0u8..4,
     ) {
-        let mut mesh = tessellated_by(Scheme::Loop, "octahedron.obj", Rates::Uniform(rate));
-        let t = pick % mesh.triangles.len();
-        match how {
-            0 => {
-                mesh.triangles.remove(t);
-            }
-            1 => mesh.triangles[t].swap(1, 2),
-            2 => {
-                let copy = mesh.triangles[t];
-                mesh.triangles.push(copy);
-            }
-            _ => {
-                let v = mesh.positions.len() as u32;
-                mesh.triangles[t][0] = (mesh.triangles[t][0] + 1) % v;
-            }
-        }
-        agreed(&mesh, "broken");
+        let mesh = tessellated_by(Scheme::Loop, "octahedron.obj", Rates::Uniform(rate));
+        agreed(&broken(mesh, pick, how), "broken");
     }
 }
