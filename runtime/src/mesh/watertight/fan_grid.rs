@@ -1,12 +1,10 @@
 //! The pairing of a triangle dual grid's output: fan blocks (the faces' hexagon fans,
-//! [`super::fans`]) and the *merge strips* between two of them, where no quad grid was found.
+//! [`super::fans`]) and the merge strips between two of them ([`super::merge_strips`]), where
+//! no quad grid was found.
 //!
-//! A merge strip is a run of triangles, each `[b_j, a_(i+1), a_i]` (the row `a` advances) or
-//! `[b_j, b_(j+1), a_i]` (the row `b` does), from `(i, j) = (0, 0)` to the rows' ends: two rows
-//! merged in order of their parameters, whatever their lengths (`kernel::merge_rows`). Its rung
-//! `a_i b_j` between two consecutive triangles is used by both, once each way. It is kept when
-//! its row `a` is a whole side of a fan block as the block's border runs it and its row `b`
-//! one of another block's run backwards ([`super::fans::FanBlock::side_point`]), each side matched once.
+//! A merge strip's rung `a_i b_j` between two consecutive triangles is used by both, once each
+//! way. It is kept when its row `a` is a whole side of a kept fan block as the block's border
+//! runs it and its row `b` one of another kept block's run backwards, each side matched once.
 //!
 //! Why the answer is the general check's: call a vertex *claimed* when it is deep in its block
 //! (an interior point, or a dual point with three interior corners), one of a matched side's
@@ -19,151 +17,44 @@
 //! inside it (its end rungs join unclaimed corner points), the sides' border edges pair with the
 //! strips' row edges, and the segment from a corner to the point next to it is run once by each
 //! of the two strips that meet there; the rungs of those two strips at that point end in two
-//! different blocks, so none is used by both. So where no other triangle touches a claimed vertex (checked,
-//! a bit per vertex) the edges with a claimed end pair, and the rest go to the general check:
-//! the other triangles', and the blocks' and strips' edges without a claimed end (the strips'
-//! end rungs, what is next to a side no strip matched, that side's border). Where
-//! another triangle does touch one, every edge goes to the general check.
+//! different blocks, so none is used by both. So where no other triangle touches a claimed
+//! vertex (checked, a bit per vertex) the edges with a claimed end pair, and the rest go to the
+//! general check: the other triangles', and the blocks' and strips' edges without a claimed end
+//! (the strips' end rungs, what is next to a side no strip matched, that side's border). Where
+//! another triangle does touch one, every edge does.
+//!
+//! Where those edges are: a block's vertices are its deep ones and its sides' points (a dual
+//! point off the deep ones has a corner on the face's border), so the unclaimed ones are its
+//! three corners, the points of the sides no strip matched, and the corners' neighbours that
+//! the rule above leaves out. Along a strip's row, a matched side, the claimed points are
+//! therefore one run (`1` or `2` to `2n - 4` or `2n - 3`), and the triangles of a strip go along
+//! both rows in order: between two triangles of a strip whose three corners are claimed, every
+//! triangle's are. So a strip's edges without a claimed end are in its first triangles, up to
+//! the first with three claimed corners, and its last ones, back to the last such.
 
-use std::ops::{Range, RangeInclusive};
+use std::ops::RangeInclusive;
 
 use rayon::prelude::*;
 
-use super::grids::{Others, SCAN_CHUNK};
+use super::fans::FanBlock;
+use super::grids::{GridStrip, Others};
+use super::merge_strips::{FanSide, MergeStrip, Rows};
 use super::{Block, BlockIndex, Seams};
 
-/// A merge strip kept: its triangles, and the block and side of its rows `a` and `b`.
-struct MergeStrip {
-    triangles: Range<usize>,
-    sides: [(usize, u8); 2],
+/// The strips the scan found: merge strips, and strips of quads (merge strips of two rows of
+/// equal length whose rows are arithmetic, which the scan takes for quads' strips first).
+pub(super) struct Strips {
+    pub(super) merges: Vec<MergeStrip>,
+    pub(super) quads: Vec<GridStrip>,
 }
 
-/// The rows of the merge strip that starts at `triangles[0]` (at least two triangles), into
-/// `a` and `b`, but for its last triangle's middle vertex, which ends one row or the other
-/// (the triangle alone does not say which): returns the strip's length and that vertex.
-fn zigzag_at(triangles: &[[u32; 3]], a: &mut Vec<u32>, b: &mut Vec<u32>) -> Option<(usize, u32)> {
-    let [[x, y, z], second, ..] = *triangles else {
-        return None;
-    };
-    a.clear();
-    b.clear();
-    a.push(z);
-    b.push(x);
-    // The pairs `(b_j, a_i)` that the next triangle must begin and end with.
-    let advance = |[x, y, z]: [u32; 3], next: [u32; 3]| {
-        if (next[0], next[2]) == (x, y) {
-            Some(true)
-        } else if (next[0], next[2]) == (y, z) {
-            Some(false)
-        } else {
-            None
-        }
-    };
-    advance([x, y, z], second)?;
-    let mut length = 1;
-    while let Some(&next) = triangles.get(length) {
-        let this = triangles[length - 1];
-        match advance(this, next) {
-            Some(true) => a.push(this[1]),
-            Some(false) => b.push(this[1]),
-            None => break,
-        }
-        length += 1;
-    }
-    Some((length, triangles[length - 1][1]))
-}
-
-/// The fan block and side whose border runs `row` (`backwards`: runs it reversed), if any.
-fn side_of_row(
-    row: &[u32],
-    backwards: bool,
-    blocks: &[Block],
-    index: &BlockIndex,
-) -> Option<(usize, u8)> {
-    // A fan block's side has `2n - 1 >= 5` points.
-    if row.len() < 5 {
-        return None;
-    }
-    let at = |k: usize| {
-        if backwards {
-            row[row.len() - 1 - k]
-        } else {
-            row[k]
-        }
-    };
-    let v = at(2);
-    let k = index.holding(v)?;
+/// The kept block that a side names (its first vertex and rate), and the side.
+fn block_side(side: FanSide, blocks: &[Block], index: &BlockIndex) -> Option<(usize, u8)> {
+    let k = index.holding(side.first)?;
     let Block::Fans(block) = &blocks[k] else {
         return None;
     };
-    let (side, place) = block.side_inside(v)?;
-    let length = 2 * block.n as usize - 1;
-    (place == 2
-        && row.len() == length
-        && (0..length).all(|p| at(p) == block.side_point(side, p as u32)))
-    .then_some((k, side))
-}
-
-/// The merge strips in the runs of `others` whose rows are two different fan blocks' sides
-/// (not yet each side once), and the triangles left.
-fn find_strips(
-    triangles: &[[u32; 3]],
-    others: &Others,
-    blocks: &[Block],
-    index: &BlockIndex,
-) -> (Vec<MergeStrip>, Vec<Range<usize>>) {
-    let found: Vec<_> = others
-        .pieces(SCAN_CHUNK)
-        .into_par_iter()
-        .map(|piece| {
-            let (mut a, mut b) = (Vec::new(), Vec::new());
-            let (mut strips, mut left) = (Vec::new(), Vec::new());
-            let mut t = piece.start;
-            while t < piece.end {
-                let strip = zigzag_at(&triangles[t..piece.end], &mut a, &mut b).and_then(
-                    |(length, last)| {
-                        let sides = |a: &[u32], b: &[u32]| {
-                            let sa = side_of_row(a, false, blocks, index)?;
-                            let sb = side_of_row(b, true, blocks, index)?;
-                            (sa.0 != sb.0).then_some([sa, sb])
-                        };
-                        // Both rows have an odd length (a side's `2n - 1` points): the last
-                        // point ends the row that is one short.
-                        if a.len() % 2 == 0 {
-                            a.push(last);
-                        } else {
-                            b.push(last);
-                        }
-                        let sides = sides(&a, &b)?;
-                        Some(MergeStrip {
-                            triangles: t..t + length,
-                            sides,
-                        })
-                    },
-                );
-                match strip {
-                    Some(strip) => {
-                        t = strip.triangles.end;
-                        strips.push(strip);
-                    }
-                    None => {
-                        left.push(t..t + 1);
-                        t += 1;
-                    }
-                }
-            }
-            (strips, left)
-        })
-        .collect();
-    let mut strips = Vec::new();
-    let mut left = Others::default();
-    for (s, l) in found {
-        strips.extend(s);
-        for run in l {
-            left.push(run);
-        }
-    }
-    (strips, left.runs)
+    ((block.first, block.n) == (side.first, side.n)).then_some((k, side.side))
 }
 
 /// The fan blocks' claimed vertices (the module's documentation), a bit each.
@@ -172,6 +63,7 @@ struct Claimed {
 }
 
 impl Claimed {
+    #[cfg(test)]
     fn set(&mut self, v: u32) {
         self.bits[(v / 64) as usize] |= 1 << (v % 64);
     }
@@ -194,6 +86,10 @@ impl Claimed {
         }
     }
 
+    fn clear(&mut self, v: u32) {
+        self.bits[(v / 64) as usize] &= !(1 << (v % 64));
+    }
+
     fn holds(&self, v: u32) -> bool {
         self.bits
             .get((v / 64) as usize)
@@ -201,67 +97,123 @@ impl Claimed {
     }
 }
 
+/// Claim a fan block's vertices (the module's documentation), `across[side]` the block across
+/// each of its sides where a strip matched it: every vertex, but its corners, the points of the
+/// sides no strip matched, and a corner's neighbour unless both sides there are matched by
+/// strips from two different blocks.
+fn claim(block: &FanBlock, across: [Option<usize>; 3], claimed: &mut Claimed) {
+    // The block's range is below the vertex count.
+    claimed.set_range(block.first..=(block.vertices().end - 1) as u32);
+    let last = 2 * block.n - 2;
+    for side in 0..3u8 {
+        if across[usize::from(side)].is_none() {
+            for p in 0..=last {
+                claimed.clear(block.side_point(side, p));
+            }
+            continue;
+        }
+        claimed.clear(block.side_point(side, 0));
+        let (this, that) = (
+            across[usize::from(side)],
+            across[usize::from((side + 2) % 3)],
+        );
+        if that.is_none() || this == that {
+            claimed.clear(block.side_point(side, 1));
+        }
+    }
+}
+
+/// The edges of the triangles `triangles` without a claimed end, into `out`; stops after the
+/// first triangle with three claimed corners, whose index it returns (`triangles.end` when
+/// none has).
+fn unclaimed_edges(
+    triangles: &[[u32; 3]],
+    order: impl Iterator<Item = usize>,
+    claimed: &Claimed,
+    out: &mut Vec<(u32, u32)>,
+) -> Option<usize> {
+    for t in order {
+        let [a, b, c] = triangles[t];
+        let [x, y, z] = [a, b, c].map(|v| claimed.holds(v));
+        if x && y && z {
+            return Some(t);
+        }
+        if !(x || y) {
+            out.push((a, b));
+        }
+        if !(y || z) {
+            out.push((b, c));
+        }
+        if !(z || x) {
+            out.push((c, a));
+        }
+    }
+    None
+}
+
 /// The directed edges left to the general check of a mesh whose kept blocks are all fan blocks
-/// (`blocks`, sorted, disjoint, below `vertices`, no seam copies), `others` the triangles
-/// outside them; `None` when a triangle names a vertex beyond `vertices`.
+/// (`blocks`, sorted, disjoint, below `vertices`, no seam copies), `strips` the strips the scan
+/// found and `left` the triangles outside blocks and strips; `None` when a triangle names a
+/// vertex beyond `vertices`.
 pub(super) fn fan_grid_edges(
     triangles: &[[u32; 3]],
     vertices: usize,
     seams: &Seams,
     blocks: &[Block],
     index: &BlockIndex,
-    others: &Others,
+    strips: Strips,
+    mut left: Others,
 ) -> Option<Vec<(u32, u32)>> {
-    let fans = |k: usize| match &blocks[k] {
-        Block::Fans(block) => Some(block),
-        Block::Grid(_) => None,
-    };
-    let (found, mut left) = find_strips(triangles, others, blocks, index);
-    // Each side with one strip at most.
-    // `across[3 k + side]`: the block across a matched side.
-    let mut across: Vec<Option<usize>> = vec![None; 3 * blocks.len()];
-    let mut strips = Vec::with_capacity(found.len());
-    for strip in found {
-        let [(ka, sa), (kb, sb)] = strip.sides;
-        let (a, b) = (3 * ka + usize::from(sa), 3 * kb + usize::from(sb));
-        if across[a].is_some() || across[b].is_some() {
-            left.push(strip.triangles);
-            continue;
+    // The strips of quads read as merge strips.
+    let mut rows = Rows::default();
+    let mut found = strips.merges;
+    for strip in strips.quads {
+        strip.rows(&mut rows);
+        match rows.sides() {
+            Some(sides) => found.push(MergeStrip {
+                triangles: strip.triangles(),
+                sides,
+            }),
+            None => left.push(strip.triangles()),
         }
-        (across[a], across[b]) = (Some(kb), Some(ka));
-        strips.push(strip);
     }
-    let matched = |k: usize, side: u8| across[3 * k + usize::from(side)].is_some();
+    // Each side with one strip at most; `across[3 k + side]`: the block across a matched side.
+    let mut across: Vec<Option<usize>> = vec![None; 3 * blocks.len()];
+    let mut kept = Vec::with_capacity(found.len());
+    for strip in found {
+        let [a, b] = strip
+            .sides
+            .map(|side| block_side(side, blocks, index).map(|(k, s)| (k, 3 * k + usize::from(s))));
+        match (a, b) {
+            (Some((ka, a)), Some((kb, b)))
+                if ka != kb && across[a].is_none() && across[b].is_none() =>
+            {
+                (across[a], across[b]) = (Some(kb), Some(ka));
+                kept.push(strip.triangles);
+            }
+            _ => left.push(strip.triangles),
+        }
+    }
     let mut claimed = Claimed {
         bits: vec![0; vertices.div_ceil(64)],
     };
-    for (k, block) in (0..blocks.len()).filter_map(|k| Some((k, fans(k)?))) {
-        for range in block.deep_ranges() {
-            claimed.set_range(range);
-        }
-        for side in 0..3u8 {
-            if matched(k, side) {
-                for p in 2..=2 * block.n - 4 {
-                    claimed.set(block.side_point(side, p));
-                }
-            }
-            // The point next to the corner before the side, on this side and the one before:
-            // claimed when both strips are there, from two different blocks.
-            let before = (side + 2) % 3;
-            let (this, that) = (
-                across[3 * k + usize::from(side)],
-                across[3 * k + usize::from(before)],
-            );
-            if this.is_some() && that.is_some() && this != that {
-                claimed.set(block.side_point(side, 1));
-            }
-        }
+    let fans = || {
+        blocks.iter().enumerate().filter_map(|(k, b)| match b {
+            Block::Fans(block) => Some((k, block)),
+            Block::Grid(_) => None,
+        })
+    };
+    for (k, block) in fans() {
+        claim(
+            block,
+            [0, 1, 2].map(|side| across[3 * k + side]),
+            &mut claimed,
+        );
     }
     // The other triangles: every edge, by position; none may touch a claimed vertex.
-    let count = left.iter().map(|run| run.len()).sum::<usize>();
-    let mut edges: Vec<(u32, u32)> = Vec::with_capacity(3 * count);
+    let mut edges: Vec<(u32, u32)> = Vec::with_capacity(3 * left.len());
     let mut touched = false;
-    for run in &left {
+    for run in &left.runs {
         for &corners in &triangles[run.clone()] {
             if corners.iter().any(|&v| v as usize >= vertices) {
                 return None;
@@ -274,35 +226,18 @@ pub(super) fn fan_grid_edges(
     if touched {
         return all_edges(triangles, vertices, seams);
     }
-    // The strips' edges without a claimed end (near the strips' ends), by pieces in parallel.
-    let pieces: Vec<Vec<(u32, u32)>> = strips
-        .par_chunks(1024)
-        .map(|strips| {
-            let mut out = Vec::new();
-            for strip in strips {
-                for &[a, b, c] in &triangles[strip.triangles.clone()] {
-                    let [x, y, z] = [a, b, c].map(|v| claimed.holds(v));
-                    if !(x || y) {
-                        out.push((a, b));
-                    }
-                    if !(y || z) {
-                        out.push((b, c));
-                    }
-                    if !(z || x) {
-                        out.push((c, a));
-                    }
-                }
-            }
-            out
-        })
-        .collect();
-    for piece in pieces {
-        edges.extend(piece);
+    // The strips' edges without a claimed end, at their two ends.
+    for strip in &kept {
+        let end = match unclaimed_edges(triangles, strip.clone(), &claimed, &mut edges) {
+            Some(t) => t + 1,
+            None => continue,
+        };
+        unclaimed_edges(triangles, (end..strip.end).rev(), &claimed, &mut edges);
     }
     // The border of the sides no strip matched.
-    for (k, block) in (0..blocks.len()).filter_map(|k| Some((k, fans(k)?))) {
+    for (k, block) in fans() {
         for side in 0..3u8 {
-            if !matched(k, side) {
+            if across[3 * k + usize::from(side)].is_none() {
                 block.side_edges(side, &mut edges);
             }
         }
@@ -325,6 +260,45 @@ fn all_edges(triangles: &[[u32; 3]], vertices: usize, seams: &Seams) -> Option<V
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A block's claims, for every way strips may match its sides (none, or from one of two
+    /// blocks), are the vertices the module's definition names one by one: the deep ones, a
+    /// matched side's points `2..=2n-4`, and a corner's neighbour where both sides there are
+    /// matched from two different blocks; nothing outside the block.
+    #[test]
+    fn claims_are_the_definition_vertex_by_vertex() {
+        let choices = [None, Some(1), Some(2)];
+        for n in 3..9 {
+            let block = FanBlock {
+                start: 0,
+                first: 70,
+                n,
+            };
+            let end = block.vertices().end as u32;
+            for pick in 0..27 {
+                let across = [pick % 3, pick / 3 % 3, pick / 9].map(|c| choices[c]);
+                let mut claimed = Claimed { bits: vec![0; 64] };
+                claim(&block, across, &mut claimed);
+                for v in 0..end + 70 {
+                    let matched = |side: u8| across[usize::from(side)];
+                    let corner_rule = (0..3u8).any(|side| {
+                        let before = (side + 2) % 3;
+                        block.side_point(side, 1) == v
+                            && matched(side).is_some()
+                            && matched(before).is_some()
+                            && matched(side) != matched(before)
+                    });
+                    let expected = (70..end).contains(&v)
+                        && (block.deep(v)
+                            || block
+                                .side_inside(v)
+                                .is_some_and(|(side, _)| matched(side).is_some())
+                            || corner_rule);
+                    assert_eq!(claimed.holds(v), expected, "rate {n}, {across:?}, {v}");
+                }
+            }
+        }
+    }
 
     /// Ranges set a word at a time are the vertices set one by one.
     #[test]

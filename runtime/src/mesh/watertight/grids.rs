@@ -7,6 +7,7 @@ use std::ops::Range;
 use rayon::prelude::*;
 
 use super::fans::{fan_block_at, FanBlock};
+use super::merge_strips::{merge_strip_at, MergeStrip, Rows};
 
 /// A run of grid quads found in the triangle list: `rows` rows of `width - 1` quads over the
 /// vertices `first..first + (rows + 1) * width`, row-major.
@@ -179,6 +180,17 @@ impl GridStrip {
         }
     }
 
+    /// The strip's rows `a_0..=a_m` and `b_0..=b_m`, into `rows`: the same triangles read as a
+    /// merge strip whose rows advance in turn ([`super::merge_strips`]).
+    pub(super) fn rows(&self, rows: &mut Rows) {
+        // A strip's vertices are the triangles' indices: they fit.
+        let v = |x: i64| x as u32;
+        rows.a.clear();
+        rows.b.clear();
+        rows.a.extend((0..=self.quads).map(|k| v(self.a_at(k))));
+        rows.b.extend((0..=self.quads).map(|k| v(self.b_at(k))));
+    }
+
     /// The end rungs `a_0 -> b_0` and `b_m -> a_m`, the strip's edges that pair outside it.
     pub(super) fn end_rungs(&self) -> [(u32, u32); 2] {
         let m = self.quads;
@@ -225,12 +237,14 @@ fn strip_at(triangles: &[[u32; 3]]) -> Option<GridStrip> {
     })
 }
 
-/// What the scan finds: grid blocks, fan blocks, strips, and the triangles outside them.
+/// What the scan finds: grid blocks, fan blocks, strips, merge strips, and the triangles
+/// outside them.
 #[derive(Debug, Default)]
 pub(super) struct Found {
     pub(super) blocks: Vec<GridBlock>,
     pub(super) fans: Vec<FanBlock>,
     pub(super) strips: Vec<GridStrip>,
+    pub(super) merges: Vec<MergeStrip>,
     pub(super) others: Others,
 }
 
@@ -250,18 +264,6 @@ impl Others {
         }
     }
 
-    /// The same triangles in runs by first triangle, adjacent runs joined (strips that matched
-    /// no side were added after every other run).
-    pub(super) fn sorted(&self) -> Others {
-        let mut runs = self.runs.clone();
-        runs.sort_unstable_by_key(|r| r.start);
-        let mut sorted = Others::default();
-        for run in runs {
-            sorted.push(run);
-        }
-        sorted
-    }
-
     pub(super) fn len(&self) -> usize {
         self.runs.iter().map(|r| r.len()).sum()
     }
@@ -278,23 +280,28 @@ impl Others {
     }
 }
 
-/// The grid blocks, fan blocks and strips of `triangles` and the triangles outside them. A
-/// block starts at a triangle `[a, a + 1, a + w + 1]` (`w >= 2`) and runs for as many complete
-/// rows as follow; where none starts, a whole fan block may ([`fan_block_at`]), else a strip,
-/// for as many quads as follow its pattern; a triangle that starts none is left to the general
-/// check. Linear: a failed start is passed over, never
-/// rescanned.
+/// The grid blocks, fan blocks, strips and merge strips of `triangles` and the triangles
+/// outside them. A block starts at a triangle `[a, a + 1, a + w + 1]` (`w >= 2`) and runs for
+/// as many complete rows as follow; where none starts, a whole fan block may ([`fan_block_at`]),
+/// else a strip, for as many quads as follow its pattern, else a merge strip between two fan
+/// blocks' sides ([`merge_strip_at`]); a triangle that starts none is left to the general
+/// check. Linear: a failed start is passed over, never rescanned, and a zigzag that is no
+/// merge strip is tried once more from its second triangle (a stray triangle may go on into a
+/// strip), then passed over whole.
 fn scan_grids(triangles: &[[u32; 3]]) -> Found {
     let mut found = Found::default();
+    let mut rows = Rows::default();
+    // Whether the triangle before failed as a merge strip's start.
+    let mut retrying = false;
     let mut t = 0;
     while t < triangles.len() {
         let [a, b, c] = triangles[t];
         let width = c.checked_sub(a).and_then(|d| d.checked_sub(1));
-        let rows = match width {
+        let rows_of_grid = match width {
             Some(w) if b == a.wrapping_add(1) && w >= 2 => complete_rows(&triangles[t..], a, w),
             _ => 0,
         };
-        match (width, rows) {
+        let passed = match (width, rows_of_grid) {
             (Some(width), rows) if rows > 0 => {
                 let block = GridBlock {
                     start: t,
@@ -302,24 +309,41 @@ fn scan_grids(triangles: &[[u32; 3]]) -> Found {
                     width,
                     rows,
                 };
-                t = block.triangles().end;
                 found.blocks.push(block);
+                block.triangles().len()
             }
             _ => {
                 if let Some(fans) = fan_block_at(&triangles[t..]) {
                     let fans = FanBlock { start: t, ..fans };
-                    t = fans.triangles().end;
                     found.fans.push(fans);
+                    fans.triangles().len()
                 } else if let Some(strip) = strip_at(&triangles[t..]) {
                     let strip = GridStrip { start: t, ..strip };
-                    t = strip.triangles().end;
                     found.strips.push(strip);
+                    strip.triangles().len()
                 } else {
-                    found.others.push(t..t + 1);
-                    t += 1;
+                    match merge_strip_at(&triangles[t..], &mut rows) {
+                        Ok(merge) => {
+                            let length = merge.triangles.len();
+                            found.merges.push(MergeStrip {
+                                triangles: t..t + length,
+                                ..merge
+                            });
+                            length
+                        }
+                        Err(zigzag) => {
+                            let passed = if retrying { zigzag } else { 1 };
+                            retrying = !retrying && zigzag > 1;
+                            found.others.push(t..t + passed);
+                            t += passed;
+                            continue;
+                        }
+                    }
                 }
             }
-        }
+        };
+        retrying = false;
+        t += passed;
     }
     found
 }
@@ -373,6 +397,9 @@ pub(super) fn scan_grids_in_parallel(triangles: &[[u32; 3]]) -> Found {
             for s in &mut found.strips {
                 s.start += offset;
             }
+            for m in &mut found.merges {
+                m.triangles = m.triangles.start + offset..m.triangles.end + offset;
+            }
             for run in &mut found.others.runs {
                 *run = run.start + offset..run.end + offset;
             }
@@ -384,6 +411,7 @@ pub(super) fn scan_grids_in_parallel(triangles: &[[u32; 3]]) -> Found {
         all.blocks.extend(piece.blocks);
         all.fans.extend(piece.fans);
         all.strips.extend(piece.strips);
+        all.merges.extend(piece.merges);
         for run in piece.others.runs {
             all.others.push(run);
         }
@@ -450,8 +478,10 @@ pub(super) mod tests {
             blocks,
             fans: fan_blocks,
             strips,
+            merges,
             others,
         } = scan_grids_in_parallel(&triangles);
+        assert_eq!(merges, []);
         let mut seen = vec![0u8; triangles.len()];
         assert_eq!(fan_blocks.len(), 3);
         let mut scanned = Vec::new();

@@ -31,9 +31,10 @@
 //!   (checked edge by edge).
 //!
 //! Where the blocks kept are all fan blocks (a triangle dual grid), the strips between them are
-//! merge strips of any two rates and the other triangles are tested by vertex, not by edge
-//! ([`fan_grid`]); where grid blocks were kept too, a fan block's inner edges are tested like a
-//! grid block's and its border edges take the general check.
+//! merge strips of any two rates, which the scan finds too ([`merge_strips`]), and the other
+//! triangles are tested by vertex, not by edge ([`fan_grid`]); where grid blocks were kept too,
+//! a fan block's inner edges are tested like a grid block's, its border edges and the merge
+//! strips take the general check.
 //!
 //! What is left, the unmatched sides' border edges, the strips' end rungs (`a_0 -> b_0`,
 //! `b_m -> a_m`) and every edge of the other triangles, takes the general check. The answer is
@@ -57,6 +58,7 @@ mod directed_edges;
 mod fan_grid;
 mod fans;
 mod grids;
+mod merge_strips;
 
 pub(crate) use directed_edges::DirectedEdges;
 use fans::FanBlock;
@@ -336,6 +338,7 @@ fn general_edges(
         blocks: grids,
         fans,
         strips,
+        merges,
         mut others,
     } = scan_grids_in_parallel(triangles);
     let mut found: Vec<Block> = grids.into_iter().map(Block::Grid).collect();
@@ -362,7 +365,26 @@ fn general_edges(
         blocks.push(b);
     }
     let index = BlockIndex::new(&blocks, vertices);
-    let grids_kept = blocks.iter().any(|b| b.grid().is_some());
+    if !blocks.is_empty() && blocks.iter().all(|b| b.grid().is_none()) {
+        // A triangle dual grid: its strips are merge strips (a strip of quads is one whose
+        // rows advance in turn), its other triangles tested by vertex.
+        return fan_grid::fan_grid_edges(
+            triangles,
+            vertices,
+            seams,
+            &blocks,
+            &index,
+            fan_grid::Strips {
+                merges,
+                quads: strips,
+            },
+            others,
+        );
+    }
+    // Merge strips pair with fan blocks only, where grid blocks are kept.
+    for merge in merges {
+        others.push(merge.triangles);
+    }
     let block_of = |v: u32| index.holding(v);
     // A strip pairs its sides with two sides of two different blocks, each side with one strip
     // only; `matched[4 k + side]` is the strip (twice its number, plus one on its side `b`).
@@ -389,18 +411,6 @@ fn general_edges(
             }
             _ => others.push(strip.triangles()),
         }
-    }
-    if !grids_kept && !blocks.is_empty() {
-        // A triangle dual grid: its strips are merge strips, its other triangles tested by
-        // vertex.
-        return fan_grid::fan_grid_edges(
-            triangles,
-            vertices,
-            seams,
-            &blocks,
-            &index,
-            &others.sorted(),
-        );
     }
     // Whether the edge `v w`, `v` inside a side of block `k` that a strip matched, is an inner
     // edge of that strip.
