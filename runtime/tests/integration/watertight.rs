@@ -178,6 +178,37 @@ fn a_fin_on_a_merge_strip_is_not_closed() {
     }
 }
 
+/// A vertex polygon (Loop's output ends with them, fanned at the limit point of each primal
+/// vertex): a fin on a spoke or a rim breaks the mesh; a closed pair of
+/// triangles on its centre leaves it closed (by edges), the spokes then checked edge by edge.
+#[test]
+#[cfg(feature = "loop")]
+fn a_fin_on_a_vertex_polygon_is_not_closed() {
+    let clean = tessellated_by(Scheme::Loop, "octahedron.obj", Rates::Uniform(5));
+    // The last polygon: the triangles at the end around one centre.
+    let centre = clean.triangles[clean.triangles.len() - 1][0];
+    let m = clean
+        .triangles
+        .iter()
+        .rev()
+        .take_while(|t| t[0] == centre)
+        .count();
+    let fan = &clean.triangles[clean.triangles.len() - m..];
+    let closed_fan = (0..m).all(|r| fan[r][2] == fan[(r + 1) % m][1]);
+    assert!(m >= 3 && closed_fan, "{fan:?}");
+    let [c, x0, x1] = fan[0];
+    for (p, q) in [(c, x0), (x0, c), (x0, x1)] {
+        assert!(!agreed(&finned(&clean, p, q), "fin on a vertex polygon"));
+    }
+    let mut pinched = clean.clone();
+    let w = pinched.positions.len() as u32;
+    pinched.positions.push([9.0, 9.0, 9.0]);
+    pinched.positions.push([9.0, 9.0, 8.0]);
+    pinched.triangles.push([c, w, w + 1]);
+    pinched.triangles.push([w + 1, w, c]);
+    assert!(agreed(&pinched, "two triangles on a polygon's centre"));
+}
+
 /// Tessellations long enough that the grid scan runs in pieces (65,536 triangles and more
 /// each), a face's grid cut between two of them, with and without texture seams (whose grids go
 /// to the general check, from every piece): closed by both checks, and broken by both where a

@@ -32,13 +32,13 @@
 //! triangle's are. So a strip's edges without a claimed end are in its first triangles, up to
 //! the first with three claimed corners, and its last ones, back to the last such.
 
-use std::ops::RangeInclusive;
-
 use rayon::prelude::*;
 
 use super::fans::FanBlock;
 use super::grids::{GridStrip, Others};
 use super::merge_strips::{FanSide, MergeStrip, Rows};
+use super::vertex_polygons::edges_off_polygons;
+use super::vertex_set::VertexSet;
 use super::{Block, BlockIndex, Seams};
 
 /// The strips the scan found: merge strips, and strips of quads (merge strips of two rows of
@@ -57,68 +57,28 @@ fn block_side(side: FanSide, blocks: &[Block], index: &BlockIndex) -> Option<(us
     ((block.first, block.n) == (side.first, side.n)).then_some((k, side.side))
 }
 
-/// The fan blocks' claimed vertices (the module's documentation), a bit each.
-struct Claimed {
-    bits: Vec<u64>,
-}
-
-impl Claimed {
-    #[cfg(test)]
-    fn set(&mut self, v: u32) {
-        self.bits[(v / 64) as usize] |= 1 << (v % 64);
-    }
-
-    /// Every vertex of `range` (a block's, below the vertex count), a word at a time.
-    fn set_range(&mut self, range: RangeInclusive<u32>) {
-        let (first, last) = (*range.start() as usize, *range.end() as usize);
-        if first > last {
-            return;
-        }
-        let (low, high) = (first / 64, last / 64);
-        let head = !0u64 << (first % 64);
-        let tail = !0u64 >> (63 - last % 64);
-        if low == high {
-            self.bits[low] |= head & tail;
-        } else {
-            self.bits[low] |= head;
-            self.bits[low + 1..high].fill(!0);
-            self.bits[high] |= tail;
-        }
-    }
-
-    fn clear(&mut self, v: u32) {
-        self.bits[(v / 64) as usize] &= !(1 << (v % 64));
-    }
-
-    fn holds(&self, v: u32) -> bool {
-        self.bits
-            .get((v / 64) as usize)
-            .is_some_and(|word| word & 1 << (v % 64) != 0)
-    }
-}
-
 /// Claim a fan block's vertices (the module's documentation), `across[side]` the block across
 /// each of its sides where a strip matched it: every vertex, but its corners, the points of the
 /// sides no strip matched, and a corner's neighbour unless both sides there are matched by
 /// strips from two different blocks.
-fn claim(block: &FanBlock, across: [Option<usize>; 3], claimed: &mut Claimed) {
+fn claim(block: &FanBlock, across: [Option<usize>; 3], claimed: &mut VertexSet) {
     // The block's range is below the vertex count.
-    claimed.set_range(block.first..=(block.vertices().end - 1) as u32);
+    claimed.insert_range(block.first..=(block.vertices().end - 1) as u32);
     let last = 2 * block.n - 2;
     for side in 0..3u8 {
         if across[usize::from(side)].is_none() {
             for p in 0..=last {
-                claimed.clear(block.side_point(side, p));
+                claimed.remove(block.side_point(side, p));
             }
             continue;
         }
-        claimed.clear(block.side_point(side, 0));
+        claimed.remove(block.side_point(side, 0));
         let (this, that) = (
             across[usize::from(side)],
             across[usize::from((side + 2) % 3)],
         );
         if that.is_none() || this == that {
-            claimed.clear(block.side_point(side, 1));
+            claimed.remove(block.side_point(side, 1));
         }
     }
 }
@@ -129,12 +89,12 @@ fn claim(block: &FanBlock, across: [Option<usize>; 3], claimed: &mut Claimed) {
 fn unclaimed_edges(
     triangles: &[[u32; 3]],
     order: impl Iterator<Item = usize>,
-    claimed: &Claimed,
+    claimed: &VertexSet,
     out: &mut Vec<(u32, u32)>,
 ) -> Option<usize> {
     for t in order {
         let [a, b, c] = triangles[t];
-        let [x, y, z] = [a, b, c].map(|v| claimed.holds(v));
+        let [x, y, z] = [a, b, c].map(|v| claimed.contains(v));
         if x && y && z {
             return Some(t);
         }
@@ -194,9 +154,7 @@ pub(super) fn fan_grid_edges(
             _ => left.push(strip.triangles),
         }
     }
-    let mut claimed = Claimed {
-        bits: vec![0; vertices.div_ceil(64)],
-    };
+    let mut claimed = VertexSet::new(vertices);
     let fans = || {
         blocks.iter().enumerate().filter_map(|(k, b)| match b {
             Block::Fans(block) => Some((k, block)),
@@ -210,19 +168,18 @@ pub(super) fn fan_grid_edges(
             &mut claimed,
         );
     }
-    // The other triangles: every edge, by position; none may touch a claimed vertex.
+    // The other triangles: every edge by position but the vertex polygons' spokes; none may
+    // touch a claimed vertex.
     let mut edges: Vec<(u32, u32)> = Vec::with_capacity(3 * left.len());
-    let mut touched = false;
-    for run in &left.runs {
-        for &corners in &triangles[run.clone()] {
-            if corners.iter().any(|&v| v as usize >= vertices) {
-                return None;
-            }
-            let [a, b, c] = corners.map(|v| seams.position(v));
-            touched |= claimed.holds(a) || claimed.holds(b) || claimed.holds(c);
-            edges.extend([(a, b), (b, c), (c, a)]);
-        }
-    }
+    let touched = edges_off_polygons(
+        triangles,
+        &left.runs,
+        vertices,
+        seams,
+        |v| index.holding(v).is_some(),
+        &claimed,
+        &mut edges,
+    )?;
     if touched {
         return all_edges(triangles, vertices, seams);
     }
@@ -277,7 +234,7 @@ mod tests {
             let end = block.vertices().end as u32;
             for pick in 0..27 {
                 let across = [pick % 3, pick / 3 % 3, pick / 9].map(|c| choices[c]);
-                let mut claimed = Claimed { bits: vec![0; 64] };
+                let mut claimed = VertexSet::new(64 * 64);
                 claim(&block, across, &mut claimed);
                 for v in 0..end + 70 {
                     let matched = |side: u8| across[usize::from(side)];
@@ -294,31 +251,9 @@ mod tests {
                                 .side_inside(v)
                                 .is_some_and(|(side, _)| matched(side).is_some())
                             || corner_rule);
-                    assert_eq!(claimed.holds(v), expected, "rate {n}, {across:?}, {v}");
+                    assert_eq!(claimed.contains(v), expected, "rate {n}, {across:?}, {v}");
                 }
             }
-        }
-    }
-
-    /// Ranges set a word at a time are the vertices set one by one.
-    #[test]
-    fn ranges_are_claimed_vertex_by_vertex() {
-        for (first, last) in [
-            (0, 0),
-            (3, 70),
-            (64, 127),
-            (63, 64),
-            (5, 4),
-            (100, 300),
-            (0, 255),
-        ] {
-            let mut words = Claimed { bits: vec![0; 5] };
-            words.set_range(first..=last);
-            let mut single = Claimed { bits: vec![0; 5] };
-            for v in first..=last {
-                single.set(v);
-            }
-            assert_eq!(words.bits, single.bits, "{first}..={last}");
         }
     }
 }

@@ -59,6 +59,8 @@ mod fan_grid;
 mod fans;
 mod grids;
 mod merge_strips;
+mod vertex_polygons;
+mod vertex_set;
 
 pub(crate) use directed_edges::DirectedEdges;
 use fans::FanBlock;
