@@ -115,7 +115,7 @@ pub(super) fn side_of_points(row: &[u32]) -> Option<FanSide> {
     // Point 0 of each side: `first`, `up(n - 1, 0) = first + 2n - 2`, `up(0, n - 1) = first
     // + n^2 - 1`.
     let (side, offset) = match p0.wrapping_sub(p1) {
-        u32::MAX => (0, 0),
+        u32::MAX => (0u8, 0),
         1 => (1, 2 * n - 2),
         2 => (2, n * n - 1),
         _ => return None,
@@ -129,26 +129,26 @@ pub(super) fn side_of_points(row: &[u32]) -> Option<FanSide> {
     // side 1 the last up and down points of dual row `t`, `up(n - 1 - t, t)` and one less; on
     // side 2 `up(0, n - 1 - t)` and `up(0, n - 2 - t) + 1`, the first points of two rows.
     let up = |i: u32, j: u32| first + j * (2 * n - j) + 2 * i;
-    let even = |t: u32| match side {
-        0 => first + 2 * t,
-        1 => up(n - 1 - t, t),
-        _ => up(0, n - 1 - t),
+    let mismatch = match side {
+        0 => differs(row, |t| first + 2 * t, |t| first + 2 * t + 1),
+        1 => differs(row, |t| up(n - 1 - t, t), |t| up(n - 1 - t, t) - 1),
+        _ => differs(row, |t| up(0, n - 1 - t), |t| up(0, n - 2 - t) + 1),
     };
-    // Only for `t < n - 1`: the last point of a side is an even one.
-    let odd = |t: u32| match side {
-        0 => first + 2 * t + 1,
-        1 => up(n - 1 - t, t) - 1,
-        _ => up(0, n - 2 - t) + 1,
+    (mismatch == 0).then_some(FanSide { first, n, side })
+}
+
+/// The bits in which a row of odd length differs from the points `even(t)`, `odd(t)` at
+/// places `2t`, `2t + 1` (`odd` only for `t` below the last pair), branch-free per point.
+fn differs(row: &[u32], even: impl Fn(u32) -> u32, odd: impl Fn(u32) -> u32) -> u32 {
+    let Some((&last, pairs)) = row.split_last() else {
+        return 0;
     };
-    let differs = (0u32..).zip(row.chunks(2)).fold(0, |differs, (t, pair)| {
-        let odd_differs = pair.get(1).map_or(0, |&p| p ^ odd(t));
-        differs | (pair[0] ^ even(t)) | odd_differs
-    });
-    (differs == 0).then_some(FanSide {
-        first,
-        n,
-        side: side as u8,
-    })
+    let t_last = (pairs.len() / 2) as u32;
+    (0u32..)
+        .zip(pairs.chunks_exact(2))
+        .fold(last ^ even(t_last), |d, (t, pair)| {
+            d | (pair[0] ^ even(t)) | (pair[1] ^ odd(t))
+        })
 }
 
 #[cfg(test)]
