@@ -83,9 +83,8 @@ fn claim(block: &FanBlock, across: [Option<usize>; 3], claimed: &mut VertexSet) 
     }
 }
 
-/// The edges of the triangles `triangles` without a claimed end, into `out`; stops after the
-/// first triangle with three claimed corners, whose index it returns (`triangles.end` when
-/// none has).
+/// The edges without a claimed end of the triangles `order` walks, into `out`; stops at the
+/// first triangle with three claimed corners and returns its index (`None` when none has).
 fn unclaimed_edges(
     triangles: &[[u32; 3]],
     order: impl Iterator<Item = usize>,

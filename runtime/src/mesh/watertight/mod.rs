@@ -383,7 +383,8 @@ fn general_edges(
             others,
         );
     }
-    // Merge strips pair with fan blocks only, where grid blocks are kept.
+    // With grid blocks kept, merge strips take the general check (they pair with fan blocks in
+    // a triangle dual grid only).
     for merge in merges {
         others.push(merge.triangles);
     }
