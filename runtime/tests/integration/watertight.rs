@@ -44,6 +44,19 @@ fn finned(mesh: &TriangleMesh, p: u32, q: u32) -> TriangleMesh {
     mesh
 }
 
+/// `mesh` with two more triangles on its vertex `v`, to two new vertices, one each way (closed
+/// in themselves, and on no edge of the mesh).
+#[cfg(feature = "loop")]
+fn pinched(mesh: &TriangleMesh, v: u32) -> TriangleMesh {
+    let mut mesh = mesh.clone();
+    let w = mesh.positions.len() as u32;
+    mesh.positions.push([9.0, 9.0, 9.0]);
+    mesh.positions.push([9.0, 9.0, 8.0]);
+    mesh.triangles.push([v, w, w + 1]);
+    mesh.triangles.push([w + 1, w, v]);
+    mesh
+}
+
 #[test]
 #[cfg(feature = "catmull-clark")]
 fn tessellations_are_closed_by_both_checks() {
@@ -168,19 +181,16 @@ fn a_fin_on_a_merge_strip_is_not_closed() {
             }
         }
         let [_, y, _] = clean.triangles[t + 6];
-        let mut pinched = clean.clone();
-        let w = pinched.positions.len() as u32;
-        pinched.positions.push([9.0, 9.0, 9.0]);
-        pinched.positions.push([9.0, 9.0, 8.0]);
-        pinched.triangles.push([y, w, w + 1]);
-        pinched.triangles.push([w + 1, w, y]);
-        assert!(agreed(&pinched, "two triangles on a strip's vertex"));
+        assert!(agreed(
+            &pinched(&clean, y),
+            "two triangles on a strip's vertex"
+        ));
     }
 }
 
 /// A vertex polygon (Loop's output ends with them, fanned at the limit point of each primal
-/// vertex): a fin on a spoke or a rim breaks the mesh; a closed pair of
-/// triangles on its centre leaves it closed (by edges), the spokes then checked edge by edge.
+/// vertex): a fin on a spoke or a rim breaks the mesh; a closed pair of triangles on its centre
+/// leaves it closed (by edges), the spokes then checked edge by edge.
 #[test]
 #[cfg(feature = "loop")]
 fn a_fin_on_a_vertex_polygon_is_not_closed() {
@@ -200,13 +210,10 @@ fn a_fin_on_a_vertex_polygon_is_not_closed() {
     for (p, q) in [(c, x0), (x0, c), (x0, x1)] {
         assert!(!agreed(&finned(&clean, p, q), "fin on a vertex polygon"));
     }
-    let mut pinched = clean.clone();
-    let w = pinched.positions.len() as u32;
-    pinched.positions.push([9.0, 9.0, 9.0]);
-    pinched.positions.push([9.0, 9.0, 8.0]);
-    pinched.triangles.push([c, w, w + 1]);
-    pinched.triangles.push([w + 1, w, c]);
-    assert!(agreed(&pinched, "two triangles on a polygon's centre"));
+    assert!(agreed(
+        &pinched(&clean, c),
+        "two triangles on a polygon's centre"
+    ));
 }
 
 /// Tessellations long enough that the grid scan runs in pieces (65,536 triangles and more
