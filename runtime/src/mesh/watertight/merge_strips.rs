@@ -125,29 +125,29 @@ pub(super) fn side_of_points(row: &[u32]) -> Option<FanSide> {
     if block.vertices().end > 1 << 32 {
         return None;
     }
-    // Point `2t` and `2t + 1` of the side: the side 0 points `first + 2t, first + 2t + 1`; on
-    // side 1 the last up and down points of dual row `t`, `up(n - 1 - t, t)` and one less; on
-    // side 2 `up(0, n - 1 - t)` and `up(0, n - 2 - t) + 1`, the first points of two rows.
-    let up = |i: u32, j: u32| first + j * (2 * n - j) + 2 * i;
+    // Each side compared with a literal side number, so that `side_point`'s choice of side
+    // and of up or down point folds away out of the loop.
+    let point = |side: u8| move |k: u32| block.side_point(side, k);
     let mismatch = match side {
-        0 => differs(row, |t| first + 2 * t, |t| first + 2 * t + 1),
-        1 => differs(row, |t| up(n - 1 - t, t), |t| up(n - 1 - t, t) - 1),
-        _ => differs(row, |t| up(0, n - 1 - t), |t| up(0, n - 2 - t) + 1),
+        0 => differs(row, point(0)),
+        1 => differs(row, point(1)),
+        _ => differs(row, point(2)),
     };
     (mismatch == 0).then_some(FanSide { first, n, side })
 }
 
-/// The bits in which a row of odd length differs from the points `even(t)`, `odd(t)` at
-/// places `2t`, `2t + 1` (`odd` only for `t` below the last pair), branch-free per point.
-fn differs(row: &[u32], even: impl Fn(u32) -> u32, odd: impl Fn(u32) -> u32) -> u32 {
+/// The bits in which a row of odd length differs from the points `point(k)`, compared a pair
+/// `2t`, `2t + 1` at a time (an up and a down point: each pair's formula is known without a
+/// branch), branch-free per point.
+fn differs(row: &[u32], point: impl Fn(u32) -> u32) -> u32 {
     let Some((&last, pairs)) = row.split_last() else {
         return 0;
     };
-    let t_last = (pairs.len() / 2) as u32;
+    let last_place = pairs.len() as u32;
     (0u32..)
         .zip(pairs.chunks_exact(2))
-        .fold(last ^ even(t_last), |d, (t, pair)| {
-            d | (pair[0] ^ even(t)) | (pair[1] ^ odd(t))
+        .fold(last ^ point(last_place), |d, (t, pair)| {
+            d | (pair[0] ^ point(2 * t)) | (pair[1] ^ point(2 * t + 1))
         })
 }
 
