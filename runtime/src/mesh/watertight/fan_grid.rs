@@ -31,12 +31,17 @@
 //! both rows in order: between two triangles of a strip whose three corners are claimed, every
 //! triangle's are. So a strip's edges without a claimed end are in its first triangles, up to
 //! the first with three claimed corners, and its last ones, back to the last such.
+//!
+//! Those first and last triangles are made again from the strip's sides and the rows they
+//! advance, which the scan recorded ([`super::merge_strips::Advances`]), and their corners
+//! tested against each row's run: the list is not read again (each strip's two ends were two
+//! cache misses, a fifth of the check on the triangulated Spot).
 
 use rayon::prelude::*;
 
 use super::fans::FanBlock;
 use super::grids::{GridStrip, Others};
-use super::merge_strips::{FanSide, MergeStrip, Rows};
+use super::merge_strips::{Advances, FanSide, MergeStrip, RowPoint, Rows, END_TRIANGLES};
 use super::vertex_polygons::edges_off_polygons;
 use super::vertex_set::VertexSet;
 use super::{Block, BlockIndex, Seams};
@@ -61,7 +66,7 @@ fn block_side(side: FanSide, blocks: &[Block], index: &BlockIndex) -> Option<(us
 /// each of its sides where a strip matched it: every vertex, but its corners, the points of the
 /// sides no strip matched, and a corner's neighbour unless both sides there are matched by
 /// strips from two different blocks.
-fn claim(block: &FanBlock, across: [Option<usize>; 3], claimed: &mut VertexSet) {
+fn claim(block: &FanBlock, across: [Option<u32>; 3], claimed: &mut VertexSet) {
     // The block's range is below the vertex count.
     claimed.insert_range(block.first..=(block.vertices().end - 1) as u32);
     let last = 2 * block.n - 2;
@@ -83,31 +88,78 @@ fn claim(block: &FanBlock, across: [Option<usize>; 3], claimed: &mut VertexSet) 
     }
 }
 
-/// The edges without a claimed end of the triangles `order` walks, into `out`; stops at the
-/// first triangle with three claimed corners and returns its index (`None` when none has).
-fn unclaimed_edges(
-    triangles: &[[u32; 3]],
-    order: impl Iterator<Item = usize>,
-    claimed: &VertexSet,
+/// The edges without a claimed end of the triangles `order` walks (each with its index, its
+/// corners named as `vertex` numbers them), into `out`; stops at the first triangle with three
+/// claimed corners and returns its index (`None` when none has).
+fn unclaimed_edges<T: Copy>(
+    order: impl Iterator<Item = (usize, [T; 3])>,
+    claimed: impl Fn(T) -> bool,
+    vertex: impl Fn(T) -> u32,
     out: &mut Vec<(u32, u32)>,
 ) -> Option<usize> {
-    for t in order {
-        let [a, b, c] = triangles[t];
-        let [x, y, z] = [a, b, c].map(|v| claimed.contains(v));
+    for (t, [a, b, c]) in order {
+        let [x, y, z] = [a, b, c].map(&claimed);
         if x && y && z {
             return Some(t);
         }
         if !(x || y) {
-            out.push((a, b));
+            out.push((vertex(a), vertex(b)));
         }
         if !(y || z) {
-            out.push((b, c));
+            out.push((vertex(b), vertex(c)));
         }
         if !(z || x) {
-            out.push((c, a));
+            out.push((vertex(c), vertex(a)));
         }
     }
     None
+}
+
+/// The edges without a claimed end of a kept strip, into `out`: those of its first triangles,
+/// up to the first with three claimed corners, and of its last ones, back to the last such.
+///
+/// The claimed points of a row (a matched side) are one run: never its two ends (a block's
+/// corners), always `2..=2n-4` (on that side alone), and points 1 and `2n - 3` as [`claim`]
+/// left them. So the triangles at the ends are made from the strip's advances and their corners
+/// tested against the two runs; the list is read only beyond the [`END_TRIANGLES`] the
+/// advances record.
+fn strip_end_edges(
+    strip: &MergeStrip,
+    triangles: &[[u32; 3]],
+    claimed: &VertexSet,
+    out: &mut Vec<(u32, u32)>,
+) {
+    let runs = [0, 1].map(|row| {
+        let last = strip.row_length(row) - 1;
+        let at = |k: u32| claimed.contains(strip.vertex((row, k)));
+        (if at(1) { 1 } else { 2 })..=(if at(last - 1) { last - 1 } else { last - 2 })
+    });
+    let in_run = |(row, k): RowPoint| runs[row & 1].contains(&k);
+    let on_list = |v: u32| claimed.contains(v);
+    let listed = |t: usize| (t, triangles[t]);
+    let all = strip.triangles.clone();
+    let made = all.len().min(END_TRIANGLES);
+    let first = unclaimed_edges(
+        all.clone().zip(strip.head()),
+        in_run,
+        |p| strip.vertex(p),
+        out,
+    )
+    .or_else(|| unclaimed_edges((all.start + made..all.end).map(listed), on_list, |v| v, out));
+    let Some(end) = first.map(|t| t + 1) else {
+        return;
+    };
+    let from_end = all.clone().rev().zip(strip.tail());
+    if unclaimed_edges(
+        from_end.take_while(|&(t, _)| t >= end),
+        in_run,
+        |p| strip.vertex(p),
+        out,
+    )
+    .is_none()
+    {
+        unclaimed_edges((end..all.end - made).rev().map(listed), on_list, |v| v, out);
+    }
 }
 
 /// The directed edges left to the general check of a mesh whose kept blocks are all fan blocks
@@ -126,20 +178,23 @@ pub(super) fn fan_grid_edges(
     // The strips of quads read as merge strips.
     let mut rows = Rows::default();
     let mut found = strips.merges;
+    found.reserve(strips.quads.len());
     for strip in strips.quads {
         strip.rows(&mut rows);
         match rows.sides() {
             Some(sides) => found.push(MergeStrip {
                 triangles: strip.triangles(),
                 sides,
+                advances: Advances::QUADS,
             }),
             None => left.push(strip.triangles()),
         }
     }
-    // Each side with one strip at most; `across[3 k + side]`: the block across a matched side.
-    let mut across: Vec<Option<usize>> = vec![None; 3 * blocks.len()];
-    let mut kept = Vec::with_capacity(found.len());
-    for strip in found {
+    // Each side with one strip at most; `across[3 k + side]`: the block across a matched side
+    // (blocks hold three vertices at least, `u32` numbers them).
+    let mut across: Vec<Option<u32>> = vec![None; 3 * blocks.len()];
+    // The strips kept stay in place (a copy's fresh pages cost more than the loop).
+    found.retain(|strip| {
         let [a, b] = strip
             .sides
             .map(|side| block_side(side, blocks, index).map(|(k, s)| (k, 3 * k + usize::from(s))));
@@ -147,12 +202,16 @@ pub(super) fn fan_grid_edges(
             (Some((ka, a)), Some((kb, b)))
                 if ka != kb && across[a].is_none() && across[b].is_none() =>
             {
-                (across[a], across[b]) = (Some(kb), Some(ka));
-                kept.push(strip.triangles);
+                (across[a], across[b]) = (Some(kb as u32), Some(ka as u32));
+                true
             }
-            _ => left.push(strip.triangles),
+            _ => {
+                left.push(strip.triangles.clone());
+                false
+            }
         }
-    }
+    });
+    let kept = found;
     let mut claimed = VertexSet::new(vertices);
     let fans = || {
         blocks.iter().enumerate().filter_map(|(k, b)| match b {
@@ -184,11 +243,7 @@ pub(super) fn fan_grid_edges(
     }
     // The strips' edges without a claimed end, at their two ends.
     for strip in &kept {
-        let end = match unclaimed_edges(triangles, strip.clone(), &claimed, &mut edges) {
-            Some(t) => t + 1,
-            None => continue,
-        };
-        unclaimed_edges(triangles, (end..strip.end).rev(), &claimed, &mut edges);
+        strip_end_edges(strip, triangles, &claimed, &mut edges);
     }
     // The border of the sides no strip matched.
     for (k, block) in fans() {
@@ -252,6 +307,64 @@ mod tests {
                             || corner_rule);
                     assert_eq!(claimed.contains(v), expected, "rate {n}, {across:?}, {v}");
                 }
+            }
+        }
+    }
+
+    /// The edges a strip's ends leave are those of its listed triangles, walked from both ends
+    /// to the first with three claimed corners, for claims made as [`claim`] makes them (every
+    /// way the sides next to the strip may be matched) and strips whose first such triangle
+    /// lies beyond the advances recorded (rates 3 and 40, 3 and 64).
+    #[test]
+    fn strip_ends_are_the_listed_triangles_edges() {
+        use super::super::merge_strips::merge_strip_at;
+        use super::super::merge_strips::tests::{merged, side};
+        let mut rows = Rows::default();
+        let choices = [None, Some(1), Some(2)];
+        for (n, m) in [(3, 3), (5, 7), (8, 8), (17, 19), (3, 40), (40, 3), (3, 64)] {
+            let one = FanBlock {
+                start: 0,
+                first: 0,
+                n,
+            };
+            let other = FanBlock {
+                start: 0,
+                first: 10_000,
+                n: m,
+            };
+            let mut triangles = Vec::new();
+            merged(
+                &side(&one, 1, false),
+                &side(&other, 0, true),
+                &mut triangles,
+            );
+            let strip = merge_strip_at(&triangles, &mut rows).expect("a strip");
+            for pick in 0..81 {
+                // Side 1 of `one` and side 0 of `other` face each other; the sides around them
+                // are matched from nothing, from a third block, or from the other one.
+                let [p0, p2, q1, q2] =
+                    [pick % 3, pick / 3 % 3, pick / 9 % 3, pick / 27].map(|c| choices[c]);
+                let mut claimed = VertexSet::new(20_000);
+                claim(&one, [p0, Some(1), p2], &mut claimed);
+                claim(&other, [Some(0), q1, q2], &mut claimed);
+                let mut made = Vec::new();
+                strip_end_edges(&strip, &triangles, &claimed, &mut made);
+                let mut listed = Vec::new();
+                let on_list = |v: u32| claimed.contains(v);
+                let all = 0..triangles.len();
+                let order = |t: usize| (t, triangles[t]);
+                if let Some(t) =
+                    unclaimed_edges(all.clone().map(order), on_list, |v| v, &mut listed)
+                {
+                    unclaimed_edges(
+                        (t + 1..all.end).rev().map(order),
+                        on_list,
+                        |v| v,
+                        &mut listed,
+                    );
+                }
+                assert_eq!(made, listed, "rates {n} {m}, pick {pick}");
+                assert!(!made.is_empty());
             }
         }
     }
