@@ -102,6 +102,11 @@ enum Command {
         /// Mixed per-input-face rates instead (3, 5, 8, 12, 7, 16 in turn).
         #[arg(long, conflicts_with = "rate")]
         mixed: bool,
+        /// Rates from a tolerance instead, chosen again every frame: each frame sets the
+        /// surface's positions, plans (the selection included) and evaluates, as a moving mesh
+        /// that keeps a tolerance does (docs/cli.md).
+        #[arg(long, conflicts_with_all = ["rate", "mixed"])]
+        tolerance: Option<f64>,
         /// Worker threads, 1..=256 (default: one per core).
         #[arg(long, value_parser = threads_arg)]
         threads: Option<usize>,
@@ -543,6 +548,7 @@ fn plan_stats(surface: &Surface, tessellator: &Tessellator<'_>) -> serde_json::V
         "triangles": tessellator.triangle_count(),
         "vertices": tessellator.vertex_count(),
         "plan_seconds": tessellator.plan_seconds(),
+        "rates_seconds": tessellator.rates_seconds(),
         "boundary_loops": surface.boundary_loops(),
         "input_faces": surface.input_faces(),
         "faces": surface.faces(),
@@ -650,6 +656,7 @@ struct BenchArgs {
     mesh: PathBuf,
     rate: u32,
     mixed: bool,
+    tolerance: Option<f64>,
     threads: Option<usize>,
     steps: u32,
     max_triangles: u64,
@@ -682,7 +689,9 @@ fn bench_command(args: BenchArgs) -> Result<(), RuntimeError> {
         .num_threads(args.threads.unwrap_or(0))
         .build()
         .map_err(|e| RuntimeError::Unsupported(format!("a pool of threads: {e}")))?;
-    let (rates, rates_label) = if args.mixed {
+    let (rates, rates_label) = if let Some(t) = args.tolerance {
+        (Rates::Tolerance(t), format!("tolerance {t}"))
+    } else if args.mixed {
         let per_face = (0..input.faces())
             .map(|f| [3, 5, 8, 12, 7, 16][f % 6])
             .collect();
@@ -690,10 +699,13 @@ fn bench_command(args: BenchArgs) -> Result<(), RuntimeError> {
     } else {
         (Rates::Uniform(args.rate), args.rate.to_string())
     };
-    let surface = pool.install(|| load_surface(&input, args.scheme, &args.table))?;
+    let mut surface = pool.install(|| load_surface(&input, args.scheme, &args.table))?;
+    let control = input.positions_f32();
+    if args.tolerance.is_some() {
+        return bench_planned_frames(&pool, &mut surface, &rates, &control, &args, rates_label);
+    }
     let mut tessellator =
         pool.install(|| surface.tessellator_within(&rates, args.max_triangles))?;
-    let control = input.positions_f32();
     // The input is valid (it was evaluated into the surface), so a frame cannot fail. In the
     // pool like every frame (a profiler that follows the frames' calls sees their work).
     pool.install(|| tessellator.evaluate(&control).map(|_| ()))?;
@@ -713,6 +725,61 @@ fn bench_command(args: BenchArgs) -> Result<(), RuntimeError> {
     report["max_seconds"] = seconds[seconds.len() - 1].into();
     report["triangles_per_second"] =
         (tessellator.triangle_count() as f64 / median.max(1e-12)).into();
+    out!("{report}")?;
+    Ok(())
+}
+
+/// `subtess bench --tolerance`: every frame sets the surface's positions, plans at the rates
+/// the tolerance chooses on them and evaluates; the medians of each part's seconds.
+fn bench_planned_frames(
+    pool: &rayon::ThreadPool,
+    surface: &mut Surface,
+    rates: &Rates,
+    control: &[[f32; 3]],
+    args: &BenchArgs,
+    rates_label: String,
+) -> Result<(), RuntimeError> {
+    // [rates, plan after the rates, evaluate, the whole frame] of every frame.
+    let mut parts: Vec<[f64; 4]> = Vec::new();
+    let mut report = serde_json::Value::Null;
+    pool.install(|| -> Result<(), RuntimeError> {
+        // One frame untimed (the table's grids are expanded on first use), then the frames.
+        for frame in 0..=args.frames {
+            let started = Instant::now();
+            surface.set_positions(control)?;
+            let mut tessellator = surface.tessellator_within(rates, args.max_triangles)?;
+            let planned = Instant::now();
+            tessellator.evaluate(control)?;
+            let (evaluate, whole) = (planned.elapsed(), started.elapsed());
+            if frame > 0 {
+                let rates = tessellator.rates_seconds();
+                parts.push([
+                    rates,
+                    tessellator.plan_seconds() - rates,
+                    evaluate.as_secs_f64(),
+                    whole.as_secs_f64(),
+                ]);
+            }
+            report = plan_stats(surface, &tessellator);
+        }
+        Ok(())
+    })?;
+    let median = |k: usize| {
+        let mut seconds: Vec<f64> = parts.iter().map(|p| p[k]).collect();
+        seconds.sort_by(f64::total_cmp);
+        seconds.get(seconds.len() / 2).copied().unwrap_or(0.0)
+    };
+    report["mesh"] = args.mesh.display().to_string().into();
+    report["rates"] = rates_label.into();
+    report["threads"] = pool.current_num_threads().into();
+    report["frames"] = args.frames.into();
+    report["per_frame"] =
+        "set the positions, choose the rates, plan at them, evaluate from the input control points"
+            .into();
+    report["median_rates_seconds"] = median(0).into();
+    report["median_plan_seconds"] = median(1).into();
+    report["median_evaluate_seconds"] = median(2).into();
+    report["median_seconds"] = median(3).into();
     out!("{report}")?;
     Ok(())
 }
@@ -829,6 +896,7 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
             mesh,
             rate,
             mixed,
+            tolerance,
             threads,
             refine,
             max_triangles,
@@ -839,6 +907,7 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
             mesh,
             rate,
             mixed,
+            tolerance,
             threads,
             steps: refine,
             max_triangles,

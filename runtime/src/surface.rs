@@ -198,6 +198,34 @@ impl Surface {
         self.refinement().map_or(0, Stencil::entries)
     }
 
+    /// Move the control points: `positions`, one per **input** vertex in OBJ order, replace
+    /// those of the mesh given to [`Surface::new`], refined through isolation's map as a frame's
+    /// are. The rates a tessellator chooses from the surface itself afterwards
+    /// ([`Rates::Tolerance`], [`Rates::View`]) are those of the moved surface, what a fresh
+    /// `Surface` of the moved mesh chooses (up to the last bits of the isolated points, which
+    /// the map composes in another order than isolation's steps), without isolating again and
+    /// with the table's grids already expanded: set the positions, plan, evaluate, frame after
+    /// frame, for a mesh that moves and keeps a tolerance. Refused, and nothing moved, unless
+    /// there is one finite point per input vertex.
+    pub fn set_positions(&mut self, positions: &[[f32; 3]]) -> Result<(), RuntimeError> {
+        check_positions(positions, self.input_vertices)?;
+        let input: Vec<[f64; 3]> = positions.iter().map(|p| p.map(f64::from)).collect();
+        let mut refined = Vec::new();
+        let moved = if self.control_points(&input, &mut refined) {
+            refined
+        } else {
+            input
+        };
+        let mesh = match &mut self.isolated {
+            Isolated::Quad(iso) => &mut iso.mesh,
+            Isolated::Triangle(iso) => &mut iso.mesh,
+        };
+        // The map has a row per isolated vertex (and no map, the input is the control).
+        debug_assert_eq!(moved.len(), mesh.positions.len());
+        mesh.positions = moved;
+        Ok(())
+    }
+
     /// Input vertices to isolated vertices; `None` when isolation took no step.
     fn refinement(&self) -> Option<&Stencil> {
         let map = match &self.isolated {
@@ -337,6 +365,7 @@ impl Surface {
     ) -> Result<Tessellator<'_>, RuntimeError> {
         let started = Instant::now();
         let (rates, faces_over_tolerance) = self.face_rates(rates)?;
+        let rates_seconds = started.elapsed().as_secs_f64();
         self.estimate_rates(&rates)
             .check("the tessellation", max_triangles)?;
         let grid: Box<dyn GridPlan + '_> = match &self.isolated {
@@ -401,6 +430,7 @@ impl Surface {
             sources,
             uvs,
             seam_copies,
+            rates_seconds,
             plan_seconds: started.elapsed().as_secs_f64(),
         })
     }
@@ -444,6 +474,7 @@ pub struct Tessellator<'s> {
     /// Texture coordinates (constant: planned once), or empty.
     uvs: Vec<[f32; 2]>,
     seam_copies: Vec<[u32; 2]>,
+    rates_seconds: f64,
     plan_seconds: f64,
 }
 
@@ -452,25 +483,7 @@ impl<'s> Tessellator<'s> {
     /// limit positions and unit normals of every output vertex. The same positions give the
     /// same frame; deformed positions give what a fresh [`Surface`] of the deformed mesh gives.
     pub fn evaluate(&mut self, positions: &[[f32; 3]]) -> Result<Frame<'_>, RuntimeError> {
-        if positions.len() != self.surface.input_vertices {
-            return Err(RuntimeError::InvalidParameter {
-                name: "positions".to_owned(),
-                reason: format!(
-                    "{} points for a mesh of {} vertices",
-                    positions.len(),
-                    self.surface.input_vertices
-                ),
-            });
-        }
-        if let Some(v) = positions
-            .iter()
-            .position(|p| p.iter().any(|c| !c.is_finite()))
-        {
-            return Err(RuntimeError::InvalidParameter {
-                name: format!("position of vertex {v}"),
-                reason: format!("{:?} is not finite", positions[v]),
-            });
-        }
+        check_positions(positions, self.surface.input_vertices)?;
         self.input.clear();
         self.input
             .extend(positions.iter().map(|p| p.map(f64::from)));
@@ -533,6 +546,35 @@ impl<'s> Tessellator<'s> {
     /// Seconds spent planning (rates, table lookups, connectivity, triangles, sources).
     pub fn plan_seconds(&self) -> f64 {
         self.plan_seconds
+    }
+
+    /// Seconds of [`Tessellator::plan_seconds`] spent choosing the rates: a tolerance's
+    /// selection or a camera's, next to nothing for rates given.
+    pub fn rates_seconds(&self) -> f64 {
+        self.rates_seconds
+    }
+}
+
+/// One finite point per input vertex, or the error that says which is not.
+fn check_positions(positions: &[[f32; 3]], input_vertices: usize) -> Result<(), RuntimeError> {
+    if positions.len() != input_vertices {
+        return Err(RuntimeError::InvalidParameter {
+            name: "positions".to_owned(),
+            reason: format!(
+                "{} points for a mesh of {input_vertices} vertices",
+                positions.len()
+            ),
+        });
+    }
+    match positions
+        .iter()
+        .position(|p| p.iter().any(|c| !c.is_finite()))
+    {
+        Some(v) => Err(RuntimeError::InvalidParameter {
+            name: format!("position of vertex {v}"),
+            reason: format!("{:?} is not finite", positions[v]),
+        }),
+        None => Ok(()),
     }
 }
 

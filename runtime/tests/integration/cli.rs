@@ -157,6 +157,32 @@ fn bench_reports_throughput() {
         .is_some_and(|t| t >= 0.0));
 }
 
+/// `bench --tolerance` chooses the rates again every frame and times the parts: the rates it
+/// reports are those `tessellate --tolerance` chooses (the same triangles), and the selection,
+/// the plan after it and the evaluation are each part of the frame.
+#[test]
+#[cfg(feature = "catmull-clark")]
+fn bench_with_a_tolerance_plans_every_frame() {
+    let out = succeeds("bench data/cube.obj --tolerance 2e-3 --threads 1 --frames 2");
+    let report = json(&out);
+    let once = json(&succeeds(&format!(
+        "tessellate data/cube.obj -o {} --tolerance 2e-3 --stats",
+        temp("bench_tolerance.obj").display()
+    )));
+    assert_eq!(report["triangles"], once["triangles"]);
+    assert_eq!(report["rate_max"], once["rate_max"]);
+    assert!(once["rates_seconds"].as_f64().is_some_and(|t| t > 0.0));
+    let part = |key: &str| report[key].as_f64().unwrap_or(f64::NAN);
+    let whole = part("median_seconds");
+    for key in [
+        "median_rates_seconds",
+        "median_plan_seconds",
+        "median_evaluate_seconds",
+    ] {
+        assert!(part(key) > 0.0 && part(key) < whole, "{key}: {report}");
+    }
+}
+
 #[test]
 fn bad_input_is_a_clear_error() {
     let bad = temp("bad.obj");

@@ -249,6 +249,84 @@ fn no_refinement_runs_when_none_is_needed() {
     assert!(isolated.refinement_weights() > 0);
 }
 
+/// A surface whose positions were set to a deformed mesh's chooses, at a tolerance, the rates
+/// a fresh surface of the deformed mesh chooses, and then makes its frame; with other rates
+/// than the undeformed surface's (so the positions did reach the selection: the deformed mesh
+/// is twice the size). Points of the
+/// wrong number or not finite are refused and change nothing.
+fn check_moved_rates(label: &str, mesh: &Mesh, scheme: Scheme, relative: f64) {
+    let mut mesh = mesh.clone();
+    mesh.face_varying = None;
+    let rest = mesh.positions_f32();
+    let extent = size(&rest);
+    let tolerance = Rates::Tolerance(relative * f64::from(extent));
+    let mut surface = Surface::new(&mesh, scheme).expect("surface");
+    let rest_rates = surface
+        .tessellator(&tolerance)
+        .expect("plan")
+        .rates()
+        .to_vec();
+    // Deformed, and grown to twice the size: the tolerance stays, so the rates must rise.
+    let deformed: Vec<[f32; 3]> = deform(&rest, extent)
+        .iter()
+        .map(|p| p.map(|c| 2.0 * c))
+        .collect();
+    surface.set_positions(&deformed).expect("moved");
+    let (rates, positions, triangles) = {
+        let mut tessellator = surface.tessellator(&tolerance).expect("moved plan");
+        let rates = tessellator.rates().to_vec();
+        let frame = tessellator.evaluate(&deformed).expect("moved frame");
+        (
+            rates,
+            frame.positions().to_vec(),
+            frame.triangles().to_vec(),
+        )
+    };
+
+    let mut fresh_mesh = mesh.clone();
+    fresh_mesh.positions = deformed.iter().map(|p| p.map(f64::from)).collect();
+    let fresh = Surface::new(&fresh_mesh, scheme).expect("fresh surface");
+    let mut fresh_tessellator = fresh.tessellator(&tolerance).expect("fresh plan");
+    assert_eq!(fresh_tessellator.rates(), &rates[..], "{label}: rates");
+    assert_ne!(rest_rates, rates, "{label}: the deformation moves no rate");
+    let reference = fresh_tessellator.evaluate(&deformed).expect("fresh frame");
+    assert_eq!(reference.triangles(), &triangles[..], "{label}: topology");
+    let worst = positions
+        .iter()
+        .zip(reference.positions())
+        .map(|(a, b)| distance(*a, *b))
+        .fold(0.0f32, f32::max);
+    assert!(worst <= 1e-5 * extent, "{label}: frame off by {worst}");
+
+    assert!(surface.set_positions(&deformed[1..]).is_err(), "{label}");
+    let mut broken = rest.clone();
+    broken[0][2] = f32::INFINITY;
+    assert!(surface.set_positions(&broken).is_err(), "{label}");
+    let kept = surface
+        .tessellator(&tolerance)
+        .expect("plan after refusals");
+    assert_eq!(
+        kept.rates(),
+        &rates[..],
+        "{label}: a refusal moved the surface"
+    );
+}
+
+#[test]
+#[cfg(feature = "catmull-clark")]
+fn moved_positions_choose_a_fresh_surfaces_rates() {
+    // The cube's valence-3 corners take an isolating step: the positions go through its map.
+    let cube = Mesh::read_obj(data("cube.obj")).expect("cube");
+    check_moved_rates("cube", &cube, Scheme::CatmullClark, 1e-3);
+    let creased = Mesh::read_obj(data("cube_creased.obj")).expect("creased cube");
+    check_moved_rates("creased cube", &creased, Scheme::CatmullClark, 1e-3);
+    #[cfg(feature = "loop")]
+    {
+        let octahedron = Mesh::read_obj(data("octahedron.obj")).expect("octahedron");
+        check_moved_rates("octahedron, loop", &octahedron, Scheme::Loop, 1e-3);
+    }
+}
+
 /// Read an OBJ file's `v` and `f` lines (triangles, `f a b c` or `f a//a ...`).
 fn read_triangles(path: &Path) -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {
     let text = std::fs::read_to_string(path).expect("output");
