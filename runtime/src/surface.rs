@@ -48,7 +48,8 @@ pub enum Rates {
     /// input face's rate.
     PerFace(Vec<u32>),
     /// Per face the smallest rate whose tessellation deviates from the limit surface by at most
-    /// this distance (in the mesh's units), measured on the mesh given to [`Surface::new`]
+    /// this distance (in the mesh's units), measured on the surface's positions: the mesh's
+    /// given to [`Surface::new`], or those set since ([`Surface::set_positions`])
     /// (docs/results.md, docs/cli.md).
     Tolerance(f64),
     /// Per face the projected size over a target edge length in pixels (docs/cli.md).
@@ -63,7 +64,8 @@ enum Isolated {
 }
 
 /// A subdivision surface: one mesh's topology prepared for one scheme. Build it once per
-/// topology; positions may change every frame ([`Tessellator::evaluate`]).
+/// topology; positions may change every frame ([`Tessellator::evaluate`], and
+/// [`Surface::set_positions`] where the rates follow them).
 ///
 /// ```
 /// let mesh = subtess::Mesh::read_obj(concat!(env!("CARGO_MANIFEST_DIR"), "/data/cube.obj"))?;
@@ -200,13 +202,14 @@ impl Surface {
 
     /// Move the control points: `positions`, one per **input** vertex in OBJ order, replace
     /// those of the mesh given to [`Surface::new`], refined through isolation's map as a frame's
-    /// are. The rates a tessellator chooses from the surface itself afterwards
-    /// ([`Rates::Tolerance`], [`Rates::View`]) are those of the moved surface, what a fresh
-    /// `Surface` of the moved mesh chooses (up to the last bits of the isolated points, which
-    /// the map composes in another order than isolation's steps), without isolating again and
-    /// with the table's grids already expanded: set the positions, plan, evaluate, frame after
-    /// frame, for a mesh that moves and keeps a tolerance. Refused, and nothing moved, unless
-    /// there is one finite point per input vertex.
+    /// are. What the surface computes from its own positions afterwards, the rates a
+    /// tessellator chooses ([`Rates::Tolerance`], [`Rates::View`]) and
+    /// [`Surface::tessellate_adaptive`], is then the moved surface's, what a fresh `Surface` of
+    /// the moved mesh gives (up to the last bits of the isolated points, which the map composes
+    /// in another order than isolation's steps), without isolating again and with the table's
+    /// grids already expanded: set the positions, plan, evaluate, frame after frame, for a mesh
+    /// that moves and keeps a tolerance. Refused, and nothing moved, unless there is one finite
+    /// point per input vertex.
     pub fn set_positions(&mut self, positions: &[[f32; 3]]) -> Result<(), RuntimeError> {
         check_positions(positions, self.input_vertices)?;
         let input: Vec<[f64; 3]> = positions.iter().map(|p| p.map(f64::from)).collect();
@@ -235,7 +238,8 @@ impl Surface {
         self.refines.then_some(map)
     }
 
-    /// The isolated mesh (at the positions given to [`Surface::new`]).
+    /// The isolated mesh (at the positions given to [`Surface::new`] or, since,
+    /// [`Surface::set_positions`]).
     fn mesh(&self) -> &Mesh {
         match &self.isolated {
             Isolated::Quad(iso) => &iso.mesh,

@@ -298,6 +298,22 @@ fn check_moved_rates(label: &str, mesh: &Mesh, scheme: Scheme, relative: f64) {
         .fold(0.0f32, f32::max);
     assert!(worst <= 1e-5 * extent, "{label}: frame off by {worst}");
 
+    // Lai–Cheng's adaptive tessellation reads the surface's positions too.
+    if scheme == Scheme::CatmullClark {
+        let options = subtess::AdaptiveOptions {
+            tolerance: 1e-3 * f64::from(extent),
+            triangulate: true,
+            ..Default::default()
+        };
+        let (moved, _) = surface.tessellate_adaptive(&options).expect("adaptive");
+        let (reference, _) = fresh.tessellate_adaptive(&options).expect("fresh adaptive");
+        assert_eq!(
+            moved.triangles(),
+            reference.triangles(),
+            "{label}: adaptive"
+        );
+    }
+
     assert!(surface.set_positions(&deformed[1..]).is_err(), "{label}");
     let mut broken = rest.clone();
     broken[0][2] = f32::INFINITY;
