@@ -318,20 +318,11 @@ mod tests {
     #[test]
     fn strip_ends_are_the_listed_triangles_edges() {
         use super::super::merge_strips::merge_strip_at;
-        use super::super::merge_strips::tests::{merged, side};
+        use super::super::merge_strips::tests::{merged, side, two_blocks};
         let mut rows = Rows::default();
         let choices = [None, Some(1), Some(2)];
         for (n, m) in [(3, 3), (5, 7), (8, 8), (17, 19), (3, 40), (40, 3), (3, 64)] {
-            let one = FanBlock {
-                start: 0,
-                first: 0,
-                n,
-            };
-            let other = FanBlock {
-                start: 0,
-                first: 10_000,
-                n: m,
-            };
+            let (one, other) = two_blocks(n, m);
             let mut triangles = Vec::new();
             merged(
                 &side(&one, 1, false),

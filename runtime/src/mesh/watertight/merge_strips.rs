@@ -307,6 +307,12 @@ pub(super) mod tests {
         }
     }
 
+    /// Two fan blocks of rates `n` and `m`, apart (at vertices 0 and 10,000).
+    pub(in crate::mesh::watertight) fn two_blocks(n: u32, m: u32) -> (FanBlock, FanBlock) {
+        let block = |first, n| FanBlock { start: 0, first, n };
+        (block(0, n), block(10_000, m))
+    }
+
     /// A side of a fan block, as its border runs it (`backwards`: the other way).
     pub(in crate::mesh::watertight) fn side(
         block: &FanBlock,
@@ -329,16 +335,7 @@ pub(super) mod tests {
     fn advances_make_the_strips_ends_again() {
         let mut rows = Rows::default();
         for (n, m) in [(3, 3), (5, 7), (7, 5), (8, 8), (17, 19), (3, 40), (40, 3)] {
-            let one = FanBlock {
-                start: 0,
-                first: 0,
-                n,
-            };
-            let other = FanBlock {
-                start: 0,
-                first: 10_000,
-                n: m,
-            };
+            let (one, other) = two_blocks(n, m);
             for (sa, sb) in [(0, 2), (1, 0), (2, 1)] {
                 let mut triangles = Vec::new();
                 merged(
