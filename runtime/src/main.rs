@@ -760,7 +760,9 @@ fn bench_planned_frames(
                     whole.as_secs_f64(),
                 ]);
             }
-            report = plan_stats(surface, &tessellator);
+            if frame == args.frames {
+                report = plan_stats(surface, &tessellator);
+            }
         }
         Ok(())
     })?;

@@ -22,6 +22,17 @@ pub(super) struct FanSide {
     pub(super) side: u8,
 }
 
+impl FanSide {
+    /// The block the side is named by (its first triangle unknown: `start` 0).
+    fn block(&self) -> FanBlock {
+        FanBlock {
+            start: 0,
+            first: self.first,
+            n: self.n,
+        }
+    }
+}
+
 /// A merge strip whose rows are fan blocks' sides: `sides[0]` its row `a`, `sides[1]` its row
 /// `b` run backwards.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -70,17 +81,12 @@ impl MergeStrip {
     /// The vertex at a point of the rows.
     pub(super) fn vertex(&self, (row, k): RowPoint) -> u32 {
         let side = self.sides[row & 1];
-        let block = FanBlock {
-            start: 0,
-            first: side.first,
-            n: side.n,
-        };
         let along = if row == 0 {
             k
         } else {
             self.row_length(1) - 1 - k
         };
-        block.side_point(side.side, along)
+        side.block().side_point(side.side, along)
     }
 
     /// The points in a row: a side's `2n - 1`.
@@ -219,8 +225,12 @@ pub(super) fn side_of_points(row: &[u32]) -> Option<FanSide> {
         2 => (2, n * n - 1),
         _ => return None,
     };
-    let first = p0.checked_sub(offset)?;
-    let block = FanBlock { start: 0, first, n };
+    let found = FanSide {
+        first: p0.checked_sub(offset)?,
+        n,
+        side,
+    };
+    let block = found.block();
     if block.vertices().end > 1 << 32 {
         return None;
     }
@@ -232,7 +242,7 @@ pub(super) fn side_of_points(row: &[u32]) -> Option<FanSide> {
         1 => differs(row, point(1)),
         _ => differs(row, point(2)),
     };
-    (mismatch == 0).then_some(FanSide { first, n, side })
+    (mismatch == 0).then_some(found)
 }
 
 /// The bits in which a row of odd length differs from the points `point(k)`, compared a pair
