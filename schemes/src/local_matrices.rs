@@ -62,7 +62,7 @@ use std::collections::HashMap;
 use crate::{BoundaryMode, QuadScheme};
 use num_bigint::BigInt;
 use num_rational::{BigRational, Rational64};
-use num_traits::Zero;
+use num_traits::{CheckedAdd, CheckedMul, Zero};
 
 /// A neighbourhood (or sector) that a scheme has no rules for.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -416,6 +416,40 @@ fn with_phantoms(nb: Neighbourhood, s: i64, a: i64, b: i64) -> Combination {
         .collect()
 }
 
+/// The row of length `len` whose entry `i` is the sum of `w * w1` over the terms `(i, w, w1)`,
+/// exactly.
+///
+/// Why two paths: the weights' denominators are small (`4 N^2` and powers of two), so the sums
+/// almost always fit in `i64` ratios, whose arithmetic needs no allocation, where every
+/// `BigRational` sum allocates and reduces: that made the operators of four patch kinds about
+/// a millisecond of a Lai–Cheng run (docs/benchmarks.md). A product or sum that would overflow
+/// sends the whole row to `BigRational`; either way the entries are the same exact numbers.
+fn exact_row(len: usize, terms: &[(usize, Rational64, Rational64)]) -> Vec<BigRational> {
+    let small = || -> Option<Vec<Rational64>> {
+        let mut r = vec![Rational64::zero(); len];
+        for &(i, w, w1) in terms {
+            r[i] = r[i].checked_add(&w.checked_mul(&w1)?)?;
+        }
+        Some(r)
+    };
+    let big = |w: Rational64| BigRational::new(BigInt::from(*w.numer()), BigInt::from(*w.denom()));
+    match small() {
+        // `Rational64`'s arithmetic keeps it reduced with a positive denominator, as
+        // `new_raw` requires.
+        Some(r) => r
+            .into_iter()
+            .map(|w| BigRational::new_raw(BigInt::from(*w.numer()), BigInt::from(*w.denom())))
+            .collect(),
+        None => {
+            let mut r = vec![BigRational::zero(); len];
+            for &(i, w, w1) in terms {
+                r[i] += big(w) * big(w1);
+            }
+            r
+        }
+    }
+}
+
 /// The local subdivision matrices of one scheme around one neighbourhood, for one sector's patch.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LocalMatrices {
@@ -443,17 +477,16 @@ impl LocalMatrices {
         let index: HashMap<GridPoint, usize> =
             layout.iter().enumerate().map(|(i, &p)| (p, i)).collect();
         let row = |combination: Combination| -> Vec<BigRational> {
-            let mut r = vec![BigRational::zero(); layout.len()];
+            let mut terms = Vec::new();
             for (level1, w1) in combination {
                 for (p, w) in refine_point(scheme, nb, level1) {
                     let i = *index.get(&p).unwrap_or_else(|| {
                         unreachable!("a patch point's rule reads only the patch's points: {p:?}")
                     });
-                    let w = w * w1;
-                    r[i] += BigRational::new(BigInt::from(*w.numer()), BigInt::from(*w.denom()));
+                    terms.push((i, w, w1));
                 }
             }
-            r
+            exact_row(layout.len(), &terms)
         };
         let one = Rational64::from_integer(1);
         let a = layout.iter().map(|&p| row(vec![(p, one)])).collect();
@@ -492,12 +525,12 @@ impl LocalMatrices {
         (-1..=2)
             .flat_map(|q| (-1..=2).map(move |p| (p, q)))
             .map(|(p, q)| {
-                let mut r = vec![BigRational::zero(); self.layout.len()];
-                for (point, w) in with_phantoms(nb, s, p, q) {
-                    r[*index.get(&point)?] +=
-                        BigRational::new(BigInt::from(*w.numer()), BigInt::from(*w.denom()));
-                }
-                Some(r)
+                let one = Rational64::from_integer(1);
+                let terms = with_phantoms(nb, s, p, q)
+                    .into_iter()
+                    .map(|(point, w)| Some((*index.get(&point)?, w, one)))
+                    .collect::<Option<Vec<_>>>()?;
+                Some(exact_row(self.layout.len(), &terms))
             })
             .collect()
     }
@@ -528,6 +561,24 @@ impl LocalMatrices {
 mod tests {
     use super::*;
     use num_traits::One;
+
+    #[test]
+    fn exact_rows_past_i64_are_big_rationals() {
+        let r = |n: i64, d: i64| Rational64::new(n, d);
+        let tiny = r(1, 1 << 40);
+        // Small terms: i64 ratios throughout.
+        let small = exact_row(2, &[(1, r(1, 3), r(3, 4)), (1, r(1, 4), r(1, 1))]);
+        assert_eq!(small[0], BigRational::zero());
+        assert_eq!(small[1], BigRational::new(BigInt::from(1), BigInt::from(2)));
+        // 2^-40 * 2^-40 overflows i64: the whole row is summed in big rationals.
+        let big = exact_row(
+            2,
+            &[(0, tiny, tiny), (0, tiny, tiny), (1, r(3, 7), r(2, 1))],
+        );
+        let two_to_79 = BigInt::from(1) << 79usize;
+        assert_eq!(big[0], BigRational::new(BigInt::from(1), two_to_79));
+        assert_eq!(big[1], BigRational::new(BigInt::from(6), BigInt::from(7)));
+    }
 
     #[test]
     fn canonical_names_wrap_around_the_vertex() {

@@ -1013,11 +1013,10 @@ pub fn tessellate_adaptive(
         .collect();
     kinds.sort_by_key(|k| (k.boundary, k.feature, k.faces, k.sector));
     kinds.dedup();
-    let mut operators: HashMap<PatchKind, Operators> = HashMap::new();
-    for kind in kinds {
-        let ops = Operators::new(mesh, kind)?;
-        operators.insert(kind, ops);
-    }
+    let operators: HashMap<PatchKind, Operators> = kinds
+        .par_iter()
+        .map(|&kind| Ok((kind, Operators::new(mesh, kind)?)))
+        .collect::<Result<_, RuntimeError>>()?;
     // Pass 1 (parallel): the adaptive marking of every face, within the polygon budget.
     let polygons = AtomicUsize::new(0);
     let mut work: Vec<(Vec<Leaf>, Vec<Marked>)> = patches
