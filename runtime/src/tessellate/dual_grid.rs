@@ -1176,8 +1176,8 @@ fn evaluate_separable_at_rate(
 /// `P_u` and `P_v` from their first term), so the output is bit-identical to one point at a time
 /// (`separable_lanes_are_the_scalar_sums_bit_for_bit`).
 ///
-/// Inlined into both of its callers (regular faces and those with phantom rows): called, it cost
-/// a rate-4 frame 5% more instructions.
+/// Inlined, through [`evaluate_separable_at_rate`], into both of its callers (regular faces and
+/// those with phantom rows): called, it cost a rate-4 frame 5% more instructions.
 #[inline(always)]
 fn evaluate_separable(
     g: &[[[f32; 3]; 4]; 4],
