@@ -107,6 +107,11 @@ enum Command {
         /// that keeps a tolerance does (docs/cli.md).
         #[arg(long, conflicts_with_all = ["rate", "mixed"])]
         tolerance: Option<f64>,
+        /// With --tolerance: Lai–Cheng's adaptive tessellation (catmull-clark) instead of the
+        /// dual grid: every frame sets the surface's positions and tessellates adaptively into
+        /// triangles (docs/cli.md).
+        #[arg(long, requires = "tolerance")]
+        adaptive: bool,
         /// Worker threads, 1..=256 (default: one per core).
         #[arg(long, value_parser = threads_arg)]
         threads: Option<usize>,
@@ -657,6 +662,7 @@ struct BenchArgs {
     rate: u32,
     mixed: bool,
     tolerance: Option<f64>,
+    adaptive: bool,
     threads: Option<usize>,
     steps: u32,
     max_triangles: u64,
@@ -701,6 +707,9 @@ fn bench_command(args: BenchArgs) -> Result<(), RuntimeError> {
     };
     let mut surface = pool.install(|| load_surface(&input, args.scheme, &args.table))?;
     let control = input.positions_f32();
+    if let (Some(tolerance), true) = (args.tolerance, args.adaptive) {
+        return bench_adaptive_frames(&pool, &mut surface, tolerance, &control, &args);
+    }
     if args.tolerance.is_some() {
         return bench_planned_frames(&pool, &mut surface, &rates, &control, &args, rates_label);
     }
@@ -782,6 +791,52 @@ fn bench_planned_frames(
     report["median_plan_seconds"] = median(1).into();
     report["median_evaluate_seconds"] = median(2).into();
     report["median_seconds"] = median(3).into();
+    out!("{report}")?;
+    Ok(())
+}
+
+/// `subtess bench --tolerance T --adaptive`: every frame sets the surface's positions and
+/// tessellates adaptively into triangles; the first frame (which makes the patch kinds'
+/// operators, kept by the surface) is reported apart, the median over the others.
+fn bench_adaptive_frames(
+    pool: &rayon::ThreadPool,
+    surface: &mut Surface,
+    tolerance: f64,
+    control: &[[f32; 3]],
+    args: &BenchArgs,
+) -> Result<(), RuntimeError> {
+    let options = AdaptiveOptions {
+        tolerance,
+        triangulate: true,
+        ..AdaptiveOptions::default()
+    };
+    let mut seconds = Vec::new();
+    let mut report = serde_json::Value::Null;
+    pool.install(|| -> Result<(), RuntimeError> {
+        for frame in 0..=args.frames {
+            let started = Instant::now();
+            surface.set_positions(control)?;
+            let (_, stats) = surface.tessellate_adaptive(&options)?;
+            seconds.push(started.elapsed().as_secs_f64());
+            if frame == args.frames {
+                report = stats.to_json();
+            }
+        }
+        Ok(())
+    })?;
+    let first = seconds.remove(0);
+    seconds.sort_by(f64::total_cmp);
+    let median = seconds.get(seconds.len() / 2).copied().unwrap_or(first);
+    let triangles = report["triangles"].as_f64().unwrap_or(0.0);
+    report["mesh"] = args.mesh.display().to_string().into();
+    report["rates"] = format!("adaptive, tolerance {tolerance}").into();
+    report["threads"] = pool.current_num_threads().into();
+    report["frames"] = args.frames.into();
+    report["per_frame"] =
+        "set the positions, tessellate adaptively (Lai–Cheng) into triangles".into();
+    report["first_frame_seconds"] = first.into();
+    report["median_seconds"] = median.into();
+    report["triangles_per_second"] = (triangles / median.max(1e-12)).into();
     out!("{report}")?;
     Ok(())
 }
@@ -899,6 +954,7 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
             rate,
             mixed,
             tolerance,
+            adaptive,
             threads,
             refine,
             max_triangles,
@@ -910,6 +966,7 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
             rate,
             mixed,
             tolerance,
+            adaptive,
             threads,
             steps: refine,
             max_triangles,

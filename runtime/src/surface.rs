@@ -10,6 +10,7 @@
 //! on every patch's control points relative to one of them, so that tangents and normals do
 //! not depend on where the mesh sits: docs/reliability.md, *Precision*).
 
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use rayon::prelude::*;
@@ -30,7 +31,7 @@ use crate::scheme::Scheme;
 use crate::stencil_table::StencilTable;
 use crate::tessellate::dual_grid::{DualGrid, MAX_RATE};
 use crate::tessellate::lai_cheng::{
-    tessellate_adaptive, AdaptiveMesh, AdaptiveOptions, AdaptiveStats,
+    tessellate_adaptive_with, AdaptiveMesh, AdaptiveOptions, AdaptiveStats, PatchOperators,
 };
 use crate::tessellate::rates::{tolerance_rates, view_rates, ViewCamera};
 use crate::tessellate::triangle_dual_grid::TriangleDualGrid;
@@ -90,6 +91,9 @@ pub struct Surface {
     /// The texture coordinates' channel (Catmull–Clark), refined as the positions were.
     channel: Option<ChannelIsolation>,
     isolation_seconds: f64,
+    /// Lai–Cheng's patch-kind operators, made by the first [`Surface::tessellate_adaptive`]
+    /// and kept (they depend on the topology only, which [`Surface::set_positions`] keeps).
+    adaptive_operators: Mutex<Option<Arc<PatchOperators>>>,
 }
 
 impl Surface {
@@ -140,6 +144,7 @@ impl Surface {
             refines,
             isolation_seconds: started.elapsed().as_secs_f64(),
             isolated,
+            adaptive_operators: Mutex::new(None),
         })
     }
 
@@ -453,8 +458,31 @@ impl Surface {
                 self.scheme
             )));
         };
-        let (mut adaptive, stats) =
-            tessellate_adaptive(&self.table, &iso.mesh, &iso.patches, options)?;
+        // Counted from here: the first call's seconds include making the operators.
+        let started = Instant::now();
+        let operators = {
+            let mut cached = self.adaptive_operators.lock().map_err(|_| {
+                RuntimeError::Unsupported(
+                    "internal: a thread panicked while making the adaptive operators".to_owned(),
+                )
+            })?;
+            match &*cached {
+                Some(operators) => Arc::clone(operators),
+                None => {
+                    let made = Arc::new(PatchOperators::new(&iso.mesh, &iso.patches)?);
+                    *cached = Some(Arc::clone(&made));
+                    made
+                }
+            }
+        };
+        let (mut adaptive, stats) = tessellate_adaptive_with(
+            &self.table,
+            &iso.mesh,
+            &iso.patches,
+            options,
+            &operators,
+            started,
+        )?;
         iso.map_to_input(&mut adaptive.sources);
         Ok((adaptive, stats))
     }

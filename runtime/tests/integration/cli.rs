@@ -183,6 +183,42 @@ fn bench_with_a_tolerance_plans_every_frame() {
     }
 }
 
+/// `bench --tolerance T --adaptive` tessellates adaptively every frame: the triangles it reports
+/// are those `tessellate --method adaptive --triangulate` makes of the same mesh, and it refuses
+/// what Lai–Cheng's method cannot take (no tolerance, a triangle scheme).
+#[test]
+#[cfg(feature = "catmull-clark")]
+fn bench_adaptive_tessellates_every_frame() {
+    let report = json(&succeeds(
+        "bench data/cube.obj --tolerance 2e-3 --adaptive --threads 1 --frames 2",
+    ));
+    let once = json(&succeeds(&format!(
+        "tessellate data/cube.obj -o {} --method adaptive --tolerance 2e-3 --triangulate --stats",
+        temp("bench_adaptive.ply").display()
+    )));
+    assert_eq!(report["triangles"], once["triangles"], "{report}");
+    assert!(
+        report["triangles"].as_u64().is_some_and(|t| t > 0),
+        "{report}"
+    );
+    for key in [
+        "first_frame_seconds",
+        "median_seconds",
+        "triangles_per_second",
+    ] {
+        assert!(
+            report[key].as_f64().is_some_and(|x| x > 0.0),
+            "{key}: {report}"
+        );
+    }
+    assert!(fails("bench data/cube.obj --adaptive").contains("--tolerance"));
+    #[cfg(feature = "loop")]
+    assert!(
+        fails("bench data/octahedron.obj --scheme loop --tolerance 1e-2 --adaptive")
+            .contains("catmull-clark")
+    );
+}
+
 #[test]
 fn bad_input_is_a_clear_error() {
     let bad = temp("bad.obj");

@@ -962,17 +962,15 @@ pub fn tessellate_adaptive(
 ) -> Result<(AdaptiveMesh, AdaptiveStats), RuntimeError> {
     let started = Instant::now();
     check_options(options)?;
-    if patches.len() != mesh.faces() {
-        return Err(RuntimeError::Unsupported(format!(
-            "{} patches for {} faces",
-            patches.len(),
-            mesh.faces()
-        )));
-    }
-    // Which faces take which path: a hole has no surface; a face the tables describe (no sharp
-    // feature on its support, a settled dart the dart patches describe, a crease vertex's
-    // sector as a boundary patch) its table patch; any other the feature descent.
-    let path: Vec<Path> = (0..mesh.faces())
+    let operators = PatchOperators::new(mesh, patches)?;
+    tessellate_adaptive_with(table, mesh, patches, options, &operators, started)
+}
+
+/// Which faces take which path: a hole has no surface; a face the tables describe (no sharp
+/// feature on its support, a settled dart the dart patches describe, a crease vertex's sector
+/// as a boundary patch) its table patch; any other the feature descent.
+fn face_paths(mesh: &Mesh) -> Vec<Path> {
+    (0..mesh.faces())
         .map(|f| {
             if mesh.holes[f] {
                 Path::Hole
@@ -982,7 +980,54 @@ pub fn tessellate_adaptive(
                 Path::Feature
             }
         })
-        .collect();
+        .collect()
+}
+
+/// The local subdivision operators of every patch kind that an isolated mesh's table faces
+/// take, built once per topology: they depend on the patches' kinds and the mesh's boundary
+/// rule, not on its positions, so a [`crate::Surface`] keeps them from frame to frame.
+#[derive(Debug)]
+pub(crate) struct PatchOperators(HashMap<PatchKind, Operators>);
+
+impl PatchOperators {
+    /// The operators of the kinds of `patches` on the table path, built in parallel.
+    pub(crate) fn new(mesh: &Mesh, patches: &[FacePatch]) -> Result<Self, RuntimeError> {
+        let mut kinds: Vec<PatchKind> = patches
+            .iter()
+            .zip(face_paths(mesh))
+            .filter(|(_, p)| *p == Path::Table)
+            .map(|(p, _)| p.kind)
+            .collect();
+        kinds.sort_by_key(|k| (k.boundary, k.feature, k.faces, k.sector));
+        kinds.dedup();
+        kinds
+            .par_iter()
+            .map(|&kind| Ok((kind, Operators::new(mesh, kind)?)))
+            .collect::<Result<_, RuntimeError>>()
+            .map(PatchOperators)
+    }
+}
+
+/// [`tessellate_adaptive`] with the patch kinds' operators given (those of `mesh` and
+/// `patches`, [`PatchOperators::new`]), its statistics' seconds counted from `started`.
+pub(crate) fn tessellate_adaptive_with(
+    table: &StencilTable,
+    mesh: &Mesh,
+    patches: &[FacePatch],
+    options: &AdaptiveOptions,
+    operators: &PatchOperators,
+    started: Instant,
+) -> Result<(AdaptiveMesh, AdaptiveStats), RuntimeError> {
+    check_options(options)?;
+    if patches.len() != mesh.faces() {
+        return Err(RuntimeError::Unsupported(format!(
+            "{} patches for {} faces",
+            patches.len(),
+            mesh.faces()
+        )));
+    }
+    let operators = &operators.0;
+    let path = face_paths(mesh);
     // The whole feature face's diagonal, for relative flatness at its hull squares (as the
     // extraordinary square uses its whole patch's).
     let feature_faces: Vec<usize> = (0..mesh.faces())
@@ -1004,19 +1049,6 @@ pub fn tessellate_adaptive(
         let p: [Point; 4] = std::array::from_fn(|c| limit_of(&corner_points[4 * k + c], mesh)[0]);
         root_diagonal[f] = longer_diagonal(&p);
     }
-    // The operators of every patch kind on the table path, built once.
-    let mut kinds: Vec<PatchKind> = patches
-        .iter()
-        .zip(&path)
-        .filter(|(_, &p)| p == Path::Table)
-        .map(|(p, _)| p.kind)
-        .collect();
-    kinds.sort_by_key(|k| (k.boundary, k.feature, k.faces, k.sector));
-    kinds.dedup();
-    let operators: HashMap<PatchKind, Operators> = kinds
-        .par_iter()
-        .map(|&kind| Ok((kind, Operators::new(mesh, kind)?)))
-        .collect::<Result<_, RuntimeError>>()?;
     // Pass 1 (parallel): the adaptive marking of every face, within the polygon budget.
     let polygons = AtomicUsize::new(0);
     let mut work: Vec<(Vec<Leaf>, Vec<Marked>)> = patches
