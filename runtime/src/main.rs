@@ -656,6 +656,27 @@ fn time_frames(pool: &rayon::ThreadPool, frames: u32, mut frame: impl FnMut() + 
     seconds
 }
 
+/// The median of `seconds` (the upper one of an even count; zero for none).
+fn median_seconds(mut seconds: Vec<f64>) -> f64 {
+    seconds.sort_by(f64::total_cmp);
+    seconds.get(seconds.len() / 2).copied().unwrap_or(0.0)
+}
+
+/// The keys every `subtess bench` report shares: what was measured, how, and what a frame does.
+fn bench_keys(
+    report: &mut serde_json::Value,
+    args: &BenchArgs,
+    pool: &rayon::ThreadPool,
+    rates: String,
+    per_frame: &str,
+) {
+    report["mesh"] = args.mesh.display().to_string().into();
+    report["rates"] = rates.into();
+    report["threads"] = pool.current_num_threads().into();
+    report["frames"] = args.frames.into();
+    report["per_frame"] = per_frame.into();
+}
+
 /// `subtess bench`'s settings.
 struct BenchArgs {
     mesh: PathBuf,
@@ -723,12 +744,13 @@ fn bench_command(args: BenchArgs) -> Result<(), RuntimeError> {
     });
     let median = seconds[seconds.len() / 2];
     let mut report = plan_stats(&surface, &tessellator);
-    report["mesh"] = args.mesh.display().to_string().into();
-    report["rates"] = rates_label.into();
-    report["threads"] = pool.current_num_threads().into();
-    report["frames"] = args.frames.into();
-    report["per_frame"] =
-        "from the input control points: refinement stencils, then positions and normals (triangles are connected once, in the plan)".into();
+    bench_keys(
+        &mut report,
+        &args,
+        &pool,
+        rates_label,
+        "from the input control points: refinement stencils, then positions and normals (triangles are connected once, in the plan)",
+    );
     report["median_seconds"] = median.into();
     report["min_seconds"] = seconds[0].into();
     report["max_seconds"] = seconds[seconds.len() - 1].into();
@@ -775,18 +797,14 @@ fn bench_planned_frames(
         }
         Ok(())
     })?;
-    let median = |k: usize| {
-        let mut seconds: Vec<f64> = parts.iter().map(|p| p[k]).collect();
-        seconds.sort_by(f64::total_cmp);
-        seconds.get(seconds.len() / 2).copied().unwrap_or(0.0)
-    };
-    report["mesh"] = args.mesh.display().to_string().into();
-    report["rates"] = rates_label.into();
-    report["threads"] = pool.current_num_threads().into();
-    report["frames"] = args.frames.into();
-    report["per_frame"] =
-        "set the positions, choose the rates, plan at them, evaluate from the input control points"
-            .into();
+    let median = |k: usize| median_seconds(parts.iter().map(|p| p[k]).collect());
+    bench_keys(
+        &mut report,
+        args,
+        pool,
+        rates_label,
+        "set the positions, choose the rates, plan at them, evaluate from the input control points",
+    );
     report["median_rates_seconds"] = median(0).into();
     report["median_plan_seconds"] = median(1).into();
     report["median_evaluate_seconds"] = median(2).into();
@@ -811,32 +829,31 @@ fn bench_adaptive_frames(
         ..AdaptiveOptions::default()
     };
     let mut seconds = Vec::new();
-    let mut report = serde_json::Value::Null;
+    let mut last = None;
     pool.install(|| -> Result<(), RuntimeError> {
-        for frame in 0..=args.frames {
+        for _ in 0..=args.frames {
             let started = Instant::now();
             surface.set_positions(control)?;
             let (_, stats) = surface.tessellate_adaptive(&options)?;
             seconds.push(started.elapsed().as_secs_f64());
-            if frame == args.frames {
-                report = stats.to_json();
-            }
+            last = Some(stats);
         }
         Ok(())
     })?;
     let first = seconds.remove(0);
-    seconds.sort_by(f64::total_cmp);
-    let median = seconds.get(seconds.len() / 2).copied().unwrap_or(first);
-    let triangles = report["triangles"].as_f64().unwrap_or(0.0);
-    report["mesh"] = args.mesh.display().to_string().into();
-    report["rates"] = format!("adaptive, tolerance {tolerance}").into();
-    report["threads"] = pool.current_num_threads().into();
-    report["frames"] = args.frames.into();
-    report["per_frame"] =
-        "set the positions, tessellate adaptively (Lai–Cheng) into triangles".into();
+    let median = median_seconds(seconds);
+    let triangles = last.as_ref().map_or(0, |stats| stats.triangles);
+    let mut report = last.map_or(serde_json::Value::Null, |stats| stats.to_json());
+    bench_keys(
+        &mut report,
+        args,
+        pool,
+        format!("adaptive, tolerance {tolerance}"),
+        "set the positions, tessellate adaptively (Lai–Cheng) into triangles",
+    );
     report["first_frame_seconds"] = first.into();
     report["median_seconds"] = median.into();
-    report["triangles_per_second"] = (triangles / median.max(1e-12)).into();
+    report["triangles_per_second"] = (triangles as f64 / median.max(1e-12)).into();
     out!("{report}")?;
     Ok(())
 }

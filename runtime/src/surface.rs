@@ -31,7 +31,8 @@ use crate::scheme::Scheme;
 use crate::stencil_table::StencilTable;
 use crate::tessellate::dual_grid::{DualGrid, MAX_RATE};
 use crate::tessellate::lai_cheng::{
-    tessellate_adaptive_with, AdaptiveMesh, AdaptiveOptions, AdaptiveStats, PatchOperators,
+    check_input, tessellate_adaptive_with, AdaptiveMesh, AdaptiveOptions, AdaptiveStats,
+    PatchOperators,
 };
 use crate::tessellate::rates::{tolerance_rates, view_rates, ViewCamera};
 use crate::tessellate::triangle_dual_grid::TriangleDualGrid;
@@ -460,6 +461,7 @@ impl Surface {
         };
         // Counted from here: the first call's seconds include making the operators.
         let started = Instant::now();
+        check_input(&iso.mesh, &iso.patches, options)?;
         let operators = {
             let mut cached = self.adaptive_operators.lock().map_err(|_| {
                 RuntimeError::Unsupported(

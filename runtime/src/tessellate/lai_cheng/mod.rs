@@ -961,9 +961,27 @@ pub fn tessellate_adaptive(
     options: &AdaptiveOptions,
 ) -> Result<(AdaptiveMesh, AdaptiveStats), RuntimeError> {
     let started = Instant::now();
-    check_options(options)?;
+    check_input(mesh, patches, options)?;
     let operators = PatchOperators::new(mesh, patches)?;
     tessellate_adaptive_with(table, mesh, patches, options, &operators, started)
+}
+
+/// The options valid and a patch per face: what [`tessellate_adaptive_with`] assumes, checked
+/// before the operators are made.
+pub(crate) fn check_input(
+    mesh: &Mesh,
+    patches: &[FacePatch],
+    options: &AdaptiveOptions,
+) -> Result<(), RuntimeError> {
+    check_options(options)?;
+    if patches.len() != mesh.faces() {
+        return Err(RuntimeError::Unsupported(format!(
+            "{} patches for {} faces",
+            patches.len(),
+            mesh.faces()
+        )));
+    }
+    Ok(())
 }
 
 /// Which faces take which path: a hole has no surface; a face the tables describe (no sharp
@@ -1009,7 +1027,8 @@ impl PatchOperators {
 }
 
 /// [`tessellate_adaptive`] with the patch kinds' operators given (those of `mesh` and
-/// `patches`, [`PatchOperators::new`]), its statistics' seconds counted from `started`.
+/// `patches`, [`PatchOperators::new`]), its statistics' seconds counted from `started`; the
+/// input passed [`check_input`].
 pub(crate) fn tessellate_adaptive_with(
     table: &StencilTable,
     mesh: &Mesh,
@@ -1018,14 +1037,6 @@ pub(crate) fn tessellate_adaptive_with(
     operators: &PatchOperators,
     started: Instant,
 ) -> Result<(AdaptiveMesh, AdaptiveStats), RuntimeError> {
-    check_options(options)?;
-    if patches.len() != mesh.faces() {
-        return Err(RuntimeError::Unsupported(format!(
-            "{} patches for {} faces",
-            patches.len(),
-            mesh.faces()
-        )));
-    }
     let operators = &operators.0;
     let path = face_paths(mesh);
     // The whole feature face's diagonal, for relative flatness at its hull squares (as the
