@@ -26,7 +26,7 @@ use std::ops::Range;
 
 use crate::mesh::triangle_mesh::VertexSource;
 use crate::tessellate::kernel::{
-    cross, for_each_range, gather_relative, unit, PointPlan, Stencils, MAX_PATCH,
+    cross, for_each_range, patch_origin, relative, unit, PointPlan, Stencils, MAX_PATCH,
 };
 use crate::RuntimeError;
 
@@ -92,7 +92,8 @@ impl LaneStencils {
     }
 
     /// Every point from the patch whose control points are the vertices `points` of `control`
-    /// ([`gather_relative`]; nothing if they are not `K`), into `positions[t]`, `normals[t]`.
+    /// ([`gather_relative`](crate::tessellate::kernel::gather_relative)'s relative points, made here as they are broadcast; nothing if they
+    /// are not `K`), into `positions[t]`, `normals[t]`.
     pub(crate) fn evaluate_patch(
         &self,
         points: &[u32],
@@ -103,16 +104,13 @@ impl LaneStencils {
         if points.len() != self.k {
             return;
         }
-        if self.k <= MAX_PATCH {
-            let mut local = [[0.0f32; 3]; MAX_PATCH];
-            let origin = gather_relative(points, control, &mut local);
-            self.evaluate(&local[..self.k], origin, positions, normals);
-        } else {
-            // Feature-adaptive stencils can be wider (729 points next to a valence-360 vertex).
-            let mut local = vec![[0.0f32; 3]; self.k];
-            let origin = gather_relative(points, control, &mut local);
-            self.evaluate(&local, origin, positions, normals);
-        }
+        let origin = patch_origin(points, control);
+        self.evaluate_with(
+            |l| relative(control[points[l] as usize], origin),
+            origin.map(|c| c as f32),
+            positions,
+            normals,
+        );
     }
 
     /// Every point of a face from its control points `local` (relative to `origin`, `K` of
@@ -125,24 +123,46 @@ impl LaneStencils {
         positions: &mut [[f32; 3]],
         normals: &mut [[f32; 3]],
     ) {
-        // The common patch sizes get their own copies, the control points in registers or
-        // fixed stack slots (Loop's regular 12, the butterfly's and √3's 27); the rest share
-        // one.
-        match self.k {
-            12 => self.evaluate_fixed::<12>(local, origin, positions, normals),
-            27 => self.evaluate_fixed::<27>(local, origin, positions, normals),
-            _ => self.evaluate_any(local, origin, positions, normals),
+        if local.len() == self.k {
+            self.evaluate_with(|l| local[l], origin, positions, normals);
         }
     }
 
-    fn evaluate_fixed<const K: usize>(
+    /// Every point of a face from its relative control points `point(0..K)`.
+    ///
+    /// Why the common patch sizes get their own copies: the control points sit in fixed stack
+    /// slots, written once as they are broadcast (no buffer cleared first, no loop counter
+    /// over `K`): Loop's regular 12, Catmull–Clark's `2N + 8` at valences 3, 5 and 6 (14, 18,
+    /// 20), the butterfly's and √3's 27. The copies for 14, 18 and 20 took a rate-4 frame of
+    /// the triangulated Spot, half of its faces at those valences, from 14.0 to 13.3 ms
+    /// (docs/benchmarks.md); the rest share one.
+    #[inline(always)]
+    fn evaluate_with(
         &self,
-        local: &[[f32; 3]],
+        point: impl Fn(usize) -> [f32; 3],
         origin: [f32; 3],
         positions: &mut [[f32; 3]],
         normals: &mut [[f32; 3]],
     ) {
-        let q: [Splat; K] = std::array::from_fn(|l| local[l].map(f32x4::splat));
+        match self.k {
+            12 => self.evaluate_fixed::<12>(point, origin, positions, normals),
+            14 => self.evaluate_fixed::<14>(point, origin, positions, normals),
+            18 => self.evaluate_fixed::<18>(point, origin, positions, normals),
+            20 => self.evaluate_fixed::<20>(point, origin, positions, normals),
+            27 => self.evaluate_fixed::<27>(point, origin, positions, normals),
+            _ => self.evaluate_any(point, origin, positions, normals),
+        }
+    }
+
+    #[inline(always)]
+    fn evaluate_fixed<const K: usize>(
+        &self,
+        point: impl Fn(usize) -> [f32; 3],
+        origin: [f32; 3],
+        positions: &mut [[f32; 3]],
+        normals: &mut [[f32; 3]],
+    ) {
+        let q: [Splat; K] = std::array::from_fn(|l| point(l).map(f32x4::splat));
         let mut sums = [[[f32x4::ZERO; 3]; 3]; CHUNK];
         for (c, weights) in self.weights.chunks(K * CHUNK).enumerate() {
             chunk_sums_fixed::<K>(weights, &q, origin, &mut sums);
@@ -152,11 +172,13 @@ impl LaneStencils {
 
     fn evaluate_any(
         &self,
-        local: &[[f32; 3]],
+        point: impl Fn(usize) -> [f32; 3],
         origin: [f32; 3],
         positions: &mut [[f32; 3]],
         normals: &mut [[f32; 3]],
     ) {
+        // Feature-adaptive stencils can be wider than MAX_PATCH (729 points next to a
+        // valence-360 vertex).
         let mut fixed = [[f32x4::ZERO; 3]; MAX_PATCH];
         let mut wide = Vec::new();
         let q = if self.k <= MAX_PATCH {
@@ -165,8 +187,8 @@ impl LaneStencils {
             wide.resize(self.k, [f32x4::ZERO; 3]);
             &mut wide[..]
         };
-        for (q, p) in q.iter_mut().zip(local) {
-            *q = p.map(f32x4::splat);
+        for (l, q) in q.iter_mut().enumerate() {
+            *q = point(l).map(f32x4::splat);
         }
         let mut sums = [[[f32x4::ZERO; 3]; 3]; CHUNK];
         for (c, weights) in self.weights.chunks(self.k * CHUNK).enumerate() {
@@ -203,7 +225,7 @@ impl LaneStencils {
 /// runs of consecutive points over the same control points, each run's stencils in lanes.
 ///
 /// Why: a point planned on its own reads its patch's `K` control points and makes each
-/// relative ([`gather_relative`]) for one point, which costs as much as its sums; the `n - 1`
+/// relative ([`gather_relative`](crate::tessellate::kernel::gather_relative)) for one point, which costs as much as its sums; the `n - 1`
 /// curve points of an edge come from one face's patch, so one gather serves them all, and their
 /// sums run four at a time. Each point is still its own stencil summed in its own order from the
 /// run's first control point, the origin it had alone: bit-identical.
@@ -282,7 +304,11 @@ impl PointGroups {
 type LaneSums = [[f32x4; 3]; 3];
 
 /// Groups whose sums are made by one call of [`chunk_sums_fixed`] or [`chunk_sums_any`].
-const CHUNK: usize = 8;
+///
+/// Why 4: the buffer of sums is cleared once per face, and a rate-4 face is four groups;
+/// eight cleared twice what a rate-4 face used (the triangulated Spot's rate-4 frame 13.1 ->
+/// 12.7 ms with four, docs/benchmarks.md).
+const CHUNK: usize = 4;
 
 /// The sums of up to [`CHUNK`] groups (`weights`, `K` steps a group) over the control points
 /// `q`.
@@ -411,7 +437,7 @@ mod tests {
 
     /// The point-by-point formula the lanes must reproduce: position and unit normal of row
     /// `point` of `s`, a stencil of `k` weights a point, over the control points `q(0..k)`,
-    /// relative to `origin` ([`gather_relative`]): the position `origin + sum w q`, and the
+    /// relative to `origin` ([`gather_relative`](crate::tessellate::kernel::gather_relative)): the position `origin + sum w q`, and the
     /// cross product of the two derivatives `sum w_u q`, `sum w_v q`.
     fn stencil_point(
         s: &Stencils,
@@ -501,7 +527,7 @@ mod tests {
     #[test]
     fn lanes_are_the_point_by_point_sums_bit_for_bit() {
         let mut next = test_numbers(0x2545_f491);
-        for k in [5, 12, 13, 27, 33] {
+        for k in [5, 12, 13, 14, 18, 20, 27, 33] {
             for points in [1, 3, 4, 7, 19] {
                 let block = |next: &mut dyn FnMut() -> f32| -> Vec<f32> {
                     (0..points * k).map(|_| next()).collect()
