@@ -108,6 +108,7 @@ impl LaneStencils {
         self.evaluate_with(
             |l| relative(control[points[l] as usize], origin),
             origin.map(|c| c as f32),
+            |t| t,
             positions,
             normals,
         );
@@ -124,7 +125,7 @@ impl LaneStencils {
         normals: &mut [[f32; 3]],
     ) {
         if local.len() == self.k {
-            self.evaluate_with(|l| local[l], origin, positions, normals);
+            self.evaluate_with(|l| local[l], origin, |t| t, positions, normals);
         }
     }
 
@@ -136,21 +137,26 @@ impl LaneStencils {
     /// 20), the butterfly's and √3's 27. The copies for 14, 18 and 20 took a rate-4 frame of
     /// the triangulated Spot, half of its faces at those valences, from 14.0 to 13.3 ms
     /// (docs/benchmarks.md); the rest share one.
+    ///
+    /// The group of points `t..t + LANES` goes to `place(t)..` of `positions` and `normals`
+    /// (the identity for a face's own points; rows of a block of a larger grid for the
+    /// quarter of a split face, `crate::tessellate::sub_patches`).
     #[inline(always)]
-    fn evaluate_with(
+    pub(crate) fn evaluate_with(
         &self,
         point: impl Fn(usize) -> [f32; 3],
         origin: [f32; 3],
+        place: impl Fn(usize) -> usize,
         positions: &mut [[f32; 3]],
         normals: &mut [[f32; 3]],
     ) {
         match self.k {
-            12 => self.evaluate_fixed::<12>(point, origin, positions, normals),
-            14 => self.evaluate_fixed::<14>(point, origin, positions, normals),
-            18 => self.evaluate_fixed::<18>(point, origin, positions, normals),
-            20 => self.evaluate_fixed::<20>(point, origin, positions, normals),
-            27 => self.evaluate_fixed::<27>(point, origin, positions, normals),
-            _ => self.evaluate_any(point, origin, positions, normals),
+            12 => self.evaluate_fixed::<12>(point, origin, place, positions, normals),
+            14 => self.evaluate_fixed::<14>(point, origin, place, positions, normals),
+            18 => self.evaluate_fixed::<18>(point, origin, place, positions, normals),
+            20 => self.evaluate_fixed::<20>(point, origin, place, positions, normals),
+            27 => self.evaluate_fixed::<27>(point, origin, place, positions, normals),
+            _ => self.evaluate_any(point, origin, place, positions, normals),
         }
     }
 
@@ -159,6 +165,7 @@ impl LaneStencils {
         &self,
         point: impl Fn(usize) -> [f32; 3],
         origin: [f32; 3],
+        place: impl Fn(usize) -> usize,
         positions: &mut [[f32; 3]],
         normals: &mut [[f32; 3]],
     ) {
@@ -166,7 +173,13 @@ impl LaneStencils {
         let mut sums = [[[f32x4::ZERO; 3]; 3]; CHUNK];
         for (c, weights) in self.weights.chunks(K * CHUNK).enumerate() {
             chunk_sums_fixed::<K>(weights, &q, origin, &mut sums);
-            self.write(c * CHUNK, &sums[..weights.len() / K], positions, normals);
+            self.write(
+                c * CHUNK,
+                &sums[..weights.len() / K],
+                &place,
+                positions,
+                normals,
+            );
         }
     }
 
@@ -174,6 +187,7 @@ impl LaneStencils {
         &self,
         point: impl Fn(usize) -> [f32; 3],
         origin: [f32; 3],
+        place: impl Fn(usize) -> usize,
         positions: &mut [[f32; 3]],
         normals: &mut [[f32; 3]],
     ) {
@@ -196,6 +210,7 @@ impl LaneStencils {
             self.write(
                 c * CHUNK,
                 &sums[..weights.len() / self.k],
+                &place,
                 positions,
                 normals,
             );
@@ -208,15 +223,17 @@ impl LaneStencils {
         &self,
         first: usize,
         sums: &[LaneSums],
+        place: &impl Fn(usize) -> usize,
         positions: &mut [[f32; 3]],
         normals: &mut [[f32; 3]],
     ) {
         for (g, &[p, du, dv]) in sums.iter().enumerate() {
             let normal = unit_cross_x4(du, dv);
             let start = (first + g) * LANES;
-            let end = self.points.min(start + LANES);
-            store_points(p, &mut positions[start..end]);
-            store_points(normal, &mut normals[start..end]);
+            let count = self.points.min(start + LANES) - start;
+            let at = place(start);
+            store_points(p, &mut positions[at..at + count]);
+            store_points(normal, &mut normals[at..at + count]);
         }
     }
 }

@@ -10,6 +10,7 @@ pub mod lai_cheng;
 mod lane_stencils;
 mod loop_quartic;
 pub mod rates;
+mod sub_patches;
 pub mod triangle_dual_grid;
 pub mod triangle_rates;
 
