@@ -197,7 +197,8 @@ enum FaceEval {
     /// A table face at a rate [`splits`](crate::tessellate::sub_patches::splits) whose table stores the
     /// scaling relation's pieces: through one subdivision step
     /// ([`crate::tessellate::sub_patches`]), the quarter at the vertex from its stencils at
-    /// half the rate (`DualGrid::lanes[lanes]`, the patch's own order) and the three regular
+    /// half the rate (`DualGrid::lanes[lanes]`, the quarter's points in the face's order) and
+    /// the three regular
     /// sub-patches as tensor products (`DualGrid::splits[split]`).
     Split {
         split: u32,
@@ -590,8 +591,9 @@ impl DualGrid {
     }
 
     /// The split of `patch`'s faces at rate `n` ([`FaceEval::Split`]): the indices of its plan
-    /// and of its quarter's lanes (the patch's stencils at rate `n / 2`, in the patch's own
-    /// order), with the regular factors of rate `n / 2`; `None` where the face does not split.
+    /// and of its quarter's lanes (the patch's stencils at rate `n / 2`, the quarter's points in
+    /// the face's order), with the regular factors of rate `n / 2`; `None` where the face does
+    /// not split.
     fn plan_split(
         &mut self,
         table: &StencilTable,

@@ -135,7 +135,7 @@ impl LaneStencils {
     /// slots, written once as they are broadcast (no buffer cleared first, no loop counter
     /// over `K`): Loop's regular 12, Catmull–Clark's `2N + 8` at valences 3, 5 and 6 (14, 18,
     /// 20), the butterfly's and √3's 27. The copies for 14, 18 and 20 took a rate-4 frame of
-    /// the triangulated Spot, half of its faces at those valences, from 14.0 to 13.3 ms
+    /// the triangulated Spot, half of its faces at those valences, from 13.9 to 13.2 ms
     /// (docs/benchmarks.md); the rest share one.
     ///
     /// The group of points `t..t + LANES` goes to `place(t)..` of `positions` and `normals`

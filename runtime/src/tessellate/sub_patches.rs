@@ -1,4 +1,4 @@
-//! Table faces at even rates through one subdivision step: three regular sub-patches evaluated
+//! Table faces at rates 16, 24, 32, ... through one subdivision step: three regular sub-patches
 //! as tensor products, the quarter at the vertex from the table at half the rate.
 //!
 //! A compact table stores, per patch, its local subdivision matrix `A` and its three regular
@@ -11,7 +11,7 @@
 //! phi(x) = psi(2x - o_b) R_b     for x in sub-patch b (o_0 = (1,0), o_1 = (1,1), o_2 = (0,1)),
 //! ```
 //!
-//! `psi` the regular bicubic B-spline. At an even rate `n = 2m` the dual point
+//! `psi` the regular bicubic B-spline. At a rate `n = 2m` the dual point
 //! `((2i+1)/2n, (2j+1)/2n)` doubles to `((2i+1)/2m, (2j+1)/2m)`: the dual point `(i, j)` of rate
 //! `m` in the quarter at the vertex, `(i - m, j)`, `(i - m, j - m)` or `(i, j - m)` of rate `m`
 //! in sub-patch 0, 1 or 2. So the face's `n^2` points are the patch's own dual grid at rate `m`
@@ -36,7 +36,7 @@ use crate::RuntimeError;
 ///
 /// Why not 8: the triangulated Spot's frame at rate 8 took 3% longer split (its rate-4
 /// tensor products and the level-1 points cost what the table's sums at rate 8 do); at 16,
-/// 15% less (docs/benchmarks.md).
+/// 14% less (docs/benchmarks.md).
 pub(crate) fn splits(n: u32) -> bool {
     n >= 16 && n % 8 == 0
 }
