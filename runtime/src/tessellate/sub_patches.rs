@@ -68,7 +68,7 @@ impl SubPatchPlan {
     /// The split of a face of patch `kind` (`k` control points, the vertex at the face's corner
     /// `corner`) at rate `n`, or `None` where the table has no pieces for it (a table of grids,
     /// a one-face boundary corner, whose stencils depend on the mesh's boundary mode), `n` is
-    /// not one [`splits`], or `K` is beyond [`MAX_PATCH`].
+    /// a rate that does not split ([`splits`]), or `K` is beyond [`MAX_PATCH`].
     pub(crate) fn new(
         table: &StencilTable,
         kind: &PatchKind,
