@@ -998,7 +998,7 @@ impl DualGrid {
     }
 
     /// Every dual point of face `f`, from its control points relative to one of them
-    /// ([`gather_relative`](crate::tessellate::kernel::gather_relative)).
+    /// ([`relative`]).
     fn evaluate_face(
         &self,
         f: usize,
@@ -1314,7 +1314,7 @@ fn evaluate_separable_at_rate(
 /// control row (and `dq[b]` with the derivative's weights), the group's columns in the lanes;
 /// then every row `j` of the group is a 4-term combination of those with the row's weights
 /// (broadcast in the basis). `g` is relative to `origin`
-/// ([`gather_relative`](crate::tessellate::kernel::gather_relative)), where every position's sum
+/// ([`relative`]), where every position's sum
 /// starts.
 ///
 /// Why this order: the contraction along `u` is made once per group of columns and serves

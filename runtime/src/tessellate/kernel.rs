@@ -182,42 +182,27 @@ pub(crate) fn merge_rows(
 }
 
 /// The origin of a patch whose control points are `control[points[l]]`: its first point (zero
-/// for none); see [`gather_relative`].
+/// for none); see [`relative`].
 #[inline(always)]
 pub(crate) fn patch_origin(points: &[u32], control: &[[f64; 3]]) -> [f64; 3] {
     points.first().map_or([0.0; 3], |&v| control[v as usize])
 }
 
-/// Control point `p` relative to `origin`, in f32: the difference is taken in f64 and rounded
-/// once, so it carries the f32 precision of the patch's own extent, whatever `origin`'s
-/// distance from the coordinate origin (docs/reliability.md, *Precision*).
+/// Control point `p` relative to `origin` (a patch's, [`patch_origin`]), in f32: the difference
+/// is taken in f64 and rounded once, so it carries the f32 precision of the patch's own extent,
+/// whatever `origin`'s distance from the coordinate origin (docs/reliability.md, *Precision*).
+///
+/// Why every evaluation sums relative points: a derivative stencil's weights sum to zero, so
+/// `sum w_l P_l = sum w_l (P_l - O)` for any `O`, but in f32 the left side's rounding grows with
+/// `|P|`, the distance from the coordinate origin, while the right side's grows with
+/// `|P_l - O|`, the patch's size. Tangents and normals are therefore computed from relative
+/// points only, which makes them independent of where the mesh sits: a small face far from the
+/// origin gets the normals it would get at the origin. Position stencils sum to one: the
+/// position is `O + sum w_l (P_l - O)`, its sum started at `O` rounded to f32 (free, and rounded
+/// at the scale of `|O|` as the output itself is).
 #[inline(always)]
 pub(crate) fn relative(p: [f64; 3], origin: [f64; 3]) -> [f32; 3] {
     [0, 1, 2].map(|x| (p[x] - origin[x]) as f32)
-}
-
-/// A patch's control points `control[points[l]]` relative to its origin ([`patch_origin`]),
-/// into `local[l]` (as long as `points`); returns the origin rounded to f32: where the
-/// positions' sums start.
-///
-/// Why: a derivative stencil's weights sum to zero, so `sum w_l P_l = sum w_l (P_l - O)` for any
-/// `O`, but in f32 the left side's rounding grows with `|P|`, the distance from the coordinate
-/// origin, while the right side's grows with `|P_l - O|`, the patch's size. Tangents and
-/// normals are therefore computed from relative points only, which makes them independent of
-/// where the mesh sits: a small face far from the origin gets the normals it would get at the
-/// origin. Position stencils sum to one: the position is `O + sum w_l (P_l - O)`, its sum
-/// started at `O` (free, and rounded at the scale of `|O|` as the output itself is).
-#[inline(always)]
-pub(crate) fn gather_relative(
-    points: &[u32],
-    control: &[[f64; 3]],
-    local: &mut [[f32; 3]],
-) -> [f32; 3] {
-    let origin = patch_origin(points, control);
-    for (l, &v) in local.iter_mut().zip(points) {
-        *l = relative(control[v as usize], origin);
-    }
-    origin.map(|c| c as f32)
 }
 
 /// The weighted sum `sum_l row[l] control[l]` in f64, its terms added in the order of the

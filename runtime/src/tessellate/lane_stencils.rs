@@ -3,7 +3,7 @@
 //! quad faces of [`crate::tessellate::dual_grid`] that are not tensor products).
 //!
 //! A face's point `t` is, as everywhere in the dual grid, three dot products over the patch's
-//! `K` control points `q_l` (relative to the first, [`crate::tessellate::kernel::gather_relative`]):
+//! `K` control points `q_l` (relative to the first, [`crate::tessellate::kernel::relative`]):
 //!
 //! ```text
 //! P(t) = O + sum_l w_l(t) q_l,   P_u(t) = sum_l u_l(t) q_l,   P_v(t) = sum_l v_l(t) q_l,
@@ -92,8 +92,8 @@ impl LaneStencils {
     }
 
     /// Every point from the patch whose control points are the vertices `points` of `control`
-    /// ([`gather_relative`](crate::tessellate::kernel::gather_relative)'s relative points, made here as they are broadcast; nothing if they
-    /// are not `K`), into `positions[t]`, `normals[t]`.
+    /// (made [`relative`] to the first as they are broadcast; nothing if they are not `K`), into
+    /// `positions[t]`, `normals[t]`.
     pub(crate) fn evaluate_patch(
         &self,
         points: &[u32],
@@ -114,22 +114,8 @@ impl LaneStencils {
         );
     }
 
-    /// Every point of a face from its control points `local` (relative to `origin`, `K` of
-    /// them), into `positions[t]`, `normals[t]`.
-    #[inline(always)]
-    pub(crate) fn evaluate(
-        &self,
-        local: &[[f32; 3]],
-        origin: [f32; 3],
-        positions: &mut [[f32; 3]],
-        normals: &mut [[f32; 3]],
-    ) {
-        if local.len() == self.k {
-            self.evaluate_with(|l| local[l], origin, |t| t, positions, normals);
-        }
-    }
-
-    /// Every point of a face from its relative control points `point(0..K)`.
+    /// Every point of a face from its control points `point(0..K)`, relative to `origin`
+    /// ([`relative`]).
     ///
     /// Why the common patch sizes get their own copies: the control points sit in fixed stack
     /// slots, written once as they are broadcast (no buffer cleared first, no loop counter
@@ -242,7 +228,7 @@ impl LaneStencils {
 /// runs of consecutive points over the same control points, each run's stencils in lanes.
 ///
 /// Why: a point planned on its own reads its patch's `K` control points and makes each
-/// relative ([`gather_relative`](crate::tessellate::kernel::gather_relative)) for one point, which costs as much as its sums; the `n - 1`
+/// relative ([`relative`]) for one point, which costs as much as its sums; the `n - 1`
 /// curve points of an edge come from one face's patch, so one gather serves them all, and their
 /// sums run four at a time. Each point is still its own stencil summed in its own order from the
 /// run's first control point, the origin it had alone: bit-identical.
@@ -454,7 +440,7 @@ mod tests {
 
     /// The point-by-point formula the lanes must reproduce: position and unit normal of row
     /// `point` of `s`, a stencil of `k` weights a point, over the control points `q(0..k)`,
-    /// relative to `origin` ([`gather_relative`](crate::tessellate::kernel::gather_relative)): the position `origin + sum w q`, and the
+    /// relative to `origin` ([`relative`]): the position `origin + sum w q`, and the
     /// cross product of the two derivatives `sum w_u q`, `sum w_v q`.
     fn stencil_point(
         s: &Stencils,
@@ -562,7 +548,7 @@ mod tests {
                     LaneStencils::new(k, points, |t| (&s, points - 1 - t)).expect("rows in range");
                 let mut positions = vec![[0.0f32; 3]; points];
                 let mut normals = vec![[0.0f32; 3]; points];
-                lanes.evaluate(&local, origin, &mut positions, &mut normals);
+                lanes.evaluate_with(|l| local[l], origin, |t| t, &mut positions, &mut normals);
                 for t in 0..points {
                     let (p, n) = stencil_point(&s, k, points - 1 - t, origin, |l| local[l]);
                     assert_eq!(positions[t].map(f32::to_bits), p.map(f32::to_bits));

@@ -26,7 +26,7 @@
 //! both derivatives, instead of the stencils' 36.
 //!
 //! Rounding: the coefficients are contracted from the differences `P_l - P_0`, taken in f64 by
-//! [`crate::tessellate::kernel::gather_relative`] (the weights of every `c_ab` but `c_00` sum
+//! [`crate::tessellate::kernel::relative`] (the weights of every `c_ab` but `c_00` sum
 //! to zero, and `c_00`'s to one), so the large absolute position enters once, as `P_0` added to
 //! `c_00`, and the monomial terms, hence the tangents and normals, carry only the patch's own
 //! extent wherever it sits; the output agrees with the stencils' to f32 rounding of the

@@ -46,8 +46,8 @@ use crate::scheme::triangle::patch::{
 };
 pub use crate::stencil_table::TriangleStencils;
 use crate::tessellate::kernel::{
-    for_each_range, gather_relative, merge_rows, Connectivity, GridPlan, PointPlan, Stencils,
-    TessellationTime,
+    for_each_range, merge_rows, patch_origin, relative, Connectivity, GridPlan, PointPlan,
+    Stencils, TessellationTime,
 };
 use crate::tessellate::lane_stencils::{LaneStencils, PointGroups};
 use crate::tessellate::loop_quartic::{self, QuarticBasis};
@@ -590,7 +590,7 @@ impl TriangleDualGrid {
     }
 
     /// Every point of face `f`, from its control points relative to the first of them
-    /// ([`gather_relative`]).
+    /// ([`relative`]).
     fn evaluate_face(
         &self,
         f: usize,
@@ -601,13 +601,15 @@ impl TriangleDualGrid {
         let n = self.rates[f] as usize;
         let plan = &self.faces[f];
         let points = &self.control[plan.control.start as usize..plan.control.end as usize];
-        let mut local = [[0.0f32; 3]; MAX_TRIANGLE_PATCH];
-        let origin = gather_relative(points, control, &mut local);
-        if plan.quartic {
+        // The relative points are made as they are read (no buffer of MAX_TRIANGLE_PATCH
+        // points cleared per face).
+        let first = patch_origin(points, control);
+        let point = |l: usize| relative(control[points[l] as usize], first);
+        let origin = first.map(|c| c as f32);
+        if plan.quartic && points.len() >= loop_quartic::POINTS {
             let params = self.params.get(n).filter(|p| p.len() == 3 * n + 1);
             if let (Some(basis), Some(params)) = (self.quartic, params) {
-                let mut net = [[0.0f32; 3]; loop_quartic::POINTS];
-                net.copy_from_slice(&local[..loop_quartic::POINTS]);
+                let net: [[f32; 3]; loop_quartic::POINTS] = std::array::from_fn(point);
                 let frame = &basis.frame[plan.corner as usize % 3];
                 return loop_quartic::evaluate_face(
                     frame, &net, origin, n, params, positions, normals,
@@ -619,7 +621,7 @@ impl TriangleDualGrid {
         // points at a time.
         if let Some(lanes) = self.lanes.get(plan.lanes as usize) {
             if lanes.control_points() == points.len() {
-                lanes.evaluate(&local[..points.len()], origin, positions, normals);
+                lanes.evaluate_with(point, origin, |t| t, positions, normals);
             }
         }
     }
