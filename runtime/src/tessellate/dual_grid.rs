@@ -470,10 +470,8 @@ impl DualGrid {
             let described = table_may_describe(mesh, patch, f);
             // The regular patch's factors, once per rate (every tensor-product face shares them).
             let tensor = regular(patch) || !described || patch.kind.boundary;
-            if tensor && !factored[n as usize] {
-                factored[n as usize] = true;
-                grid.bases[n as usize] = unless_absent(regular_stencils(table, n))?
-                    .and_then(|s| SeparableBasis::from_stencils(&s, n as usize));
+            if tensor {
+                grid.factor(table, n, &mut factored)?;
             }
             let factors = grid.bases[n as usize].is_some();
             let s = if described {
@@ -528,7 +526,7 @@ impl DualGrid {
             let split = match splits.get(&key) {
                 Some(&split) => split,
                 None => {
-                    let split = grid.plan_split(table, patch, n)?;
+                    let split = grid.plan_split(table, patch, n, &mut factored)?;
                     splits.insert(key, split);
                     split
                 }
@@ -546,17 +544,7 @@ impl DualGrid {
             let lanes = match layouts.get(&key) {
                 Some(&lanes) => lanes,
                 None => {
-                    let n = n as usize;
-                    let corner = patch.corner;
-                    let lanes = LaneStencils::new(k, n * n, |t| {
-                        let (pi, pj) = dual_index_in_patch(corner, t % n, t / n, n);
-                        (&s, pj * n + pi)
-                    })
-                    .ok_or_else(|| RuntimeError::LayoutMismatch {
-                        key: key.0,
-                        table: s.position.len() / (n * n).max(1),
-                        patch: k,
-                    })?;
+                    let lanes = face_lanes(&s, patch, n)?;
                     let index = grid.lanes.len() as u32;
                     grid.lanes.push(lanes);
                     layouts.insert(key, index);
@@ -599,39 +587,45 @@ impl DualGrid {
         table: &StencilTable,
         patch: &FacePatch,
         n: u32,
+        factored: &mut [bool],
     ) -> Result<Option<(u32, u32)>, RuntimeError> {
         let k = patch.points.len();
         let Some(split) = SubPatchPlan::new(table, &patch.kind, k, patch.corner, n)? else {
             return Ok(None);
         };
         let m = n / 2;
-        if self.bases[m as usize].is_none() {
-            self.bases[m as usize] = unless_absent(regular_stencils(table, m))?
-                .and_then(|s| SeparableBasis::from_stencils(&s, m as usize));
-        }
+        self.factor(table, m, factored)?;
         let Some(s) = unless_absent(stencils(table, patch, PointSet::Dual, m))? else {
             return Ok(None);
         };
         if self.bases[m as usize].is_none() {
             return Ok(None);
         }
-        let m = m as usize;
-        let corner = patch.corner;
-        let lanes = LaneStencils::new(k, m * m, |t| {
-            let (pi, pj) = dual_index_in_patch(corner, t % m, t / m, m);
-            (&s, pj * m + pi)
-        })
-        .ok_or_else(|| RuntimeError::LayoutMismatch {
-            key: section(patch, StencilKind::Position, PointSet::Dual, m as u32),
-            table: s.position.len() / (m * m).max(1),
-            patch: k,
-        })?;
-        self.lanes.push(lanes);
+        self.lanes.push(face_lanes(&s, patch, m)?);
         self.splits.push(split);
         Ok(Some((
             (self.splits.len() - 1) as u32,
             (self.lanes.len() - 1) as u32,
         )))
+    }
+
+    /// The regular patch's separable factors at rate `n` into `bases[n]`, once per rate
+    /// (`factored[n]`: tried; every tensor product at that rate shares them).
+    fn factor(
+        &mut self,
+        table: &StencilTable,
+        n: u32,
+        factored: &mut [bool],
+    ) -> Result<(), RuntimeError> {
+        let n = n as usize;
+        if let (Some(done), Some(basis)) = (factored.get_mut(n), self.bases.get_mut(n)) {
+            if !*done {
+                *done = true;
+                *basis = unless_absent(regular_stencils(table, n as u32))?
+                    .and_then(|s| SeparableBasis::from_stencils(&s, n));
+            }
+        }
+        Ok(())
     }
 
     fn face_vertex(&self, f: usize, i: u32, j: u32) -> u32 {
@@ -1198,6 +1192,22 @@ fn connect_strip(strip: &Strip, out: &mut [[u32; 3]]) {
     }
 }
 
+/// A patch's stencils `s` at rate `n` in lanes, in the order of a face whose corner
+/// `patch.corner` is the patch's vertex (point `t` of the face is the patch's grid point
+/// [`dual_index_in_patch`]).
+fn face_lanes(s: &Stencils, patch: &FacePatch, n: u32) -> Result<LaneStencils, RuntimeError> {
+    let (k, corner, n) = (patch.points.len(), patch.corner, n as usize);
+    LaneStencils::new(k, n * n, |t| {
+        let (pi, pj) = dual_index_in_patch(corner, t % n, t / n, n);
+        (s, pj * n + pi)
+    })
+    .ok_or_else(|| RuntimeError::LayoutMismatch {
+        key: section(patch, StencilKind::Position, PointSet::Dual, n as u32),
+        table: s.position.len() / (n * n).max(1),
+        patch: k,
+    })
+}
+
 /// The 4 x 4 control grid of a regular interior patch at corner 0, `cells[a][b]` at layout
 /// position `(a - 1, b - 1)` (columns along `u`).
 fn regular_cells(patch: &FacePatch) -> [[u32; 4]; 4] {
@@ -1340,7 +1350,7 @@ fn evaluate_separable(
     positions: &mut [[f32; 3]],
     normals: &mut [[f32; 3]],
 ) {
-    let end = (n - 1) * stride + n;
+    let end = n.saturating_sub(1) * stride + n;
     let (positions, normals) = (&mut positions[..end], &mut normals[..end]);
     let groups = n.div_ceil(LANES);
     let (Some(xs), Some(dxs), Some(ys), Some(dys)) = (

@@ -36,7 +36,7 @@ use crate::RuntimeError;
 ///
 /// Why not 8: the triangulated Spot's frame at rate 8 took 3% longer split (its rate-4
 /// tensor products and the level-1 points cost what the table's sums at rate 8 do); at 16,
-/// 14% less (docs/benchmarks.md).
+/// 12% less (docs/benchmarks.md).
 pub(crate) fn splits(n: u32) -> bool {
     n >= 16 && n % 8 == 0
 }
