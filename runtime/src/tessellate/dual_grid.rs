@@ -72,6 +72,12 @@ struct SeparableBasis {
     /// `y` and `dy` broadcast: `y_splat[j][b]` holds `y[b][j]` in every lane.
     y_splat: Vec<[f32x4; 4]>,
     dy_splat: Vec<[f32x4; 4]>,
+    /// Rows `j` and `n - 1 - j`, for `j < n / 2`, as even and odd parts of row `j`'s weights,
+    /// broadcast: `[(y0 + y3) / 2, (y1 + y2) / 2, (y0 - y3) / 2, (y1 - y2) / 2]`, then the same
+    /// of `dy` ([`rows_by_pairs`]). Empty unless every row `n - 1 - j` is row `j` mirrored
+    /// (`y[b]` at `n - 1 - j` equal to `y[3 - b]` at `j`, `dy` with its sign changed), as the
+    /// B-spline's are at the dual points `(2j + 1) / 2n`.
+    y_pairs: Vec<[f32x4; 8]>,
 }
 
 /// Grid coordinates `(a, b)` (each in -1..=2) of the regular patch's layout entries
@@ -117,7 +123,30 @@ impl SeparableBasis {
                 .map(|i| f.each_ref().map(|w| f32x4::splat(w[i])))
                 .collect()
         };
+        let mirrored = (0..n).all(|j| {
+            (0..4).all(|b| y[b][n - 1 - j] == y[3 - b][j] && dy[b][n - 1 - j] == -dy[3 - b][j])
+        });
+        let half = |a: f32, b: f32| f32x4::splat((a + b) * 0.5);
+        let y_pairs = (0..if mirrored { n / 2 } else { 0 })
+            .map(|j| {
+                let (w, d) = (
+                    [0, 1, 2, 3].map(|b| y[b][j]),
+                    [0, 1, 2, 3].map(|b| dy[b][j]),
+                );
+                [
+                    half(w[0], w[3]),
+                    half(w[1], w[2]),
+                    half(w[0], -w[3]),
+                    half(w[1], -w[2]),
+                    half(d[0], d[3]),
+                    half(d[1], d[2]),
+                    half(d[0], -d[3]),
+                    half(d[1], -d[2]),
+                ]
+            })
+            .collect();
         SeparableBasis {
+            y_pairs,
             x_lanes: lanes(&x),
             dx_lanes: lanes(&dx),
             y_splat: splat(&y),
@@ -1300,7 +1329,9 @@ fn reflect_phantoms(g: &mut [[[f32; 3]; 4]; 4], phantoms: u8) {
 /// Why: with `n` a constant the compiler unrolls the rows and keeps the group's contractions in
 /// registers across them; a frame at rate 8 took 6–7% fewer instructions and less time that
 /// way, at rate 4 4–7% fewer instructions and 2–4% less time (docs/benchmarks.md); at rate 16
-/// it made no difference. The sums are the same, in the same order.
+/// it made no difference. The sums are the same, in the same order. At rate 4 the rows go by
+/// pairs ([`rows_by_pairs`]) when the basis has them (the B-spline's factors are mirrored; a
+/// basis that is not takes the general path, which needs no pairs).
 #[inline(always)]
 fn evaluate_separable_at_rate(
     g: &[[[f32; 3]; 4]; 4],
@@ -1311,11 +1342,12 @@ fn evaluate_separable_at_rate(
     positions: &mut [[f32; 3]],
     normals: &mut [[f32; 3]],
 ) {
+    let out = (positions, normals);
     match (n, stride) {
-        (4, 4) => evaluate_separable(g, origin, basis, 4, 4, positions, normals),
-        (8, 8) => evaluate_separable(g, origin, basis, 8, 8, positions, normals),
-        (8, 16) => evaluate_separable(g, origin, basis, 8, 16, positions, normals),
-        _ => evaluate_separable(g, origin, basis, n, stride, positions, normals),
+        (4, 4) if basis.y_pairs.len() == 2 => evaluate_separable(g, origin, basis, 4, 4, true, out),
+        (8, 8) => evaluate_separable(g, origin, basis, 8, 8, false, out),
+        (8, 16) => evaluate_separable(g, origin, basis, 8, 16, false, out),
+        _ => evaluate_separable(g, origin, basis, n, stride, false, out),
     }
 }
 
@@ -1336,7 +1368,9 @@ fn evaluate_separable_at_rate(
 /// `q'[b] = sum_a x'_a g[a][b]`, then `P = O + sum_b y_b q[b]`, `P_u = sum_b y_b q'[b]`,
 /// `P_v = sum_b y'_b q[b]`, each over `a, b = 0..4`: `q` and `q'` from zero, `P` from `O`,
 /// `P_u` and `P_v` from their first term), so the output is bit-identical to one point at a time
-/// (`separable_lanes_are_the_scalar_sums_bit_for_bit`).
+/// (`separable_lanes_are_the_scalar_sums_bit_for_bit`); except where `paired`, which
+/// [`evaluate_separable_at_rate`] sets at rate 4 when the rows' factors are mirrored: then the
+/// rows are made two at a time by [`rows_by_pairs`], whose sums differ in their rounding.
 ///
 /// Inlined, through [`evaluate_separable_at_rate`], into both of its callers (regular faces and
 /// those with phantom rows): called, it cost a rate-4 frame 5% more instructions.
@@ -1347,8 +1381,8 @@ fn evaluate_separable(
     basis: &SeparableBasis,
     n: usize,
     stride: usize,
-    positions: &mut [[f32; 3]],
-    normals: &mut [[f32; 3]],
+    paired: bool,
+    (positions, normals): (&mut [[f32; 3]], &mut [[f32; 3]]),
 ) {
     let end = n.saturating_sub(1) * stride + n;
     let (positions, normals) = (&mut positions[..end], &mut normals[..end]);
@@ -1377,7 +1411,28 @@ fn evaluate_separable(
         }
         let at = k * LANES;
         let end = n.min(at + LANES);
-        for (j, (y, dy)) in ys.iter().zip(dys).enumerate() {
+        // Rows by pairs (`paired`: the caller found them) only at rate 4, where a face's block
+        // is a few cache lines: at rates 8 and 16 the rows written alternately from both ends
+        // of the block (straight to memory) made the frame slower, though it took fewer
+        // instructions (docs/benchmarks.md).
+        let (pairs, rows) = if paired {
+            (n / 2, n / 2..n - n / 2)
+        } else {
+            (0, 0..n)
+        };
+        let pairs = basis.y_pairs.iter().take(pairs);
+        rows_by_pairs(
+            &q,
+            &dq,
+            origin,
+            pairs,
+            n,
+            stride,
+            at..end,
+            (positions, normals),
+        );
+        for j in rows {
+            let (y, dy) = (&ys[j], &dys[j]);
             let mut p = origin;
             let mut du: [f32x4; 3] = std::array::from_fn(|c| y[0] * dq[0][c]);
             let mut dv: [f32x4; 3] = std::array::from_fn(|c| dy[0] * q[0][c]);
@@ -1394,6 +1449,65 @@ fn evaluate_separable(
             let row = j * stride;
             store_points(p, &mut positions[row + at..row + end]);
             store_points(unit_cross_x4(du, dv), &mut normals[row + at..row + end]);
+        }
+    }
+}
+
+/// Rows `j` and `n - 1 - j` of a group ([`evaluate_separable`]) for every `j` of `pairs`
+/// ([`SeparableBasis::y_pairs`]), columns `columns`: with `s_0 = q_0 + q_3`, `s_1 = q_1 + q_2`,
+/// `d_0 = q_0 - q_3`, `d_1 = q_1 - q_2` and row `j`'s even and odd weights `e_b`, `o_b`, the sum
+/// `sum_b y_b q_b` is `E + O` on row `j` and `E - O` on its mirror, `E = e_0 s_0 + e_1 s_1`,
+/// `O = o_0 d_0 + o_1 d_1` (for `P_v`, whose weights change sign under the mirror, `O - E`):
+/// 4 products for two rows' sums where they took 8 (the sums of `s` and `d`, made once, serve
+/// every pair).
+///
+/// Why: at rate 4, 5% off a frame of the torus (docs/benchmarks.md). The sums differ from
+/// [`evaluate_separable`]'s row by row in their rounding only
+/// (`paired_rows_are_the_row_sums_to_rounding`).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn rows_by_pairs<'a>(
+    q: &[[f32x4; 3]; 4],
+    dq: &[[f32x4; 3]; 4],
+    origin: [f32x4; 3],
+    pairs: impl Iterator<Item = &'a [f32x4; 8]>,
+    n: usize,
+    stride: usize,
+    columns: std::ops::Range<usize>,
+    (positions, normals): (&mut [[f32; 3]], &mut [[f32; 3]]),
+) {
+    let even_odd = |q: &[[f32x4; 3]; 4]| -> [[f32x4; 3]; 4] {
+        [
+            std::array::from_fn(|c| q[0][c] + q[3][c]),
+            std::array::from_fn(|c| q[1][c] + q[2][c]),
+            std::array::from_fn(|c| q[0][c] - q[3][c]),
+            std::array::from_fn(|c| q[1][c] - q[2][c]),
+        ]
+    };
+    let (sq, sdq) = (even_odd(q), even_odd(dq));
+    for (j, w) in pairs.enumerate() {
+        let mut p = [[f32x4::ZERO; 3]; 2];
+        let mut du = [[f32x4::ZERO; 3]; 2];
+        let mut dv = [[f32x4::ZERO; 3]; 2];
+        for c in 0..3 {
+            let e = origin[c] + w[0] * sq[0][c] + w[1] * sq[1][c];
+            let o = w[2] * sq[2][c] + w[3] * sq[3][c];
+            p[0][c] = e + o;
+            p[1][c] = e - o;
+            let e = w[0] * sdq[0][c] + w[1] * sdq[1][c];
+            let o = w[2] * sdq[2][c] + w[3] * sdq[3][c];
+            du[0][c] = e + o;
+            du[1][c] = e - o;
+            let e = w[4] * sq[0][c] + w[5] * sq[1][c];
+            let o = w[6] * sq[2][c] + w[7] * sq[3][c];
+            dv[0][c] = e + o;
+            dv[1][c] = o - e;
+        }
+        for (r, row) in [j, n - 1 - j].into_iter().enumerate() {
+            let row = row * stride;
+            let out = row + columns.start..row + columns.end;
+            store_points(p[r], &mut positions[out.clone()]);
+            store_points(unit_cross_x4(du[r], dv[r]), &mut normals[out]);
         }
     }
 }
@@ -1574,6 +1688,79 @@ mod tests {
         }
         assert!(worst_position < 2e-6, "positions off by {worst_position:e}");
         assert!(worst_angle < 1e-5, "normals off by {worst_angle:e} rad");
+    }
+
+    /// At rate 4 the rows are made by pairs ([`rows_by_pairs`]): the embedded table's factors
+    /// at that rate are mirrored (so the frame takes that path), and for mirrored factors the
+    /// pairs give the rows' sums of [`evaluate_separable`] one row at a time to the rounding of
+    /// `f32` sums of terms below 8 in size: positions within 4e-6, normals within 1e-5 rad, on
+    /// random nets; factors that are not mirrored have no pairs.
+    #[test]
+    #[cfg(feature = "catmull-clark")]
+    fn paired_rows_are_the_row_sums_to_rounding() {
+        let table = StencilTable::default_catmull_clark().expect("embedded table");
+        let s = regular_stencils(&table, 4).expect("rate-4 regular stencils");
+        let real = SeparableBasis::from_stencils(&s, 4).expect("the regular patch factors");
+        assert_eq!(
+            real.y_pairs.len(),
+            2,
+            "the table's rate-4 factors are mirrored"
+        );
+        let mut next = test_numbers(0x5eed_1234);
+        let mut mirrored = |odd: bool| -> [Vec<f32>; 4] {
+            let mut f: [Vec<f32>; 4] = std::array::from_fn(|_| vec![0.0; 4]);
+            for j in 0..2 {
+                for b in 0..4 {
+                    let w = next();
+                    f[b][j] = w;
+                    f[3 - b][3 - j] = if odd { -w } else { w };
+                }
+            }
+            f
+        };
+        let (x, dx, y, dy) = (
+            mirrored(false),
+            mirrored(true),
+            mirrored(false),
+            mirrored(true),
+        );
+        let basis = SeparableBasis::from_factors(x.clone(), dx, y.clone(), dy);
+        assert_eq!(basis.y_pairs.len(), 2);
+        let mut skewed = y.clone();
+        skewed[0][3] += 0.25;
+        let lopsided = SeparableBasis::from_factors(x.clone(), x.clone(), skewed, y);
+        assert!(
+            lopsided.y_pairs.is_empty(),
+            "rows that are not mirrored have no pairs"
+        );
+        for _ in 0..50 {
+            let g: [[[f32; 3]; 4]; 4] = std::array::from_fn(|_| {
+                std::array::from_fn(|_| [next() * 4.0, next() * 4.0, next() * 4.0])
+            });
+            let origin = [next(), next() * 8.0, 2.0];
+            let by = |paired: bool| {
+                let mut out = (vec![[0.0f32; 3]; 16], vec![[0.0f32; 3]; 16]);
+                let rows = (&mut out.0[..], &mut out.1[..]);
+                evaluate_separable(&g, origin, &basis, 4, 4, paired, rows);
+                out
+            };
+            let ((p, n), (p1, n1)) = (by(true), by(false));
+            for k in 0..16 {
+                let d = (0..3)
+                    .map(|c| (p[k][c] - p1[k][c]).abs())
+                    .fold(0.0, f32::max);
+                assert!(d < 4e-6, "point {k}: {:?} != {:?}", p[k], p1[k]);
+                // The angle between two unit normals: its sine small, its cosine positive.
+                let sine = crate::mesh::geometry::norm(cross(n[k], n1[k]));
+                let cosine: f32 = (0..3).map(|c| n[k][c] * n1[k][c]).sum();
+                assert!(
+                    sine < 1e-5 && cosine > 0.0,
+                    "normal {k}: {:?} != {:?}",
+                    n[k],
+                    n1[k]
+                );
+            }
+        }
     }
 
     /// The lanes give the scalar tensor-product sums (the formulas of [`evaluate_separable`]'s
