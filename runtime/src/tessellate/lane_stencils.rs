@@ -35,11 +35,11 @@ pub(crate) const LANES: usize = 4;
 
 /// One step `l` of a group of points: the weights of control point `l` for position, d/du and
 /// d/dv, one lane per point (aligned vectors: a multiply takes its weights from memory).
-type LaneWeights = [f32x4; 3];
+pub(crate) type LaneWeights = [f32x4; 3];
 
 /// A control point's coordinates, each broadcast to every lane once per face (not once per
 /// group of points).
-type Splat = [f32x4; 3];
+pub(crate) type Splat = [f32x4; 3];
 
 /// The stencils of every point of one kind of face (table section, face corner, rate) in the
 /// face's output order, `LANES` points a group.
@@ -304,14 +304,14 @@ impl PointGroups {
 }
 
 /// One group's sums: `[position, d/du, d/dv][coordinate]`, a point per lane.
-type LaneSums = [[f32x4; 3]; 3];
+pub(crate) type LaneSums = [[f32x4; 3]; 3];
 
 /// Groups whose sums are made by one call of [`chunk_sums_fixed`] or [`chunk_sums_any`].
 ///
 /// Why 4: the buffer of sums is cleared once per face, and a rate-4 face is four groups;
 /// eight cleared twice what a rate-4 face used (the triangulated Spot's rate-4 frame 13.1 ->
 /// 12.7 ms with four, docs/benchmarks.md).
-const CHUNK: usize = 4;
+pub(crate) const CHUNK: usize = 4;
 
 /// The sums of up to [`CHUNK`] groups (`weights`, `K` steps a group) over the control points
 /// `q`.
@@ -321,7 +321,7 @@ const CHUNK: usize = 4;
 /// instead of by lane, shuffling every step (measured: three times the instructions); made
 /// apart and stored whole, every step is one vector multiply-add per quantity and coordinate.
 #[inline(never)]
-fn chunk_sums_fixed<const K: usize>(
+pub(crate) fn chunk_sums_fixed<const K: usize>(
     weights: &[LaneWeights],
     q: &[Splat; K],
     origin: [f32; 3],

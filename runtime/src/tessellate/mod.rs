@@ -9,6 +9,7 @@ mod kernel;
 pub mod lai_cheng;
 mod lane_stencils;
 mod loop_quartic;
+mod mirror_stencils;
 pub mod rates;
 mod sub_patches;
 pub mod triangle_dual_grid;
