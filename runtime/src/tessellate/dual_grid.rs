@@ -42,8 +42,8 @@ use crate::scheme::patch::{dual_index_in_patch, FacePatch, PatchKind};
 use crate::stencil_table::StencilTable;
 pub use crate::tessellate::kernel::TessellationTime;
 use crate::tessellate::kernel::{
-    for_each_range, merge_rows, patch_origin, relative, table_may_describe, unless_absent,
-    Connectivity, GridPlan, PointPlan, Stencils, MAX_PATCH,
+    append_control, for_each_range, merge_rows, patch_origin, relative, table_may_describe,
+    unless_absent, Connectivity, GridPlan, PointPlan, Stencils, MAX_PATCH,
 };
 use crate::tessellate::lane_stencils::{
     store_points, unit_cross_x4, LaneStencils, PointGroups, LANES,
@@ -570,12 +570,11 @@ impl DualGrid {
                 }
             };
             if let Some((split, lanes)) = split {
-                let start = grid.control.len() as u32;
-                grid.control.extend_from_slice(&patch.points);
+                let control = append_control(&mut grid.control, &patch.points)?;
                 grid.faces.push(FaceEval::Split {
                     split,
                     lanes,
-                    control: start..grid.control.len() as u32,
+                    control,
                 });
                 continue;
             }
@@ -595,12 +594,8 @@ impl DualGrid {
                 }
             };
             if let Some(mirror) = mirror {
-                let start = grid.control.len() as u32;
-                grid.control.extend_from_slice(&patch.points);
-                grid.faces.push(FaceEval::Mirror {
-                    mirror,
-                    control: start..grid.control.len() as u32,
-                });
+                let control = append_control(&mut grid.control, &patch.points)?;
+                grid.faces.push(FaceEval::Mirror { mirror, control });
                 continue;
             }
             let lanes = match layouts.get(&key) {
@@ -613,12 +608,8 @@ impl DualGrid {
                     index
                 }
             };
-            let start = grid.control.len() as u32;
-            grid.control.extend_from_slice(&patch.points);
-            grid.faces.push(FaceEval::Table {
-                lanes,
-                control: start..grid.control.len() as u32,
-            });
+            let control = append_control(&mut grid.control, &patch.points)?;
+            grid.faces.push(FaceEval::Table { lanes, control });
         }
         grid.plan_connectivity(table, mesh, patches, channel)?;
         grid.plan_local(mesh, &local_faces)?;
@@ -752,16 +743,10 @@ impl DualGrid {
         // The primal grid's rotation into the patch: as for dual points, with n + 1 points a row.
         let (pi, pj) = dual_index_in_patch(patch.corner, i as usize, j as usize, n as usize + 1);
         let k = patch.points.len();
-        let start = self.control.len() as u32;
-        self.control.extend_from_slice(&patch.points);
+        let control = append_control(&mut self.control, &patch.points)?;
         let row = pj * (n as usize + 1) + pi;
-        self.boundary_points.push(PointPlan::from_row(
-            &s,
-            row,
-            k,
-            start..self.control.len() as u32,
-            source,
-        ));
+        self.boundary_points
+            .push(PointPlan::from_row(&s, row, k, control, source));
         Ok(())
     }
 
@@ -803,22 +788,21 @@ impl DualGrid {
             let lanes = LaneStencils::new(control.len(), n * n, |t| (&s, t)).ok_or_else(|| {
                 RuntimeError::Unsupported(format!("face {f} has no points at rate {n}"))
             })?;
-            let start = self.control.len() as u32;
-            self.control.extend_from_slice(&control);
+            let control = append_control(&mut self.control, &control)?;
             self.faces[f] = FaceEval::Local {
-                control: start..self.control.len() as u32,
+                control,
                 lanes: self.lanes.len() as u32,
             };
             self.lanes.push(lanes);
         }
-        for (&(plan, _), stencil) in self.local_points.iter().zip(&stencils[at..]) {
+        for (&(plan, _), stencil) in std::mem::take(&mut self.local_points)
+            .iter()
+            .zip(&stencils[at..])
+        {
             let (control, weights) = dense(std::slice::from_ref(stencil));
-            let start = self.control.len() as u32;
-            self.control.extend_from_slice(&control);
-            self.boundary_points[plan].control = start..self.control.len() as u32;
+            self.boundary_points[plan].control = append_control(&mut self.control, &control)?;
             self.boundary_points[plan].weights = weights;
         }
-        self.local_points.clear();
         Ok(())
     }
 

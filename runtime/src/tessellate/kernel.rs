@@ -188,6 +188,26 @@ pub(crate) fn patch_origin(points: &[u32], control: &[[f64; 3]]) -> [f64; 3] {
     points.first().map_or([0.0; 3], |&v| control[v as usize])
 }
 
+/// `points` appended to a plan's control-point indices `control`, and where they lie there;
+/// refused when the indices would pass `u32` (billions of patch corners).
+pub(crate) fn append_control(
+    control: &mut Vec<u32>,
+    points: &[u32],
+) -> Result<Range<u32>, RuntimeError> {
+    let start = control.len();
+    let end = start.saturating_add(points.len());
+    let (Ok(first), Ok(last)) = (u32::try_from(start), u32::try_from(end)) else {
+        return Err(RuntimeError::OverBudget {
+            what: "the tessellation's plan".to_owned(),
+            estimate: format!("{end} control-point indices for its patches"),
+            limit: format!("{} indices", u32::MAX),
+            raise: "the plan's indices are 32-bit".to_owned(),
+        });
+    };
+    control.extend_from_slice(points);
+    Ok(first..last)
+}
+
 /// Control point `p` relative to `origin` (a patch's, [`patch_origin`]), in f32: the difference
 /// is taken in f64 and rounded once, so it carries the f32 precision of the patch's own extent,
 /// whatever `origin`'s distance from the coordinate origin (docs/reliability.md, *Precision*).

@@ -46,8 +46,8 @@ use crate::scheme::triangle::patch::{
 };
 pub use crate::stencil_table::TriangleStencils;
 use crate::tessellate::kernel::{
-    for_each_range, merge_rows, patch_origin, relative, Connectivity, GridPlan, PointPlan,
-    Stencils, TessellationTime,
+    append_control, for_each_range, merge_rows, patch_origin, relative, Connectivity, GridPlan,
+    PointPlan, Stencils, TessellationTime,
 };
 use crate::tessellate::lane_stencils::{LaneStencils, PointGroups};
 use crate::tessellate::loop_quartic::{self, QuarticBasis};
@@ -388,11 +388,10 @@ impl TriangleDualGrid {
                     (index, quartic)
                 }
             };
-            let start = grid.control.len() as u32;
-            grid.control.extend_from_slice(&patch.points);
+            let control = append_control(&mut grid.control, &patch.points)?;
             grid.faces.push(FacePlan {
                 lanes,
-                control: start..grid.control.len() as u32,
+                control,
                 corner: patch.corner as u8,
                 quartic,
             });
@@ -456,8 +455,7 @@ impl TriangleDualGrid {
         let (pi, pj) = primal_in_patch(patch.corner, n, i, j);
         let k = patch.points.len();
         let at = primal_index(n, pi, pj);
-        let start = self.control.len() as u32;
-        self.control.extend_from_slice(&patch.points);
+        let control = append_control(&mut self.control, &patch.points)?;
         let index = self.first[self.rates.len()] + self.points.len() as u32;
         let source = VertexSource {
             face: f as u32,
@@ -466,13 +464,8 @@ impl TriangleDualGrid {
             denominator: n,
             subface: 0,
         };
-        self.points.push(PointPlan::from_row(
-            &s,
-            at,
-            k,
-            start..self.control.len() as u32,
-            source,
-        ));
+        self.points
+            .push(PointPlan::from_row(&s, at, k, control, source));
         Ok(index)
     }
 
