@@ -112,6 +112,17 @@ enum Command {
         /// triangles (docs/cli.md).
         #[arg(long, requires = "tolerance")]
         adaptive: bool,
+        /// With --tolerance: move the mesh every frame, as an arm bends at a joint: the points
+        /// beyond the middle of the bounding box's longest side turn about its shortest axis by
+        /// up to DEGREES (a sine over 60 frames), blended across a band of a tenth of that
+        /// side (docs/cli.md). 0, the default, sets the same points every frame.
+        #[arg(
+            long,
+            requires = "tolerance",
+            conflicts_with = "adaptive",
+            default_value_t = 0.0
+        )]
+        motion: f64,
         /// Worker threads, 1..=256 (default: one per core).
         #[arg(long, value_parser = threads_arg)]
         threads: Option<usize>,
@@ -684,6 +695,7 @@ struct BenchArgs {
     mixed: bool,
     tolerance: Option<f64>,
     adaptive: bool,
+    motion: f64,
     threads: Option<usize>,
     steps: u32,
     max_triangles: u64,
@@ -770,17 +782,22 @@ fn bench_planned_frames(
     args: &BenchArgs,
     rates_label: String,
 ) -> Result<(), RuntimeError> {
-    // [rates, plan after the rates, evaluate, the whole frame] of every frame.
-    let mut parts: Vec<[f64; 4]> = Vec::new();
+    // [rates, plan after the rates, evaluate, the whole frame, faces sampled] of every frame.
+    let mut parts: Vec<[f64; 5]> = Vec::new();
     let mut report = serde_json::Value::Null;
+    // The frames' points, made before the timing.
+    let moved: Vec<Vec<[f32; 3]>> = (0..=args.frames)
+        .map(|frame| joint_motion(control, args.motion, frame))
+        .collect();
     pool.install(|| -> Result<(), RuntimeError> {
-        // One frame untimed (the table's grids are expanded on first use), then the frames.
-        for frame in 0..=args.frames {
+        // One frame untimed (the table's grids are expanded on first use, and the rates are
+        // chosen on every face), then the frames.
+        for (frame, points) in moved.iter().enumerate() {
             let started = Instant::now();
-            surface.set_positions(control)?;
+            surface.set_positions(points)?;
             let mut tessellator = surface.tessellator_within(rates, args.max_triangles)?;
             let planned = Instant::now();
-            tessellator.evaluate(control)?;
+            tessellator.evaluate(points)?;
             let (evaluate, whole) = (planned.elapsed(), started.elapsed());
             if frame > 0 {
                 let rates = tessellator.rates_seconds();
@@ -789,9 +806,10 @@ fn bench_planned_frames(
                     tessellator.plan_seconds() - rates,
                     evaluate.as_secs_f64(),
                     whole.as_secs_f64(),
+                    tessellator.faces_sampled().map_or(f64::NAN, |n| n as f64),
                 ]);
             }
-            if frame == args.frames {
+            if frame == args.frames as usize {
                 report = plan_stats(surface, &tessellator);
             }
         }
@@ -809,8 +827,53 @@ fn bench_planned_frames(
     report["median_plan_seconds"] = median(1).into();
     report["median_evaluate_seconds"] = median(2).into();
     report["median_seconds"] = median(3).into();
+    report["motion_degrees"] = args.motion.into();
+    let sampled = median(4);
+    if sampled.is_finite() {
+        report["median_faces_sampled"] = sampled.into();
+    }
     out!("{report}")?;
     Ok(())
+}
+
+/// Frame `frame` of `subtess bench --motion DEGREES`: the points beyond the middle of the
+/// bounding box's longest side turned about the box's shortest axis (through its centre) by
+/// `DEGREES sin(2 pi frame / 60)`, blended by a smoothstep across a band of a tenth of that side
+/// about the middle, as skinning bends an arm at a joint; `points` itself for 0 degrees.
+fn joint_motion(points: &[[f32; 3]], degrees: f64, frame: u32) -> Vec<[f32; 3]> {
+    if degrees == 0.0 {
+        return points.to_vec();
+    }
+    let (mut low, mut high) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for p in points {
+        for c in 0..3 {
+            low[c] = low[c].min(f64::from(p[c]));
+            high[c] = high[c].max(f64::from(p[c]));
+        }
+    }
+    let extent = [0, 1, 2].map(|c| high[c] - low[c]);
+    let mut axes = [0, 1, 2];
+    axes.sort_by(|&a, &b| extent[b].total_cmp(&extent[a]));
+    let [long, middle, _] = axes;
+    let centre = [0, 1, 2].map(|c| 0.5 * (low[c] + high[c]));
+    let angle = degrees.to_radians() * (std::f64::consts::TAU * f64::from(frame) / 60.0).sin();
+    let band = 0.05 * extent[long];
+    points
+        .iter()
+        .map(|p| {
+            let along = f64::from(p[long]) - centre[long];
+            let t = ((along + band) / (2.0 * band)).clamp(0.0, 1.0);
+            let (sin, cos) = (angle * t * t * (3.0 - 2.0 * t)).sin_cos();
+            let (x, y) = (
+                f64::from(p[long]) - centre[long],
+                f64::from(p[middle]) - centre[middle],
+            );
+            let mut q = *p;
+            q[long] = (centre[long] + cos * x - sin * y) as f32;
+            q[middle] = (centre[middle] + sin * x + cos * y) as f32;
+            q
+        })
+        .collect()
 }
 
 /// `subtess bench --tolerance T --adaptive`: every frame sets the surface's positions and
@@ -972,6 +1035,7 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
             mixed,
             tolerance,
             adaptive,
+            motion,
             threads,
             refine,
             max_triangles,
@@ -984,6 +1048,7 @@ fn run(cli: Cli) -> Result<(), RuntimeError> {
             mixed,
             tolerance,
             adaptive,
+            motion,
             threads,
             steps: refine,
             max_triangles,

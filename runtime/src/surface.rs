@@ -34,7 +34,8 @@ use crate::tessellate::lai_cheng::{
     check_input, tessellate_adaptive_with, AdaptiveMesh, AdaptiveOptions, AdaptiveStats,
     PatchOperators,
 };
-use crate::tessellate::rates::{tolerance_rates, view_rates, ViewCamera};
+use crate::tessellate::rate_memory::RateMemory;
+use crate::tessellate::rates::{view_rates, ViewCamera, RATIONAL_RATES};
 use crate::tessellate::triangle_dual_grid::TriangleDualGrid;
 use crate::tessellate::triangle_rates::triangle_tolerance_rates;
 use crate::tessellate::GridPlan;
@@ -95,6 +96,9 @@ pub struct Surface {
     /// Lai–Cheng's patch-kind operators, made by the first [`Surface::tessellate_adaptive`]
     /// and kept (they depend on the topology only, which [`Surface::set_positions`] keeps).
     adaptive_operators: Mutex<Option<Arc<PatchOperators>>>,
+    /// The last tolerance selection (Catmull–Clark), what lets the next frame keep the rates
+    /// of faces that moved almost rigidly ([`RateMemory`]).
+    rate_memory: Mutex<Option<RateMemory>>,
 }
 
 impl Surface {
@@ -146,6 +150,7 @@ impl Surface {
             isolation_seconds: started.elapsed().as_secs_f64(),
             isolated,
             adaptive_operators: Mutex::new(None),
+            rate_memory: Mutex::new(None),
         })
     }
 
@@ -297,8 +302,8 @@ impl Surface {
         OutputEstimate::dual_grid(self.scheme.is_triangle(), rates)
     }
 
-    /// Per isolated face rates, and how many faces miss a tolerance.
-    fn face_rates(&self, rates: &Rates) -> Result<(Vec<u32>, Option<usize>), RuntimeError> {
+    /// Per isolated face rates, and what a tolerance's selection reports.
+    fn face_rates(&self, rates: &Rates) -> Result<FaceRates, RuntimeError> {
         let faces = self.faces();
         let check = |n: u32, what: &str| {
             if (1..=MAX_RATE).contains(&n) {
@@ -311,7 +316,7 @@ impl Surface {
             }
         };
         Ok(match rates {
-            Rates::Uniform(n) => (vec![check(*n, "rate")?; faces], None),
+            Rates::Uniform(n) => FaceRates::given(vec![check(*n, "rate")?; faces]),
             Rates::PerFace(per_input) => {
                 if per_input.len() != self.input_faces {
                     return Err(RuntimeError::InvalidParameter {
@@ -331,12 +336,27 @@ impl Surface {
                     .iter()
                     .map(|&f| per_input[f as usize])
                     .collect();
-                (rates, None)
+                FaceRates::given(rates)
             }
             Rates::Tolerance(t) => {
+                let mut sampled = None;
                 let chosen = match &self.isolated {
                     Isolated::Quad(iso) => {
-                        tolerance_rates(&self.table, &iso.mesh, &iso.patches, *t)?
+                        let mut memory = self.rate_memory.lock().map_err(|_| {
+                            RuntimeError::Unsupported(
+                                "internal: a thread panicked while choosing rates".to_owned(),
+                            )
+                        })?;
+                        let chosen = RateMemory::rates(
+                            &mut memory,
+                            &self.table,
+                            &iso.mesh,
+                            &iso.patches,
+                            *t,
+                            &RATIONAL_RATES,
+                        )?;
+                        sampled = memory.as_ref().map(RateMemory::sampled);
+                        chosen
                     }
                     Isolated::Triangle(iso)
                         if self.scheme == Scheme::Sqrt3
@@ -351,9 +371,13 @@ impl Surface {
                     Isolated::Triangle(iso) => triangle_tolerance_rates(&self.table, iso, *t)?,
                 };
                 let unmet = chosen.unmet.len();
-                (chosen.rates, Some(unmet))
+                FaceRates {
+                    rates: chosen.rates,
+                    faces_over_tolerance: Some(unmet),
+                    faces_sampled: sampled,
+                }
             }
-            Rates::View(camera) => (view_rates(self.mesh(), camera)?, None),
+            Rates::View(camera) => FaceRates::given(view_rates(self.mesh(), camera)?),
         })
     }
 
@@ -374,7 +398,11 @@ impl Surface {
         max_triangles: u64,
     ) -> Result<Tessellator<'_>, RuntimeError> {
         let started = Instant::now();
-        let (rates, faces_over_tolerance) = self.face_rates(rates)?;
+        let FaceRates {
+            rates,
+            faces_over_tolerance,
+            faces_sampled,
+        } = self.face_rates(rates)?;
         let rates_seconds = started.elapsed().as_secs_f64();
         self.estimate_rates(&rates)
             .check("the tessellation", max_triangles)?;
@@ -432,6 +460,7 @@ impl Surface {
             grid,
             rates,
             faces_over_tolerance,
+            faces_sampled,
             input: Vec::new(),
             control: Vec::new(),
             positions: vec![[0.0; 3]; vertices],
@@ -497,6 +526,7 @@ pub struct Tessellator<'s> {
     grid: Box<dyn GridPlan + 's>,
     rates: Vec<u32>,
     faces_over_tolerance: Option<usize>,
+    faces_sampled: Option<usize>,
     /// The input points of the current frame, in f64.
     input: Vec<[f64; 3]>,
     /// The isolated control points of the current frame (when isolation took steps).
@@ -564,6 +594,15 @@ impl<'s> Tessellator<'s> {
         self.faces_over_tolerance
     }
 
+    /// With [`Rates::Tolerance`] (Catmull–Clark): how many faces the selection sampled. The
+    /// first plan of a surface samples every face; after [`Surface::set_positions`], a face
+    /// whose neighbourhood moved almost rigidly since it was sampled keeps its rate unsampled
+    /// where a bound proves the selection would choose it again (the rates are a fresh
+    /// surface's either way; docs/runtime.md).
+    pub fn faces_sampled(&self) -> Option<usize> {
+        self.faces_sampled
+    }
+
     /// How many faces take a polynomial fast path: quads the separable (tensor-product)
     /// bicubic, Loop triangles one quartic per face (0 for the other triangle schemes).
     pub fn separable_faces(&self) -> usize {
@@ -586,6 +625,25 @@ impl<'s> Tessellator<'s> {
     /// selection or a camera's, next to nothing for rates given.
     pub fn rates_seconds(&self) -> f64 {
         self.rates_seconds
+    }
+}
+
+/// Per isolated face rates, and with a tolerance how many faces miss it and how many its
+/// selection sampled.
+struct FaceRates {
+    rates: Vec<u32>,
+    faces_over_tolerance: Option<usize>,
+    faces_sampled: Option<usize>,
+}
+
+impl FaceRates {
+    /// Rates given or from a camera: nothing to report.
+    fn given(rates: Vec<u32>) -> Self {
+        FaceRates {
+            rates,
+            faces_over_tolerance: None,
+            faces_sampled: None,
+        }
     }
 }
 

@@ -10,6 +10,7 @@ pub mod lai_cheng;
 mod lane_stencils;
 mod loop_quartic;
 mod mirror_stencils;
+pub(crate) mod rate_memory;
 pub mod rates;
 mod sub_patches;
 pub mod triangle_dual_grid;

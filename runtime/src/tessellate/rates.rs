@@ -1587,6 +1587,28 @@ pub fn tolerance_rates_among(
     tolerance: f64,
     candidates: &[u32],
 ) -> Result<ToleranceRates, RuntimeError> {
+    with_selection(table, mesh, patches, tolerance, candidates, |choose| {
+        let choices = (0..patches.len())
+            .into_par_iter()
+            .map(choose)
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(ToleranceRates::from_choices(&choices))
+    })
+}
+
+/// Runs `body` with the selection of [`tolerance_rates_among`] for one face at a time
+/// (`choose(f)`, from the mesh's current positions): what a full selection and a partial one
+/// ([`super::rate_memory`]) share.
+pub(crate) fn with_selection<R>(
+    table: &StencilTable,
+    mesh: &Mesh,
+    patches: &[FacePatch],
+    tolerance: f64,
+    candidates: &[u32],
+    body: impl FnOnce(
+        &(dyn Fn(usize) -> Result<FaceChoice, RuntimeError> + Sync),
+    ) -> Result<R, RuntimeError>,
+) -> Result<R, RuntimeError> {
     check_tolerance(tolerance)?;
     let sorted = sorted_candidates(candidates, &RATIONAL_RATES)?;
     let adaptive = adaptive_faces(table, mesh, patches)?;
@@ -1594,48 +1616,61 @@ pub fn tolerance_rates_among(
     // A rate below the largest is only compared with the tolerance; the largest's deviation is
     // reported when no rate meets it, so it is measured in full.
     let largest = sorted.last().copied().unwrap_or(0);
-    select_rates(
-        patches.len(),
-        tolerance,
-        &sorted,
-        |f| {
-            if ctx.hole(f) {
-                return Ok(Samples::none());
-            }
-            Samples::new(&ctx.points[f], SELECTION_GRID)
-        },
-        |f, samples, n| {
-            if ctx.hole(f) {
-                return Ok(0.0);
-            }
-            let stop = if n == largest {
-                f64::INFINITY
-            } else {
-                tolerance
-            };
-            // Most samples are interior, where the face's own dual points are all of
-            // `L_{f,n}`: a failing rate is refuted there before its neighbours' rows and its
-            // corners' polygons are evaluated, unless the last rate failed only outside.
-            let local = FaceLocal::new(&ctx, f, n)?;
-            let mut worst = 0.0f64;
-            if !samples.outside_first.get() {
-                worst = local.deviation_up_to(samples, stop, |interior| interior)?;
+    let choose = |f: usize| {
+        choose_rate(
+            f,
+            tolerance,
+            &sorted,
+            |f| {
+                if ctx.hole(f) {
+                    return Ok(Samples::none());
+                }
+                Samples::new(&ctx.points[f], SELECTION_GRID)
+            },
+            |f, samples, n| {
+                if ctx.hole(f) {
+                    return Ok(0.0);
+                }
+                let stop = if n == largest {
+                    f64::INFINITY
+                } else {
+                    tolerance
+                };
+                // Most samples are interior, where the face's own dual points are all of
+                // `L_{f,n}`: a failing rate is refuted there before its neighbours' rows and
+                // its corners' polygons are evaluated, unless the last rate failed only
+                // outside.
+                let local = FaceLocal::new(&ctx, f, n)?;
+                let mut worst = 0.0f64;
+                if !samples.outside_first.get() {
+                    worst = local.deviation_up_to(samples, stop, |interior| interior)?;
+                    if worst > stop {
+                        return Ok(worst);
+                    }
+                }
+                worst = worst.max(local.deviation_up_to(samples, stop, |interior| !interior)?);
                 if worst > stop {
+                    samples.outside_first.set(true);
                     return Ok(worst);
                 }
-            }
-            worst = worst.max(local.deviation_up_to(samples, stop, |interior| !interior)?);
-            if worst > stop {
-                samples.outside_first.set(true);
-                return Ok(worst);
-            }
-            if samples.outside_first.get() {
-                samples.outside_first.set(false);
-                worst = worst.max(local.deviation_up_to(samples, stop, |interior| interior)?);
-            }
-            Ok(worst)
-        },
-    )
+                if samples.outside_first.get() {
+                    samples.outside_first.set(false);
+                    worst = worst.max(local.deviation_up_to(samples, stop, |interior| interior)?);
+                }
+                Ok(worst)
+            },
+        )
+    };
+    body(&choose)
+}
+
+/// The faces the selection samples by feature-adaptive refinement, ascending ([module docs](self)).
+pub(crate) fn adaptive_face_list(
+    table: &StencilTable,
+    mesh: &Mesh,
+    patches: &[FacePatch],
+) -> Result<Vec<usize>, RuntimeError> {
+    Ok(adaptive_faces(table, mesh, patches)?.faces)
 }
 
 /// A tolerance is a positive, finite distance.
@@ -1674,10 +1709,79 @@ pub(crate) fn sorted_candidates(
     Ok(sorted)
 }
 
-/// The selection shared by the quad and triangle tolerance rates: per face `f` (in parallel)
-/// the smallest `n` of `sorted` (ascending, non-empty) with `deviation(f, &prepare(f), n) <=
-/// tolerance`, trying them in order, or the largest (and `f` listed as unmet). `prepare` is
-/// what every rate reuses (the face's samples).
+/// One face's rate from the selection ([`choose_rate`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct FaceChoice {
+    /// The smallest candidate meeting the tolerance, or the largest.
+    pub(crate) rate: u32,
+    /// `e_f(rate)`.
+    pub(crate) deviation: f64,
+    /// Whether `rate` meets the tolerance.
+    pub(crate) met: bool,
+    /// The least of the values that refuted the smaller candidates: each is one sample's
+    /// deviation at that rate, beyond the tolerance (infinity when no smaller candidate was
+    /// tried). What lets a later frame keep `rate` ([`super::rate_memory`]).
+    pub(crate) refuted: f64,
+}
+
+impl ToleranceRates {
+    /// The rates of `choices`, face by face.
+    pub(crate) fn from_choices(choices: &[FaceChoice]) -> Self {
+        ToleranceRates {
+            rates: choices.iter().map(|c| c.rate).collect(),
+            deviations: choices.iter().map(|c| c.deviation).collect(),
+            unmet: choices
+                .iter()
+                .enumerate()
+                .filter(|(_, c)| !c.met)
+                .map(|(f, _)| f)
+                .collect(),
+        }
+    }
+}
+
+/// The selection of face `f` shared by the quad and triangle tolerance rates: the smallest `n`
+/// of `sorted` (ascending, non-empty) with `deviation(f, &prepare(f), n) <= tolerance`, trying
+/// them in order, or the largest (not met). `prepare` is what every rate reuses (the face's
+/// samples); `deviation` may stop at the first sample beyond the tolerance for a rate below the
+/// largest, and returns that sample's deviation then.
+pub(crate) fn choose_rate<S>(
+    f: usize,
+    tolerance: f64,
+    sorted: &[u32],
+    prepare: impl Fn(usize) -> Result<S, RuntimeError>,
+    deviation: impl Fn(usize, &S, u32) -> Result<f64, RuntimeError>,
+) -> Result<FaceChoice, RuntimeError> {
+    let largest = *sorted
+        .last()
+        .ok_or_else(|| RuntimeError::InvalidParameter {
+            name: "candidate rates".to_owned(),
+            reason: "none given".to_owned(),
+        })?;
+    let prepared = prepare(f)?;
+    let mut refuted = f64::INFINITY;
+    let mut last = 0.0;
+    for &n in sorted {
+        last = deviation(f, &prepared, n)?;
+        if last <= tolerance {
+            return Ok(FaceChoice {
+                rate: n,
+                deviation: last,
+                met: true,
+                refuted,
+            });
+        }
+        refuted = refuted.min(last);
+    }
+    Ok(FaceChoice {
+        rate: largest,
+        deviation: last,
+        met: false,
+        refuted,
+    })
+}
+
+/// [`choose_rate`] for every face, in parallel.
 pub(crate) fn select_rates<S>(
     faces: usize,
     tolerance: f64,
@@ -1685,36 +1789,11 @@ pub(crate) fn select_rates<S>(
     prepare: impl Fn(usize) -> Result<S, RuntimeError> + Sync,
     deviation: impl Fn(usize, &S, u32) -> Result<f64, RuntimeError> + Sync,
 ) -> Result<ToleranceRates, RuntimeError> {
-    let largest = *sorted
-        .last()
-        .ok_or_else(|| RuntimeError::InvalidParameter {
-            name: "candidate rates".to_owned(),
-            reason: "none given".to_owned(),
-        })?;
-    let chosen = (0..faces)
+    let choices = (0..faces)
         .into_par_iter()
-        .map(|f| -> Result<(u32, f64, bool), RuntimeError> {
-            let prepared = prepare(f)?;
-            let mut last = 0.0;
-            for &n in sorted {
-                last = deviation(f, &prepared, n)?;
-                if last <= tolerance {
-                    return Ok((n, last, true));
-                }
-            }
-            Ok((largest, last, false))
-        })
+        .map(|f| choose_rate(f, tolerance, sorted, &prepare, &deviation))
         .collect::<Result<Vec<_>, _>>()?;
-    Ok(ToleranceRates {
-        rates: chosen.iter().map(|c| c.0).collect(),
-        deviations: chosen.iter().map(|c| c.1).collect(),
-        unmet: chosen
-            .iter()
-            .enumerate()
-            .filter(|(_, c)| !c.2)
-            .map(|(f, _)| f)
-            .collect(),
-    })
+    Ok(ToleranceRates::from_choices(&choices))
 }
 
 /// The measured deviation of a finished tessellation: the largest Euclidean distance from the
