@@ -481,7 +481,8 @@ fn corner_frame(corners: &[u32], positions: &[[f64; 3]]) -> ([f64; 3], [[f64; 3]
     (centre, [e1, e2, e3])
 }
 
-#[cfg(test)]
+// The embedded Catmull–Clark table's.
+#[cfg(all(test, feature = "catmull-clark"))]
 mod tests {
     use super::*;
     use crate::mesh::test_meshes::octahedron;
