@@ -344,6 +344,18 @@ fn check_moved_rates(label: &str, mesh: &Mesh, scheme: Scheme, relative: f64) {
         &rates[..],
         "{label}: a refusal moved the surface"
     );
+    if scheme == Scheme::CatmullClark {
+        // Nothing moved since the last selection: the faces the table describes keep their
+        // rates unsampled (those sampled by refinement, next to sharp features, never do).
+        // (The cube: none of 24; the creased cube: the 20 faces at or next to its creases.)
+        let sampled = kept.faces_sampled().expect("a tolerance's count");
+        let faces = kept.rates().len();
+        let at_rest = if label == "cube" { 0 } else { faces - 1 };
+        assert!(
+            sampled <= at_rest,
+            "{label}: {sampled} of {faces} faces sampled at rest"
+        );
+    }
 }
 
 #[test]
