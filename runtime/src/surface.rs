@@ -34,10 +34,10 @@ use crate::tessellate::lai_cheng::{
     check_input, tessellate_adaptive_with, AdaptiveMesh, AdaptiveOptions, AdaptiveStats,
     PatchOperators,
 };
-use crate::tessellate::rate_memory::RateMemory;
+use crate::tessellate::rate_memory::{QuadSelection, RateMemory};
 use crate::tessellate::rates::{view_rates, ViewCamera, RATIONAL_RATES};
 use crate::tessellate::triangle_dual_grid::TriangleDualGrid;
-use crate::tessellate::triangle_rates::triangle_tolerance_rates;
+use crate::tessellate::triangle_rates::{triangle_table_rates, TriangleSelection};
 use crate::tessellate::GridPlan;
 use crate::RuntimeError;
 
@@ -96,7 +96,7 @@ pub struct Surface {
     /// Lai–Cheng's patch-kind operators, made by the first [`Surface::tessellate_adaptive`]
     /// and kept (they depend on the topology only, which [`Surface::set_positions`] keeps).
     adaptive_operators: Mutex<Option<Arc<PatchOperators>>>,
-    /// The last tolerance selection (Catmull–Clark), what lets the next frame keep the rates
+    /// The last tolerance selection, what lets the next frame keep the rates
     /// of faces that moved almost rigidly ([`RateMemory`]).
     rate_memory: Mutex<Option<RateMemory>>,
 }
@@ -339,37 +339,40 @@ impl Surface {
                 FaceRates::given(rates)
             }
             Rates::Tolerance(t) => {
-                let mut sampled = None;
+                if let Isolated::Triangle(iso) = &self.isolated {
+                    if self.scheme == Scheme::Sqrt3 && iso.patches.iter().any(|p| p.kind.boundary) {
+                        return Err(RuntimeError::Unsupported(
+                            "tolerance rates for √3 on a mesh with boundary (use --rate or \
+                             per-face rates)"
+                                .to_owned(),
+                        ));
+                    }
+                }
+                let mut memory = self.rate_memory.lock().map_err(|_| {
+                    RuntimeError::Unsupported(
+                        "internal: a thread panicked while choosing rates".to_owned(),
+                    )
+                })?;
                 let chosen = match &self.isolated {
                     Isolated::Quad(iso) => {
-                        let mut memory = self.rate_memory.lock().map_err(|_| {
-                            RuntimeError::Unsupported(
-                                "internal: a thread panicked while choosing rates".to_owned(),
-                            )
-                        })?;
-                        let chosen = RateMemory::rates(
-                            &mut memory,
+                        let selection = QuadSelection::new(
                             &self.table,
                             &iso.mesh,
                             &iso.patches,
                             *t,
                             &RATIONAL_RATES,
                         )?;
-                        sampled = memory.as_ref().map(RateMemory::sampled);
-                        chosen
+                        let candidates = selection.candidates().to_vec();
+                        RateMemory::rates(&mut memory, &selection, *t, &candidates)?
                     }
-                    Isolated::Triangle(iso)
-                        if self.scheme == Scheme::Sqrt3
-                            && iso.patches.iter().any(|p| p.kind.boundary) =>
-                    {
-                        return Err(RuntimeError::Unsupported(
-                            "tolerance rates for √3 on a mesh with boundary (use --rate or \
-                             per-face rates)"
-                                .to_owned(),
-                        ))
+                    Isolated::Triangle(iso) => {
+                        let rates = triangle_table_rates(&self.table);
+                        let selection = TriangleSelection::new(&self.table, iso, *t, &rates)?;
+                        let candidates = selection.candidates().to_vec();
+                        RateMemory::rates(&mut memory, &selection, *t, &candidates)?
                     }
-                    Isolated::Triangle(iso) => triangle_tolerance_rates(&self.table, iso, *t)?,
                 };
+                let sampled = memory.as_ref().map(RateMemory::sampled);
                 let unmet = chosen.unmet.len();
                 FaceRates {
                     rates: chosen.rates,
@@ -594,7 +597,7 @@ impl<'s> Tessellator<'s> {
         self.faces_over_tolerance
     }
 
-    /// With [`Rates::Tolerance`] (Catmull–Clark): how many faces the selection sampled. The
+    /// With [`Rates::Tolerance`]: how many faces the selection sampled. The
     /// first plan of a surface samples every face; after [`Surface::set_positions`], a face
     /// whose neighbourhood moved almost rigidly since it was sampled keeps its rate unsampled
     /// where a bound proves the selection would choose it again (the rates are a fresh

@@ -53,10 +53,31 @@ use crate::mesh::topology::Mesh;
 use crate::scheme::patch::{FacePatch, PatchKind};
 use crate::stencil_table::StencilTable;
 use crate::tessellate::rates::{
-    adaptive_face_list, sorted_candidates, with_selection, FaceChoice, ToleranceRates,
-    MAX_SELECTED_RATE, RATIONAL_RATES, SELECTION_GRID,
+    adaptive_face_list, check_tolerance, sorted_candidates, with_selection, FaceChoice,
+    ToleranceRates, MAX_SELECTED_RATE, RATIONAL_RATES, SELECTION_GRID,
 };
 use crate::RuntimeError;
+
+/// A mesh's tolerance selection at its current positions, as [`RateMemory`] reads it: the
+/// quad one ([`QuadSelection`]) and the triangle schemes'
+/// ([`super::triangle_rates::TriangleSelection`]).
+pub(crate) trait Selection: Sync {
+    /// Every point the stencils read (the isolated vertices, then any phantoms).
+    fn control(&self) -> &[[f64; 3]];
+    /// How many faces.
+    fn faces(&self) -> usize;
+    /// Face `f`'s corners (indices into [`Selection::control`]): its frame.
+    fn corners(&self, f: usize) -> &[u32];
+    /// Whether face `f` is a hole (no surface, nothing sampled).
+    fn hole(&self, f: usize) -> bool;
+    /// Per face, the points its deviations read, and per rate `n` (at `n`) the bound of the
+    /// stencils of its samples plus the largest of `L_{f,m}`'s for the candidates `m <= n`
+    /// ([`StencilBound::NONE`] where the face cannot be kept).
+    #[allow(clippy::type_complexity)]
+    fn neighbourhoods(&self) -> Result<Vec<(Vec<u32>, Vec<StencilBound>)>, RuntimeError>;
+    /// The choices of `faces` at the current positions.
+    fn choose(&self, faces: &[usize]) -> Result<Vec<FaceChoice>, RuntimeError>;
+}
 
 /// Rates chosen for a tolerance, and what lets the next frame keep them.
 #[derive(Debug)]
@@ -65,7 +86,7 @@ pub(crate) struct RateMemory {
     candidates: Vec<u32>,
     choices: Vec<FaceChoice>,
     /// Every face's neighbourhood as it was sampled, made by the first frame that reuses the
-    /// rates; until then the isolated control points of the first selection.
+    /// rates; until then the control points of the first selection.
     neighbourhoods: Result<Neighbourhoods, Vec<[f64; 3]>>,
     /// Faces sampled by the last selection (all of them by the first).
     sampled: usize,
@@ -74,29 +95,53 @@ pub(crate) struct RateMemory {
 /// What stencils can do to a distance: the largest `|w|_1` of a set of stencils, and the largest
 /// `|sum w - 1|` (the `f32` weights' rounding), each summed over the two ends of a distance.
 #[derive(Clone, Copy, Debug)]
-struct StencilBound {
+pub(crate) struct StencilBound {
     norm: f64,
     sum_error: f64,
 }
 
 impl StencilBound {
-    const NONE: StencilBound = StencilBound {
+    pub(crate) const NONE: StencilBound = StencilBound {
         norm: f64::INFINITY,
         sum_error: f64::INFINITY,
     };
-    const ZERO: StencilBound = StencilBound {
+    pub(crate) const ZERO: StencilBound = StencilBound {
         norm: 0.0,
         sum_error: 0.0,
     };
 
-    fn max(self, other: StencilBound) -> StencilBound {
+    /// The bound of a table section's `points` stencils (`NONE` for an empty or ragged one).
+    /// Its norm is never below one: the closed-form samples (B-spline, box spline) have
+    /// non-negative weights summing to one, whatever the table's rounding.
+    pub(crate) fn of_weights(weights: &[f32], points: usize) -> StencilBound {
+        let k = weights.len() / points.max(1);
+        if k == 0 || k * points != weights.len() {
+            return StencilBound::NONE;
+        }
+        weights.chunks_exact(k).fold(
+            StencilBound {
+                norm: 1.0,
+                sum_error: 0.0,
+            },
+            |bound, w| {
+                let norm = w.iter().map(|x| f64::from(x.abs())).sum::<f64>();
+                let sum = w.iter().map(|&x| f64::from(x)).sum::<f64>();
+                bound.max(StencilBound {
+                    norm,
+                    sum_error: (sum - 1.0).abs(),
+                })
+            },
+        )
+    }
+
+    pub(crate) fn max(self, other: StencilBound) -> StencilBound {
         StencilBound {
             norm: self.norm.max(other.norm),
             sum_error: self.sum_error.max(other.sum_error),
         }
     }
 
-    fn plus(self, other: StencilBound) -> StencilBound {
+    pub(crate) fn plus(self, other: StencilBound) -> StencilBound {
         StencilBound {
             norm: self.norm + other.norm,
             sum_error: self.sum_error + other.sum_error,
@@ -114,7 +159,7 @@ struct Neighbourhoods {
     /// Per face, for each rate `n` at `n` (`0` unused): `C_f` and the weights' sum error, its
     /// samples' plus the largest of `L_{f,m}` for `m <= n`; infinite where the face cannot be
     /// kept (sampled adaptively, or next to such a face).
-    bounds: Vec<[StencilBound; MAX_SELECTED_RATE as usize + 1]>,
+    bounds: Vec<Vec<StencilBound>>,
     /// Per face, as it was sampled: its neighbourhood's points relative to its corner centre
     /// (in `points`' order), that centre and its corner frame.
     sampled: Vec<[f32; 3]>,
@@ -128,38 +173,35 @@ struct Neighbourhoods {
 }
 
 impl RateMemory {
-    /// The rates for `tolerance` among `candidates` at the mesh's current positions: those of
-    /// [`super::rates::tolerance_rates_among`], with the faces that `memory` (the last frame's
-    /// selection of the same mesh, tolerance and candidates) proves unchanged kept without
-    /// sampling (module docs). `memory` is then this frame's. The deviations of kept faces are
-    /// upper bounds of `e_f(n_f)`, not the measured values.
+    /// The rates of `selection` (for `tolerance` among the sorted `candidates`): its choices,
+    /// with the faces that `memory` (the last frame's selection of the same mesh, tolerance and
+    /// candidates) proves unchanged kept without sampling (module docs). `memory` is then this
+    /// frame's. The deviations of kept faces are upper bounds of `e_f(n_f)`, not the measured
+    /// values.
     pub(crate) fn rates(
         memory: &mut Option<RateMemory>,
-        table: &StencilTable,
-        mesh: &Mesh,
-        patches: &[FacePatch],
+        selection: &dyn Selection,
         tolerance: f64,
         candidates: &[u32],
     ) -> Result<ToleranceRates, RuntimeError> {
-        let sorted = sorted_candidates(candidates, &RATIONAL_RATES)?;
         match memory {
             Some(m)
                 if m.tolerance == tolerance
-                    && m.candidates == sorted
-                    && m.choices.len() == patches.len() =>
+                    && m.candidates == candidates
+                    && m.choices.len() == selection.faces() =>
             {
-                m.reuse(table, mesh, patches)
+                m.reuse(selection)
             }
             _ => {
-                let faces: Vec<usize> = (0..patches.len()).collect();
-                let choices = choose(table, mesh, patches, tolerance, &sorted, &faces)?;
+                let faces: Vec<usize> = (0..selection.faces()).collect();
+                let choices = selection.choose(&faces)?;
                 let rates = ToleranceRates::from_choices(&choices);
                 *memory = Some(RateMemory {
                     tolerance,
-                    candidates: sorted,
+                    candidates: candidates.to_vec(),
                     sampled: choices.len(),
                     choices,
-                    neighbourhoods: Err(mesh.positions.clone()),
+                    neighbourhoods: Err(selection.control().to_vec()),
                 });
                 Ok(rates)
             }
@@ -172,21 +214,17 @@ impl RateMemory {
     }
 
     /// A frame after the first: keep what the bound proves, sample the rest.
-    fn reuse(
-        &mut self,
-        table: &StencilTable,
-        mesh: &Mesh,
-        patches: &[FacePatch],
-    ) -> Result<ToleranceRates, RuntimeError> {
+    fn reuse(&mut self, selection: &dyn Selection) -> Result<ToleranceRates, RuntimeError> {
+        let now = selection.control();
         if let Err(first) = &self.neighbourhoods {
-            if first.len() != mesh.positions.len() {
+            if first.len() != now.len() {
                 return Err(RuntimeError::Unsupported(format!(
                     "rates kept for {} control points, the mesh has {}",
                     first.len(),
-                    mesh.positions.len()
+                    now.len()
                 )));
             }
-            self.neighbourhoods = Ok(Neighbourhoods::new(table, mesh, patches, first)?);
+            self.neighbourhoods = Ok(Neighbourhoods::new(selection, first)?);
         }
         let Ok(near) = &mut self.neighbourhoods else {
             return Err(RuntimeError::Unsupported(
@@ -194,21 +232,23 @@ impl RateMemory {
             ));
         };
         let tolerance = self.tolerance;
-        let now = &mesh.positions;
         // Per face: what the motion since it was sampled may add to its deviations, when that
         // keeps its rate.
-        let kept: Vec<Option<f64>> = (0..patches.len())
+        let kept: Vec<Option<f64>> = (0..self.choices.len())
             .into_par_iter()
             .map(|f| {
                 let choice = &self.choices[f];
-                if mesh.holes[f] {
+                if selection.hole(f) {
                     return Some(0.0);
                 }
-                let bound = near.bounds[f][choice.rate as usize];
+                let bound = near.bounds[f]
+                    .get(choice.rate as usize)
+                    .copied()
+                    .unwrap_or(StencilBound::NONE);
                 if !bound.norm.is_finite() {
                     return None;
                 }
-                let moved = near.residual(f, mesh.face(f), now);
+                let moved = near.residual(f, selection.corners(f), now);
                 // The weights' sums times the rigid map's translation, and f64's rounding.
                 let margin = bound.sum_error * moved.translation
                     + 1e-12 * bound.norm * (near.scale[f] + moved.scale);
@@ -218,15 +258,15 @@ impl RateMemory {
                 (within && choice.refuted - change > tolerance).then_some(change)
             })
             .collect();
-        let resample: Vec<usize> = (0..patches.len()).filter(|&f| kept[f].is_none()).collect();
+        let resample: Vec<usize> = (0..kept.len()).filter(|&f| kept[f].is_none()).collect();
         let fresh = if resample.is_empty() {
             Vec::new()
         } else {
-            choose(table, mesh, patches, tolerance, &self.candidates, &resample)?
+            selection.choose(&resample)?
         };
         for (&f, choice) in resample.iter().zip(fresh) {
             self.choices[f] = choice;
-            near.record(f, mesh.face(f), now);
+            near.record(f, selection.corners(f), now);
         }
         self.sampled = resample.len();
         let mut rates = ToleranceRates::from_choices(&self.choices);
@@ -237,49 +277,84 @@ impl RateMemory {
     }
 }
 
-/// The choices of `faces` at the mesh's current positions.
-fn choose(
-    table: &StencilTable,
-    mesh: &Mesh,
-    patches: &[FacePatch],
+/// The quad selection of [`super::rates`] over an isolated Catmull–Clark mesh.
+pub(crate) struct QuadSelection<'a> {
+    table: &'a StencilTable,
+    mesh: &'a Mesh,
+    patches: &'a [FacePatch],
     tolerance: f64,
-    sorted: &[u32],
-    faces: &[usize],
-) -> Result<Vec<FaceChoice>, RuntimeError> {
-    with_selection(table, mesh, patches, tolerance, sorted, |choose| {
-        faces
-            .par_iter()
-            .map(|&f| choose(f))
-            .collect::<Result<Vec<_>, _>>()
-    })
+    candidates: Vec<u32>,
 }
 
-impl Neighbourhoods {
-    /// Per face the control points of every face sharing a vertex with it (the samples read
-    /// the face's own, `L_{f,n}` the rows and corner points of those around it) and the bounds
-    /// of their stencils.
-    fn new(
-        table: &StencilTable,
-        mesh: &Mesh,
-        patches: &[FacePatch],
-        positions: &[[f64; 3]],
+impl<'a> QuadSelection<'a> {
+    /// `mesh`'s selection for `tolerance` among `candidates` (rates of the table, sorted).
+    pub(crate) fn new(
+        table: &'a StencilTable,
+        mesh: &'a Mesh,
+        patches: &'a [FacePatch],
+        tolerance: f64,
+        candidates: &[u32],
     ) -> Result<Self, RuntimeError> {
+        check_tolerance(tolerance)?;
+        Ok(QuadSelection {
+            table,
+            mesh,
+            patches,
+            tolerance,
+            candidates: sorted_candidates(candidates, &RATIONAL_RATES)?,
+        })
+    }
+
+    /// The sorted candidates.
+    pub(crate) fn candidates(&self) -> &[u32] {
+        &self.candidates
+    }
+}
+
+impl Selection for QuadSelection<'_> {
+    fn control(&self) -> &[[f64; 3]] {
+        &self.mesh.positions
+    }
+
+    fn faces(&self) -> usize {
+        self.patches.len()
+    }
+
+    fn corners(&self, f: usize) -> &[u32] {
+        self.mesh.face(f)
+    }
+
+    fn hole(&self, f: usize) -> bool {
+        self.mesh.holes[f]
+    }
+
+    fn choose(&self, faces: &[usize]) -> Result<Vec<FaceChoice>, RuntimeError> {
+        with_selection(
+            self.table,
+            self.mesh,
+            self.patches,
+            self.tolerance,
+            &self.candidates,
+            |choose| {
+                faces
+                    .par_iter()
+                    .map(|&f| choose(f))
+                    .collect::<Result<Vec<_>, _>>()
+            },
+        )
+    }
+
+    /// The control points of every face sharing a vertex with the face (the samples read the
+    /// face's own, `L_{f,n}` the rows and corner points of those around it).
+    fn neighbourhoods(&self) -> Result<Vec<(Vec<u32>, Vec<StencilBound>)>, RuntimeError> {
+        let (table, mesh, patches) = (self.table, self.mesh, self.patches);
         // The faces sampled adaptively, which the bound does not cover.
         let adaptive = adaptive_face_list(table, mesh, patches)?;
-        let mut index: HashMap<PatchKind, usize> = HashMap::new();
-        let mut kinds = Vec::new();
-        for patch in patches {
-            index.entry(patch.kind).or_insert_with(|| {
-                kinds.push(patch.kind);
-                kinds.len() - 1
-            });
-        }
-        let kind_bounds = kinds
-            .par_iter()
-            .map(|kind| KindBounds::new(table, kind))
-            .collect::<Vec<_>>();
-        let bounds_of = |g: usize| index.get(&patches[g].kind).map(|&k| &kind_bounds[k]);
-        let per_face = (0..patches.len())
+        let kind_bounds = by_kind(patches.iter().map(|p| p.kind), |kind| {
+            KindBounds::new(table, kind)
+        });
+        let bounds_of = |g: usize| kind_bounds.get(&patches[g].kind);
+        Ok((0..patches.len())
             .into_par_iter()
             .map(|f| {
                 let mut around: Vec<usize> = mesh
@@ -296,7 +371,7 @@ impl Neighbourhoods {
                     .collect();
                 points.sort_unstable();
                 points.dedup();
-                let mut bounds = [StencilBound::NONE; MAX_SELECTED_RATE as usize + 1];
+                let mut bounds = vec![StencilBound::NONE; MAX_SELECTED_RATE as usize + 1];
                 let described = around.iter().all(|g| adaptive.binary_search(g).is_err());
                 if let (Some(own), true) = (bounds_of(f), described) {
                     for (n, bound) in bounds.iter_mut().enumerate().skip(1) {
@@ -309,7 +384,14 @@ impl Neighbourhoods {
                 }
                 (points, bounds)
             })
-            .collect::<Vec<_>>();
+            .collect())
+    }
+}
+
+impl Neighbourhoods {
+    /// `selection`'s neighbourhoods, every face sampled at `control`.
+    fn new(selection: &dyn Selection, control: &[[f64; 3]]) -> Result<Self, RuntimeError> {
+        let per_face = selection.neighbourhoods()?;
         let mut offsets = Vec::with_capacity(per_face.len() + 1);
         offsets.push(0);
         let mut points = Vec::new();
@@ -331,7 +413,7 @@ impl Neighbourhoods {
             radius: vec![0.0; faces],
         };
         for f in 0..faces {
-            near.record(f, mesh.face(f), positions);
+            near.record(f, selection.corners(f), control);
         }
         Ok(near)
     }
@@ -399,6 +481,26 @@ struct Motion {
     scale: f64,
 }
 
+/// What `each` makes of every distinct kind of `kinds` (in parallel), by kind.
+pub(crate) fn by_kind<T: Send>(
+    kinds: impl Iterator<Item = PatchKind>,
+    each: impl Fn(&PatchKind) -> T + Sync,
+) -> HashMap<PatchKind, T> {
+    let mut distinct: Vec<PatchKind> = Vec::new();
+    for kind in kinds {
+        if !distinct.contains(&kind) {
+            distinct.push(kind);
+        }
+    }
+    distinct
+        .into_par_iter()
+        .map(|kind| {
+            let made = each(&kind);
+            (kind, made)
+        })
+        .collect()
+}
+
 /// The bounds of a patch kind's position stencils.
 #[derive(Debug)]
 struct KindBounds {
@@ -420,26 +522,7 @@ impl KindBounds {
                 PointSet::Primal => n + 1,
                 _ => n,
             } as usize;
-            let k = weights.len() / (side * side).max(1);
-            if k == 0 {
-                return StencilBound::NONE;
-            }
-            // A norm never below one: the closed-form B-spline samples have non-negative weights
-            // summing to one, whatever the table's rounding.
-            weights.chunks_exact(k).fold(
-                StencilBound {
-                    norm: 1.0,
-                    sum_error: 0.0,
-                },
-                |bound, w| {
-                    let norm = w.iter().map(|x| f64::from(x.abs())).sum::<f64>();
-                    let sum = w.iter().map(|&x| f64::from(x)).sum::<f64>();
-                    bound.max(StencilBound {
-                        norm,
-                        sum_error: (sum - 1.0).abs(),
-                    })
-                },
-            )
+            StencilBound::of_weights(weights, side * side)
         };
         let samples =
             grid(PointSet::Primal, SELECTION_GRID).max(grid(PointSet::Dual, SELECTION_GRID));
@@ -481,15 +564,12 @@ fn corner_frame(corners: &[u32], positions: &[[f64; 3]]) -> ([f64; 3], [[f64; 3]
     (centre, [e1, e2, e3])
 }
 
-// The embedded Catmull–Clark table's.
-#[cfg(all(test, feature = "catmull-clark"))]
+#[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::test_meshes::octahedron;
-    use crate::scheme::catmull_clark::isolate::isolate;
-    use crate::tessellate::rates::tolerance_rates;
 
     /// `p` turned by `angle` about the axis `(1, 2, 2) / 3` and moved by `shift`.
+    #[allow(dead_code)] // without either scheme's feature
     fn rigid(p: [f64; 3], angle: f64, shift: [f64; 3]) -> [f64; 3] {
         let k = [1.0 / 3.0, 2.0 / 3.0, 2.0 / 3.0];
         let (sin, cos) = angle.sin_cos();
@@ -498,15 +578,20 @@ mod tests {
         [0, 1, 2].map(|c| p[c] * cos + across[c] * sin + k[c] * along + shift[c])
     }
 
-    /// The rates of the memory and of a fresh selection through frames that stay, turn, move,
-    /// bend and grow an isolated octahedron: the same every frame, the memory's deviations at
-    /// least the measured ones, and few faces sampled where nothing but a rigid motion (and
-    /// rounding) happened. The fresh rates of every frame.
-    fn kept_through_frames(tolerance: f64) -> Vec<Vec<u32>> {
-        let table = StencilTable::default_catmull_clark().expect("embedded table");
-        // Valence-3 and valence-4 vertices, two isolating steps: table faces of both kinds.
-        let (mut mesh, patches, _) = isolate(&octahedron()).expect("isolates");
-        let rest = mesh.positions.clone();
+    /// Frames that keep, turn, move, bend and grow the points `rest` (about 1 across), through
+    /// `frame(points, memory) -> (kept, fresh, faces)`: the memory's rates and a fresh
+    /// selection's at those points. Their rates are the same every frame, the memory's
+    /// deviations at least the measured ones, and few faces are sampled where nothing but a
+    /// rigid motion (and rounding) happened. The fresh rates of every frame.
+    #[allow(dead_code)] // without either scheme's feature
+    fn kept_through_frames(
+        rest: &[[f64; 3]],
+        tolerance: f64,
+        mut frame: impl FnMut(
+            &[[f64; 3]],
+            &mut Option<RateMemory>,
+        ) -> (ToleranceRates, ToleranceRates, usize),
+    ) -> Vec<Vec<u32>> {
         // A bump of `height` about the first vertex, which bends the faces around it.
         let bump = |height: f64| -> Vec<[f64; 3]> {
             let centre = rest[0];
@@ -525,9 +610,9 @@ mod tests {
                 .collect()
         };
         let frames: Vec<(&str, Vec<[f64; 3]>)> = vec![
-            ("first", rest.clone()),
-            ("at rest again", rest.clone()),
-            ("turned and moved", turn(rest.clone())),
+            ("first", rest.to_vec()),
+            ("at rest again", rest.to_vec()),
+            ("turned and moved", turn(rest.to_vec())),
             ("turned, moved and touched", turn(bump(1e-6 * tolerance))),
             ("bumped", bump(0.3)),
             ("grown", rest.iter().map(|p| p.map(|c| 1.7 * c)).collect()),
@@ -535,17 +620,7 @@ mod tests {
         let mut memory = None;
         let mut fresh_rates = Vec::new();
         for (label, positions) in frames {
-            mesh.positions = positions;
-            let kept = RateMemory::rates(
-                &mut memory,
-                &table,
-                &mesh,
-                &patches,
-                tolerance,
-                &RATIONAL_RATES,
-            )
-            .expect("kept");
-            let fresh = tolerance_rates(&table, &mesh, &patches, tolerance).expect("fresh");
+            let (kept, fresh, faces) = frame(&positions, &mut memory);
             assert_eq!(kept.rates, fresh.rates, "{label}: rates at {tolerance}");
             assert_eq!(kept.unmet, fresh.unmet, "{label}: unmet at {tolerance}");
             for (f, (bound, measured)) in kept.deviations.iter().zip(&fresh.deviations).enumerate()
@@ -557,12 +632,11 @@ mod tests {
             }
             let sampled = memory.as_ref().map_or(0, RateMemory::sampled);
             match label {
-                "first" => assert_eq!(sampled, patches.len(), "the first frame samples all"),
+                "first" => assert_eq!(sampled, faces, "the first frame samples all"),
                 "bumped" | "grown" => assert!(sampled > 0, "{label}: nothing sampled"),
                 _ => assert!(
-                    sampled * 10 < patches.len(),
-                    "{label}: {sampled} of {} faces sampled at {tolerance}",
-                    patches.len()
+                    sampled * 10 < faces,
+                    "{label}: {sampled} of {faces} faces sampled at {tolerance}"
                 ),
             }
             fresh_rates.push(fresh.rates);
@@ -570,14 +644,70 @@ mod tests {
         fresh_rates
     }
 
-    #[test]
-    fn kept_rates_are_a_fresh_selections() {
-        let rates = kept_through_frames(1e-2);
+    /// [`kept_through_frames`] at two tolerances, the second met by no rate; `top` the largest
+    /// rate.
+    #[allow(dead_code)] // without either scheme's feature
+    fn check_tolerances(
+        rest: &[[f64; 3]],
+        top: u32,
+        mut frame: impl FnMut(
+            &[[f64; 3]],
+            f64,
+            &mut Option<RateMemory>,
+        ) -> (ToleranceRates, ToleranceRates, usize),
+    ) {
+        let rates = kept_through_frames(rest, 1e-2, |p, m| frame(p, 1e-2, m));
         // The bump and the growth move rates: a memory that kept everything would fail above.
         assert_ne!(rates[3], rates[4], "the bump moves no rate");
         assert_ne!(rates[4], rates[5], "the growth moves no rate");
-        // No rate meets this one: every face keeps the largest while every rate stays refuted.
-        let rates = kept_through_frames(1e-7);
-        assert!(rates.iter().flatten().all(|&n| n == MAX_SELECTED_RATE));
+        // Every face keeps the largest rate while every rate stays refuted.
+        let rates = kept_through_frames(rest, 1e-7, |p, m| frame(p, 1e-7, m));
+        assert!(rates.iter().flatten().all(|&n| n == top));
+    }
+
+    #[test]
+    #[cfg(feature = "catmull-clark")]
+    fn kept_quad_rates_are_a_fresh_selections() {
+        use crate::mesh::test_meshes::octahedron;
+        use crate::scheme::catmull_clark::isolate::isolate;
+        use crate::tessellate::rates::tolerance_rates;
+        let table = StencilTable::default_catmull_clark().expect("embedded table");
+        // Valence-3 and valence-4 vertices, two isolating steps: table faces of both kinds.
+        let (mut mesh, patches, _) = isolate(&octahedron()).expect("isolates");
+        let rest = mesh.positions.clone();
+        check_tolerances(&rest, MAX_SELECTED_RATE, |positions, tolerance, memory| {
+            mesh.positions = positions.to_vec();
+            let selection = QuadSelection::new(&table, &mesh, &patches, tolerance, &RATIONAL_RATES)
+                .expect("selection");
+            let kept = RateMemory::rates(memory, &selection, tolerance, selection.candidates())
+                .expect("kept");
+            let fresh = tolerance_rates(&table, &mesh, &patches, tolerance).expect("fresh");
+            (kept, fresh, patches.len())
+        });
+    }
+
+    #[test]
+    #[cfg(feature = "loop")]
+    fn kept_triangle_rates_are_a_fresh_selections() {
+        use crate::mesh::test_meshes::octahedron;
+        use crate::scheme::loop_scheme::isolate::isolate_loop;
+        use crate::tessellate::triangle_rates::{
+            triangle_table_rates, triangle_tolerance_rates, TriangleSelection,
+        };
+        let table = StencilTable::default_loop().expect("embedded table");
+        let rates = triangle_table_rates(&table);
+        let top = rates.last().copied().expect("rates");
+        // Valence-4 vertices, one isolating step: regular and extraordinary triangles.
+        let mut iso = isolate_loop(&octahedron()).expect("isolates");
+        let rest = iso.mesh.positions.clone();
+        check_tolerances(&rest, top, |positions, tolerance, memory| {
+            iso.mesh.positions = positions.to_vec();
+            let selection =
+                TriangleSelection::new(&table, &iso, tolerance, &rates).expect("selection");
+            let kept = RateMemory::rates(memory, &selection, tolerance, selection.candidates())
+                .expect("kept");
+            let fresh = triangle_tolerance_rates(&table, &iso, tolerance).expect("fresh");
+            (kept, fresh, iso.patches.len())
+        });
     }
 }

@@ -1781,21 +1781,6 @@ pub(crate) fn choose_rate<S>(
     })
 }
 
-/// [`choose_rate`] for every face, in parallel.
-pub(crate) fn select_rates<S>(
-    faces: usize,
-    tolerance: f64,
-    sorted: &[u32],
-    prepare: impl Fn(usize) -> Result<S, RuntimeError> + Sync,
-    deviation: impl Fn(usize, &S, u32) -> Result<f64, RuntimeError> + Sync,
-) -> Result<ToleranceRates, RuntimeError> {
-    let choices = (0..faces)
-        .into_par_iter()
-        .map(|f| choose_rate(f, tolerance, sorted, &prepare, &deviation))
-        .collect::<Result<Vec<_>, _>>()?;
-    Ok(ToleranceRates::from_choices(&choices))
-}
-
 /// The measured deviation of a finished tessellation: the largest Euclidean distance from the
 /// limit surface, sampled at the table's primal and dual points at rate `grid` of every face
 /// (`(grid+1)^2 + grid^2` a face), to the nearest triangle of `tessellation` (the one-sided

@@ -2,7 +2,8 @@
 //! rate whose tessellation deviates from the limit surface by at most a tolerance `T`
 //! ([`triangle_tolerance_rates`]), and the measured deviation of a finished tessellation
 //! ([`measure_triangle_deviation`]). The quad analogue is [`crate::tessellate::rates`]; the selection loop
-//! and the nearest-triangle search are shared with it.
+//! and the nearest-triangle search are shared with it, and so is the memory that keeps a moving
+//! mesh's rates from frame to frame (`TriangleSelection`, `tessellate/rate_memory.rs`).
 //!
 //! # What is measured
 //!
@@ -71,6 +72,7 @@
 //!   measure the output again on other grids.
 
 use std::collections::{BTreeSet, HashMap};
+use std::sync::OnceLock;
 
 use rayon::prelude::*;
 use table_format::{PointSet, StencilKind};
@@ -84,7 +86,10 @@ use crate::scheme::triangle::patch::{dual_in_patch, dual_index, primal_in_patch,
 use crate::stencil_table::StencilTable;
 use crate::tessellate::kernel::{extend_weighted_sums, merge_rows, Stencils};
 use crate::tessellate::loop_quartic::{polynomial_row, row_value, QuarticBasis};
-use crate::tessellate::rates::{check_tolerance, select_rates, sorted_candidates, ToleranceRates};
+use crate::tessellate::rate_memory::{by_kind, Selection, StencilBound};
+use crate::tessellate::rates::{
+    check_tolerance, choose_rate, sorted_candidates, FaceChoice, ToleranceRates,
+};
 use crate::tessellate::triangle_dual_grid::{
     is_loop_regular, zigzag_cell, TriangleStencils, MAX_TRIANGLE_RATE,
 };
@@ -728,40 +733,191 @@ pub fn triangle_tolerance_rates_among(
     tolerance: f64,
     candidates: &[u32],
 ) -> Result<ToleranceRates, RuntimeError> {
-    let ctx = Context::new(table, iso)?;
-    check_tolerance(tolerance)?;
-    let sorted = sorted_candidates(candidates, &triangle_table_rates(table))?;
-    let grid = sample_grid(table)?;
-    let masks: BTreeSet<u8> = (0..iso.patches.len())
-        .map(|f| ctx.boundary_mask(f))
-        .collect();
-    let keys: Vec<(u32, u8)> = sorted
-        .iter()
-        .flat_map(|&n| masks.iter().map(move |&m| (n, m)))
-        .collect();
-    let templates: HashMap<(u32, u8), Template> = keys
-        .par_iter()
-        .map(|&(n, m)| Ok(((n, m), Template::new(n, m, &grid)?)))
-        .collect::<Result<_, RuntimeError>>()?;
-    // Only the largest rate's deviation is reported when no rate meets the tolerance.
-    let largest = sorted.last().copied().unwrap_or(0);
-    select_rates(
-        iso.patches.len(),
-        tolerance,
-        &sorted,
-        |f| Ok((ctx.boundary_mask(f), ctx.samples(f, &grid)?)),
-        |f, (mask, samples), n| {
-            let template = templates.get(&(n, *mask)).ok_or_else(|| {
-                RuntimeError::Unsupported(format!("no sample template at rate {n}"))
-            })?;
-            let stop = if n == largest {
-                f64::INFINITY
-            } else {
-                tolerance
-            };
-            Ok(template.deviation_up_to(&ctx.local_points(f, n)?, samples, stop))
-        },
-    )
+    let selection = TriangleSelection::new(table, iso, tolerance, candidates)?;
+    let faces: Vec<usize> = (0..iso.patches.len()).collect();
+    Ok(ToleranceRates::from_choices(&selection.choose(&faces)?))
+}
+
+/// The selection of [`triangle_tolerance_rates_among`] at the isolated mesh's current
+/// positions, face by face: what a full selection and [`super::rate_memory::RateMemory`]
+/// share.
+pub(crate) struct TriangleSelection<'a> {
+    ctx: Context<'a>,
+    tolerance: f64,
+    candidates: Vec<u32>,
+    grid: SampleGrid,
+    /// Per candidate rate and boundary pattern, where the samples lie in `L_{f,n}`
+    /// ([`TriangleSelection::templates`]).
+    templates: OnceLock<HashMap<(u32, u8), Template>>,
+}
+
+impl<'a> TriangleSelection<'a> {
+    /// `iso`'s selection for `tolerance` among `candidates` (rates of the table).
+    pub(crate) fn new(
+        table: &'a StencilTable,
+        iso: &'a TriangleIsolation,
+        tolerance: f64,
+        candidates: &[u32],
+    ) -> Result<Self, RuntimeError> {
+        let ctx = Context::new(table, iso)?;
+        check_tolerance(tolerance)?;
+        let candidates = sorted_candidates(candidates, &triangle_table_rates(table))?;
+        let grid = sample_grid(table)?;
+        Ok(TriangleSelection {
+            ctx,
+            tolerance,
+            candidates,
+            grid,
+            templates: OnceLock::new(),
+        })
+    }
+
+    /// Per candidate rate and boundary pattern, where the samples lie in `L_{f,n}`: made the
+    /// first time a face is sampled (a frame that keeps every rate samples none).
+    fn templates(&self) -> Result<&HashMap<(u32, u8), Template>, RuntimeError> {
+        if let Some(templates) = self.templates.get() {
+            return Ok(templates);
+        }
+        let masks: BTreeSet<u8> = (0..self.faces())
+            .map(|f| self.ctx.boundary_mask(f))
+            .collect();
+        let keys: Vec<(u32, u8)> = self
+            .candidates
+            .iter()
+            .flat_map(|&n| masks.iter().map(move |&m| (n, m)))
+            .collect();
+        let templates = keys
+            .par_iter()
+            .map(|&(n, m)| Ok(((n, m), Template::new(n, m, &self.grid)?)))
+            .collect::<Result<_, RuntimeError>>()?;
+        Ok(self.templates.get_or_init(|| templates))
+    }
+
+    /// The sorted candidates.
+    pub(crate) fn candidates(&self) -> &[u32] {
+        &self.candidates
+    }
+
+    /// The bounds of a patch kind's position stencils: its samples', and per candidate rate
+    /// (at its index in the candidates) its dual and primal grids'.
+    fn kind_bounds(&self, kind: &PatchKind) -> (StencilBound, Vec<[StencilBound; 2]>) {
+        let table = self.ctx.table;
+        let section = |points: PointSet, n: u32| {
+            let key = kind.section(StencilKind::Position, points, n);
+            table
+                .triangle_weights(&key)
+                .map_or(StencilBound::NONE, |w| {
+                    StencilBound::of_weights(w, points.count(n) as usize)
+                })
+        };
+        let samples = self
+            .grid
+            .rates
+            .iter()
+            .flat_map(|&n| [PointSet::TrianglePrimal, PointSet::TriangleDual].map(|p| (p, n)))
+            .map(|(p, n)| section(p, n))
+            .fold(StencilBound::ZERO, StencilBound::max);
+        let rates = self
+            .candidates
+            .iter()
+            .map(|&n| {
+                [
+                    section(PointSet::TriangleDual, n),
+                    section(PointSet::TrianglePrimal, n),
+                ]
+            })
+            .collect();
+        (samples, rates)
+    }
+}
+
+impl Selection for TriangleSelection<'_> {
+    fn control(&self) -> &[[f64; 3]] {
+        &self.ctx.control
+    }
+
+    fn faces(&self) -> usize {
+        self.ctx.iso.patches.len()
+    }
+
+    fn corners(&self, f: usize) -> &[u32] {
+        self.ctx.iso.mesh.face(f)
+    }
+
+    fn hole(&self, _: usize) -> bool {
+        false
+    }
+
+    fn choose(&self, faces: &[usize]) -> Result<Vec<FaceChoice>, RuntimeError> {
+        if faces.is_empty() {
+            return Ok(Vec::new());
+        }
+        let (ctx, grid, templates) = (&self.ctx, &self.grid, self.templates()?);
+        // Only the largest rate's deviation is reported when no rate meets the tolerance.
+        let largest = self.candidates.last().copied().unwrap_or(0);
+        faces
+            .par_iter()
+            .map(|&f| {
+                choose_rate(
+                    f,
+                    self.tolerance,
+                    &self.candidates,
+                    |f| Ok((ctx.boundary_mask(f), ctx.samples(f, grid)?)),
+                    |f, (mask, samples), n| {
+                        let template = templates.get(&(n, *mask)).ok_or_else(|| {
+                            RuntimeError::Unsupported(format!("no sample template at rate {n}"))
+                        })?;
+                        let stop = if n == largest {
+                            f64::INFINITY
+                        } else {
+                            self.tolerance
+                        };
+                        Ok(template.deviation_up_to(&ctx.local_points(f, n)?, samples, stop))
+                    },
+                )
+            })
+            .collect()
+    }
+
+    /// A triangle's samples read its patch's points; `L_{f,n}` its own dual and primal points
+    /// and the neighbours' rows across its sides, their patches' points.
+    fn neighbourhoods(&self) -> Result<Vec<(Vec<u32>, Vec<StencilBound>)>, RuntimeError> {
+        let (patches, mesh) = (&self.ctx.iso.patches, &self.ctx.iso.mesh);
+        let kind_bounds = by_kind(patches.iter().map(|p| p.kind), |k| self.kind_bounds(k));
+        let bounds_of = |g: usize| kind_bounds.get(&patches[g].kind);
+        let top = self.candidates.last().copied().unwrap_or(0) as usize;
+        Ok((0..patches.len())
+            .into_par_iter()
+            .map(|f| {
+                let first = mesh.face_halfedges(f).start;
+                let across: Vec<usize> = (0..3)
+                    .filter_map(|s| {
+                        let t = mesh.twin[first + s];
+                        (t != NONE).then(|| mesh.face_of[t as usize] as usize)
+                    })
+                    .collect();
+                let mut points: Vec<u32> = std::iter::once(f)
+                    .chain(across.iter().copied())
+                    .flat_map(|g| patches[g].points.iter().copied())
+                    .collect();
+                points.sort_unstable();
+                points.dedup();
+                let mut bounds = vec![StencilBound::NONE; top + 1];
+                if let Some((samples, own)) = bounds_of(f) {
+                    let mut local = StencilBound::ZERO;
+                    for (k, &n) in self.candidates.iter().enumerate() {
+                        local = local.max(own[k][0]).max(own[k][1]);
+                        for &g in &across {
+                            local =
+                                local.max(bounds_of(g).map_or(StencilBound::NONE, |b| b.1[k][0]));
+                        }
+                        bounds[n as usize] = samples.plus(local);
+                    }
+                }
+                (points, bounds)
+            })
+            .collect())
+    }
 }
 
 /// The measured deviation of a finished triangle tessellation: the largest Euclidean distance
