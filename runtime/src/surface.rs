@@ -362,14 +362,12 @@ impl Surface {
                             *t,
                             &RATIONAL_RATES,
                         )?;
-                        let candidates = selection.candidates().to_vec();
-                        RateMemory::rates(&mut memory, &selection, *t, &candidates)?
+                        RateMemory::rates(&mut memory, &selection)?
                     }
                     Isolated::Triangle(iso) => {
                         let rates = triangle_table_rates(&self.table);
                         let selection = TriangleSelection::new(&self.table, iso, *t, &rates)?;
-                        let candidates = selection.candidates().to_vec();
-                        RateMemory::rates(&mut memory, &selection, *t, &candidates)?
+                        RateMemory::rates(&mut memory, &selection)?
                     }
                 };
                 let sampled = memory.as_ref().map(RateMemory::sampled);

@@ -62,6 +62,10 @@ use crate::RuntimeError;
 /// quad one ([`QuadSelection`]) and the triangle schemes'
 /// ([`super::triangle_rates::TriangleSelection`]).
 pub(crate) trait Selection: Sync {
+    /// The tolerance.
+    fn tolerance(&self) -> f64;
+    /// The candidate rates, ascending.
+    fn candidates(&self) -> &[u32];
     /// Every point the stencils read (the isolated vertices, then any phantoms).
     fn control(&self) -> &[[f64; 3]];
     /// How many faces.
@@ -173,17 +177,15 @@ struct Neighbourhoods {
 }
 
 impl RateMemory {
-    /// The rates of `selection` (for `tolerance` among the sorted `candidates`): its choices,
-    /// with the faces that `memory` (the last frame's selection of the same mesh, tolerance and
-    /// candidates) proves unchanged kept without sampling (module docs). `memory` is then this
-    /// frame's. The deviations of kept faces are upper bounds of `e_f(n_f)`, not the measured
-    /// values.
+    /// The rates of `selection`: its choices, with the faces that `memory` (the last frame's
+    /// selection of the same mesh, tolerance and candidates) proves unchanged kept without
+    /// sampling (module docs). `memory` is then this frame's. The deviations of kept faces are
+    /// upper bounds of `e_f(n_f)`, not the measured values.
     pub(crate) fn rates(
         memory: &mut Option<RateMemory>,
         selection: &dyn Selection,
-        tolerance: f64,
-        candidates: &[u32],
     ) -> Result<ToleranceRates, RuntimeError> {
+        let (tolerance, candidates) = (selection.tolerance(), selection.candidates());
         match memory {
             Some(m)
                 if m.tolerance == tolerance
@@ -304,14 +306,17 @@ impl<'a> QuadSelection<'a> {
             candidates: sorted_candidates(candidates, &RATIONAL_RATES)?,
         })
     }
-
-    /// The sorted candidates.
-    pub(crate) fn candidates(&self) -> &[u32] {
-        &self.candidates
-    }
 }
 
 impl Selection for QuadSelection<'_> {
+    fn tolerance(&self) -> f64 {
+        self.tolerance
+    }
+
+    fn candidates(&self) -> &[u32] {
+        &self.candidates
+    }
+
     fn control(&self) -> &[[f64; 3]] {
         &self.mesh.positions
     }
@@ -679,8 +684,7 @@ mod tests {
             mesh.positions = positions.to_vec();
             let selection = QuadSelection::new(&table, &mesh, &patches, tolerance, &RATIONAL_RATES)
                 .expect("selection");
-            let kept = RateMemory::rates(memory, &selection, tolerance, selection.candidates())
-                .expect("kept");
+            let kept = RateMemory::rates(memory, &selection).expect("kept");
             let fresh = tolerance_rates(&table, &mesh, &patches, tolerance).expect("fresh");
             (kept, fresh, patches.len())
         });
@@ -704,8 +708,7 @@ mod tests {
             iso.mesh.positions = positions.to_vec();
             let selection =
                 TriangleSelection::new(&table, &iso, tolerance, &rates).expect("selection");
-            let kept = RateMemory::rates(memory, &selection, tolerance, selection.candidates())
-                .expect("kept");
+            let kept = RateMemory::rates(memory, &selection).expect("kept");
             let fresh = triangle_tolerance_rates(&table, &iso, tolerance).expect("fresh");
             (kept, fresh, iso.patches.len())
         });

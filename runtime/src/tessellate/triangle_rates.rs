@@ -793,11 +793,6 @@ impl<'a> TriangleSelection<'a> {
         Ok(self.templates.get_or_init(|| templates))
     }
 
-    /// The sorted candidates.
-    pub(crate) fn candidates(&self) -> &[u32] {
-        &self.candidates
-    }
-
     /// The bounds of a patch kind's position stencils: its samples', and per candidate rate
     /// (at its index in the candidates) its dual and primal grids'.
     fn kind_bounds(&self, kind: &PatchKind) -> (StencilBound, Vec<[StencilBound; 2]>) {
@@ -832,6 +827,14 @@ impl<'a> TriangleSelection<'a> {
 }
 
 impl Selection for TriangleSelection<'_> {
+    fn tolerance(&self) -> f64 {
+        self.tolerance
+    }
+
+    fn candidates(&self) -> &[u32] {
+        &self.candidates
+    }
+
     fn control(&self) -> &[[f64; 3]] {
         &self.ctx.control
     }
