@@ -40,6 +40,14 @@ fn threads_arg(text: &str) -> Result<usize, String> {
     }
 }
 
+/// `--motion`: a finite angle in degrees.
+fn degrees_arg(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(d) if d.is_finite() => Ok(d),
+        _ => Err(format!("{text}: an angle in degrees (a finite number)")),
+    }
+}
+
 /// Write one line on stdout. A closed pipe (`subtess tables info | head -1`) ends the
 /// program quietly with status 0, as Unix tools do; any other write error is an error.
 fn print_line(line: std::fmt::Arguments) -> Result<(), RuntimeError> {
@@ -120,7 +128,8 @@ enum Command {
             long,
             requires = "tolerance",
             conflicts_with = "adaptive",
-            default_value_t = 0.0
+            default_value_t = 0.0,
+            value_parser = degrees_arg
         )]
         motion: f64,
         /// Worker threads, 1..=256 (default: one per core).

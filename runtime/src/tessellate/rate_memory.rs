@@ -89,11 +89,19 @@ pub(crate) struct RateMemory {
     tolerance: f64,
     candidates: Vec<u32>,
     choices: Vec<FaceChoice>,
-    /// Every face's neighbourhood as it was sampled, made by the first frame that reuses the
-    /// rates; until then the control points of the first selection.
-    neighbourhoods: Result<Neighbourhoods, Vec<[f64; 3]>>,
+    /// Where every face was sampled.
+    sampled_at: SampledAt,
     /// Faces sampled by the last selection (all of them by the first).
     sampled: usize,
+}
+
+/// Where the faces were sampled: the first selection's control points, until the first frame
+/// that reuses the rates makes every face's neighbourhood from them (a single selection, as
+/// `subtess tessellate` makes, never pays for the neighbourhoods).
+#[derive(Debug)]
+enum SampledAt {
+    First(Vec<[f64; 3]>),
+    Faces(Neighbourhoods),
 }
 
 /// What stencils can do to a distance: the largest `|w|_1` of a set of stencils, and the largest
@@ -203,7 +211,7 @@ impl RateMemory {
                     candidates: candidates.to_vec(),
                     sampled: choices.len(),
                     choices,
-                    neighbourhoods: Err(selection.control().to_vec()),
+                    sampled_at: SampledAt::First(selection.control().to_vec()),
                 });
                 Ok(rates)
             }
@@ -218,7 +226,7 @@ impl RateMemory {
     /// A frame after the first: keep what the bound proves, sample the rest.
     fn reuse(&mut self, selection: &dyn Selection) -> Result<ToleranceRates, RuntimeError> {
         let now = selection.control();
-        if let Err(first) = &self.neighbourhoods {
+        if let SampledAt::First(first) = &self.sampled_at {
             if first.len() != now.len() {
                 return Err(RuntimeError::Unsupported(format!(
                     "rates kept for {} control points, the mesh has {}",
@@ -226,9 +234,9 @@ impl RateMemory {
                     now.len()
                 )));
             }
-            self.neighbourhoods = Ok(Neighbourhoods::new(selection, first)?);
+            self.sampled_at = SampledAt::Faces(Neighbourhoods::new(selection, first)?);
         }
-        let Ok(near) = &mut self.neighbourhoods else {
+        let SampledAt::Faces(near) = &mut self.sampled_at else {
             return Err(RuntimeError::Unsupported(
                 "internal: the kept rates' neighbourhoods are missing".to_owned(),
             ));
