@@ -290,13 +290,7 @@ impl<'a> PatchPoints<'a> {
         let PatchPoints::Table { patch, control, .. } = self else {
             return None;
         };
-        let kind = &patch.kind;
-        if kind.boundary
-            || kind.feature != table_format::Feature::None
-            || kind.faces != 4
-            || patch.corner != 0
-            || control.len() != REGULAR_LAYOUT.len()
-        {
+        if !self.is_regular() || patch.corner != 0 {
             return None;
         }
         let mut net = [[[0.0; 3]; 4]; 4];
@@ -304,6 +298,20 @@ impl<'a> PatchPoints<'a> {
             net[(a + 1) as usize][(b + 1) as usize] = q;
         }
         Some(net)
+    }
+
+    /// Whether the face is a table face whose patch is the bicubic B-spline of a regular
+    /// interior grid (in any rotation: its stencils are that spline's weights, rounded to
+    /// `f32`).
+    fn is_regular(&self) -> bool {
+        let PatchPoints::Table { patch, control, .. } = self else {
+            return false;
+        };
+        let kind = &patch.kind;
+        !kind.boundary
+            && kind.feature == table_format::Feature::None
+            && kind.faces == 4
+            && control.len() == REGULAR_LAYOUT.len()
     }
 
     /// The control points of a table face (none for an adaptive one, whose grids hold
@@ -409,7 +417,7 @@ impl Grid<'_> {
 /// deviation reads. So are the other grids of the asked rate's *chunk* ([`rate_chunk`]), both
 /// point sets: a descent's cost is its refinement (building each level's neighbourhood), not its
 /// points, and the selection asks for the rates in order.
-struct AdaptiveGrids<'a> {
+pub(crate) struct AdaptiveGrids<'a> {
     mesh: &'a Mesh,
     /// The faces evaluated adaptively, ascending.
     faces: Vec<usize>,
@@ -611,6 +619,11 @@ struct Samples {
     /// Whether the last rate was refuted outside the interior (in a side strip or a corner
     /// square): then the next rate is scanned there first.
     outside_first: Cell<bool>,
+    /// The rates refuted so far, each at its sample; and, for a face whose neighbourhood is
+    /// regular ([`Context::regular`]), the kept rate's chart deviation
+    /// ([`FaceLocal::corner_chart_deviation`], with the scan's largest).
+    refutations: RefCell<Vec<Refutation>>,
+    chart: Cell<Option<f64>>,
 }
 
 impl Samples {
@@ -621,6 +634,8 @@ impl Samples {
             positions: Vec::new(),
             start: Cell::new(0),
             outside_first: Cell::new(false),
+            refutations: RefCell::new(Vec::new()),
+            chart: Cell::new(None),
         }
     }
 
@@ -654,6 +669,8 @@ impl Samples {
             positions,
             start: Cell::new(0),
             outside_first: Cell::new(false),
+            refutations: RefCell::new(Vec::new()),
+            chart: Cell::new(None),
         })
     }
 }
@@ -677,32 +694,71 @@ fn selection_axes(grid: u32) -> [Vec<f64>; 2] {
 /// take `16 side^2`.
 fn tensor_product(net: &[[[f64; 3]; 4]; 4], axis: &[f64], out: &mut Vec<[f64; 3]>) {
     let basis: Vec<[f64; 4]> = axis.iter().map(|&t| bspline(t).0).collect();
-    // rows[i][b]: net row b (offset b - 1 along v) at u_i.
-    let rows: Vec<[[f64; 3]; 4]> = basis
-        .iter()
-        .map(|w| {
-            std::array::from_fn(|b| {
-                let mut p = [0.0; 3];
-                for (a, column) in net.iter().enumerate() {
-                    for c in 0..3 {
-                        p[c] += w[a] * column[b][c];
-                    }
-                }
-                p
-            })
-        })
-        .collect();
+    let rows: Vec<[[f64; 3]; 4]> = basis.iter().map(|w| net_rows(net, w)).collect();
     for w in &basis {
-        out.extend(rows.iter().map(|row| {
-            let mut p = [0.0; 3];
-            for (b, q) in row.iter().enumerate() {
-                for c in 0..3 {
-                    p[c] += w[b] * q[c];
-                }
-            }
-            p
-        }));
+        out.extend(rows.iter().map(|row| row_curve(row, w)));
     }
+}
+
+/// The four rows of `net` (`rows[b]`: net row `b`, offset `b - 1` along `v`) at the `u` whose
+/// B-spline weights are `w`.
+fn net_rows(net: &[[[f64; 3]; 4]; 4], w: &[f64; 4]) -> [[f64; 3]; 4] {
+    std::array::from_fn(|b| {
+        let mut p = [0.0; 3];
+        for (a, column) in net.iter().enumerate() {
+            for c in 0..3 {
+                p[c] += w[a] * column[b][c];
+            }
+        }
+        p
+    })
+}
+
+/// The curve through the four points `row` ([`net_rows`]) at the `v` whose weights are `w`.
+fn row_curve(row: &[[f64; 3]; 4], w: &[f64; 4]) -> [f64; 3] {
+    let mut p = [0.0; 3];
+    for (b, q) in row.iter().enumerate() {
+        for c in 0..3 {
+            p[c] += w[b] * q[c];
+        }
+    }
+    p
+}
+
+/// Sample `index` of a face ([`Samples::new`] at `grid`): its parameters and its position,
+/// computed as [`Samples::new`] computes it (the same value to the bit).
+fn sample_at(
+    points: &PatchPoints,
+    grid: u32,
+    index: usize,
+) -> Result<([f64; 2], [f64; 3]), RuntimeError> {
+    let primal = grid_side(true, grid) as usize;
+    let (set, side, k) = if index < primal * primal {
+        (PointSet::Primal, primal, index)
+    } else {
+        (PointSet::Dual, grid as usize, index - primal * primal)
+    };
+    let (i, j) = (k % side, k / side);
+    let [primal_axis, dual_axis] = selection_axes(grid);
+    let axis = if set == PointSet::Primal {
+        primal_axis
+    } else {
+        dual_axis
+    };
+    let (Some(&u), Some(&v)) = (axis.get(i), axis.get(j)) else {
+        return Err(RuntimeError::InvalidParameter {
+            name: "sample".to_owned(),
+            reason: format!(
+                "{index} (a face has {} samples)",
+                primal * primal + side * side
+            ),
+        });
+    };
+    let position = match points.bspline_net() {
+        Some(net) => row_curve(&net_rows(&net, &bspline(u).0), &bspline(v).0),
+        None => points.at(&points.grid(set, grid)?, i, j),
+    };
+    Ok(([u, v], position))
 }
 
 /// Dual-grid index `(i, j)` of point `t` of the row next to side `side` of a face at rate `n`,
@@ -1052,16 +1108,7 @@ impl<'p> FaceLocal<'p> {
     /// deviation needs no more: a corner square's search stops at the first triangle that
     /// near).
     fn deviation_at(&self, u: f64, v: f64, p: [f64; 3], floor: f64) -> Result<f64, RuntimeError> {
-        let n = self.n as f64;
-        let h = 0.5 / n;
-        let (low_u, high_u, low_v, high_v) = (u <= h, u >= 1.0 - h, v <= h, v >= 1.0 - h);
-        if (low_u || high_u) && (low_v || high_v) {
-            let corner = match (low_u, low_v) {
-                (true, true) => 0,
-                (false, true) => 1,
-                (false, false) => 2,
-                (true, false) => 3,
-            };
+        if let Some((corner, _, _)) = corner_square(u, v, self.n) {
             // The nearest triangle, from the one nearest the last sample here (the next sample
             // is mostly nearest it too, and then bounds the rest tightest): one whose ball is
             // farther than the nearest so far cannot be nearer (the margin keeps rounding in the
@@ -1104,86 +1151,108 @@ impl<'p> FaceLocal<'p> {
         AxisPlace::new(u, self.n).interior_with(&AxisPlace::new(v, self.n), self.n)
     }
 
-    /// `L_{f,n}(u, v)` outside the corner squares.
+    /// `L_{f,n}(u, v)` outside the corner squares ([`linear_terms`]).
     fn at(&self, u: f64, v: f64) -> Result<[f64; 3], RuntimeError> {
-        let n = self.n as f64;
-        let h = 0.5 / n;
-        let distances = [v, 1.0 - u, 1.0 - v, u];
-        let (side, nearest) =
-            distances
-                .iter()
-                .copied()
-                .enumerate()
-                .fold(
-                    (0, f64::INFINITY),
-                    |best, (s, d)| {
-                        if d < best.1 {
-                            (s, d)
-                        } else {
-                            best
-                        }
-                    },
-                );
-        if nearest >= h || self.n == 1 {
-            // Interior: cell (i, j) of the dual grid, local (a, b) in [0,1]^2, split along a = b.
-            if self.n == 1 {
-                return Ok(self.d(0, 0));
-            }
-            return Ok(in_cell(
-                |i, j| self.d(i, j),
-                &AxisPlace::new(u, self.n),
-                &AxisPlace::new(v, self.n),
-            ));
+        let terms = linear_terms(u, v, self.n, |side| {
+            Ok(matches!(self.beyond(side)?, Beyond::Curve(_)))
+        })?;
+        let mut points = [[0.0; 3]; 3];
+        for (point, &(_, vertex)) in points.iter_mut().zip(&terms) {
+            *point = match vertex {
+                Vertex::Dual(i, j) => self.d(i, j),
+                Vertex::Beyond(side, t) => match self.beyond(side)? {
+                    Beyond::Face(row) | Beyond::Curve(row) => row[t],
+                },
+            };
         }
-        // A side's strip, in scaled side coordinates: the face's row point t at (2t + 1, 1),
-        // the curve point t at (2t, 0), the neighbour's row point t at (2t + 1, -1).
-        let s = match side {
-            0 => u,
-            1 => v,
-            2 => 1.0 - u,
-            _ => 1.0 - v,
+        Ok(combine(&[
+            (terms[0].0, points[0]),
+            (terms[1].0, points[1]),
+            (terms[2].0, points[2]),
+        ]))
+    }
+
+    /// Whether corner `corner`'s fan ([`FaceLocal::make_corner`]) starts at this face or at the
+    /// face opposite, and that opposite face's point there, where the corner is an interior
+    /// vertex of four faces; `None` elsewhere.
+    fn corner_chart(&self, corner: usize) -> Result<Option<(bool, [f64; 3])>, RuntimeError> {
+        let (ctx, f, m) = (self.ctx, self.f, self.n);
+        let mesh = ctx.mesh;
+        let (fan, closed) = sector(mesh, mesh.face_halfedges(f).start + corner);
+        let own = mesh.face_halfedges(f).start + corner;
+        let me = fan.iter().position(|&h| h == own);
+        let (true, 4, Some(me)) = (closed, fan.len(), me) else {
+            return Ok(None);
         };
-        let sigma = (2.0 * n * s).clamp(1.0, 2.0 * n - 1.0);
-        let delta = (2.0 * n * nearest).clamp(0.0, 1.0);
-        Ok(match self.beyond(side)? {
-            Beyond::Face(other) => {
-                // Cell i between the rows: quad (F_i, F_i+1, G_i+1, G_i) split as
-                // [G_i, F_i+1, F_i], [G_i, G_i+1, F_i+1]; alpha along, beta from G (0) to F (1).
-                let x = (sigma - 1.0) / 2.0;
-                let i = (x as usize).min(self.n - 2);
-                let alpha = x - i as f64;
-                let beta = (1.0 + delta) / 2.0;
-                let (f0, f1) = (self.row(side, i), self.row(side, i + 1));
-                let (g0, g1) = (other[i], other[i + 1]);
-                if beta >= alpha {
-                    combine(&[(1.0 - beta, g0), (alpha, f1), (beta - alpha, f0)])
-                } else {
-                    combine(&[(1.0 - alpha, g0), (alpha - beta, g1), (beta, f1)])
+        let h = fan[(me + 2) % 4];
+        let g = mesh.face_of[h] as usize;
+        let (i, j) = row_index(h - mesh.face_halfedges(g).start, 0, m);
+        let opposite = ctx.points[g].at(&self.neighbour_grid(g)?, i, j);
+        Ok(Some((me % 2 == 0, opposite)))
+    }
+
+    /// The largest distance from a corner square's sample to the point of `L_{f,n}` at its own
+    /// parameters in the regular chart ([`FaceLocal::chart_point`]), over every corner square;
+    /// `None` where a corner is not an interior vertex of four faces whose sides are the
+    /// neighbours' rows.
+    fn corner_chart_deviation(&self, samples: &Samples) -> Result<Option<f64>, RuntimeError> {
+        let Some(charts) = self.corner_charts()? else {
+            return Ok(None);
+        };
+        // The corner squares' samples: rows and columns within `h` of a side.
+        let mut largest = 0.0f64;
+        let mut offset = 0;
+        for axis in self.ctx.places(self.n)? {
+            let side = axis.places.len();
+            let near: Vec<usize> = (0..side).filter(|&i| axis.places[i].near_side).collect();
+            for &j in &near {
+                for &i in &near {
+                    let k = offset + j * side + i;
+                    let (Some(&[u, v]), Some(&p)) = (samples.uv.get(k), samples.positions.get(k))
+                    else {
+                        continue;
+                    };
+                    if let Some(x) = self.chart_point(&charts, u, v) {
+                        largest = largest.max(distance(p, x));
+                    }
                 }
             }
-            Beyond::Curve(c) => {
-                let j = ((sigma / 2.0) as usize).min(self.n - 1);
-                let centre = (2 * j + 1) as f64;
-                if (sigma - centre).abs() <= 1.0 - delta {
-                    // [C_j, C_{j+1}, D_j].
-                    let w1 = (sigma - 2.0 * j as f64 - delta) / 2.0;
-                    combine(&[
-                        (1.0 - delta - w1, c[j]),
-                        (w1, c[j + 1]),
-                        (delta, self.row(side, j)),
-                    ])
-                } else {
-                    // [C_k, D_k, D_{k-1}], k = 1..n-1 the curve point nearest sigma.
-                    let k = if sigma < centre { j } else { j + 1 }.clamp(1, self.n - 1);
-                    let x = sigma - 2.0 * k as f64;
-                    combine(&[
-                        (1.0 - delta, c[k]),
-                        ((delta + x) / 2.0, self.row(side, k)),
-                        ((delta - x) / 2.0, self.row(side, k - 1)),
-                    ])
-                }
-            }
-        })
+            offset += side * side;
+        }
+        Ok(Some(largest))
+    }
+
+    /// Per corner, the fan's diagonal and the four faces' corner points in the order of
+    /// [`chart_corner_terms`]; `None` where a corner is not an interior vertex of four faces
+    /// whose sides are the neighbours' rows.
+    fn corner_charts(&self) -> Result<Option<[CornerChart; 4]>, RuntimeError> {
+        let n = self.n;
+        let mut charts = [(false, [[0.0; 3]; 4]); 4];
+        for (corner, chart) in charts.iter_mut().enumerate() {
+            let Some((through_face, opposite)) = self.corner_chart(corner)? else {
+                return Ok(None);
+            };
+            let (Beyond::Face(next), Beyond::Face(previous)) =
+                (self.beyond(corner)?, self.beyond((corner + 3) % 4)?)
+            else {
+                return Ok(None);
+            };
+            let (i, j) = row_index(corner, 0, n);
+            *chart = (
+                through_face,
+                [self.d(i, j), next[0], previous[n - 1], opposite],
+            );
+        }
+        Ok(Some(charts))
+    }
+
+    /// The point of `L_{f,n}` at `(u, v)` in a corner square, from the corners' `charts`
+    /// ([`chart_corner_terms`]); `None` outside the corner squares.
+    fn chart_point(&self, charts: &[CornerChart; 4], u: f64, v: f64) -> Option<[f64; 3]> {
+        let (corner, a, b) = corner_square(u, v, self.n)?;
+        let (through_face, points) = charts[corner];
+        let terms = chart_corner_terms(a, b, 0.5 / self.n as f64, through_face);
+        Some(combine(&terms.map(|(w, k)| (w, points[k as usize]))))
     }
 
     /// `e_f(n)` over the samples.
@@ -1314,12 +1383,168 @@ fn once<T>(
 /// `L_{f,n}` in the interior: the dual grid's cell that holds the sample with places `u` and `v`,
 /// split along `a = b` (the tessellator's diagonal), the dual point `(i, j)` read by `at`.
 fn in_cell(at: impl Fn(usize, usize) -> [f64; 3], u: &AxisPlace, v: &AxisPlace) -> [f64; 3] {
+    let [(x, p), (y, q), (z, r)] = cell_terms(u, v);
+    combine(&[(x, at(p.0, p.1)), (y, at(q.0, q.1)), (z, at(r.0, r.1))])
+}
+
+/// [`in_cell`]'s weights and dual points.
+fn cell_terms(u: &AxisPlace, v: &AxisPlace) -> [(f64, (usize, usize)); 3] {
     let ((i, a), (j, b)) = ((u.cell, u.fraction), (v.cell, v.fraction));
-    let (p, q, r, s) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
     if a >= b {
-        combine(&[(1.0 - a, p), (a - b, q), (b, r)])
+        [(1.0 - a, (i, j)), (a - b, (i + 1, j)), (b, (i + 1, j + 1))]
     } else {
-        combine(&[(1.0 - b, p), (b - a, s), (a, r)])
+        [(1.0 - b, (i, j)), (b - a, (i, j + 1)), (a, (i + 1, j + 1))]
+    }
+}
+
+/// A corner's fan in the regular chart: whether its diagonal runs through the face, and the
+/// points of [`chart_corner_terms`].
+type CornerChart = (bool, [[f64; 3]; 4]);
+
+/// A vertex of `L_{f,n}` outside the corner squares: the face's dual point `(i, j)`, or point
+/// `t` of what lies beyond side `side` ([`Beyond`]: the neighbour's row or the boundary curve).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Vertex {
+    Dual(usize, usize),
+    Beyond(usize, usize),
+}
+
+/// Which corner square of the rate-`n` tessellation holds `(u, v)`, if any, with the sample's
+/// distances from the corner along the corner's two sides: `a` along side `corner` (which
+/// starts there), `b` back along side `corner - 1` (which ends there). The squares are
+/// `[0, h]^2` and its rotations, `h = 1/2n`; a sample on the line `u = h` at rate 1 belongs to
+/// the lower corner.
+fn corner_square(u: f64, v: f64, n: usize) -> Option<(usize, f64, f64)> {
+    let h = 0.5 / n as f64;
+    let (low_u, high_u, low_v, high_v) = (u <= h, u >= 1.0 - h, v <= h, v >= 1.0 - h);
+    if !((low_u || high_u) && (low_v || high_v)) {
+        return None;
+    }
+    Some(match (low_u, low_v) {
+        (true, true) => (0, u, v),
+        (false, true) => (1, v, 1.0 - u),
+        (false, false) => (2, 1.0 - u, 1.0 - v),
+        (true, false) => (3, 1.0 - v, u),
+    })
+}
+
+/// `L_{f,n}(u, v)` outside the corner squares as an affine combination of three of its
+/// vertices (`is_curve(side)`: whether a boundary curve lies beyond side `side`): in the
+/// interior `[h, 1-h]^2` the dual grid's cell split along `D_ij - D_{i+1,j+1}` ([`in_cell`]);
+/// in a side rectangle the strip to the neighbour's row (the rows' quads split as the
+/// tessellator's merge splits them) or to the boundary curve, in scaled side coordinates: the
+/// face's row point `t` at `(2t + 1, 1)`, the curve point `t` at `(2t, 0)`, the neighbour's row
+/// point `t` at `(2t + 1, -1)`.
+fn linear_terms(
+    u: f64,
+    v: f64,
+    n: usize,
+    is_curve: impl FnOnce(usize) -> Result<bool, RuntimeError>,
+) -> Result<[(f64, Vertex); 3], RuntimeError> {
+    let nf = n as f64;
+    let h = 0.5 / nf;
+    let distances = [v, 1.0 - u, 1.0 - v, u];
+    let (side, nearest) =
+        distances
+            .iter()
+            .copied()
+            .enumerate()
+            .fold(
+                (0, f64::INFINITY),
+                |best, (s, d)| if d < best.1 { (s, d) } else { best },
+            );
+    if n == 1 {
+        let d = Vertex::Dual(0, 0);
+        return Ok([(1.0, d), (0.0, d), (0.0, d)]);
+    }
+    if nearest >= h {
+        let terms = cell_terms(&AxisPlace::new(u, n), &AxisPlace::new(v, n));
+        return Ok(terms.map(|(w, (i, j))| (w, Vertex::Dual(i, j))));
+    }
+    let s = match side {
+        0 => u,
+        1 => v,
+        2 => 1.0 - u,
+        _ => 1.0 - v,
+    };
+    let sigma = (2.0 * nf * s).clamp(1.0, 2.0 * nf - 1.0);
+    let delta = (2.0 * nf * nearest).clamp(0.0, 1.0);
+    let row = |t: usize| {
+        let (i, j) = row_index(side, t, n);
+        Vertex::Dual(i, j)
+    };
+    let beyond = |t: usize| Vertex::Beyond(side, t);
+    Ok(if !is_curve(side)? {
+        // Cell i between the rows: quad (F_i, F_i+1, G_i+1, G_i) split as
+        // [G_i, F_i+1, F_i], [G_i, G_i+1, F_i+1]; alpha along, beta from G (0) to F (1).
+        let x = (sigma - 1.0) / 2.0;
+        let i = (x as usize).min(n - 2);
+        let alpha = x - i as f64;
+        let beta = (1.0 + delta) / 2.0;
+        if beta >= alpha {
+            [
+                (1.0 - beta, beyond(i)),
+                (alpha, row(i + 1)),
+                (beta - alpha, row(i)),
+            ]
+        } else {
+            [
+                (1.0 - alpha, beyond(i)),
+                (alpha - beta, beyond(i + 1)),
+                (beta, row(i + 1)),
+            ]
+        }
+    } else {
+        let j = ((sigma / 2.0) as usize).min(n - 1);
+        let centre = (2 * j + 1) as f64;
+        if (sigma - centre).abs() <= 1.0 - delta {
+            // [C_j, C_{j+1}, D_j].
+            let w1 = (sigma - 2.0 * j as f64 - delta) / 2.0;
+            [
+                (1.0 - delta - w1, beyond(j)),
+                (w1, beyond(j + 1)),
+                (delta, row(j)),
+            ]
+        } else {
+            // [C_k, D_k, D_{k-1}], k = 1..n-1 the curve point nearest sigma.
+            let k = if sigma < centre { j } else { j + 1 }.clamp(1, n - 1);
+            let x = sigma - 2.0 * k as f64;
+            [
+                (1.0 - delta, beyond(k)),
+                ((delta + x) / 2.0, row(k)),
+                ((delta - x) / 2.0, row(k - 1)),
+            ]
+        }
+    })
+}
+
+/// The point of a corner square's fan at the sample's own parameters, for an interior vertex of
+/// four faces: in the chart of the corner (`a` along side `corner`, `b` back along side
+/// `corner - 1`, [`corner_square`]) the four faces' corner dual points lie at `(h, h)` (the
+/// face's own, `0`), `(h, -h)` (beyond side `corner`, `1`), `(-h, h)` (beyond side
+/// `corner - 1`, `2`) and `(-h, -h)` (the face opposite, `3`), and the fan splits their square
+/// along the diagonal through the face (`through_face`) or along the other one. The weights
+/// (barycentric in the triangle that holds `(a, b)`) and the points' numbers.
+fn chart_corner_terms(a: f64, b: f64, h: f64, through_face: bool) -> [(f64, u8); 3] {
+    let (a, b) = (a / h, b / h);
+    if !through_face {
+        // The triangle (own, beyond `corner`, beyond `corner - 1`) holds the whole square.
+        let own = (a + b) / 2.0;
+        let along = (1.0 - own + (a - b) / 2.0) / 2.0;
+        return [(own, 0), (along, 1), (1.0 - own - along, 2)];
+    }
+    if a >= b {
+        [
+            ((1.0 + b) / 2.0, 0),
+            ((a - b) / 2.0, 1),
+            ((1.0 - a) / 2.0, 3),
+        ]
+    } else {
+        [
+            ((1.0 + a) / 2.0, 0),
+            ((b - a) / 2.0, 2),
+            ((1.0 - b) / 2.0, 3),
+        ]
     }
 }
 
@@ -1444,6 +1669,24 @@ impl<'a> Context<'a> {
             })
     }
 
+    /// Whether face `f` and every face sharing a vertex with it are regular interior B-spline
+    /// patches ([`PatchPoints::is_regular`]) around vertices of four faces: then its samples
+    /// and `L_{f,n}` are stencils on one regular grid of control points ([`chart_norm`]).
+    fn regular(&self, f: usize) -> bool {
+        let mesh = self.mesh;
+        let patch = |g: usize| !mesh.holes[g] && self.points[g].is_regular();
+        patch(f)
+            && mesh.face_halfedges(f).all(|h| {
+                let v = mesh.face_vertices[h] as usize;
+                let mut faces = 0;
+                let all = mesh.fan_iter(v).all(|e| {
+                    faces += 1;
+                    mesh.cut(e, false) == Cut::None && patch(mesh.face_of[e] as usize)
+                });
+                all && faces == 4 && !mesh.is_cone_tip(v)
+            })
+    }
+
     /// Whether face `f` is a hole: it has no surface, no samples and no deviation.
     fn hole(&self, f: usize) -> bool {
         self.mesh.holes[f]
@@ -1453,7 +1696,7 @@ impl<'a> Context<'a> {
 /// The surface faces the table does not describe exactly, ascending: those the tessellator
 /// evaluates by feature-adaptive refinement ([`table_may_describe`]: sharp and semi-sharp
 /// features at a corner), and those whose patch the table lacks (a valence beyond it).
-fn adaptive_faces<'a>(
+pub(crate) fn adaptive_faces<'a>(
     table: &StencilTable,
     mesh: &'a Mesh,
     patches: &[FacePatch],
@@ -1587,13 +1830,22 @@ pub fn tolerance_rates_among(
     tolerance: f64,
     candidates: &[u32],
 ) -> Result<ToleranceRates, RuntimeError> {
-    with_selection(table, mesh, patches, tolerance, candidates, |choose| {
-        let choices = (0..patches.len())
-            .into_par_iter()
-            .map(choose)
-            .collect::<Result<Vec<_>, _>>()?;
-        Ok(ToleranceRates::from_choices(&choices))
-    })
+    let adaptive = adaptive_faces(table, mesh, patches)?;
+    with_selection(
+        table,
+        mesh,
+        patches,
+        &adaptive,
+        tolerance,
+        candidates,
+        |choose| {
+            let choices = (0..patches.len())
+                .into_par_iter()
+                .map(choose)
+                .collect::<Result<Vec<_>, _>>()?;
+            Ok(ToleranceRates::from_choices(&choices))
+        },
+    )
 }
 
 /// Runs `body` with the selection of [`tolerance_rates_among`] for one face at a time
@@ -1603,6 +1855,7 @@ pub(crate) fn with_selection<R>(
     table: &StencilTable,
     mesh: &Mesh,
     patches: &[FacePatch],
+    adaptive: &AdaptiveGrids,
     tolerance: f64,
     candidates: &[u32],
     body: impl FnOnce(
@@ -1611,13 +1864,13 @@ pub(crate) fn with_selection<R>(
 ) -> Result<R, RuntimeError> {
     check_tolerance(tolerance)?;
     let sorted = sorted_candidates(candidates, &RATIONAL_RATES)?;
-    let adaptive = adaptive_faces(table, mesh, patches)?;
-    let ctx = Context::new(table, mesh, patches, &adaptive)?;
+    let ctx = Context::new(table, mesh, patches, adaptive)?;
     // A rate below the largest is only compared with the tolerance; the largest's deviation is
     // reported when no rate meets it, so it is measured in full.
     let largest = sorted.last().copied().unwrap_or(0);
     let choose = |f: usize| {
-        choose_rate(
+        let regular = ctx.regular(f);
+        let (mut choice, samples) = choose_rate(
             f,
             tolerance,
             &sorted,
@@ -1636,32 +1889,84 @@ pub(crate) fn with_selection<R>(
                 } else {
                     tolerance
                 };
-                // Most samples are interior, where the face's own dual points are all of
-                // `L_{f,n}`: a failing rate is refuted there before its neighbours' rows and
-                // its corners' polygons are evaluated, unless the last rate failed only
-                // outside.
                 let local = FaceLocal::new(&ctx, f, n)?;
-                let mut worst = 0.0f64;
-                if !samples.outside_first.get() {
-                    worst = local.deviation_up_to(samples, stop, |interior| interior)?;
-                    if worst > stop {
-                        return Ok(worst);
-                    }
-                }
-                worst = worst.max(local.deviation_up_to(samples, stop, |interior| !interior)?);
+                let worst = scan(&local, samples, stop)?;
                 if worst > stop {
-                    samples.outside_first.set(true);
-                    return Ok(worst);
-                }
-                if samples.outside_first.get() {
-                    samples.outside_first.set(false);
-                    worst = worst.max(local.deviation_up_to(samples, stop, |interior| interior)?);
+                    // The scan stopped at the refuting sample.
+                    samples.refutations.borrow_mut().push(Refutation {
+                        rate: n,
+                        sample: samples.start.get(),
+                        deviation: worst,
+                    });
+                } else if regular && worst <= tolerance {
+                    if let Some(corners) = local.corner_chart_deviation(samples)? {
+                        samples.chart.set(Some(worst.max(corners)));
+                    }
                 }
                 Ok(worst)
             },
-        )
+        )?;
+        choice.refutations = samples.refutations.take();
+        if let (true, Some(deviation)) = (choice.met, samples.chart.get()) {
+            choice.chart = Some(ChartBound {
+                deviation,
+                norm: chart_norm(choice.rate)?,
+            });
+        }
+        Ok(choice)
     };
     body(&choose)
+}
+
+/// `e_f(n)` of `local`'s face over `samples`, or a sample's deviation beyond `stop`
+/// ([`FaceLocal::deviation_up_to`]). Most samples are interior, where the face's own dual
+/// points are all of `L_{f,n}`: a failing rate is refuted there before its neighbours' rows and
+/// its corners' polygons are evaluated, unless the last rate failed only outside.
+fn scan(local: &FaceLocal, samples: &Samples, stop: f64) -> Result<f64, RuntimeError> {
+    let mut worst = 0.0f64;
+    if !samples.outside_first.get() {
+        worst = local.deviation_up_to(samples, stop, |interior| interior)?;
+        if worst > stop {
+            return Ok(worst);
+        }
+    }
+    worst = worst.max(local.deviation_up_to(samples, stop, |interior| !interior)?);
+    if worst > stop {
+        samples.outside_first.set(true);
+        return Ok(worst);
+    }
+    if samples.outside_first.get() {
+        samples.outside_first.set(false);
+        worst = worst.max(local.deviation_up_to(samples, stop, |interior| interior)?);
+    }
+    Ok(worst)
+}
+
+/// The deviation of each `(face, rate, sample)` of `checks` at the mesh's current positions:
+/// what [`FaceLocal::deviation_at`] measures there in full (a later frame's look at the samples
+/// that refuted its rates, [`super::rate_memory`]).
+pub(crate) fn sample_deviations(
+    table: &StencilTable,
+    mesh: &Mesh,
+    patches: &[FacePatch],
+    adaptive: &AdaptiveGrids,
+    checks: &[(usize, u32, usize)],
+) -> Result<Vec<f64>, RuntimeError> {
+    let ctx = Context::new(table, mesh, patches, adaptive)?;
+    checks
+        .par_iter()
+        .map(|&(f, n, sample)| {
+            let points = ctx
+                .points
+                .get(f)
+                .ok_or_else(|| RuntimeError::InvalidParameter {
+                    name: "face".to_owned(),
+                    reason: format!("{f} (the mesh has {} faces)", patches.len()),
+                })?;
+            let ([u, v], p) = sample_at(points, SELECTION_GRID, sample)?;
+            FaceLocal::new(&ctx, f, n)?.deviation_at(u, v, p, 0.0)
+        })
+        .collect()
 }
 
 /// The faces the selection samples by feature-adaptive refinement, ascending ([module docs](self)).
@@ -1710,7 +2015,7 @@ pub(crate) fn sorted_candidates(
 }
 
 /// One face's rate from the selection ([`choose_rate`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub(crate) struct FaceChoice {
     /// The smallest candidate meeting the tolerance, or the largest.
     pub(crate) rate: u32,
@@ -1722,6 +2027,33 @@ pub(crate) struct FaceChoice {
     /// deviation at that rate, beyond the tolerance (infinity when no smaller candidate was
     /// tried). What lets a later frame keep `rate` ([`super::rate_memory`]).
     pub(crate) refuted: f64,
+    /// Each smaller candidate's refutation, in order, where the selection recorded them (the
+    /// quad one does): what lets a later frame look at those samples alone.
+    pub(crate) refutations: Vec<Refutation>,
+    /// Where the face's neighbourhood is regular and `rate` met the tolerance, the chart's
+    /// bound of `e_f(rate)` ([`ChartBound`]).
+    pub(crate) chart: Option<ChartBound>,
+}
+
+/// A candidate rate the selection refuted, at the sample (its index in the face's samples, the
+/// primal grid at [`SELECTION_GRID`] then the dual one) that deviated by `deviation`, beyond the
+/// tolerance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Refutation {
+    pub(crate) rate: u32,
+    pub(crate) sample: usize,
+    pub(crate) deviation: f64,
+}
+
+/// A bound of a regular face's deviation at its rate that motion moves little: the largest
+/// distance from a sample to the point of `L_{f,n}` at the sample's own parameters
+/// (`deviation`, at least `e_f(n)`: those points lie on `L_{f,n}`; in a corner square the fan's
+/// point, [`chart_corner_terms`]), and the norm of the stencils of those differences
+/// ([`chart_norm`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct ChartBound {
+    pub(crate) deviation: f64,
+    pub(crate) norm: f64,
 }
 
 impl ToleranceRates {
@@ -1740,18 +2072,116 @@ impl ToleranceRates {
     }
 }
 
+/// The largest `|c|_1` at rate `n` over the samples, `c` the stencil of `S(u, v) - x(u, v)` on a
+/// regular grid of control points, where `S` is the bicubic B-spline and `x` the point of
+/// `L_{f,n}` at the sample's parameters (what [`linear_terms`] combines, or in a corner square
+/// the fan's point under either diagonal, [`chart_corner_terms`]), plus `2^-20` for the table's
+/// `f32` rounding of the dual points' stencils (at most `2^-24` each, weights of norm one).
+///
+/// Why it is small: `c` annihilates every control net that is an affine function of the grid
+/// (the spline reproduces it, and so does linear interpolation between its points), so
+/// `|c|_1` is second order in the spacing `1/n`: 0.50 at rate 1, 0.18 at 2, 0.047 at 4, where
+/// `|w|_1 + |l|_1` of the two ends is 2. If every control point moves by at most `delta` after a
+/// rigid map, the distance moves by at most `|c|_1 delta` ([`super::rate_memory`]).
+pub(crate) fn chart_norm(n: u32) -> Result<f64, RuntimeError> {
+    static NORMS: [OnceLock<f64>; MAX_SELECTED_RATE as usize] =
+        [const { OnceLock::new() }; MAX_SELECTED_RATE as usize];
+    let slot = (n as usize)
+        .checked_sub(1)
+        .and_then(|k| NORMS.get(k))
+        .ok_or_else(|| RuntimeError::InvalidParameter {
+            name: "rate".to_owned(),
+            reason: format!("{n} (the selection measures rates 1..={MAX_SELECTED_RATE})"),
+        })?;
+    Ok(*slot.get_or_init(|| measured_chart_norm(n as usize) + 2f64.powi(-20)))
+}
+
+/// The B-spline surface of the regular grid at `(x, y)` (the face `[0, 1]^2`, `x, y` in
+/// `[-1/2, 3/2]`) as weights on the control points `-2..=3` along each axis (`x` inner).
+fn chart_stencil(x: f64, y: f64) -> [f64; 36] {
+    let cell = |t: f64| (t.floor() as i64).clamp(-1, 1);
+    let (kx, ky) = (cell(x), cell(y));
+    let (wx, wy) = (bspline(x - kx as f64).0, bspline(y - ky as f64).0);
+    let mut w = [0.0; 36];
+    for (b, &y_weight) in wy.iter().enumerate() {
+        for (a, &x_weight) in wx.iter().enumerate() {
+            let (i, j) = ((kx + 1) as usize + a, (ky + 1) as usize + b);
+            w[j * 6 + i] = x_weight * y_weight;
+        }
+    }
+    w
+}
+
+/// [`chart_norm`] without the rounding allowance.
+fn measured_chart_norm(n: usize) -> f64 {
+    let h = 0.5 / n as f64;
+    let dual = |t: usize| (2 * t + 1) as f64 * h;
+    // Where a vertex of `L_{f,n}` lies in the face's chart.
+    let place = |vertex: Vertex| match vertex {
+        Vertex::Dual(i, j) => (dual(i), dual(j)),
+        Vertex::Beyond(side, t) => {
+            let (along, across) = (dual(t), -h);
+            match side {
+                0 => (along, across),
+                1 => (1.0 - across, along),
+                2 => (1.0 - along, 1.0 - across),
+                _ => (across, 1.0 - along),
+            }
+        }
+    };
+    let norm = |sample: [f64; 36], terms: &[(f64, (f64, f64))]| {
+        let mut c = sample;
+        for &(weight, (x, y)) in terms {
+            for (c, w) in c.iter_mut().zip(chart_stencil(x, y)) {
+                *c -= weight * w;
+            }
+        }
+        c.iter().map(|x| x.abs()).sum::<f64>()
+    };
+    let [primal, dual_axis] = selection_axes(SELECTION_GRID);
+    let mut largest = 0.0f64;
+    for axis in [primal, dual_axis] {
+        for &v in &axis {
+            for &u in &axis {
+                let sample = chart_stencil(u, v);
+                if let Some((corner, a, b)) = corner_square(u, v, n) {
+                    // The corner's chart back to the face's: `(a, b)` from the vertex.
+                    let to_face = |(a, b): (f64, f64)| match corner {
+                        0 => (a, b),
+                        1 => (1.0 - b, a),
+                        2 => (1.0 - a, 1.0 - b),
+                        _ => (b, 1.0 - a),
+                    };
+                    let points = [(h, h), (h, -h), (-h, h), (-h, -h)].map(to_face);
+                    for through_face in [true, false] {
+                        let terms = chart_corner_terms(a, b, h, through_face)
+                            .map(|(w, k)| (w, points[k as usize]));
+                        largest = largest.max(norm(sample, &terms));
+                    }
+                    continue;
+                }
+                let Ok(terms) = linear_terms(u, v, n, |_| Ok(false)) else {
+                    continue;
+                };
+                largest = largest.max(norm(sample, &terms.map(|(w, x)| (w, place(x)))));
+            }
+        }
+    }
+    largest
+}
+
 /// The selection of face `f` shared by the quad and triangle tolerance rates: the smallest `n`
 /// of `sorted` (ascending, non-empty) with `deviation(f, &prepare(f), n) <= tolerance`, trying
 /// them in order, or the largest (not met). `prepare` is what every rate reuses (the face's
 /// samples); `deviation` may stop at the first sample beyond the tolerance for a rate below the
-/// largest, and returns that sample's deviation then.
+/// largest, and returns that sample's deviation then. The choice, with what `prepare` made.
 pub(crate) fn choose_rate<S>(
     f: usize,
     tolerance: f64,
     sorted: &[u32],
     prepare: impl Fn(usize) -> Result<S, RuntimeError>,
     deviation: impl Fn(usize, &S, u32) -> Result<f64, RuntimeError>,
-) -> Result<FaceChoice, RuntimeError> {
+) -> Result<(FaceChoice, S), RuntimeError> {
     let largest = *sorted
         .last()
         .ok_or_else(|| RuntimeError::InvalidParameter {
@@ -1761,24 +2191,22 @@ pub(crate) fn choose_rate<S>(
     let prepared = prepare(f)?;
     let mut refuted = f64::INFINITY;
     let mut last = 0.0;
+    let choice = |rate, deviation, met, refuted| FaceChoice {
+        rate,
+        deviation,
+        met,
+        refuted,
+        refutations: Vec::new(),
+        chart: None,
+    };
     for &n in sorted {
         last = deviation(f, &prepared, n)?;
         if last <= tolerance {
-            return Ok(FaceChoice {
-                rate: n,
-                deviation: last,
-                met: true,
-                refuted,
-            });
+            return Ok((choice(n, last, true, refuted), prepared));
         }
         refuted = refuted.min(last);
     }
-    Ok(FaceChoice {
-        rate: largest,
-        deviation: last,
-        met: false,
-        refuted,
-    })
+    Ok((choice(largest, last, false, refuted), prepared))
 }
 
 /// The measured deviation of a finished tessellation: the largest Euclidean distance from the
@@ -1957,6 +2385,106 @@ pub fn view_rates(mesh: &Mesh, camera: &ViewCamera) -> Result<Vec<u32>, RuntimeE
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A sample looked at again ([`sample_at`]) is the selection's sample to the bit: on a
+    /// regular torus (closed form) and around extraordinary vertices (table stencils).
+    #[test]
+    #[cfg(feature = "catmull-clark")]
+    fn a_sample_alone_is_the_selections_sample() {
+        let table = StencilTable::default_catmull_clark().expect("embedded table");
+        let torus = crate::mesh::test_meshes::quad_torus(6, 5);
+        let torus_patches = crate::scheme::patch::gather_patches(&torus).expect("patches");
+        let (octahedron, octahedron_patches, _) =
+            crate::scheme::catmull_clark::isolate::isolate(&crate::mesh::test_meshes::octahedron())
+                .expect("isolates");
+        for (mesh, patches) in [(&torus, &torus_patches), (&octahedron, &octahedron_patches)] {
+            for patch in patches.iter().step_by(7) {
+                let points = PatchPoints::new(&table, mesh, patch).expect("table patch");
+                let samples = Samples::new(&points, SELECTION_GRID).expect("samples");
+                for (k, (uv, p)) in samples.uv.iter().zip(&samples.positions).enumerate() {
+                    let alone = sample_at(&points, SELECTION_GRID, k).expect("a sample");
+                    assert_eq!(alone, (*uv, *p), "sample {k}");
+                }
+                assert!(sample_at(&points, SELECTION_GRID, samples.uv.len()).is_err());
+            }
+        }
+    }
+
+    /// [`chart_norm`] against the same norms computed independently (numpy, from the cubic
+    /// B-spline basis and the tessellation's triangles written out again).
+    #[test]
+    fn chart_norms_are_the_splines_interpolation_errors() {
+        let expected = [
+            (1, 0.5008680555555557),
+            (2, 0.1802300347222222),
+            (3, 0.08061247332723678),
+            (4, 0.04709455702039919),
+            (8, 0.011940492524041061),
+            (24, 0.0013352088168015067),
+        ];
+        for (n, norm) in expected {
+            let measured = chart_norm(n).expect("a rate of the table") - 2f64.powi(-20);
+            assert!(
+                (measured - norm).abs() < 1e-12,
+                "rate {n}: {measured} against {norm}"
+            );
+        }
+        assert!(chart_norm(0).is_err() && chart_norm(25).is_err());
+    }
+
+    /// On regular tori, the corner squares' chart points ([`FaceLocal::chart_point`]) are
+    /// points of `L_{f,n}`: no nearer to a sample than its nearest triangle; and where the
+    /// control points are an affine image of the grid they are the limit surface itself (every
+    /// vertex of the fan in its place: a wrong one moves the point off the plane of the grid).
+    #[test]
+    #[cfg(feature = "catmull-clark")]
+    fn chart_points_lie_on_the_local_tessellation() {
+        let table = StencilTable::default_catmull_clark().expect("embedded table");
+        let m = 10;
+        let mut bent = crate::mesh::test_meshes::quad_torus(m, m);
+        for (k, p) in bent.positions.iter_mut().enumerate() {
+            p[2] += 0.3 * ((k * 7919 % 13) as f64 / 13.0 - 0.5);
+        }
+        let mut flat = bent.clone();
+        for (k, p) in flat.positions.iter_mut().enumerate() {
+            let (i, j) = ((k % m) as f64, (k / m) as f64);
+            *p = [i + 0.3 * j, 0.5 * j - 0.2 * i, 0.2 * i - 0.1 * j];
+        }
+        for (mesh, affine) in [(&bent, false), (&flat, true)] {
+            let patches = crate::scheme::patch::gather_patches(mesh).expect("patches");
+            let adaptive = adaptive_faces(&table, mesh, &patches).expect("adaptive faces");
+            let ctx = Context::new(&table, mesh, &patches, &adaptive).expect("context");
+            let mut checked = 0;
+            for f in 0..patches.len() {
+                assert!(ctx.regular(f), "face {f} of a regular torus");
+                // Faces whose neighbourhood does not reach across the seam of `flat`.
+                let corner = mesh.face(f)[0] as usize;
+                let (i, j) = (corner % m, corner / m);
+                if affine && !((2..m - 3).contains(&i) && (2..m - 3).contains(&j)) {
+                    continue;
+                }
+                let samples = Samples::new(&ctx.points[f], SELECTION_GRID).expect("samples");
+                for n in 1..=5 {
+                    let local = FaceLocal::new(&ctx, f, n).expect("local tessellation");
+                    let charts = local.corner_charts().expect("charts").expect("regular");
+                    for (&[u, v], &p) in samples.uv.iter().zip(&samples.positions) {
+                        let Some(x) = local.chart_point(&charts, u, v) else {
+                            continue;
+                        };
+                        let nearest = local.deviation_at(u, v, p, 0.0).expect("deviation");
+                        let chart = distance(p, x);
+                        assert!(
+                            chart >= nearest - 1e-12,
+                            "face {f}, rate {n}, ({u}, {v}): chart {chart} below {nearest}"
+                        );
+                        assert!(!affine || chart < 1e-5, "face {f}, rate {n}: {chart}");
+                        checked += 1;
+                    }
+                }
+            }
+            assert!(checked > 1000, "{checked} corner samples");
+        }
+    }
 
     fn message(text: &str, faces: usize) -> String {
         match parse_rates(text, faces) {

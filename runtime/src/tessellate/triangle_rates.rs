@@ -851,6 +851,15 @@ impl Selection for TriangleSelection<'_> {
         false
     }
 
+    /// The triangle selection records no refutations ([`FaceChoice::refutations`]), so it is
+    /// never asked.
+    fn sample_deviations(&self, checks: &[(usize, u32, usize)]) -> Result<Vec<f64>, RuntimeError> {
+        Err(RuntimeError::Unsupported(format!(
+            "internal: {} samples looked at again, but the triangle selection records no refutations",
+            checks.len()
+        )))
+    }
+
     fn choose(&self, faces: &[usize]) -> Result<Vec<FaceChoice>, RuntimeError> {
         if faces.is_empty() {
             return Ok(Vec::new());
@@ -878,6 +887,7 @@ impl Selection for TriangleSelection<'_> {
                         Ok(template.deviation_up_to(&ctx.local_points(f, n)?, samples, stop))
                     },
                 )
+                .map(|(choice, _)| choice)
             })
             .collect()
     }
