@@ -41,7 +41,9 @@
 //! `delta` is measured against the neighbourhood as it was when the face was sampled (kept in
 //! `f32` about its corner centre, whose rounding is added), after the rigid map that carries the
 //! frame of the face's corner diagonals then to their frame now: any rigid map gives a valid
-//! bound, and this one is exact for a part of the mesh that moves rigidly.
+//! bound, and this one is exact for a part of the mesh that moves rigidly. Where it does not
+//! keep the rate, the rigid map nearest the motion in least squares (Kabsch) is tried: for a
+//! neighbourhood that bends, its largest residual is mostly smaller.
 //!
 //! # Regular faces: the difference's own stencil
 //!
@@ -295,42 +297,51 @@ impl RateMemory {
                 if !bound.norm.is_finite() {
                     return Test::Sample;
                 }
-                let moved = near.residual(f, selection.corners(f), now);
-                // The weights' sums times the rigid map's translation, and f64's rounding.
-                let margin = bound.sum_error * moved.translation
-                    + 1e-12 * bound.norm * (near.scale[f] + moved.scale);
-                let change = bound.norm * moved.residual + margin;
-                let mut deviation = choice.deviation + change;
-                if let Some(chart) = choice.chart {
-                    deviation =
-                        deviation.min(chart.deviation + chart.norm * moved.residual + margin);
-                }
-                // A face that met no rate keeps the largest while every rate stays refuted.
-                if choice.met && deviation > tolerance {
-                    return Test::Sample;
-                }
-                if choice.refuted - change > tolerance {
-                    return Test::Keep(deviation);
-                }
-                // The refutations the motion may have undone, looked at again, where every
-                // smaller candidate's was recorded.
-                let smaller = self
-                    .candidates
-                    .iter()
-                    .take_while(|&&n| n < choice.rate)
-                    .count();
-                if !choice.met || choice.refutations.len() != smaller {
-                    return Test::Sample;
-                }
-                Test::LookAgain(
-                    deviation,
-                    choice
-                        .refutations
+                let test = |moved: &Motion| {
+                    // The weights' sums times the rigid map's translation, and f64's rounding.
+                    let margin = bound.sum_error * moved.translation
+                        + 1e-12 * bound.norm * (near.scale[f] + moved.scale);
+                    let change = bound.norm * moved.residual + margin;
+                    let mut deviation = choice.deviation + change;
+                    if let Some(chart) = choice.chart {
+                        deviation =
+                            deviation.min(chart.deviation + chart.norm * moved.residual + margin);
+                    }
+                    // A face that met no rate keeps the largest while every rate stays refuted.
+                    if choice.met && deviation > tolerance {
+                        return Test::Sample;
+                    }
+                    if choice.refuted - change > tolerance {
+                        return Test::Keep(deviation);
+                    }
+                    // The refutations the motion may have undone, looked at again, where every
+                    // smaller candidate's was recorded.
+                    let smaller = self
+                        .candidates
                         .iter()
-                        .filter(|r| r.deviation - change <= tolerance)
-                        .map(|r| (f, r.rate, r.sample))
-                        .collect(),
-                )
+                        .take_while(|&&n| n < choice.rate)
+                        .count();
+                    if !choice.met || choice.refutations.len() != smaller {
+                        return Test::Sample;
+                    }
+                    Test::LookAgain(
+                        deviation,
+                        choice
+                            .refutations
+                            .iter()
+                            .filter(|r| r.deviation - change <= tolerance)
+                            .map(|r| (f, r.rate, r.sample))
+                            .collect(),
+                    )
+                };
+                // The corner frames first (exact for a rigid motion, and cheap); where they do
+                // not keep the rate, the rigid map nearest the motion in least squares.
+                match test(&near.residual(f, selection.corners(f), now)) {
+                    Test::Sample => near
+                        .fitted_residual(f, now)
+                        .map_or(Test::Sample, |moved| test(&moved)),
+                    kept => kept,
+                }
             })
             .collect();
         let checks: Vec<(usize, u32, usize)> = tests
@@ -610,6 +621,93 @@ impl Neighbourhoods {
     }
 }
 
+impl Neighbourhoods {
+    /// How face `f`'s neighbourhood moved since it was sampled, measured after the rigid map
+    /// nearest the motion in least squares (Kabsch: the rotation is the orthogonal polar factor
+    /// of the points' cross-covariance, by Newton's iteration `X -> (X + X^-T) / 2`); `None` where
+    /// that map is not a proper rotation to `1e-12` (a motion that flips or flattens it).
+    fn fitted_residual(&self, f: usize, now: &[[f64; 3]]) -> Option<Motion> {
+        let range = self.offsets[f]..self.offsets[f + 1];
+        let (then, points) = (&self.sampled[range.clone()], &self.points[range]);
+        let count = then.len() as f64;
+        let mut mean_then = [0.0; 3];
+        let mut mean_now = [0.0; 3];
+        for (kept, &i) in then.iter().zip(points) {
+            let q = now[i as usize];
+            for c in 0..3 {
+                mean_then[c] += f64::from(kept[c]) / count;
+                mean_now[c] += q[c] / count;
+            }
+        }
+        // M = sum (q - q_mean)(p - p_mean)^T: the rotation maximizing sum (q - q_mean) . R (p - p_mean).
+        let mut m = [[0.0; 3]; 3];
+        for (kept, &i) in then.iter().zip(points) {
+            let p = sub(kept.map(f64::from), mean_then);
+            let q = sub(now[i as usize], mean_now);
+            for (r, row) in m.iter_mut().enumerate() {
+                for (c, x) in row.iter_mut().enumerate() {
+                    *x += q[r] * p[c];
+                }
+            }
+        }
+        let rotation = polar_rotation(m)?;
+        let (mut residual, mut scale) = (0.0f64, 0.0f64);
+        for (kept, &i) in then.iter().zip(points) {
+            let p = sub(kept.map(f64::from), mean_then);
+            let q = now[i as usize];
+            let carried = [0, 1, 2].map(|r| mean_now[r] + dot(rotation[r], p));
+            residual = residual.max(norm(sub(q, carried)));
+            scale = scale.max(norm(q));
+        }
+        // x -> R (x - c - p_mean) + q_mean, c the corner centre then: translation q_mean - R (c + p_mean).
+        let origin = [0, 1, 2].map(|c| self.centres[f][c] + mean_then[c]);
+        let turned = [0, 1, 2].map(|r| dot(rotation[r], origin));
+        Some(Motion {
+            residual: residual + self.radius[f] * 2f64.powi(-23),
+            translation: norm(sub(mean_now, turned)),
+            scale,
+        })
+    }
+}
+
+/// The rotation nearest `m` (its orthogonal polar factor), or `None` where `m` is singular,
+/// reflects, or the iteration does not settle on a rotation to `1e-12`.
+fn polar_rotation(m: [[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
+    let size = m.iter().flatten().map(|x| x * x).sum::<f64>().sqrt();
+    if !(size > 0.0 && size.is_finite()) {
+        return None;
+    }
+    let mut x = m.map(|row| row.map(|v| v / size));
+    for _ in 0..40 {
+        let inverse_transpose = inverse_transpose(x)?;
+        let next: [[f64; 3]; 3] = std::array::from_fn(|r| {
+            std::array::from_fn(|c| (x[r][c] + inverse_transpose[r][c]) / 2.0)
+        });
+        let step = (0..3)
+            .flat_map(|r| (0..3).map(move |c| (r, c)))
+            .map(|(r, c)| (next[r][c] - x[r][c]).abs())
+            .fold(0.0, f64::max);
+        x = next;
+        if step < 1e-15 {
+            break;
+        }
+    }
+    // A proper rotation: orthonormal rows, determinant one.
+    let orthogonal = (0..3)
+        .all(|r| (0..3).all(|c| (dot(x[r], x[c]) - if r == c { 1.0 } else { 0.0 }).abs() <= 1e-12));
+    (orthogonal && dot(cross(x[0], x[1]), x[2]) > 0.0).then_some(x)
+}
+
+/// `(a^-1)^T`, the cofactor matrix over the determinant; `None` for a singular `a`.
+fn inverse_transpose(a: [[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
+    let cofactors = [cross(a[1], a[2]), cross(a[2], a[0]), cross(a[0], a[1])];
+    let det = dot(a[0], cofactors[0]);
+    if !(det.abs() > 1e-300 && det.is_finite()) {
+        return None;
+    }
+    Some(cofactors.map(|row| row.map(|v| v / det)))
+}
+
 /// What a frame does with a face's rate ([`RateMemory::rates`]).
 enum Test {
     /// Kept, with the bound of its deviation now.
@@ -725,6 +823,45 @@ mod tests {
         let across = cross(k, p);
         let along = dot(k, p) * (1.0 - cos);
         [0, 1, 2].map(|c| p[c] * cos + across[c] * sin + k[c] * along + shift[c])
+    }
+
+    /// The least-squares rotation of a cloud turned by a known rotation, and stretched along
+    /// one axis, is that rotation; a mirror image has none.
+    #[test]
+    fn the_polar_rotation_is_the_turn() {
+        let cloud: Vec<[f64; 3]> = (0..40)
+            .map(|k| {
+                let t = k as f64;
+                [(0.7 * t).sin(), (1.3 * t).cos(), 0.1 * t - 2.0]
+            })
+            .collect();
+        let covariance = |moved: &dyn Fn([f64; 3]) -> [f64; 3]| {
+            let mut m = [[0.0; 3]; 3];
+            for &p in &cloud {
+                let q = moved(p);
+                for (r, row) in m.iter_mut().enumerate() {
+                    for (c, x) in row.iter_mut().enumerate() {
+                        *x += q[r] * p[c];
+                    }
+                }
+            }
+            m
+        };
+        // The rotation's rows: its images of the axes, transposed.
+        let axes =
+            [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]].map(|e| rigid(e, 0.9, [0.0; 3]));
+        let turned = polar_rotation(covariance(&|p| rigid(p, 0.9, [0.0; 3]))).expect("a rotation");
+        for r in 0..3 {
+            for c in 0..3 {
+                assert!((turned[r][c] - axes[c][r]).abs() < 1e-12, "{turned:?}");
+            }
+        }
+        let stretched = polar_rotation(covariance(&|p| {
+            rigid([1.5 * p[0], p[1], p[2]], 0.9, [0.0; 3])
+        }));
+        assert!(stretched.is_some());
+        assert!(polar_rotation(covariance(&|p| [-p[0], p[1], p[2]])).is_none());
+        assert!(polar_rotation([[0.0; 3]; 3]).is_none());
     }
 
     /// Frames that keep, turn, move, bend and grow the points `rest` (about 1 across), through
