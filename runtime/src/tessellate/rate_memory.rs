@@ -619,13 +619,11 @@ impl Neighbourhoods {
             scale,
         }
     }
-}
 
-impl Neighbourhoods {
     /// How face `f`'s neighbourhood moved since it was sampled, measured after the rigid map
     /// nearest the motion in least squares (Kabsch: the rotation is the orthogonal polar factor
     /// of the points' cross-covariance, by Newton's iteration `X -> (X + X^-T) / 2`); `None` where
-    /// that map is not a proper rotation to `1e-12` (a motion that flips or flattens it).
+    /// that map is not a proper rotation ([`polar_rotation`]: a motion that flips or flattens it).
     fn fitted_residual(&self, f: usize, now: &[[f64; 3]]) -> Option<Motion> {
         let range = self.offsets[f]..self.offsets[f + 1];
         let (then, points) = (&self.sampled[range.clone()], &self.points[range]);
@@ -671,7 +669,8 @@ impl Neighbourhoods {
 }
 
 /// The rotation nearest `m` (its orthogonal polar factor), or `None` where `m` is singular,
-/// reflects, or the iteration does not settle on a rotation to `1e-12`.
+/// reflects, or the iteration does not settle on a rotation to `1e-14` (well inside the
+/// `1e-12` of the margin's rounding term, which then also covers the rest).
 fn polar_rotation(m: [[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
     let size = m.iter().flatten().map(|x| x * x).sum::<f64>().sqrt();
     if !(size > 0.0 && size.is_finite()) {
@@ -694,7 +693,7 @@ fn polar_rotation(m: [[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
     }
     // A proper rotation: orthonormal rows, determinant one.
     let orthogonal = (0..3)
-        .all(|r| (0..3).all(|c| (dot(x[r], x[c]) - if r == c { 1.0 } else { 0.0 }).abs() <= 1e-12));
+        .all(|r| (0..3).all(|c| (dot(x[r], x[c]) - if r == c { 1.0 } else { 0.0 }).abs() <= 1e-14));
     (orthogonal && dot(cross(x[0], x[1]), x[2]) > 0.0).then_some(x)
 }
 
