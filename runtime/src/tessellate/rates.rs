@@ -1194,8 +1194,12 @@ impl<'p> FaceLocal<'p> {
     /// The largest distance from a corner square's sample to the point of `L_{f,n}` at its own
     /// parameters in the regular chart ([`FaceLocal::chart_point`]), over every corner square;
     /// `None` where a corner is not an interior vertex of four faces whose sides are the
-    /// neighbours' rows.
-    fn corner_chart_deviation(&self, samples: &Samples) -> Result<Option<f64>, RuntimeError> {
+    /// neighbours' rows, or as soon as a distance exceeds `stop` (the bound is of no use then).
+    fn corner_chart_deviation(
+        &self,
+        samples: &Samples,
+        stop: f64,
+    ) -> Result<Option<f64>, RuntimeError> {
         let Some(charts) = self.corner_charts()? else {
             return Ok(None);
         };
@@ -1214,6 +1218,9 @@ impl<'p> FaceLocal<'p> {
                     };
                     if let Some(x) = self.chart_point(&charts, u, v) {
                         largest = largest.max(distance(p, x));
+                        if largest > stop {
+                            return Ok(None);
+                        }
                     }
                 }
             }
@@ -1899,7 +1906,7 @@ pub(crate) fn with_selection<R>(
                         deviation: worst,
                     });
                 } else if regular && worst <= tolerance {
-                    if let Some(corners) = local.corner_chart_deviation(samples)? {
+                    if let Some(corners) = local.corner_chart_deviation(samples, tolerance)? {
                         samples.chart.set(Some(worst.max(corners)));
                     }
                 }
