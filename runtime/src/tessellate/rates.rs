@@ -1694,6 +1694,16 @@ impl<'a> Context<'a> {
             })
     }
 
+    /// Face `f`'s points, or the error that names a face the mesh does not have.
+    fn face(&self, f: usize) -> Result<&PatchPoints<'a>, RuntimeError> {
+        self.points
+            .get(f)
+            .ok_or_else(|| RuntimeError::InvalidParameter {
+                name: "face".to_owned(),
+                reason: format!("{f} (the mesh has {} faces)", self.points.len()),
+            })
+    }
+
     /// Whether face `f` is a hole: it has no surface, no samples and no deviation.
     fn hole(&self, f: usize) -> bool {
         self.mesh.holes[f]
@@ -1791,16 +1801,10 @@ pub fn face_deviation(
 ) -> Result<f64, RuntimeError> {
     let adaptive = adaptive_faces(table, mesh, patches)?;
     let ctx = Context::new(table, mesh, patches, &adaptive)?;
+    let points = ctx.face(face)?;
     if ctx.hole(face) {
         return Ok(0.0);
     }
-    let points = ctx
-        .points
-        .get(face)
-        .ok_or_else(|| RuntimeError::InvalidParameter {
-            name: "face".to_owned(),
-            reason: format!("{face} (the mesh has {} faces)", patches.len()),
-        })?;
     let samples = Samples::new(points, SELECTION_GRID)?;
     FaceLocal::new(&ctx, face, n)?.deviation(&samples)
 }
@@ -1963,14 +1967,7 @@ pub(crate) fn sample_deviations(
     checks
         .par_iter()
         .map(|&(f, n, sample)| {
-            let points = ctx
-                .points
-                .get(f)
-                .ok_or_else(|| RuntimeError::InvalidParameter {
-                    name: "face".to_owned(),
-                    reason: format!("{f} (the mesh has {} faces)", patches.len()),
-                })?;
-            let ([u, v], p) = sample_at(points, SELECTION_GRID, sample)?;
+            let ([u, v], p) = sample_at(ctx.face(f)?, SELECTION_GRID, sample)?;
             FaceLocal::new(&ctx, f, n)?.deviation_at(u, v, p, 0.0)
         })
         .collect()
@@ -2167,10 +2164,11 @@ fn measured_chart_norm(n: usize) -> f64 {
                     }
                     continue;
                 }
-                let Ok(terms) = linear_terms(u, v, n, |_| Ok(false)) else {
-                    continue;
+                // Never an error here (no side is a curve); were it one, no bound.
+                largest = match linear_terms(u, v, n, |_| Ok(false)) {
+                    Ok(terms) => largest.max(norm(sample, &terms.map(|(w, x)| (w, place(x))))),
+                    Err(_) => f64::INFINITY,
                 };
-                largest = largest.max(norm(sample, &terms.map(|(w, x)| (w, place(x)))));
             }
         }
     }
@@ -2415,6 +2413,21 @@ mod tests {
                 assert!(sample_at(&points, SELECTION_GRID, samples.uv.len()).is_err());
             }
         }
+    }
+
+    /// A face the mesh does not have is an error, not a panic.
+    #[test]
+    #[cfg(feature = "catmull-clark")]
+    fn a_face_beyond_the_mesh_is_refused() {
+        let table = StencilTable::default_catmull_clark().expect("embedded table");
+        let mesh = crate::mesh::test_meshes::quad_torus(6, 5);
+        let patches = crate::scheme::patch::gather_patches(&mesh).expect("patches");
+        assert!(face_deviation(&table, &mesh, &patches, 29, 3).is_ok());
+        let error = face_deviation(&table, &mesh, &patches, 30, 3).expect_err("face 30 of 30");
+        assert!(
+            error.to_string().contains("30 (the mesh has 30 faces)"),
+            "{error}"
+        );
     }
 
     /// [`chart_norm`] against the same norms computed independently (numpy, from the cubic
