@@ -1108,41 +1108,65 @@ impl<'p> FaceLocal<'p> {
     /// deviation needs no more: a corner square's search stops at the first triangle that
     /// near).
     fn deviation_at(&self, u: f64, v: f64, p: [f64; 3], floor: f64) -> Result<f64, RuntimeError> {
-        if let Some((corner, _, _)) = corner_square(u, v, self.n) {
-            // The nearest triangle, from the one nearest the last sample here (the next sample
-            // is mostly nearest it too, and then bounds the rest tightest): one whose ball is
-            // farther than the nearest so far cannot be nearer (the margin keeps rounding in the
-            // bound from skipping a tie).
-            let triangles = self.corner(corner)?;
-            let hint = &self.nearest[corner];
-            let first = hint.get().min(triangles.len().saturating_sub(1));
-            let Some(t) = triangles.get(first) else {
-                return Ok(f64::INFINITY);
-            };
-            // Most samples of a scan lie nearer the last sample's triangle than the largest
-            // deviation so far, which a bound shows without the exact search.
-            if floor > 0.0 {
-                if let Some(bound) = t.upper_bound(p).filter(|&b| b <= floor) {
-                    return Ok(bound);
-                }
-            }
-            let mut nearest = point_triangle_distance(p, &t.triangle);
-            for (k, t) in triangles.iter().enumerate() {
-                if nearest <= floor {
-                    break;
-                }
-                let centre = distance(p, t.centre);
-                if k != first && centre - t.radius - 1e-12 * (centre + t.radius) <= nearest {
-                    let d = point_triangle_distance(p, &t.triangle);
-                    if d < nearest {
-                        nearest = d;
-                        hint.set(k);
-                    }
-                }
-            }
-            return Ok(nearest);
+        let (u, v) = (AxisPlace::new(u, self.n), AxisPlace::new(v, self.n));
+        self.deviation_placed(&u, &v, p, floor)
+    }
+
+    /// [`FaceLocal::deviation_at`] at the sample with places `u` and `v` (a scan places its
+    /// rows and columns once).
+    fn deviation_placed(
+        &self,
+        u: &AxisPlace,
+        v: &AxisPlace,
+        p: [f64; 3],
+        floor: f64,
+    ) -> Result<f64, RuntimeError> {
+        match u.corner_with(v) {
+            Some(corner) => self.corner_deviation(corner, p, floor),
+            None => Ok(distance(p, self.at(u, v)?)),
         }
-        Ok(distance(p, self.at(u, v)?))
+    }
+
+    /// The distance from `p` to the nearest triangle around corner `corner`, or any value at
+    /// most `floor` where that is at most `floor` ([`FaceLocal::deviation_at`]).
+    fn corner_deviation(
+        &self,
+        corner: usize,
+        p: [f64; 3],
+        floor: f64,
+    ) -> Result<f64, RuntimeError> {
+        // The nearest triangle, from the one nearest the last sample here (the next sample is
+        // mostly nearest it too, and then bounds the rest tightest): one whose ball is farther
+        // than the nearest so far cannot be nearer (the margin keeps rounding in the bound from
+        // skipping a tie).
+        let triangles = self.corner(corner)?;
+        let hint = &self.nearest[corner];
+        let first = hint.get().min(triangles.len().saturating_sub(1));
+        let Some(t) = triangles.get(first) else {
+            return Ok(f64::INFINITY);
+        };
+        // Most samples of a scan lie nearer the last sample's triangle than the largest
+        // deviation so far, which a bound shows without the exact search.
+        if floor > 0.0 {
+            if let Some(bound) = t.upper_bound(p).filter(|&b| b <= floor) {
+                return Ok(bound);
+            }
+        }
+        let mut nearest = point_triangle_distance(p, &t.triangle);
+        for (k, t) in triangles.iter().enumerate() {
+            if nearest <= floor {
+                break;
+            }
+            let centre = distance(p, t.centre);
+            if k != first && centre - t.radius - 1e-12 * (centre + t.radius) <= nearest {
+                let d = point_triangle_distance(p, &t.triangle);
+                if d < nearest {
+                    nearest = d;
+                    hint.set(k);
+                }
+            }
+        }
+        Ok(nearest)
     }
 
     /// Whether `(u, v)` lies in the interior `[h, 1-h]^2`, outside the corner squares: there
@@ -1151,8 +1175,9 @@ impl<'p> FaceLocal<'p> {
         AxisPlace::new(u, self.n).interior_with(&AxisPlace::new(v, self.n), self.n)
     }
 
-    /// `L_{f,n}(u, v)` outside the corner squares ([`linear_terms`]).
-    fn at(&self, u: f64, v: f64) -> Result<[f64; 3], RuntimeError> {
+    /// `L_{f,n}` outside the corner squares at the sample with places `u` and `v`
+    /// ([`linear_terms`]).
+    fn at(&self, u: &AxisPlace, v: &AxisPlace) -> Result<[f64; 3], RuntimeError> {
         let terms = linear_terms(u, v, self.n, |side| {
             Ok(matches!(self.beyond(side)?, Beyond::Curve(_)))
         })?;
@@ -1208,7 +1233,7 @@ impl<'p> FaceLocal<'p> {
         let mut offset = 0;
         for axis in self.ctx.places(self.n)? {
             let side = axis.places.len();
-            let near: Vec<usize> = (0..side).filter(|&i| axis.places[i].near_side).collect();
+            let near: Vec<usize> = (0..side).filter(|&i| axis.places[i].near_side()).collect();
             for &j in &near {
                 for &i in &near {
                     let k = offset + j * side + i;
@@ -1306,10 +1331,7 @@ impl<'p> FaceLocal<'p> {
             let side = axis.places.len();
             for (j, row) in axis.places.iter().enumerate() {
                 let row_samples = offset + j * side..offset + (j + 1) * side;
-                let (Some(positions), Some(uv)) = (
-                    samples.positions.get(row_samples.clone()),
-                    samples.uv.get(row_samples),
-                ) else {
+                let Some(positions) = samples.positions.get(row_samples) else {
                     break;
                 };
                 let interior = axis.interior_columns(row, n);
@@ -1333,8 +1355,12 @@ impl<'p> FaceLocal<'p> {
                 }
                 if keep(false) {
                     for i in (0..interior.start).chain(interior.end..side) {
-                        let [u, v] = uv[i];
-                        let deviation = self.deviation_at(u, v, positions[i], largest.value)?;
+                        let deviation = self.deviation_placed(
+                            &axis.places[i],
+                            row,
+                            positions[i],
+                            largest.value,
+                        )?;
                         if largest.raise(deviation) && largest.value > stop {
                             samples.start.set(offset + j * side + i);
                             return Ok(largest.value);
@@ -1423,15 +1449,26 @@ enum Vertex {
 /// the lower corner.
 fn corner_square(u: f64, v: f64, n: usize) -> Option<(usize, f64, f64)> {
     let h = 0.5 / n as f64;
-    let (low_u, high_u, low_v, high_v) = (u <= h, u >= 1.0 - h, v <= h, v >= 1.0 - h);
+    let corner = corner_of([u <= h, u >= 1.0 - h], [v <= h, v >= 1.0 - h])?;
+    Some(match corner {
+        0 => (0, u, v),
+        1 => (1, v, 1.0 - u),
+        2 => (2, 1.0 - u, 1.0 - v),
+        _ => (3, 1.0 - v, u),
+    })
+}
+
+/// The corner square of a sample whose `u` lies within `h` of 0 or of 1 (`[low, high]`), and
+/// its `v` likewise; `None` unless both do. Corner `c` is where side `c` starts.
+fn corner_of([low_u, high_u]: [bool; 2], [low_v, high_v]: [bool; 2]) -> Option<usize> {
     if !((low_u || high_u) && (low_v || high_v)) {
         return None;
     }
     Some(match (low_u, low_v) {
-        (true, true) => (0, u, v),
-        (false, true) => (1, v, 1.0 - u),
-        (false, false) => (2, 1.0 - u, 1.0 - v),
-        (true, false) => (3, 1.0 - v, u),
+        (true, true) => 0,
+        (false, true) => 1,
+        (false, false) => 2,
+        (true, false) => 3,
     })
 }
 
@@ -1443,39 +1480,32 @@ fn corner_square(u: f64, v: f64, n: usize) -> Option<(usize, f64, f64)> {
 /// face's row point `t` at `(2t + 1, 1)`, the curve point `t` at `(2t, 0)`, the neighbour's row
 /// point `t` at `(2t + 1, -1)`.
 fn linear_terms(
-    u: f64,
-    v: f64,
+    u: &AxisPlace,
+    v: &AxisPlace,
     n: usize,
     is_curve: impl FnOnce(usize) -> Result<bool, RuntimeError>,
 ) -> Result<[(f64, Vertex); 3], RuntimeError> {
-    let nf = n as f64;
-    let h = 0.5 / nf;
-    let distances = [v, 1.0 - u, 1.0 - v, u];
-    let (side, nearest) =
-        distances
-            .iter()
-            .copied()
-            .enumerate()
-            .fold(
-                (0, f64::INFINITY),
-                |best, (s, d)| if d < best.1 { (s, d) } else { best },
-            );
     if n == 1 {
         let d = Vertex::Dual(0, 0);
         return Ok([(1.0, d), (0.0, d), (0.0, d)]);
     }
-    if nearest >= h {
-        let terms = cell_terms(&AxisPlace::new(u, n), &AxisPlace::new(v, n));
+    if u.inside && v.inside {
+        let terms = cell_terms(u, v);
         return Ok(terms.map(|(w, (i, j))| (w, Vertex::Dual(i, j))));
     }
-    let s = match side {
-        0 => u,
-        1 => v,
-        2 => 1.0 - u,
-        _ => 1.0 - v,
+    // Outside the corner squares one parameter alone lies within `h` of an end: the side
+    // there, the other parameter along it (side 0 runs with `u`, 1 with `v`, 2 and 3 against
+    // them).
+    let (side, along, across) = if v.low {
+        (0, &u.along[0], v)
+    } else if u.high {
+        (1, &v.along[0], u)
+    } else if v.high {
+        (2, &u.along[1], v)
+    } else {
+        (3, &v.along[1], u)
     };
-    let sigma = (2.0 * nf * s).clamp(1.0, 2.0 * nf - 1.0);
-    let delta = (2.0 * nf * nearest).clamp(0.0, 1.0);
+    let (sigma, delta) = (along.sigma, across.depth);
     let row = |t: usize| {
         let (i, j) = row_index(side, t, n);
         Vertex::Dual(i, j)
@@ -1484,9 +1514,7 @@ fn linear_terms(
     Ok(if !is_curve(side)? {
         // Cell i between the rows: quad (F_i, F_i+1, G_i+1, G_i) split as
         // [G_i, F_i+1, F_i], [G_i, G_i+1, F_i+1]; alpha along, beta from G (0) to F (1).
-        let x = (sigma - 1.0) / 2.0;
-        let i = (x as usize).min(n - 2);
-        let alpha = x - i as f64;
+        let (i, alpha) = (along.cell, along.alpha);
         let beta = (1.0 + delta) / 2.0;
         if beta >= alpha {
             [
@@ -1557,13 +1585,44 @@ fn chart_corner_terms(a: f64, b: f64, h: f64, through_face: bool) -> [(f64, u8);
 
 /// A sample parameter `t` (along `u` or `v`) against the dual grid at rate `n`: the cell (of
 /// cells `0..n-1` between dual points `(2i+1)/2n`) that [`in_cell`] interpolates in, and the
-/// fraction in it. A scan computes it once per row and column of samples.
+/// fraction in it; and where `t` lies in the side strips' scaled coordinates ([`linear_terms`]).
+/// A scan computes it once per row and column of samples.
 struct AxisPlace {
     cell: usize,
     fraction: f64,
-    /// Whether `t` lies in `[h, 1-h]` (`h = 1/2n`), and whether in `[0, h]` or `[1-h, 1]`.
+    /// Whether `t` lies in `[h, 1-h]` (`h = 1/2n`), in `[0, h]`, in `[1-h, 1]`.
     inside: bool,
-    near_side: bool,
+    low: bool,
+    high: bool,
+    /// `delta = 2n d` clamped to `[0, 1]`, `d` the distance from `t` to the nearer end: how far
+    /// into a side strip a sample `d` from that side lies.
+    depth: f64,
+    /// Along a side that runs with `t` (`s = t`) and against it (`s = 1 - t`).
+    along: [Along; 2],
+}
+
+/// A sample's place along a side strip at rate `n`: `sigma = 2ns` clamped to `[1, 2n-1]`, and
+/// the strip's cell `i` (between the rows' points `i` and `i+1`, at `2i+1` and `2i+3`) with the
+/// fraction `alpha` in it.
+struct Along {
+    sigma: f64,
+    cell: usize,
+    alpha: f64,
+}
+
+impl Along {
+    fn new(s: f64, n: usize) -> Self {
+        let nf = n as f64;
+        let sigma = (2.0 * nf * s).clamp(1.0, 2.0 * nf - 1.0);
+        let x = (sigma - 1.0) / 2.0;
+        // `x >= 0`: truncation is the floor.
+        let cell = (x as usize).min(n.saturating_sub(2));
+        Along {
+            sigma,
+            cell,
+            alpha: x - cell as f64,
+        }
+    }
 }
 
 impl AxisPlace {
@@ -1573,18 +1632,33 @@ impl AxisPlace {
         // `x >= 0`: truncation is the floor.
         let cell = (x as usize).min(n.saturating_sub(2));
         let h = 0.5 / nf;
+        let nearer = if t <= 0.5 { t } else { 1.0 - t };
         AxisPlace {
             cell,
             fraction: x - cell as f64,
             inside: t >= h && 1.0 - t >= h,
-            near_side: t <= h || t >= 1.0 - h,
+            low: t <= h,
+            high: t >= 1.0 - h,
+            depth: (2.0 * nf * nearer).clamp(0.0, 1.0),
+            along: [Along::new(t, n), Along::new(1.0 - t, n)],
         }
+    }
+
+    /// Whether `t` lies within `h` of either end.
+    fn near_side(&self) -> bool {
+        self.low || self.high
     }
 
     /// Whether the sample at places `self` (along `u`) and `v` lies in the interior of the rate-`n`
     /// tessellation, `[h, 1-h]^2` with `h = 1/2n`, outside the corner squares (n >= 2).
     fn interior_with(&self, v: &AxisPlace, n: usize) -> bool {
-        n >= 2 && self.inside && v.inside && !(self.near_side && v.near_side)
+        n >= 2 && self.inside && v.inside && !(self.near_side() && v.near_side())
+    }
+
+    /// The corner square that holds the sample at places `self` (along `u`) and `v`, if any
+    /// ([`corner_square`]).
+    fn corner_with(&self, v: &AxisPlace) -> Option<usize> {
+        corner_of([self.low, self.high], [v.low, v.high])
     }
 }
 
@@ -1612,7 +1686,7 @@ impl AxisPlaces {
             start..end
         };
         let inside = range(&|p| p.inside);
-        let strictly_inside = range(&|p| p.inside && !p.near_side);
+        let strictly_inside = range(&|p| p.inside && !p.near_side());
         AxisPlaces {
             places,
             inside,
@@ -1625,7 +1699,7 @@ impl AxisPlaces {
     fn interior_columns(&self, row: &AxisPlace, n: usize) -> std::ops::Range<usize> {
         if n < 2 || !row.inside {
             0..0
-        } else if row.near_side {
+        } else if row.near_side() {
             self.strictly_inside.clone()
         } else {
             self.inside.clone()
@@ -2165,7 +2239,8 @@ fn measured_chart_norm(n: usize) -> f64 {
                     continue;
                 }
                 // Never an error here (no side is a curve); were it one, no bound.
-                largest = match linear_terms(u, v, n, |_| Ok(false)) {
+                let places = (AxisPlace::new(u, n), AxisPlace::new(v, n));
+                largest = match linear_terms(&places.0, &places.1, n, |_| Ok(false)) {
                     Ok(terms) => largest.max(norm(sample, &terms.map(|(w, x)| (w, place(x))))),
                     Err(_) => f64::INFINITY,
                 };
