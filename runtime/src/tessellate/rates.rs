@@ -609,8 +609,9 @@ pub fn table_positions(
 
 /// Limit-surface samples of one face: parameters and positions.
 struct Samples {
-    uv: Vec<[f64; 2]>,
-    /// Grid by grid ([`selection_axes`]), `j` outer.
+    /// The rate of the sample grids ([`selection_axes`]).
+    grid: u32,
+    /// Grid by grid, `j` outer.
     positions: Vec<[f64; 3]>,
     /// Where the next early-stopping scan starts: the sample that refuted the last rate. The
     /// next rate's deviation peaks in the same region of the face (where it bends most), so a
@@ -630,7 +631,7 @@ impl Samples {
     /// No samples: a hole's.
     fn none() -> Self {
         Samples {
-            uv: Vec::new(),
+            grid: SELECTION_GRID,
             positions: Vec::new(),
             start: Cell::new(0),
             outside_first: Cell::new(false),
@@ -642,18 +643,12 @@ impl Samples {
     /// The primal and dual points of the face at rate `grid`.
     fn new(points: &PatchPoints, grid: u32) -> Result<Self, RuntimeError> {
         let count = (grid_side(true, grid).pow(2) + grid_side(false, grid).pow(2)) as usize;
-        let mut uv = Vec::with_capacity(count);
         let mut positions = Vec::with_capacity(count);
         for (set, axis) in [PointSet::Primal, PointSet::Dual]
             .into_iter()
             .zip(selection_axes(grid))
         {
             let g = points.grid(set, grid)?;
-            for &v in &axis {
-                for &u in &axis {
-                    uv.push([u, v]);
-                }
-            }
             let side = g.side();
             match points.bspline_net() {
                 Some(net) => tensor_product(&net, &axis, &mut positions),
@@ -665,7 +660,7 @@ impl Samples {
             }
         }
         Ok(Samples {
-            uv,
+            grid,
             positions,
             start: Cell::new(0),
             outside_first: Cell::new(false),
@@ -675,17 +670,48 @@ impl Samples {
     }
 }
 
+impl Samples {
+    /// The parameters `(u, v)` of sample `k` ([`sample_place`]).
+    fn uv(&self, k: usize) -> Option<[f64; 2]> {
+        sample_place(self.grid, k).map(|(_, _, uv)| uv)
+    }
+}
+
 /// The parameters along either axis of the samples at rate `grid`: the primal grid's `i / grid`,
 /// `i = 0..=grid`, then the dual grid's `(2i + 1) / 2 grid`, `i = 0..grid`. Each grid of samples
 /// is the square of its axis.
 fn selection_axes(grid: u32) -> [Vec<f64>; 2] {
-    let n = f64::from(grid);
     [
-        (0..=grid).map(|i| f64::from(i) / n).collect(),
-        (0..grid)
-            .map(|i| f64::from(2 * i + 1) / (2.0 * n))
-            .collect(),
+        (0..=grid).map(|i| axis_parameter(true, grid, i)).collect(),
+        (0..grid).map(|i| axis_parameter(false, grid, i)).collect(),
     ]
+}
+
+/// Parameter `i` of [`selection_axes`]'s primal or dual axis.
+fn axis_parameter(primal: bool, grid: u32, i: u32) -> f64 {
+    let n = f64::from(grid);
+    if primal {
+        f64::from(i) / n
+    } else {
+        f64::from(2 * i + 1) / (2.0 * n)
+    }
+}
+
+/// Sample `index` of a face at rate `grid` (the primal grid's `(grid + 1)^2` samples, then the
+/// dual grid's `grid^2`, each `j` outer): its grid, its indices there and its parameters.
+fn sample_place(grid: u32, index: usize) -> Option<(PointSet, (usize, usize), [f64; 2])> {
+    let primal = grid_side(true, grid) as usize;
+    let (set, side, k) = if index < primal * primal {
+        (PointSet::Primal, primal, index)
+    } else {
+        (PointSet::Dual, grid as usize, index - primal * primal)
+    };
+    let (i, j) = (k % side, k / side);
+    if j >= side {
+        return None;
+    }
+    let t = |i: usize| axis_parameter(set == PointSet::Primal, grid, i as u32);
+    Some((set, (i, j), [t(i), t(j)]))
 }
 
 /// The cubic B-spline surface of `net` ([`PatchPoints::bspline_net`]) at the grid `axis x axis`
@@ -732,25 +758,13 @@ fn sample_at(
     grid: u32,
     index: usize,
 ) -> Result<([f64; 2], [f64; 3]), RuntimeError> {
-    let primal = grid_side(true, grid) as usize;
-    let (set, side, k) = if index < primal * primal {
-        (PointSet::Primal, primal, index)
-    } else {
-        (PointSet::Dual, grid as usize, index - primal * primal)
-    };
-    let (i, j) = (k % side, k / side);
-    let [primal_axis, dual_axis] = selection_axes(grid);
-    let axis = if set == PointSet::Primal {
-        primal_axis
-    } else {
-        dual_axis
-    };
-    let (Some(&u), Some(&v)) = (axis.get(i), axis.get(j)) else {
+    let Some((set, (i, j), [u, v])) = sample_place(grid, index) else {
+        let (primal, dual) = (grid_side(true, grid), grid_side(false, grid));
         return Err(RuntimeError::InvalidParameter {
             name: "sample".to_owned(),
             reason: format!(
                 "{index} (a face has {} samples)",
-                primal * primal + side * side
+                primal * primal + dual * dual
             ),
         });
     };
@@ -933,7 +947,7 @@ impl<'p> FaceLocal<'p> {
     /// interior `[h, 1-h]^2`, [`FaceLocal::is_interior`]), what lies beyond each side and the
     /// triangles around each corner, each made when first read.
     fn new(ctx: &'p Context<'p>, f: usize, n: u32) -> Result<Self, RuntimeError> {
-        let own = &ctx.points[f];
+        let own = ctx.face(f)?;
         let grid = own.grid(PointSet::Dual, n)?;
         let count = grid.side() * grid.side();
         Ok(FaceLocal {
@@ -977,7 +991,7 @@ impl<'p> FaceLocal<'p> {
         if let Some(&(_, grid)) = self.neighbours.borrow().iter().find(|(h, _)| *h == g) {
             return Ok(grid);
         }
-        let grid = self.ctx.points[g].grid(PointSet::Dual, self.n as u32)?;
+        let grid = self.ctx.face(g)?.grid(PointSet::Dual, self.n as u32)?;
         self.neighbours.borrow_mut().push((g, grid));
         Ok(grid)
     }
@@ -1018,7 +1032,7 @@ impl<'p> FaceLocal<'p> {
         // The neighbour's row runs the other way along the shared edge.
         let grid = self.neighbour_grid(g)?;
         let mut row = Vec::with_capacity(m);
-        ctx.points[g].extend(
+        ctx.face(g)?.extend(
             &grid,
             (0..m).map(|t| row_index(other, m - 1 - t, m)),
             &mut row,
@@ -1062,7 +1076,7 @@ impl<'p> FaceLocal<'p> {
             ring.push(if g == f {
                 self.d(i, j)
             } else {
-                ctx.points[g].at(&self.neighbour_grid(g)?, i, j)
+                ctx.face(g)?.at(&self.neighbour_grid(g)?, i, j)
             });
         }
         // The polygon's fan, two triangles of each strip and the corner cell's two.
@@ -1212,7 +1226,7 @@ impl<'p> FaceLocal<'p> {
         let h = fan[(me + 2) % 4];
         let g = mesh.face_of[h] as usize;
         let (i, j) = row_index(h - mesh.face_halfedges(g).start, 0, m);
-        let opposite = ctx.points[g].at(&self.neighbour_grid(g)?, i, j);
+        let opposite = ctx.face(g)?.at(&self.neighbour_grid(g)?, i, j);
         Ok(Some((me % 2 == 0, opposite)))
     }
 
@@ -1236,9 +1250,8 @@ impl<'p> FaceLocal<'p> {
             let near: Vec<usize> = (0..side).filter(|&i| axis.places[i].near_side()).collect();
             for &j in &near {
                 for &i in &near {
-                    let k = offset + j * side + i;
-                    let (Some(&[u, v]), Some(&p)) = (samples.uv.get(k), samples.positions.get(k))
-                    else {
+                    let (u, v) = (axis.places[i].t, axis.places[j].t);
+                    let Some(&p) = samples.positions.get(offset + j * side + i) else {
                         continue;
                     };
                     if let Some(x) = self.chart_point(&charts, u, v) {
@@ -1306,11 +1319,9 @@ impl<'p> FaceLocal<'p> {
         stop: f64,
         keep: impl Fn(bool) -> bool,
     ) -> Result<f64, RuntimeError> {
-        let count = samples.uv.len().min(samples.positions.len());
         let first = samples.start.get();
         let mut worst = 0.0f64;
-        if first < count {
-            let ([u, v], p) = (samples.uv[first], samples.positions[first]);
+        if let (Some([u, v]), Some(&p)) = (samples.uv(first), samples.positions.get(first)) {
             if keep(self.is_interior(u, v)) {
                 worst = self.deviation_at(u, v, p, 0.0)?;
                 if worst > stop {
@@ -1354,16 +1365,15 @@ impl<'p> FaceLocal<'p> {
                     }
                 }
                 if keep(false) {
-                    for i in (0..interior.start).chain(interior.end..side) {
-                        let deviation = self.deviation_placed(
-                            &axis.places[i],
-                            row,
-                            positions[i],
-                            largest.value,
-                        )?;
-                        if largest.raise(deviation) && largest.value > stop {
-                            samples.start.set(offset + j * side + i);
-                            return Ok(largest.value);
+                    for columns in [0..interior.start, interior.end..side] {
+                        let places = axis.places.get(columns.clone()).unwrap_or_default();
+                        let points = positions.get(columns.clone()).unwrap_or_default();
+                        for ((place, &p), i) in places.iter().zip(points).zip(columns) {
+                            let deviation = self.deviation_placed(place, row, p, largest.value)?;
+                            if largest.raise(deviation) && largest.value > stop {
+                                samples.start.set(offset + j * side + i);
+                                return Ok(largest.value);
+                            }
                         }
                     }
                 }
@@ -1588,6 +1598,8 @@ fn chart_corner_terms(a: f64, b: f64, h: f64, through_face: bool) -> [(f64, u8);
 /// fraction in it; and where `t` lies in the side strips' scaled coordinates ([`linear_terms`]).
 /// A scan computes it once per row and column of samples.
 struct AxisPlace {
+    /// The parameter.
+    t: f64,
     cell: usize,
     fraction: f64,
     /// Whether `t` lies in `[h, 1-h]` (`h = 1/2n`), in `[0, h]`, in `[1-h, 1]`.
@@ -1634,6 +1646,7 @@ impl AxisPlace {
         let h = 0.5 / nf;
         let nearer = if t <= 0.5 { t } else { 1.0 - t };
         AxisPlace {
+            t,
             cell,
             fraction: x - cell as f64,
             inside: t >= h && 1.0 - t >= h,
@@ -1710,10 +1723,12 @@ impl AxisPlaces {
 /// The mesh and every face's patch points: what evaluates any face.
 struct Context<'a> {
     mesh: &'a Mesh,
-    points: Vec<PatchPoints<'a>>,
-    /// Per rate `n = 1..=MAX_SELECTED_RATE` (at `n - 1`), the axes of the samples at rate
-    /// [`SELECTION_GRID`] placed: what every scan reads its samples by.
-    places: Vec<[AxisPlaces; 2]>,
+    table: &'a StencilTable,
+    patches: &'a [FacePatch],
+    adaptive: &'a AdaptiveGrids<'a>,
+    /// Per face, its points, gathered when the selection first reads the face: a selection kept
+    /// across frames resamples a few faces, and reads those and their neighbours only.
+    points: Vec<OnceLock<PatchPoints<'a>>>,
 }
 
 impl<'a> Context<'a> {
@@ -1725,25 +1740,26 @@ impl<'a> Context<'a> {
         adaptive: &'a AdaptiveGrids<'a>,
     ) -> Result<Self, RuntimeError> {
         check_faces(mesh, patches)?;
-        let points = patches
-            .par_iter()
-            .enumerate()
-            .map(|(f, patch)| PatchPoints::of_face(table, mesh, patch, f, adaptive))
-            .collect::<Result<Vec<_>, _>>()?;
-        let places = (1..=MAX_SELECTED_RATE as usize)
-            .map(|n| selection_axes(SELECTION_GRID).map(|axis| AxisPlaces::new(&axis, n)))
-            .collect();
         Ok(Context {
             mesh,
-            points,
-            places,
+            table,
+            patches,
+            adaptive,
+            points: (0..patches.len()).map(|_| OnceLock::new()).collect(),
         })
     }
 
-    /// The sample grids' axes placed at rate `n`.
-    fn places(&self, n: usize) -> Result<&[AxisPlaces; 2], RuntimeError> {
+    /// The sample grids' axes placed at rate `n`: the same for every face and selection, made
+    /// once per process.
+    fn places(&self, n: usize) -> Result<&'static [AxisPlaces; 2], RuntimeError> {
+        static PLACES: OnceLock<Vec<[AxisPlaces; 2]>> = OnceLock::new();
+        let places = PLACES.get_or_init(|| {
+            (1..=MAX_SELECTED_RATE as usize)
+                .map(|n| selection_axes(SELECTION_GRID).map(|axis| AxisPlaces::new(&axis, n)))
+                .collect()
+        });
         n.checked_sub(1)
-            .and_then(|k| self.places.get(k))
+            .and_then(|k| places.get(k))
             .ok_or_else(|| RuntimeError::InvalidParameter {
                 name: "rate".to_owned(),
                 reason: format!("{n} (the selection measures rates 1..={MAX_SELECTED_RATE})"),
@@ -1755,7 +1771,7 @@ impl<'a> Context<'a> {
     /// and `L_{f,n}` are stencils on one regular grid of control points ([`chart_norm`]).
     fn regular(&self, f: usize) -> bool {
         let mesh = self.mesh;
-        let patch = |g: usize| !mesh.holes[g] && self.points[g].is_regular();
+        let patch = |g: usize| !mesh.holes[g] && self.face(g).is_ok_and(|p| p.is_regular());
         patch(f)
             && mesh.face_halfedges(f).all(|h| {
                 let v = mesh.face_vertices[h] as usize;
@@ -1770,12 +1786,17 @@ impl<'a> Context<'a> {
 
     /// Face `f`'s points, or the error that names a face the mesh does not have.
     fn face(&self, f: usize) -> Result<&PatchPoints<'a>, RuntimeError> {
-        self.points
-            .get(f)
-            .ok_or_else(|| RuntimeError::InvalidParameter {
+        let (Some(cell), Some(patch)) = (self.points.get(f), self.patches.get(f)) else {
+            return Err(RuntimeError::InvalidParameter {
                 name: "face".to_owned(),
                 reason: format!("{f} (the mesh has {} faces)", self.points.len()),
-            })
+            });
+        };
+        if let Some(points) = cell.get() {
+            return Ok(points);
+        }
+        let points = PatchPoints::of_face(self.table, self.mesh, patch, f, self.adaptive)?;
+        Ok(cell.get_or_init(|| points))
     }
 
     /// Whether face `f` is a hole: it has no surface, no samples and no deviation.
@@ -1963,7 +1984,7 @@ pub(crate) fn with_selection<R>(
                 if ctx.hole(f) {
                     return Ok(Samples::none());
                 }
-                Samples::new(&ctx.points[f], SELECTION_GRID)
+                Samples::new(ctx.face(f)?, SELECTION_GRID)
             },
             |f, samples, n| {
                 if ctx.hole(f) {
@@ -2319,7 +2340,7 @@ pub fn measure_deviation(
         .into_par_iter()
         .filter(|&f| !ctx.hole(f))
         .map(|f| -> Result<f64, RuntimeError> {
-            let samples = Samples::new(&ctx.points[f], grid)?;
+            let samples = Samples::new(ctx.face(f)?, grid)?;
             Ok(samples
                 .positions
                 .iter()
@@ -2481,11 +2502,23 @@ mod tests {
             for patch in patches.iter().step_by(7) {
                 let points = PatchPoints::new(&table, mesh, patch).expect("table patch");
                 let samples = Samples::new(&points, SELECTION_GRID).expect("samples");
-                for (k, (uv, p)) in samples.uv.iter().zip(&samples.positions).enumerate() {
+                for (k, p) in samples.positions.iter().enumerate() {
                     let alone = sample_at(&points, SELECTION_GRID, k).expect("a sample");
-                    assert_eq!(alone, (*uv, *p), "sample {k}");
+                    let uv = samples.uv(k).expect("parameters");
+                    assert_eq!(alone, (uv, *p), "sample {k}");
                 }
-                assert!(sample_at(&points, SELECTION_GRID, samples.uv.len()).is_err());
+                // The parameters in the order the samples were evaluated in.
+                let order = selection_axes(SELECTION_GRID).into_iter().flat_map(|axis| {
+                    let rows = axis.clone();
+                    rows.into_iter()
+                        .flat_map(move |v| axis.clone().into_iter().map(move |u| [u, v]))
+                });
+                for (k, uv) in order.enumerate() {
+                    assert_eq!(samples.uv(k), Some(uv), "sample {k}");
+                }
+                let count = samples.positions.len();
+                assert!(sample_at(&points, SELECTION_GRID, count).is_err());
+                assert!(samples.uv(count).is_none());
             }
         }
     }
@@ -2558,11 +2591,13 @@ mod tests {
                 if affine && !((2..m - 3).contains(&i) && (2..m - 3).contains(&j)) {
                     continue;
                 }
-                let samples = Samples::new(&ctx.points[f], SELECTION_GRID).expect("samples");
+                let samples =
+                    Samples::new(ctx.face(f).expect("points"), SELECTION_GRID).expect("samples");
                 for n in 1..=5 {
                     let local = FaceLocal::new(&ctx, f, n).expect("local tessellation");
                     let charts = local.corner_charts().expect("charts").expect("regular");
-                    for (&[u, v], &p) in samples.uv.iter().zip(&samples.positions) {
+                    for (k, &p) in samples.positions.iter().enumerate() {
+                        let [u, v] = samples.uv(k).expect("parameters");
                         let Some(x) = local.chart_point(&charts, u, v) else {
                             continue;
                         };
@@ -2636,11 +2671,13 @@ mod tests {
             let adaptive = adaptive_faces(&table, mesh, patches).expect("adaptive faces");
             let ctx = Context::new(&table, mesh, patches, &adaptive).expect("context");
             for f in [0, 5, 17] {
-                let samples = Samples::new(&ctx.points[f], SELECTION_GRID).expect("samples");
+                let samples =
+                    Samples::new(ctx.face(f).expect("points"), SELECTION_GRID).expect("samples");
                 for n in [1, 2, 3, 7, 16] {
                     let local = FaceLocal::new(&ctx, f, n).expect("local");
                     let mut largest = 0.0f64;
-                    for (&[u, v], &p) in samples.uv.iter().zip(&samples.positions) {
+                    for (k, &p) in samples.positions.iter().enumerate() {
+                        let [u, v] = samples.uv(k).expect("parameters");
                         let deviation = local.deviation_at(u, v, p, 0.0).expect("deviation");
                         largest = largest.max(deviation);
                         let h = 0.5 / f64::from(n);
