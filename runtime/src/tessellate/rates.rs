@@ -1127,7 +1127,10 @@ impl<'p> FaceLocal<'p> {
     }
 
     /// [`FaceLocal::deviation_at`] at the sample with places `u` and `v` (a scan places its
-    /// rows and columns once).
+    /// rows and columns once). Inlined into the scans: most corner samples end at the hinted
+    /// triangle's bound ([`FaceLocal::corner_deviation`]), a few dozen instructions that a call
+    /// would add a third to.
+    #[inline(always)]
     fn deviation_placed(
         &self,
         u: &AxisPlace,
@@ -1136,37 +1139,64 @@ impl<'p> FaceLocal<'p> {
         floor: f64,
     ) -> Result<f64, RuntimeError> {
         match u.corner_with(v) {
-            Some(corner) => self.corner_deviation(corner, p, floor),
-            None => Ok(distance(p, self.at(u, v)?)),
+            Some(corner) => Ok(self.corner_deviation(corner, self.corner(corner)?, p, floor)),
+            None => self.side_deviation(u, v, p),
         }
     }
 
-    /// The distance from `p` to the nearest triangle around corner `corner`, or any value at
-    /// most `floor` where that is at most `floor` ([`FaceLocal::deviation_at`]).
+    /// `|S - L_{f,n}(u, v)|` outside the corner squares.
+    #[inline(never)]
+    fn side_deviation(
+        &self,
+        u: &AxisPlace,
+        v: &AxisPlace,
+        p: [f64; 3],
+    ) -> Result<f64, RuntimeError> {
+        Ok(distance(p, self.at(u, v)?))
+    }
+
+    /// The distance from `p` to the nearest of corner `corner`'s `triangles`, or any value at
+    /// most `floor` where that is at most `floor` ([`FaceLocal::deviation_at`]). Most samples of
+    /// a scan lie nearer the last sample's triangle than the largest deviation so far, which its
+    /// bound shows without the exact search.
+    #[inline]
     fn corner_deviation(
         &self,
         corner: usize,
+        triangles: &[Corner],
         p: [f64; 3],
         floor: f64,
-    ) -> Result<f64, RuntimeError> {
-        // The nearest triangle, from the one nearest the last sample here (the next sample is
-        // mostly nearest it too, and then bounds the rest tightest): one whose ball is farther
-        // than the nearest so far cannot be nearer (the margin keeps rounding in the bound from
-        // skipping a tie).
-        let triangles = self.corner(corner)?;
-        let hint = &self.nearest[corner];
-        let first = hint.get().min(triangles.len().saturating_sub(1));
+    ) -> f64 {
+        let first = self.nearest[corner]
+            .get()
+            .min(triangles.len().saturating_sub(1));
         let Some(t) = triangles.get(first) else {
-            return Ok(f64::INFINITY);
+            return f64::INFINITY;
         };
-        // Most samples of a scan lie nearer the last sample's triangle than the largest
-        // deviation so far, which a bound shows without the exact search.
         if floor > 0.0 {
             if let Some(bound) = t.upper_bound(p).filter(|&b| b <= floor) {
-                return Ok(bound);
+                return bound;
             }
         }
-        let mut nearest = point_triangle_distance(p, &t.triangle);
+        self.nearest_triangle(corner, triangles, first, p, floor)
+    }
+
+    /// The exact search of [`FaceLocal::corner_deviation`], from triangle `first` (the one nearest
+    /// the last sample here: the next sample is mostly nearest it too, and then bounds the rest
+    /// tightest): one whose ball is farther than the nearest so far cannot be nearer (the margin
+    /// keeps rounding in the bound from skipping a tie).
+    #[inline(never)]
+    fn nearest_triangle(
+        &self,
+        corner: usize,
+        triangles: &[Corner],
+        first: usize,
+        p: [f64; 3],
+        floor: f64,
+    ) -> f64 {
+        let mut nearest = triangles
+            .get(first)
+            .map_or(f64::INFINITY, |t| point_triangle_distance(p, &t.triangle));
         for (k, t) in triangles.iter().enumerate() {
             if nearest <= floor {
                 break;
@@ -1176,11 +1206,11 @@ impl<'p> FaceLocal<'p> {
                 let d = point_triangle_distance(p, &t.triangle);
                 if d < nearest {
                     nearest = d;
-                    hint.set(k);
+                    self.nearest[corner].set(k);
                 }
             }
         }
-        Ok(nearest)
+        nearest
     }
 
     /// Whether `(u, v)` lies in the interior `[h, 1-h]^2`, outside the corner squares: there
@@ -1190,25 +1220,28 @@ impl<'p> FaceLocal<'p> {
     }
 
     /// `L_{f,n}` outside the corner squares at the sample with places `u` and `v`
-    /// ([`linear_terms`]).
+    /// ([`linear_terms`]): in a side strip, what lies beyond the side looked up once.
+    #[inline]
     fn at(&self, u: &AxisPlace, v: &AxisPlace) -> Result<[f64; 3], RuntimeError> {
-        let terms = linear_terms(u, v, self.n, |side| {
-            Ok(matches!(self.beyond(side)?, Beyond::Curve(_)))
-        })?;
-        let mut points = [[0.0; 3]; 3];
-        for (point, &(_, vertex)) in points.iter_mut().zip(&terms) {
-            *point = match vertex {
-                Vertex::Dual(i, j) => self.d(i, j),
-                Vertex::Beyond(side, t) => match self.beyond(side)? {
-                    Beyond::Face(row) | Beyond::Curve(row) => row[t],
-                },
-            };
+        if self.n >= 2 && !(u.inside && v.inside) {
+            let (side, along, across) = strip_of(u, v);
+            let beyond = self.beyond(side)?;
+            let (Beyond::Face(points) | Beyond::Curve(points)) = beyond;
+            let curve = matches!(beyond, Beyond::Curve(_));
+            let terms = strip_terms(along, across.depth, self.n, curve);
+            return Ok(combine(&terms.map(|(w, point)| {
+                (
+                    w,
+                    match point {
+                        StripPoint::Row(t) => self.row(side, t),
+                        StripPoint::Beyond(t) => points[t],
+                    },
+                )
+            })));
         }
-        Ok(combine(&[
-            (terms[0].0, points[0]),
-            (terms[1].0, points[1]),
-            (terms[2].0, points[2]),
-        ]))
+        Ok(combine(
+            &dual_terms(u, v, self.n).map(|(w, (i, j))| (w, self.d(i, j))),
+        ))
     }
 
     /// Whether corner `corner`'s fan ([`FaceLocal::make_corner`]) starts at this face or at the
@@ -1495,18 +1528,48 @@ fn linear_terms(
     n: usize,
     is_curve: impl FnOnce(usize) -> Result<bool, RuntimeError>,
 ) -> Result<[(f64, Vertex); 3], RuntimeError> {
+    if n == 1 || (u.inside && v.inside) {
+        return Ok(dual_terms(u, v, n).map(|(w, (i, j))| (w, Vertex::Dual(i, j))));
+    }
+    let (side, along, across) = strip_of(u, v);
+    let terms = strip_terms(along, across.depth, n, is_curve(side)?);
+    Ok(terms.map(|(w, point)| {
+        (
+            w,
+            match point {
+                StripPoint::Row(t) => {
+                    let (i, j) = row_index(side, t, n);
+                    Vertex::Dual(i, j)
+                }
+                StripPoint::Beyond(t) => Vertex::Beyond(side, t),
+            },
+        )
+    }))
+}
+
+/// [`linear_terms`] at rate 1 (the face's one dual point) or in the interior ([`cell_terms`]),
+/// where `L_{f,n}` is the face's own dual points alone.
+fn dual_terms(u: &AxisPlace, v: &AxisPlace, n: usize) -> [(f64, (usize, usize)); 3] {
     if n == 1 {
-        let d = Vertex::Dual(0, 0);
-        return Ok([(1.0, d), (0.0, d), (0.0, d)]);
+        [(1.0, (0, 0)), (0.0, (0, 0)), (0.0, (0, 0))]
+    } else {
+        cell_terms(u, v)
     }
-    if u.inside && v.inside {
-        let terms = cell_terms(u, v);
-        return Ok(terms.map(|(w, (i, j))| (w, Vertex::Dual(i, j))));
-    }
-    // Outside the corner squares one parameter alone lies within `h` of an end: the side
-    // there, the other parameter along it (side 0 runs with `u`, 1 with `v`, 2 and 3 against
-    // them).
-    let (side, along, across) = if v.low {
+}
+
+/// A vertex of a side strip of `L_{f,n}`: point `t` of the face's row next to the side
+/// ([`row_index`]), or point `t` of what lies beyond the side ([`Beyond`]).
+#[derive(Clone, Copy)]
+enum StripPoint {
+    Row(usize),
+    Beyond(usize),
+}
+
+/// The side strip that holds a sample outside the interior and the corner squares (one of its
+/// parameters alone lies within `h` of an end), with the sample's places along and across it:
+/// side 0 runs with `u`, 1 with `v`, 2 and 3 against them.
+fn strip_of<'p>(u: &'p AxisPlace, v: &'p AxisPlace) -> (usize, &'p Along, &'p AxisPlace) {
+    if v.low {
         (0, &u.along[0], v)
     } else if u.high {
         (1, &v.along[0], u)
@@ -1514,29 +1577,30 @@ fn linear_terms(
         (2, &u.along[1], v)
     } else {
         (3, &v.along[1], u)
-    };
-    let (sigma, delta) = (along.sigma, across.depth);
-    let row = |t: usize| {
-        let (i, j) = row_index(side, t, n);
-        Vertex::Dual(i, j)
-    };
-    let beyond = |t: usize| Vertex::Beyond(side, t);
-    Ok(if !is_curve(side)? {
+    }
+}
+
+/// `L_{f,n}` in a side strip ([`linear_terms`]) at `along`, `delta = across.depth`: to the
+/// neighbour's row, or to the boundary curve (`curve`).
+fn strip_terms(along: &Along, delta: f64, n: usize, curve: bool) -> [(f64, StripPoint); 3] {
+    use StripPoint::{Beyond, Row};
+    let sigma = along.sigma;
+    if !curve {
         // Cell i between the rows: quad (F_i, F_i+1, G_i+1, G_i) split as
         // [G_i, F_i+1, F_i], [G_i, G_i+1, F_i+1]; alpha along, beta from G (0) to F (1).
         let (i, alpha) = (along.cell, along.alpha);
         let beta = (1.0 + delta) / 2.0;
         if beta >= alpha {
             [
-                (1.0 - beta, beyond(i)),
-                (alpha, row(i + 1)),
-                (beta - alpha, row(i)),
+                (1.0 - beta, Beyond(i)),
+                (alpha, Row(i + 1)),
+                (beta - alpha, Row(i)),
             ]
         } else {
             [
-                (1.0 - alpha, beyond(i)),
-                (alpha - beta, beyond(i + 1)),
-                (beta, row(i + 1)),
+                (1.0 - alpha, Beyond(i)),
+                (alpha - beta, Beyond(i + 1)),
+                (beta, Row(i + 1)),
             ]
         }
     } else {
@@ -1546,21 +1610,21 @@ fn linear_terms(
             // [C_j, C_{j+1}, D_j].
             let w1 = (sigma - 2.0 * j as f64 - delta) / 2.0;
             [
-                (1.0 - delta - w1, beyond(j)),
-                (w1, beyond(j + 1)),
-                (delta, row(j)),
+                (1.0 - delta - w1, Beyond(j)),
+                (w1, Beyond(j + 1)),
+                (delta, Row(j)),
             ]
         } else {
             // [C_k, D_k, D_{k-1}], k = 1..n-1 the curve point nearest sigma.
             let k = if sigma < centre { j } else { j + 1 }.clamp(1, n - 1);
             let x = sigma - 2.0 * k as f64;
             [
-                (1.0 - delta, beyond(k)),
-                ((delta + x) / 2.0, row(k)),
-                ((delta - x) / 2.0, row(k - 1)),
+                (1.0 - delta, Beyond(k)),
+                ((delta + x) / 2.0, Row(k)),
+                ((delta - x) / 2.0, Row(k - 1)),
             ]
         }
-    })
+    }
 }
 
 /// The point of a corner square's fan at the sample's own parameters, for an interior vertex of
