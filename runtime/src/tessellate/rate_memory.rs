@@ -572,7 +572,7 @@ impl Neighbourhoods {
     fn record(&mut self, f: usize, corners: &[u32], positions: &[[f64; 3]]) {
         let (centre, frame) = corner_frame(corners, positions);
         let range = self.offsets[f]..self.offsets[f + 1];
-        let (mut scale, mut radius) = (0.0f64, 0.0f64);
+        let mut squared = LargestSquares::default();
         for (kept, &i) in self.sampled[range.clone()]
             .iter_mut()
             .zip(&self.points[range])
@@ -580,9 +580,9 @@ impl Neighbourhoods {
             let p = positions[i as usize];
             let d = sub(p, centre);
             *kept = d.map(|x| x as f32);
-            scale = scale.max(norm(p));
-            radius = radius.max(norm(d));
+            squared.add(d, p);
         }
+        let (radius, scale) = squared.roots();
         self.centres[f] = centre;
         self.frames[f] = frame;
         self.scale[f] = scale;
@@ -603,14 +603,14 @@ impl Neighbourhoods {
             }
         }
         let range = self.offsets[f]..self.offsets[f + 1];
-        let (mut residual, mut scale) = (0.0f64, 0.0f64);
+        let mut squared = LargestSquares::default();
         for (kept, &i) in self.sampled[range.clone()].iter().zip(&self.points[range]) {
             let d = kept.map(f64::from);
             let q = now[i as usize];
             let carried = [0, 1, 2].map(|r| centre[r] + dot(rotation[r], d));
-            residual = residual.max(norm(sub(q, carried)));
-            scale = scale.max(norm(q));
+            squared.add(sub(q, carried), q);
         }
+        let (residual, scale) = squared.roots();
         let turned = [0, 1, 2].map(|r| dot(rotation[r], self.centres[f]));
         Motion {
             // A stored coordinate is within 2^-24 of its size of the f64 one.
@@ -649,14 +649,14 @@ impl Neighbourhoods {
             }
         }
         let rotation = polar_rotation(m)?;
-        let (mut residual, mut scale) = (0.0f64, 0.0f64);
+        let mut squared = LargestSquares::default();
         for (kept, &i) in then.iter().zip(points) {
             let p = sub(kept.map(f64::from), mean_then);
             let q = now[i as usize];
             let carried = [0, 1, 2].map(|r| mean_now[r] + dot(rotation[r], p));
-            residual = residual.max(norm(sub(q, carried)));
-            scale = scale.max(norm(q));
+            squared.add(sub(q, carried), q);
         }
+        let (residual, scale) = squared.roots();
         // x -> R (x - c - p_mean) + q_mean, c the corner centre then: translation q_mean - R (c + p_mean).
         let origin = [0, 1, 2].map(|c| self.centres[f][c] + mean_then[c]);
         let turned = [0, 1, 2].map(|r| dot(rotation[r], origin));
@@ -665,6 +665,27 @@ impl Neighbourhoods {
             translation: norm(sub(mean_now, turned)),
             scale,
         })
+    }
+}
+
+/// The largest squared lengths of a neighbourhood's residuals and of its points: the roots
+/// taken once, at the end (a correctly rounded root is monotone, so the root of the largest
+/// square is the largest root to the bit).
+#[derive(Default)]
+struct LargestSquares {
+    residual: f64,
+    scale: f64,
+}
+
+impl LargestSquares {
+    fn add(&mut self, residual: [f64; 3], point: [f64; 3]) {
+        self.residual = self.residual.max(dot(residual, residual));
+        self.scale = self.scale.max(dot(point, point));
+    }
+
+    /// The largest residual and the largest point's length.
+    fn roots(&self) -> (f64, f64) {
+        (self.residual.sqrt(), self.scale.sqrt())
     }
 }
 

@@ -848,7 +848,7 @@ struct FaceLocal<'p> {
 /// A triangle around a corner, with a ball that holds it: `|p - centre| - radius` is a lower
 /// bound of the distance from `p` to the triangle that costs a tenth of the distance itself;
 /// and the dual vectors of its edges, which give an upper bound nearly as cheaply
-/// ([`Corner::upper_bound`]).
+/// ([`Corner::bound_within`]).
 struct Corner {
     triangle: [[f64; 3]; 3],
     centre: [f64; 3],
@@ -869,10 +869,15 @@ impl Corner {
             (1.0 / 3.0, triangle[1]),
             (1.0 / 3.0, triangle[2]),
         ]);
+        // The root of the largest square: the largest distance, to the bit.
         let radius = triangle
             .iter()
-            .map(|&q| distance(q, centre))
-            .fold(0.0, f64::max);
+            .map(|&q| {
+                let d = sub(q, centre);
+                dot(d, d)
+            })
+            .fold(0.0, f64::max)
+            .sqrt();
         let [a, b, c] = triangle;
         let edges = [sub(b, a), sub(c, a)];
         let [ab, ac] = edges;
@@ -898,13 +903,43 @@ impl Corner {
         }
     }
 
-    /// A distance from `p` to the triangle at least [`point_triangle_distance`]'s, roundings
-    /// included: the distance to the point of the triangle at `p`'s projection's barycentric
-    /// coordinates, clamped into it (where the projection lies inside, the distance itself),
-    /// plus a margin far above both computations' rounding. About a third of the exact
-    /// search's operations: a corner sample that it shows below the largest deviation so far
-    /// needs nothing else.
+    /// Whether a distance from `p` to the triangle at least [`point_triangle_distance`]'s,
+    /// roundings included, is at most `floor`: the distance to the point of the triangle at
+    /// `p`'s projection's barycentric coordinates, clamped into it (where the projection lies
+    /// inside, the distance itself), plus a margin far above both computations' rounding. About
+    /// a third of the exact search's operations: a corner sample that it shows below the
+    /// largest deviation so far needs nothing else.
+    ///
+    /// The root is taken only where the squares leave the answer open (a root's latency
+    /// dominates a scan of corner samples): with `r = floor - margin` at least half of `floor`,
+    /// `|off|^2 <= r^2 (1 - 1e-14)` puts the bound below `floor` by far more than its roundings,
+    /// and `|off|^2 > r^2 (1 + 1e-14)` above it.
+    fn bound_within(&self, p: [f64; 3], floor: f64) -> bool {
+        let Some((squared, slack, rounding)) = self.bound_parts(p) else {
+            return false;
+        };
+        let r = floor - (slack + rounding);
+        if r >= 0.5 * floor {
+            if squared <= r * r * (1.0 - 1e-14) {
+                return true;
+            }
+            if squared > r * r * (1.0 + 1e-14) {
+                return false;
+            }
+        }
+        squared.sqrt() + slack + rounding <= floor
+    }
+
+    /// The bound [`Corner::bound_within`] compares with its floor.
+    #[cfg(test)]
     fn upper_bound(&self, p: [f64; 3]) -> Option<f64> {
+        let (squared, slack, rounding) = self.bound_parts(p)?;
+        Some(squared.sqrt() + slack + rounding)
+    }
+
+    /// [`Corner::bound_within`]'s squared distance and its two margins.
+    #[inline]
+    fn bound_parts(&self, p: [f64; 3]) -> Option<(f64, f64, f64)> {
         let [u, w] = self.duals?;
         let ap = sub(p, self.triangle[0]);
         let (beta, gamma) = (dot(u, ap).max(0.0), dot(w, ap).max(0.0));
@@ -917,7 +952,7 @@ impl Corner {
         let [ab, ac] = self.edges;
         let off: [f64; 3] = std::array::from_fn(|k| ap[k] - beta * ab[k] - gamma * ac[k]);
         let largest = p.iter().fold(0.0f64, |m, &x| m.max(x.abs()));
-        Some(dot(off, off).sqrt() + self.slack + 1e-12 * largest)
+        Some((dot(off, off), self.slack, 1e-12 * largest))
     }
 }
 
@@ -1126,11 +1161,7 @@ impl<'p> FaceLocal<'p> {
         self.deviation_placed(&u, &v, p, floor)
     }
 
-    /// [`FaceLocal::deviation_at`] at the sample with places `u` and `v` (a scan places its
-    /// rows and columns once). Inlined into the scans: most corner samples end at the hinted
-    /// triangle's bound ([`FaceLocal::corner_deviation`]), a few dozen instructions that a call
-    /// would add a third to.
-    #[inline(always)]
+    /// [`FaceLocal::deviation_at`] at the sample with places `u` and `v`.
     fn deviation_placed(
         &self,
         u: &AxisPlace,
@@ -1140,26 +1171,15 @@ impl<'p> FaceLocal<'p> {
     ) -> Result<f64, RuntimeError> {
         match u.corner_with(v) {
             Some(corner) => Ok(self.corner_deviation(corner, self.corner(corner)?, p, floor)),
-            None => self.side_deviation(u, v, p),
+            None => Ok(distance(p, self.at(u, v)?)),
         }
-    }
-
-    /// `|S - L_{f,n}(u, v)|` outside the corner squares.
-    #[inline(never)]
-    fn side_deviation(
-        &self,
-        u: &AxisPlace,
-        v: &AxisPlace,
-        p: [f64; 3],
-    ) -> Result<f64, RuntimeError> {
-        Ok(distance(p, self.at(u, v)?))
     }
 
     /// The distance from `p` to the nearest of corner `corner`'s `triangles`, or any value at
     /// most `floor` where that is at most `floor` ([`FaceLocal::deviation_at`]). Most samples of
     /// a scan lie nearer the last sample's triangle than the largest deviation so far, which its
     /// bound shows without the exact search.
-    #[inline]
+    #[inline(always)]
     fn corner_deviation(
         &self,
         corner: usize,
@@ -1173,10 +1193,8 @@ impl<'p> FaceLocal<'p> {
         let Some(t) = triangles.get(first) else {
             return f64::INFINITY;
         };
-        if floor > 0.0 {
-            if let Some(bound) = t.upper_bound(p).filter(|&b| b <= floor) {
-                return bound;
-            }
+        if floor > 0.0 && t.bound_within(p, floor) {
+            return floor;
         }
         self.nearest_triangle(corner, triangles, first, p, floor)
     }
@@ -1276,7 +1294,9 @@ impl<'p> FaceLocal<'p> {
             return Ok(None);
         };
         // The corner squares' samples: rows and columns within `h` of a side.
-        let mut largest = 0.0f64;
+        // The largest square, its root taken where it grows (the root of the largest square is
+        // the largest distance, to the bit).
+        let (mut squared, mut largest) = (0.0f64, 0.0f64);
         let mut offset = 0;
         for axis in self.ctx.places(self.n)? {
             let side = axis.places.len();
@@ -1288,9 +1308,13 @@ impl<'p> FaceLocal<'p> {
                         continue;
                     };
                     if let Some(x) = self.chart_point(&charts, u, v) {
-                        largest = largest.max(distance(p, x));
-                        if largest > stop {
-                            return Ok(None);
+                        let d = sub(p, x);
+                        if dot(d, d) > squared {
+                            squared = dot(d, d);
+                            largest = squared.sqrt();
+                            if largest > stop {
+                                return Ok(None);
+                            }
                         }
                     }
                 }
@@ -1402,8 +1426,21 @@ impl<'p> FaceLocal<'p> {
                         let places = axis.places.get(columns.clone()).unwrap_or_default();
                         let points = positions.get(columns.clone()).unwrap_or_default();
                         for ((place, &p), i) in places.iter().zip(points).zip(columns) {
-                            let deviation = self.deviation_placed(place, row, p, largest.value)?;
-                            if largest.raise(deviation) && largest.value > stop {
+                            let raised = match place.corner_with(row) {
+                                Some(corner) => {
+                                    let triangles = self.corner(corner)?;
+                                    let floor = largest.value;
+                                    largest
+                                        .raise(self.corner_deviation(corner, triangles, p, floor))
+                                }
+                                // As in the interior: the root only where it may be the largest.
+                                None => {
+                                    let d = sub(p, self.at(place, row)?);
+                                    let squared = dot(d, d);
+                                    squared > largest.below && largest.raise(squared.sqrt())
+                                }
+                            };
+                            if raised && largest.value > stop {
                                 samples.start.set(offset + j * side + i);
                                 return Ok(largest.value);
                             }
@@ -2809,6 +2846,28 @@ mod tests {
             let exact = point_triangle_distance(p, &triangle);
             if let Some(bound) = corner.upper_bound(p) {
                 proptest::prop_assert!(bound >= exact, "{bound} below {exact}");
+                // The comparison through squares is the comparison of the bound, near it too.
+                for floor in [
+                    bound,
+                    // The neighbours of a positive bound.
+                    f64::from_bits(bound.to_bits() + 1),
+                    f64::from_bits(bound.to_bits() - 1),
+                    bound * (1.0 + 1e-15),
+                    bound * (1.0 - 1e-15),
+                    bound * (1.0 + 1e-13),
+                    bound * (1.0 - 1e-13),
+                    bound * 1.5,
+                    bound * 0.75,
+                    exact,
+                ] {
+                    proptest::prop_assert_eq!(
+                        corner.bound_within(p, floor),
+                        bound <= floor,
+                        "floor {} against the bound {}",
+                        floor,
+                        bound
+                    );
+                }
                 use crate::mesh::geometry::{closest_point_on_segment, closest_point_on_triangle};
                 let [a, b, c] = triangle;
                 let closest = closest_point_on_triangle(p, a, b, c);
