@@ -10,7 +10,7 @@
 //! on every patch's control points relative to one of them, so that tangents and normals do
 //! not depend on where the mesh sits: docs/reliability.md, *Precision*).
 
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
 
 use rayon::prelude::*;
@@ -37,7 +37,9 @@ use crate::tessellate::lai_cheng::{
 use crate::tessellate::rate_memory::{QuadSelection, RateMemory};
 use crate::tessellate::rates::{view_rates, ViewCamera, RATIONAL_RATES};
 use crate::tessellate::triangle_dual_grid::TriangleDualGrid;
-use crate::tessellate::triangle_rates::{triangle_table_rates, TriangleSelection};
+use crate::tessellate::triangle_rates::{
+    triangle_table_rates, TriangleSampling, TriangleSelection,
+};
 use crate::tessellate::GridPlan;
 use crate::RuntimeError;
 
@@ -99,6 +101,9 @@ pub struct Surface {
     /// The last tolerance selection, what lets the next frame keep the rates
     /// of faces that moved almost rigidly ([`RateMemory`]).
     rate_memory: Mutex<Option<RateMemory>>,
+    /// A triangle mesh's sampling grid and sample templates, made by the first tolerance
+    /// selection and kept (the table's and the topology's alone).
+    triangle_sampling: OnceLock<TriangleSampling>,
 }
 
 impl Surface {
@@ -151,6 +156,7 @@ impl Surface {
             isolated,
             adaptive_operators: Mutex::new(None),
             rate_memory: Mutex::new(None),
+            triangle_sampling: OnceLock::new(),
         })
     }
 
@@ -366,7 +372,15 @@ impl Surface {
                     }
                     Isolated::Triangle(iso) => {
                         let rates = triangle_table_rates(&self.table);
-                        let selection = TriangleSelection::new(&self.table, iso, *t, &rates)?;
+                        let sampling = match self.triangle_sampling.get() {
+                            Some(sampling) => sampling,
+                            None => {
+                                let sampling = TriangleSampling::new(&self.table)?;
+                                self.triangle_sampling.get_or_init(|| sampling)
+                            }
+                        };
+                        let selection =
+                            TriangleSelection::sharing(&self.table, iso, *t, &rates, sampling)?;
                         RateMemory::rates(&mut memory, &selection)?
                     }
                 };

@@ -1026,7 +1026,7 @@ mod tests {
         use crate::mesh::test_meshes::octahedron;
         use crate::scheme::loop_scheme::isolate::isolate_loop;
         use crate::tessellate::triangle_rates::{
-            triangle_table_rates, triangle_tolerance_rates, TriangleSelection,
+            triangle_table_rates, triangle_tolerance_rates, TriangleSampling, TriangleSelection,
         };
         let table = StencilTable::default_loop().expect("embedded table");
         let rates = triangle_table_rates(&table);
@@ -1034,10 +1034,12 @@ mod tests {
         // Valence-4 vertices, one isolating step: regular and extraordinary triangles.
         let mut iso = isolate_loop(&octahedron()).expect("isolates");
         let rest = iso.mesh.positions.clone();
+        // Kept across the frames, as a surface keeps it.
+        let sampling = TriangleSampling::new(&table).expect("sampling");
         check_tolerances(&rest, top, |positions, tolerance, memory| {
             iso.mesh.positions = positions.to_vec();
-            let selection =
-                TriangleSelection::new(&table, &iso, tolerance, &rates).expect("selection");
+            let selection = TriangleSelection::sharing(&table, &iso, tolerance, &rates, &sampling)
+                .expect("selection");
             let kept = RateMemory::rates(memory, &selection).expect("kept");
             let fresh = triangle_tolerance_rates(&table, &iso, tolerance).expect("fresh");
             (kept, fresh, iso.patches.len())

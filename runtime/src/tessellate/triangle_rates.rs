@@ -745,10 +745,51 @@ pub(crate) struct TriangleSelection<'a> {
     ctx: Context<'a>,
     tolerance: f64,
     candidates: Vec<u32>,
+    sampling: Sampling<'a>,
+}
+
+/// What a triangle selection measures with, from the table and the mesh's topology alone: the
+/// sampling grid `G`, and per candidate rate and boundary pattern where the samples lie in
+/// `L_{f,n}`. A surface keeps one across frames ([`TriangleSelection::sharing`]): made anew,
+/// it was a fifth of a bent frame's selection on the hand.
+pub(crate) struct TriangleSampling {
     grid: SampleGrid,
-    /// Per candidate rate and boundary pattern, where the samples lie in `L_{f,n}`
-    /// ([`TriangleSelection::templates`]).
     templates: OnceLock<HashMap<(u32, u8), Template>>,
+}
+
+impl TriangleSampling {
+    /// `table`'s sampling grid; the templates are made when a selection first samples a face.
+    pub(crate) fn new(table: &StencilTable) -> Result<Self, RuntimeError> {
+        Ok(TriangleSampling {
+            grid: sample_grid(table)?,
+            templates: OnceLock::new(),
+        })
+    }
+}
+
+impl std::fmt::Debug for TriangleSampling {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("TriangleSampling")
+            .field("rates", &self.grid.rates)
+            .field("samples", &self.grid.params.len())
+            .field("templates", &self.templates.get().map(HashMap::len))
+            .finish()
+    }
+}
+
+/// A selection's [`TriangleSampling`]: its own, or one a surface keeps.
+enum Sampling<'a> {
+    Own(TriangleSampling),
+    Shared(&'a TriangleSampling),
+}
+
+impl Sampling<'_> {
+    fn get(&self) -> &TriangleSampling {
+        match self {
+            Sampling::Own(sampling) => sampling,
+            Sampling::Shared(sampling) => sampling,
+        }
+    }
 }
 
 impl<'a> TriangleSelection<'a> {
@@ -759,23 +800,52 @@ impl<'a> TriangleSelection<'a> {
         tolerance: f64,
         candidates: &[u32],
     ) -> Result<Self, RuntimeError> {
+        let sampling = Sampling::Own(TriangleSampling::new(table)?);
+        Self::with_sampling(table, iso, tolerance, candidates, sampling)
+    }
+
+    /// [`TriangleSelection::new`] measuring with `sampling`, made for `table` and kept with
+    /// `iso` (its templates are those of the first selection's candidates and `iso`'s boundary
+    /// patterns: every later selection must ask for the same).
+    pub(crate) fn sharing(
+        table: &'a StencilTable,
+        iso: &'a TriangleIsolation,
+        tolerance: f64,
+        candidates: &[u32],
+        sampling: &'a TriangleSampling,
+    ) -> Result<Self, RuntimeError> {
+        Self::with_sampling(
+            table,
+            iso,
+            tolerance,
+            candidates,
+            Sampling::Shared(sampling),
+        )
+    }
+
+    fn with_sampling(
+        table: &'a StencilTable,
+        iso: &'a TriangleIsolation,
+        tolerance: f64,
+        candidates: &[u32],
+        sampling: Sampling<'a>,
+    ) -> Result<Self, RuntimeError> {
         let ctx = Context::new(table, iso)?;
         check_tolerance(tolerance)?;
         let candidates = sorted_candidates(candidates, &triangle_table_rates(table))?;
-        let grid = sample_grid(table)?;
         Ok(TriangleSelection {
             ctx,
             tolerance,
             candidates,
-            grid,
-            templates: OnceLock::new(),
+            sampling,
         })
     }
 
     /// Per candidate rate and boundary pattern, where the samples lie in `L_{f,n}`: made the
     /// first time a face is sampled (a frame that keeps every rate samples none).
     fn templates(&self) -> Result<&HashMap<(u32, u8), Template>, RuntimeError> {
-        if let Some(templates) = self.templates.get() {
+        let sampling = self.sampling.get();
+        if let Some(templates) = sampling.templates.get() {
             return Ok(templates);
         }
         let masks: BTreeSet<u8> = (0..self.faces())
@@ -788,9 +858,9 @@ impl<'a> TriangleSelection<'a> {
             .collect();
         let templates = keys
             .par_iter()
-            .map(|&(n, m)| Ok(((n, m), Template::new(n, m, &self.grid)?)))
+            .map(|&(n, m)| Ok(((n, m), Template::new(n, m, &sampling.grid)?)))
             .collect::<Result<_, RuntimeError>>()?;
-        Ok(self.templates.get_or_init(|| templates))
+        Ok(sampling.templates.get_or_init(|| templates))
     }
 
     /// The bounds of a patch kind's position stencils: its samples', and per candidate rate
@@ -806,6 +876,8 @@ impl<'a> TriangleSelection<'a> {
                 })
         };
         let samples = self
+            .sampling
+            .get()
             .grid
             .rates
             .iter()
@@ -864,7 +936,7 @@ impl Selection for TriangleSelection<'_> {
         if faces.is_empty() {
             return Ok(Vec::new());
         }
-        let (ctx, grid, templates) = (&self.ctx, &self.grid, self.templates()?);
+        let (ctx, grid, templates) = (&self.ctx, &self.sampling.get().grid, self.templates()?);
         // Only the largest rate's deviation is reported when no rate meets the tolerance.
         let largest = self.candidates.last().copied().unwrap_or(0);
         faces
