@@ -35,7 +35,7 @@ use crate::tessellate::lai_cheng::{
     PatchOperators,
 };
 use crate::tessellate::rate_memory::{QuadSelection, RateMemory};
-use crate::tessellate::rates::{view_rates, ViewCamera, RATIONAL_RATES};
+use crate::tessellate::rates::{adaptive_face_list, view_rates, ViewCamera, RATIONAL_RATES};
 use crate::tessellate::triangle_dual_grid::TriangleDualGrid;
 use crate::tessellate::triangle_rates::{
     triangle_table_rates, TriangleSampling, TriangleSelection,
@@ -101,9 +101,11 @@ pub struct Surface {
     /// The last tolerance selection, what lets the next frame keep the rates
     /// of faces that moved almost rigidly ([`RateMemory`]).
     rate_memory: Mutex<Option<RateMemory>>,
-    /// A triangle mesh's sampling grid and sample templates, made by the first tolerance
-    /// selection and kept (the table's and the topology's alone).
+    /// A triangle mesh's sampling grid and sample templates, and a quad mesh's faces sampled
+    /// adaptively, found by the first tolerance selection and kept (the table's and the
+    /// topology's alone).
     triangle_sampling: OnceLock<TriangleSampling>,
+    quad_adaptive_faces: OnceLock<Vec<usize>>,
 }
 
 impl Surface {
@@ -157,6 +159,7 @@ impl Surface {
             adaptive_operators: Mutex::new(None),
             rate_memory: Mutex::new(None),
             triangle_sampling: OnceLock::new(),
+            quad_adaptive_faces: OnceLock::new(),
         })
     }
 
@@ -361,13 +364,22 @@ impl Surface {
                 })?;
                 let chosen = match &self.isolated {
                     Isolated::Quad(iso) => {
+                        let adaptive = match self.quad_adaptive_faces.get() {
+                            Some(faces) => faces,
+                            None => {
+                                let faces =
+                                    adaptive_face_list(&self.table, &iso.mesh, &iso.patches)?;
+                                self.quad_adaptive_faces.get_or_init(|| faces)
+                            }
+                        };
                         let selection = QuadSelection::new(
                             &self.table,
                             &iso.mesh,
                             &iso.patches,
                             *t,
                             &RATIONAL_RATES,
-                        )?;
+                        )?
+                        .knowing(adaptive);
                         RateMemory::rates(&mut memory, &selection)?
                     }
                     Isolated::Triangle(iso) => {

@@ -80,9 +80,9 @@ use crate::mesh::topology::Mesh;
 use crate::scheme::patch::{FacePatch, PatchKind};
 use crate::stencil_table::StencilTable;
 use crate::tessellate::rates::{
-    adaptive_face_list, adaptive_faces, check_tolerance, sample_deviations, sorted_candidates,
-    with_selection, AdaptiveGrids, FaceChoice, ToleranceRates, MAX_SELECTED_RATE, RATIONAL_RATES,
-    SELECTION_GRID,
+    adaptive_face_list, adaptive_faces, adaptive_grids, check_tolerance, sample_deviations,
+    sorted_candidates, with_selection, AdaptiveGrids, FaceChoice, ToleranceRates,
+    MAX_SELECTED_RATE, RATIONAL_RATES, SELECTION_GRID,
 };
 use crate::RuntimeError;
 
@@ -408,6 +408,9 @@ pub(crate) struct QuadSelection<'a> {
     /// The faces sampled adaptively and their grids at these positions, found once for the
     /// frame's choices and its samples looked at again.
     adaptive: OnceLock<AdaptiveGrids<'a>>,
+    /// Those faces where a surface keeps them ([`adaptive_face_list`]: the table and the
+    /// topology decide them).
+    adaptive_faces: Option<&'a [usize]>,
 }
 
 impl<'a> QuadSelection<'a> {
@@ -427,7 +430,15 @@ impl<'a> QuadSelection<'a> {
             tolerance,
             candidates: sorted_candidates(candidates, &RATIONAL_RATES)?,
             adaptive: OnceLock::new(),
+            adaptive_faces: None,
         })
+    }
+
+    /// This selection with the faces sampled adaptively already found (`faces`:
+    /// [`adaptive_face_list`] of the same table, mesh and patches).
+    pub(crate) fn knowing(mut self, faces: &'a [usize]) -> Self {
+        self.adaptive_faces = Some(faces);
+        self
     }
 }
 
@@ -437,7 +448,10 @@ impl<'a> QuadSelection<'a> {
         if let Some(grids) = self.adaptive.get() {
             return Ok(grids);
         }
-        let grids = adaptive_faces(self.table, self.mesh, self.patches)?;
+        let grids = match self.adaptive_faces {
+            Some(faces) => adaptive_grids(self.mesh, faces),
+            None => adaptive_faces(self.table, self.mesh, self.patches)?,
+        };
         Ok(self.adaptive.get_or_init(|| grids))
     }
 }
@@ -999,11 +1013,14 @@ mod tests {
         let (mut charts, mut looked_again) = (0, 0);
         for (mut mesh, patches) in [(octahedron, octahedron_patches), (torus, torus_patches)] {
             let rest = mesh.positions.clone();
+            // Found once, as a surface finds them.
+            let adaptive = adaptive_face_list(&table, &mesh, &patches).expect("adaptive faces");
             check_tolerances(&rest, MAX_SELECTED_RATE, |positions, tolerance, memory| {
                 mesh.positions = positions.to_vec();
                 let selection =
                     QuadSelection::new(&table, &mesh, &patches, tolerance, &RATIONAL_RATES)
-                        .expect("selection");
+                        .expect("selection")
+                        .knowing(&adaptive);
                 let kept = RateMemory::rates(memory, &selection).expect("kept");
                 let fresh = tolerance_rates(&table, &mesh, &patches, tolerance).expect("fresh");
                 if let Some(m) = memory.as_ref() {

@@ -1906,31 +1906,22 @@ impl<'a> Context<'a> {
     }
 }
 
-/// The surface faces the table does not describe exactly, ascending: those the tessellator
-/// evaluates by feature-adaptive refinement ([`table_may_describe`]: sharp and semi-sharp
-/// features at a corner), and those whose patch the table lacks (a valence beyond it).
+/// The grids of the faces of [`adaptive_face_list`], computed when first read.
 pub(crate) fn adaptive_faces<'a>(
     table: &StencilTable,
     mesh: &'a Mesh,
     patches: &[FacePatch],
 ) -> Result<AdaptiveGrids<'a>, RuntimeError> {
-    check_faces(mesh, patches)?;
-    let faces: Vec<Option<usize>> = patches
-        .par_iter()
-        .enumerate()
-        .map(|(f, patch)| {
-            let key = patch
-                .kind
-                .section(StencilKind::Position, PointSet::Dual, SELECTION_GRID);
-            let described = table_may_describe(mesh, patch, f);
-            let from_table = described && unless_absent(table.weights(&key))?.is_some();
-            Ok((!mesh.holes[f] && !from_table).then_some(f))
-        })
-        .collect::<Result<_, RuntimeError>>()?;
     Ok(AdaptiveGrids::new(
         mesh,
-        faces.into_iter().flatten().collect(),
+        adaptive_face_list(table, mesh, patches)?,
     ))
+}
+
+/// [`adaptive_faces`] over faces already found ([`adaptive_face_list`]: the table and the
+/// topology decide them, so a surface finds them once).
+pub(crate) fn adaptive_grids<'a>(mesh: &'a Mesh, faces: &[usize]) -> AdaptiveGrids<'a> {
+    AdaptiveGrids::new(mesh, faces.to_vec())
 }
 
 /// The faces around the corner at half-edge `h` whose corner points make its vertex polygon in
@@ -2169,13 +2160,29 @@ pub(crate) fn sample_deviations(
         .collect()
 }
 
-/// The faces the selection samples by feature-adaptive refinement, ascending ([module docs](self)).
+/// The faces the selection samples by feature-adaptive refinement, ascending ([module
+/// docs](self)): the surface faces the table does not describe exactly, those the tessellator
+/// evaluates by feature-adaptive refinement ([`table_may_describe`]: sharp and semi-sharp
+/// features at a corner) and those whose patch the table lacks (a valence beyond it).
 pub(crate) fn adaptive_face_list(
     table: &StencilTable,
     mesh: &Mesh,
     patches: &[FacePatch],
 ) -> Result<Vec<usize>, RuntimeError> {
-    Ok(adaptive_faces(table, mesh, patches)?.faces)
+    check_faces(mesh, patches)?;
+    let faces: Vec<Option<usize>> = patches
+        .par_iter()
+        .enumerate()
+        .map(|(f, patch)| {
+            let key = patch
+                .kind
+                .section(StencilKind::Position, PointSet::Dual, SELECTION_GRID);
+            let described = table_may_describe(mesh, patch, f);
+            let from_table = described && unless_absent(table.weights(&key))?.is_some();
+            Ok((!mesh.holes[f] && !from_table).then_some(f))
+        })
+        .collect::<Result<_, RuntimeError>>()?;
+    Ok(faces.into_iter().flatten().collect())
 }
 
 /// A tolerance is a positive, finite distance.
