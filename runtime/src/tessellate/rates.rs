@@ -1158,20 +1158,9 @@ impl<'p> FaceLocal<'p> {
     /// near).
     fn deviation_at(&self, u: f64, v: f64, p: [f64; 3], floor: f64) -> Result<f64, RuntimeError> {
         let (u, v) = (AxisPlace::new(u, self.n), AxisPlace::new(v, self.n));
-        self.deviation_placed(&u, &v, p, floor)
-    }
-
-    /// [`FaceLocal::deviation_at`] at the sample with places `u` and `v`.
-    fn deviation_placed(
-        &self,
-        u: &AxisPlace,
-        v: &AxisPlace,
-        p: [f64; 3],
-        floor: f64,
-    ) -> Result<f64, RuntimeError> {
-        match u.corner_with(v) {
+        match u.corner_with(&v) {
             Some(corner) => Ok(self.corner_deviation(corner, self.corner(corner)?, p, floor)),
-            None => Ok(distance(p, self.at(u, v)?)),
+            None => Ok(distance(p, self.at(&u, &v)?)),
         }
     }
 
