@@ -165,10 +165,12 @@ fn bench_reports_throughput() {
 fn bench_with_a_tolerance_plans_every_frame() {
     let out = succeeds("bench data/cube.obj --tolerance 2e-3 --threads 1 --frames 2");
     let report = json(&out);
+    let obj = temp("bench_tolerance.obj");
     let once = json(&succeeds(&format!(
         "tessellate data/cube.obj -o {} --tolerance 2e-3 --stats",
-        temp("bench_tolerance.obj").display()
+        obj.display()
     )));
+    let _ = std::fs::remove_file(obj);
     assert_eq!(report["triangles"], once["triangles"]);
     assert_eq!(report["rate_max"], once["rate_max"]);
     assert!(once["rates_seconds"].as_f64().is_some_and(|t| t > 0.0));
@@ -192,10 +194,12 @@ fn bench_adaptive_tessellates_every_frame() {
     let report = json(&succeeds(
         "bench data/cube.obj --tolerance 2e-3 --adaptive --threads 1 --frames 2",
     ));
+    let ply = temp("bench_adaptive.ply");
     let once = json(&succeeds(&format!(
         "tessellate data/cube.obj -o {} --method adaptive --tolerance 2e-3 --triangulate --stats",
-        temp("bench_adaptive.ply").display()
+        ply.display()
     )));
+    let _ = std::fs::remove_file(ply);
     assert_eq!(report["triangles"], once["triangles"], "{report}");
     assert!(
         report["triangles"].as_u64().is_some_and(|t| t > 0),

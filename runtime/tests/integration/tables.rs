@@ -101,10 +101,26 @@ fn a_missing_valence_names_what_the_table_has() {
     assert!(text.contains("stencilgen tables"), "{text}");
 }
 
-fn temp(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("subtess-tests-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir.join(name)
+/// A folder of one test's own for its files, removed with them when the test ends, passed or
+/// not (tests run side by side: one folder each, so none removes another's).
+struct Scratch(std::path::PathBuf);
+
+impl Scratch {
+    fn new(test: &str) -> Self {
+        let dir = std::env::temp_dir().join(format!("subtess-tests-{}-{test}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        Scratch(dir)
+    }
+
+    fn path(&self, name: &str) -> std::path::PathBuf {
+        self.0.join(name)
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
 }
 
 /// A small table written by the generator: `subtess tables info` and the loader read it back.
@@ -122,7 +138,8 @@ fn small_table() -> Vec<u8> {
 
 #[test]
 fn generated_files_round_trip_through_subtess() {
-    let path = temp("small.subtess");
+    let scratch = Scratch::new("round-trip");
+    let path = scratch.path("small.subtess");
     std::fs::write(&path, small_table()).expect("write");
     let table = StencilTable::read(&path).expect("valid table");
     // Compact: 4 patches (valences 3, 4; two sectors of the 2-face boundary vertex) x 5 pieces,
@@ -145,6 +162,7 @@ fn generated_files_round_trip_through_subtess() {
 /// Bad files: each a clear error from `subtess tables info`, never a panic.
 #[test]
 fn bad_files_are_clear_errors() {
+    let scratch = Scratch::new("bad-files");
     let good = small_table();
     let mut flipped = good.clone();
     flipped[good.len() / 2] ^= 1;
@@ -181,7 +199,7 @@ fn bad_files_are_clear_errors() {
         ("flipped.subtess", flipped, "checksum"),
     ];
     for (name, bytes, message) in cases {
-        let path = temp(name);
+        let path = scratch.path(name);
         std::fs::write(&path, bytes).expect("write");
         let out = Command::new(env!("CARGO_BIN_EXE_subtess"))
             .args(["tables", "info"])
