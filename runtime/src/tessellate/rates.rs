@@ -706,7 +706,8 @@ fn sample_place(grid: u32, index: usize) -> Option<(PointSet, (usize, usize), [f
     } else {
         (PointSet::Dual, grid as usize, index - primal * primal)
     };
-    let (i, j) = (k % side, k / side);
+    // A grid of no points (rate 0) has no samples.
+    let (i, j) = (k.checked_rem(side)?, k.checked_div(side)?);
     if j >= side {
         return None;
     }
@@ -1287,7 +1288,7 @@ impl<'p> FaceLocal<'p> {
         // the largest distance, to the bit).
         let (mut squared, mut largest) = (0.0f64, 0.0f64);
         let mut offset = 0;
-        for axis in self.ctx.places(self.n)? {
+        for axis in placed_axes(self.n)? {
             let side = axis.places.len();
             let near: Vec<usize> = (0..side).filter(|&i| axis.places[i].near_side()).collect();
             for &j in &near {
@@ -1384,7 +1385,7 @@ impl<'p> FaceLocal<'p> {
         };
         let mut largest = Largest::new(worst);
         let mut offset = 0;
-        for axis in self.ctx.places(n)? {
+        for axis in placed_axes(n)? {
             let side = axis.places.len();
             for (j, row) in axis.places.iter().enumerate() {
                 let row_samples = offset + j * side..offset + (j + 1) * side;
@@ -1810,6 +1811,23 @@ impl AxisPlaces {
     }
 }
 
+/// The sample grids' axes placed at rate `n`: the same for every face and selection, made
+/// once per process.
+fn placed_axes(n: usize) -> Result<&'static [AxisPlaces; 2], RuntimeError> {
+    static PLACES: OnceLock<Vec<[AxisPlaces; 2]>> = OnceLock::new();
+    let places = PLACES.get_or_init(|| {
+        (1..=MAX_SELECTED_RATE as usize)
+            .map(|n| selection_axes(SELECTION_GRID).map(|axis| AxisPlaces::new(&axis, n)))
+            .collect()
+    });
+    n.checked_sub(1)
+        .and_then(|k| places.get(k))
+        .ok_or_else(|| RuntimeError::InvalidParameter {
+            name: "rate".to_owned(),
+            reason: format!("{n} (the selection measures rates 1..={MAX_SELECTED_RATE})"),
+        })
+}
+
 /// The mesh and every face's patch points: what evaluates any face.
 struct Context<'a> {
     mesh: &'a Mesh,
@@ -1837,23 +1855,6 @@ impl<'a> Context<'a> {
             adaptive,
             points: (0..patches.len()).map(|_| OnceLock::new()).collect(),
         })
-    }
-
-    /// The sample grids' axes placed at rate `n`: the same for every face and selection, made
-    /// once per process.
-    fn places(&self, n: usize) -> Result<&'static [AxisPlaces; 2], RuntimeError> {
-        static PLACES: OnceLock<Vec<[AxisPlaces; 2]>> = OnceLock::new();
-        let places = PLACES.get_or_init(|| {
-            (1..=MAX_SELECTED_RATE as usize)
-                .map(|n| selection_axes(SELECTION_GRID).map(|axis| AxisPlaces::new(&axis, n)))
-                .collect()
-        });
-        n.checked_sub(1)
-            .and_then(|k| places.get(k))
-            .ok_or_else(|| RuntimeError::InvalidParameter {
-                name: "rate".to_owned(),
-                reason: format!("{n} (the selection measures rates 1..={MAX_SELECTED_RATE})"),
-            })
     }
 
     /// Whether face `f` and every face sharing a vertex with it are regular interior B-spline
