@@ -4,6 +4,7 @@
 //! [`crate::mesh::TriangleMesh`].
 
 pub mod bezier;
+mod difference_norm;
 pub mod dual_grid;
 mod kernel;
 pub mod lai_cheng;

@@ -45,21 +45,28 @@
 //! keep the rate, the rigid map nearest the motion in least squares (Kabsch) is tried: for a
 //! neighbourhood that bends, its largest residual is mostly smaller.
 //!
-//! # Regular faces: the difference's own stencil
+//! # Table faces: the difference's own stencil
 //!
 //! `C_f` bounds the two ends of a distance apart, but the distance is `|sum_i c_i P_i|` with one
-//! stencil `c = w - sum_k beta_k v_k` (the sample's less the `L_{f,n}` point's), and where the
-//! face and every face sharing a vertex with it are regular B-spline patches, `c` annihilates
-//! every control net that is an affine image of the grid: `|c|_1` is second order in `1/n`
-//! ([`super::rates::chart_norm`]: 0.50 at rate 1, 0.18 at 2, 0.047 at 4). Taking as the point of
-//! `L_{f,n}` the one at the sample's own parameters (in a corner square, the fan's point in the
-//! regular chart of the vertex), whose distance from the sample is at least the nearest
-//! triangle's, such a face keeps `n_f` also when
+//! stencil `c = w - sum_k beta_k v_k` (the sample's less the `L_{f,n}` point's), which
+//! annihilates every control net whose limit surface is affine in the face's parameters where
+//! the stencils are smooth functions of them: `|c|_1` is second order in `1/n`. Taking as the
+//! point of `L_{f,n}` the one at the sample's own parameters (in a corner square, the fan's point
+//! in the regular chart of a vertex of four faces, [`super::rates::chart_corner`]), whose
+//! distance from the sample is at least the nearest triangle's, a table face keeps `n_f` also
+//! when
 //!
 //! ```text
-//! max_s |S_f(s) - x_s| + |c|_1 delta + margin <= T
+//! max( max_s |S_f(s) - x_s| + |c|_1 delta,  e_fans + C_f delta ) + margin <= T
 //! ```
 //!
+//! with the first maximum over the samples outside the corner squares of corners without a
+//! chart (extraordinary vertices, boundaries) and `e_fans` the largest deviation in those.
+//! Where the face and every face sharing a vertex with it are regular B-spline patches, `|c|_1`
+//! is the same for every face ([`super::rates::chart_norm`]: 0.50 at rate 1, 0.18 at 2, 0.047
+//! at 4) and there are no such corners; elsewhere it is the face's own
+//! ([`super::difference_norm`], made the first time a frame needs it, per face and rate).
+
 //! # Refuting samples looked at again
 //!
 //! A rate is refuted by one sample beyond `T`, often by little (the scan stops at the first), so
@@ -79,6 +86,7 @@ use crate::mesh::geometry::{cross, dot, norm, sub};
 use crate::mesh::topology::Mesh;
 use crate::scheme::patch::{FacePatch, PatchKind};
 use crate::stencil_table::StencilTable;
+use crate::tessellate::difference_norm::difference_norm;
 use crate::tessellate::rates::{
     adaptive_face_list, adaptive_faces, adaptive_grids, check_tolerance, sample_deviations,
     sorted_candidates, with_selection, AdaptiveGrids, FaceChoice, ToleranceRates,
@@ -113,6 +121,12 @@ pub(crate) trait Selection: Sync {
     /// [`super::rates::Refutation`]): the samples that refuted a face's smaller rates, looked
     /// at again. Only selections that record their refutations are asked.
     fn sample_deviations(&self, checks: &[(usize, u32, usize)]) -> Result<Vec<f64>, RuntimeError>;
+    /// Where face `f`'s deviations at rate `n` outside its uncharted corners have a stencil of
+    /// their own ([`super::rates::ChartBound`] without a norm), the largest norm of those
+    /// stencils ([`super::difference_norm`]); `None` where there is none to use.
+    fn difference_norm(&self, _f: usize, _n: u32) -> Option<f64> {
+        None
+    }
 }
 
 /// Rates chosen for a tolerance, and what lets the next frame keep them.
@@ -206,6 +220,10 @@ struct Neighbourhoods {
     /// samples' plus the largest of `L_{f,m}` for `m <= n`; infinite where the face cannot be
     /// kept (sampled adaptively, or next to such a face).
     bounds: Vec<Vec<StencilBound>>,
+    /// Per face and rate (`f (MAX_SELECTED_RATE + 1) + n`), the norm of its deviations' own
+    /// stencils ([`Selection::difference_norm`]), made when a frame first needs it: it depends
+    /// on the topology alone.
+    differences: Vec<OnceLock<Option<f64>>>,
     /// Per face, as it was sampled: its neighbourhood's points relative to its corner centre
     /// (in `points`' order), that centre and its corner frame.
     sampled: Vec<[f32; 3]>,
@@ -303,9 +321,19 @@ impl RateMemory {
                         + 1e-12 * bound.norm * (near.scale[f] + moved.scale);
                     let change = bound.norm * moved.residual + margin;
                     let mut deviation = choice.deviation + change;
+                    // The chart's bound: its norm read where it is the same for every face, made
+                    // once per face and rate where it is the face's own and the plain one fails.
                     if let Some(chart) = choice.chart {
-                        deviation =
-                            deviation.min(chart.deviation + chart.norm * moved.residual + margin);
+                        let norm = chart.norm.or_else(|| {
+                            (deviation > tolerance)
+                                .then(|| near.difference_norm(f, choice.rate, selection))
+                                .flatten()
+                        });
+                        if let Some(norm) = norm {
+                            let fans = chart.fans.map_or(0.0, |d| d + bound.norm * moved.residual);
+                            let charted = (chart.deviation + norm * moved.residual).max(fans);
+                            deviation = deviation.min(charted + margin);
+                        }
                     }
                     // A face that met no rate keeps the largest while every rate stays refuted.
                     if choice.met && deviation > tolerance {
@@ -508,6 +536,15 @@ impl Selection for QuadSelection<'_> {
         )
     }
 
+    /// Where the norm cannot be made (a table that lacks a grid), the face has none and is
+    /// sampled again: the selection reports the error itself.
+    fn difference_norm(&self, f: usize, n: u32) -> Option<f64> {
+        let adaptive = self.adaptive().ok()?;
+        difference_norm(self.table, self.mesh, self.patches, &adaptive.faces, f, n)
+            .ok()
+            .flatten()
+    }
+
     /// The control points of every face sharing a vertex with the face (the samples read the
     /// face's own, `L_{f,n}` the rows and corner points of those around it).
     fn neighbourhoods(&self) -> Result<Vec<(Vec<u32>, Vec<StencilBound>)>, RuntimeError> {
@@ -567,6 +604,9 @@ impl Neighbourhoods {
         }
         let faces = bounds.len();
         let mut near = Neighbourhoods {
+            differences: (0..faces * (MAX_SELECTED_RATE as usize + 1))
+                .map(|_| OnceLock::new())
+                .collect(),
             sampled: vec![[0.0; 3]; points.len()],
             offsets,
             points,
@@ -580,6 +620,15 @@ impl Neighbourhoods {
             near.record(f, selection.corners(f), control);
         }
         Ok(near)
+    }
+
+    /// Face `f`'s [`Selection::difference_norm`] at rate `n`, made once.
+    fn difference_norm(&self, f: usize, n: u32, selection: &dyn Selection) -> Option<f64> {
+        let slot = f
+            .checked_mul(MAX_SELECTED_RATE as usize + 1)
+            .and_then(|k| k.checked_add(n as usize))
+            .and_then(|k| self.differences.get(k))?;
+        *slot.get_or_init(|| selection.difference_norm(f, n))
     }
 
     /// Face `f` (its corners `corners`) sampled at `positions`: where its neighbourhood is.
@@ -942,6 +991,8 @@ mod tests {
             // Motions of the order of the tolerance: some faces keep their rates by the
             // bounds, some by their refuting samples looked at again, some are sampled.
             ("grown, nudged", grow(bump(0.1 * tolerance))),
+            ("grown, nudged by a third", grow(bump(0.3 * tolerance))),
+            ("grown, nudged by half", grow(bump(0.5 * tolerance))),
             ("grown, nudged more", grow(bump(tolerance))),
             ("grown, nudged most", grow(bump(3.0 * tolerance))),
         ];
@@ -1010,7 +1061,7 @@ mod tests {
             *p = p.map(|c| c / 4.0);
         }
         let torus_patches = gather_patches(&torus).expect("patches");
-        let (mut charts, mut looked_again) = (0, 0);
+        let (mut charts, mut looked_again, mut own_norms) = (0, 0, 0);
         for (mut mesh, patches) in [(octahedron, octahedron_patches), (torus, torus_patches)] {
             let rest = mesh.positions.clone();
             // Found once, as a surface finds them.
@@ -1026,14 +1077,22 @@ mod tests {
                 if let Some(m) = memory.as_ref() {
                     charts += m.choices.iter().filter(|c| c.chart.is_some()).count();
                     looked_again += m.looked_again();
+                    if let SampledAt::Faces(near) = &m.sampled_at {
+                        own_norms += near
+                            .differences
+                            .iter()
+                            .filter(|d| d.get().is_some())
+                            .count();
+                    }
                 }
                 (kept, fresh, patches.len())
             });
         }
-        // The regular faces' bound and the second look were both put to the test.
+        // The charts' bounds (the faces around the valence-3 vertices with their own norms)
+        // and the second look were all put to the test.
         assert!(
-            charts > 0 && looked_again > 0,
-            "{charts} charts, {looked_again} looked again"
+            charts > 0 && looked_again > 0 && own_norms > 0,
+            "{charts} charts, {looked_again} looked again, {own_norms} own norms"
         );
     }
 

@@ -300,6 +300,11 @@ impl<'a> PatchPoints<'a> {
         Some(net)
     }
 
+    /// Whether the face's points come from the table.
+    fn is_table(&self) -> bool {
+        matches!(self, PatchPoints::Table { .. })
+    }
+
     /// Whether the face is a table face whose patch is the bicubic B-spline of a regular
     /// interior grid (in any rotation: its stencils are that spline's weights, rounded to
     /// `f32`).
@@ -331,9 +336,7 @@ impl<'a> PatchPoints<'a> {
         corner: usize,
         (i, j): (usize, usize),
     ) -> &'g [f32] {
-        let (pi, pj) = dual_index_in_patch(corner, i, j, side);
-        let k = self.control().len();
-        &weights[(pj * side + pi) * k..][..k]
+        grid_row(weights, side, corner, self.control().len(), (i, j))
     }
 
     /// The limit position at grid point `(i, j)` of `grid`, in the face's own indices.
@@ -386,6 +389,19 @@ impl<'a> PatchPoints<'a> {
     }
 }
 
+/// The weights of point `(i, j)` (the face's own indices) of a table section of `side x side`
+/// points of `k` weights each, whose patch starts at the face's corner `corner`.
+pub(super) fn grid_row(
+    weights: &[f32],
+    side: usize,
+    corner: usize,
+    k: usize,
+    (i, j): (usize, usize),
+) -> &[f32] {
+    let (pi, pj) = dual_index_in_patch(corner, i, j, side);
+    &weights[(pj * side + pi) * k..][..k]
+}
+
 /// One grid of one face: a table section of its patch, with the rotation into the patch, or
 /// an adaptive face's positions in its own indices (`j` outer).
 #[derive(Clone, Copy)]
@@ -420,7 +436,7 @@ impl Grid<'_> {
 pub(crate) struct AdaptiveGrids<'a> {
     mesh: &'a Mesh,
     /// The faces evaluated adaptively, ascending.
-    faces: Vec<usize>,
+    pub(super) faces: Vec<usize>,
     /// Per grid (`2 (n - 1)` primal, `2 (n - 1) + 1` dual), per face of `faces`: its positions
     /// once computed.
     grids: Vec<OnceLock<FaceGrids>>,
@@ -585,7 +601,7 @@ impl<'a> AdaptiveGrids<'a> {
 }
 
 /// Points on a side of a quad's grid at rate `n`: `n + 1` primal points, `n` dual ones.
-fn grid_side(primal: bool, n: u32) -> u32 {
+pub(super) fn grid_side(primal: bool, n: u32) -> u32 {
     if primal {
         n + 1
     } else {
@@ -620,11 +636,11 @@ struct Samples {
     /// Whether the last rate was refuted outside the interior (in a side strip or a corner
     /// square): then the next rate is scanned there first.
     outside_first: Cell<bool>,
-    /// The rates refuted so far, each at its sample; and, for a face whose neighbourhood is
-    /// regular ([`Context::regular`]), the kept rate's chart deviation
-    /// ([`FaceLocal::corner_chart_deviation`], with the scan's largest).
+    /// The rates refuted so far, each at its sample; and, for a table face, the kept rate's
+    /// chart deviation and its fans' ([`FaceLocal::corner_chart_deviation`], the former with the
+    /// scan's largest).
     refutations: RefCell<Vec<Refutation>>,
-    chart: Cell<Option<f64>>,
+    chart: Cell<Option<(f64, Option<f64>)>>,
 }
 
 impl Samples {
@@ -699,7 +715,10 @@ fn axis_parameter(primal: bool, grid: u32, i: u32) -> f64 {
 
 /// Sample `index` of a face at rate `grid` (the primal grid's `(grid + 1)^2` samples, then the
 /// dual grid's `grid^2`, each `j` outer): its grid, its indices there and its parameters.
-fn sample_place(grid: u32, index: usize) -> Option<(PointSet, (usize, usize), [f64; 2])> {
+pub(super) fn sample_place(
+    grid: u32,
+    index: usize,
+) -> Option<(PointSet, (usize, usize), [f64; 2])> {
     let primal = grid_side(true, grid) as usize;
     let (set, side, k) = if index < primal * primal {
         (PointSet::Primal, primal, index)
@@ -779,7 +798,7 @@ fn sample_at(
 /// Dual-grid index `(i, j)` of point `t` of the row next to side `side` of a face at rate `n`,
 /// in the side's direction (sides run counter-clockwise: 0 `v = 0`, 1 `u = 1`, 2 `v = 1`,
 /// 3 `u = 0`); `t = 0` is the point nearest corner `side`.
-fn row_index(side: usize, t: usize, n: usize) -> (usize, usize) {
+pub(super) fn row_index(side: usize, t: usize, n: usize) -> (usize, usize) {
     let last = n - 1;
     match side {
         0 => (t, 0),
@@ -790,7 +809,7 @@ fn row_index(side: usize, t: usize, n: usize) -> (usize, usize) {
 }
 
 /// Primal index of point `t/n` along side `side` (counter-clockwise, from corner `side`).
-fn curve_index(side: usize, t: usize, n: usize) -> (usize, usize) {
+pub(super) fn curve_index(side: usize, t: usize, n: usize) -> (usize, usize) {
     match side {
         0 => (t, 0),
         1 => (n, t),
@@ -1050,9 +1069,7 @@ impl<'p> FaceLocal<'p> {
     fn make_beyond(&self, side: usize) -> Result<Beyond, RuntimeError> {
         let (ctx, f) = (self.ctx, self.f);
         let m = self.n;
-        let mesh = ctx.mesh;
-        let h = mesh.face_halfedges(f).start + side;
-        if mesh.cut(h, false) != Cut::None {
+        let Some((g, other)) = across(ctx.mesh, f, side) else {
             let primal = self.primal()?;
             let mut curve = Vec::with_capacity(m + 1);
             self.own.extend(
@@ -1061,18 +1078,11 @@ impl<'p> FaceLocal<'p> {
                 &mut curve,
             );
             return Ok(Beyond::Curve(curve));
-        }
-        let t = mesh.twin[h] as usize;
-        let g = mesh.face_of[t] as usize;
-        let other = t - mesh.face_halfedges(g).start;
-        // The neighbour's row runs the other way along the shared edge.
+        };
         let grid = self.neighbour_grid(g)?;
         let mut row = Vec::with_capacity(m);
-        ctx.face(g)?.extend(
-            &grid,
-            (0..m).map(|t| row_index(other, m - 1 - t, m)),
-            &mut row,
-        );
+        ctx.face(g)?
+            .extend(&grid, (0..m).map(|t| beyond_index(other, t, m)), &mut row);
         Ok(Beyond::Face(row))
     }
 
@@ -1252,97 +1262,91 @@ impl<'p> FaceLocal<'p> {
         ))
     }
 
-    /// Whether corner `corner`'s fan ([`FaceLocal::make_corner`]) starts at this face or at the
-    /// face opposite, and that opposite face's point there, where the corner is an interior
-    /// vertex of four faces; `None` elsewhere.
-    fn corner_chart(&self, corner: usize) -> Result<Option<(bool, [f64; 3])>, RuntimeError> {
-        let (ctx, f, m) = (self.ctx, self.f, self.n);
-        let mesh = ctx.mesh;
-        let (fan, closed) = sector(mesh, mesh.face_halfedges(f).start + corner);
-        let own = mesh.face_halfedges(f).start + corner;
-        let me = fan.iter().position(|&h| h == own);
-        let (true, 4, Some(me)) = (closed, fan.len(), me) else {
-            return Ok(None);
-        };
-        let h = fan[(me + 2) % 4];
-        let g = mesh.face_of[h] as usize;
-        let (i, j) = row_index(h - mesh.face_halfedges(g).start, 0, m);
-        let opposite = ctx.face(g)?.at(&self.neighbour_grid(g)?, i, j);
-        Ok(Some((me % 2 == 0, opposite)))
-    }
-
     /// The largest distance from a corner square's sample to the point of `L_{f,n}` at its own
-    /// parameters in the regular chart ([`FaceLocal::chart_point`]), over every corner square;
-    /// `None` where a corner is not an interior vertex of four faces whose sides are the
-    /// neighbours' rows, or as soon as a distance exceeds `stop` (the bound is of no use then).
+    /// parameters in the regular chart ([`FaceLocal::chart_point`]) over the corners that have
+    /// one ([`chart_corner`]), and the largest deviation (to the nearest triangle) over those
+    /// that do not (`None` where all have one); `None` as soon as either exceeds `stop` (the
+    /// bound is of no use then).
     fn corner_chart_deviation(
         &self,
         samples: &Samples,
         stop: f64,
-    ) -> Result<Option<f64>, RuntimeError> {
-        let Some(charts) = self.corner_charts()? else {
-            return Ok(None);
-        };
-        // The corner squares' samples: rows and columns within `h` of a side.
-        // The largest square, its root taken where it grows (the root of the largest square is
-        // the largest distance, to the bit).
-        let (mut squared, mut largest) = (0.0f64, 0.0f64);
+    ) -> Result<Option<(f64, Option<f64>)>, RuntimeError> {
+        let charts = self.corner_charts()?;
+        // The corner squares' samples: rows and columns within `h` of a side. The largest
+        // squares, their roots taken where they grow (the root of the largest square is the
+        // largest distance, to the bit).
+        let (mut squared, mut largest, mut fans) = (0.0f64, 0.0f64, None::<f64>);
         let mut offset = 0;
         for axis in placed_axes(self.n)? {
             let side = axis.places.len();
             let near: Vec<usize> = (0..side).filter(|&i| axis.places[i].near_side()).collect();
             for &j in &near {
                 for &i in &near {
-                    let (u, v) = (axis.places[i].t, axis.places[j].t);
-                    let Some(&p) = samples.positions.get(offset + j * side + i) else {
+                    let (u, v) = (&axis.places[i], &axis.places[j]);
+                    let (Some(&p), Some(corner)) = (
+                        samples.positions.get(offset + j * side + i),
+                        u.corner_with(v),
+                    ) else {
                         continue;
                     };
-                    if let Some(x) = self.chart_point(&charts, u, v) {
-                        let d = sub(p, x);
-                        if dot(d, d) > squared {
-                            squared = dot(d, d);
-                            largest = squared.sqrt();
-                            if largest > stop {
-                                return Ok(None);
+                    match self.chart_point(&charts, u.t, v.t) {
+                        Some(x) => {
+                            let d = sub(p, x);
+                            if dot(d, d) > squared {
+                                squared = dot(d, d);
+                                largest = squared.sqrt();
                             }
                         }
+                        None => {
+                            // The largest so far as the floor: a sample below it leaves the
+                            // largest as it is, whatever value stands for it.
+                            let triangles = self.corner(corner)?;
+                            let floor = fans.unwrap_or(0.0);
+                            let d = self.corner_deviation(corner, triangles, p, floor);
+                            fans = Some(floor.max(d));
+                        }
+                    }
+                    if largest.max(fans.unwrap_or(0.0)) > stop {
+                        return Ok(None);
                     }
                 }
             }
             offset += side * side;
         }
-        Ok(Some(largest))
+        Ok(Some((largest, fans)))
     }
 
-    /// Per corner, the fan's diagonal and the four faces' corner points in the order of
-    /// [`chart_corner_terms`]; `None` where a corner is not an interior vertex of four faces
-    /// whose sides are the neighbours' rows.
-    fn corner_charts(&self) -> Result<Option<[CornerChart; 4]>, RuntimeError> {
-        let n = self.n;
-        let mut charts = [(false, [[0.0; 3]; 4]); 4];
+    /// Per corner with a regular chart ([`chart_corner`]), the fan's diagonal and the four
+    /// faces' corner points in the order of [`chart_corner_terms`].
+    fn corner_charts(&self) -> Result<[Option<CornerChart>; 4], RuntimeError> {
+        let mut charts = [None; 4];
         for (corner, chart) in charts.iter_mut().enumerate() {
-            let Some((through_face, opposite)) = self.corner_chart(corner)? else {
-                return Ok(None);
-            };
-            let (Beyond::Face(next), Beyond::Face(previous)) =
-                (self.beyond(corner)?, self.beyond((corner + 3) % 4)?)
-            else {
-                return Ok(None);
-            };
-            let (i, j) = row_index(corner, 0, n);
-            *chart = (
+            let Some(ChartCorner {
                 through_face,
-                [self.d(i, j), next[0], previous[n - 1], opposite],
-            );
+                points,
+            }) = chart_corner(self.ctx.mesh, self.f, corner, self.n)
+            else {
+                continue;
+            };
+            let mut at = [[0.0; 3]; 4];
+            for (x, (g, (i, j))) in at.iter_mut().zip(points) {
+                *x = if g == self.f {
+                    self.d(i, j)
+                } else {
+                    self.ctx.face(g)?.at(&self.neighbour_grid(g)?, i, j)
+                };
+            }
+            *chart = Some((through_face, at));
         }
-        Ok(Some(charts))
+        Ok(charts)
     }
 
-    /// The point of `L_{f,n}` at `(u, v)` in a corner square, from the corners' `charts`
-    /// ([`chart_corner_terms`]); `None` outside the corner squares.
-    fn chart_point(&self, charts: &[CornerChart; 4], u: f64, v: f64) -> Option<[f64; 3]> {
+    /// The point of `L_{f,n}` at `(u, v)` in a corner square whose corner has a chart in
+    /// `charts` ([`chart_corner_terms`]); `None` elsewhere.
+    fn chart_point(&self, charts: &[Option<CornerChart>; 4], u: f64, v: f64) -> Option<[f64; 3]> {
         let (corner, a, b) = corner_square(u, v, self.n)?;
-        let (through_face, points) = charts[corner];
+        let (through_face, points) = charts[corner]?;
         let terms = chart_corner_terms(a, b, 0.5 / self.n as f64, through_face);
         Some(combine(&terms.map(|(w, k)| (w, points[k as usize]))))
     }
@@ -1507,7 +1511,7 @@ type CornerChart = (bool, [[f64; 3]; 4]);
 /// A vertex of `L_{f,n}` outside the corner squares: the face's dual point `(i, j)`, or point
 /// `t` of what lies beyond side `side` ([`Beyond`]: the neighbour's row or the boundary curve).
 #[derive(Clone, Copy, Debug, PartialEq)]
-enum Vertex {
+pub(super) enum Vertex {
     Dual(usize, usize),
     Beyond(usize, usize),
 }
@@ -1517,7 +1521,7 @@ enum Vertex {
 /// starts there), `b` back along side `corner - 1` (which ends there). The squares are
 /// `[0, h]^2` and its rotations, `h = 1/2n`; a sample on the line `u = h` at rate 1 belongs to
 /// the lower corner.
-fn corner_square(u: f64, v: f64, n: usize) -> Option<(usize, f64, f64)> {
+pub(super) fn corner_square(u: f64, v: f64, n: usize) -> Option<(usize, f64, f64)> {
     let h = 0.5 / n as f64;
     let corner = corner_of([u <= h, u >= 1.0 - h], [v <= h, v >= 1.0 - h])?;
     Some(match corner {
@@ -1549,7 +1553,7 @@ fn corner_of([low_u, high_u]: [bool; 2], [low_v, high_v]: [bool; 2]) -> Option<u
 /// tessellator's merge splits them) or to the boundary curve, in scaled side coordinates: the
 /// face's row point `t` at `(2t + 1, 1)`, the curve point `t` at `(2t, 0)`, the neighbour's row
 /// point `t` at `(2t + 1, -1)`.
-fn linear_terms(
+pub(super) fn linear_terms(
     u: &AxisPlace,
     v: &AxisPlace,
     n: usize,
@@ -1661,7 +1665,7 @@ fn strip_terms(along: &Along, delta: f64, n: usize, curve: bool) -> [(f64, Strip
 /// `corner - 1`, `2`) and `(-h, -h)` (the face opposite, `3`), and the fan splits their square
 /// along the diagonal through the face (`through_face`) or along the other one. The weights
 /// (barycentric in the triangle that holds `(a, b)`) and the points' numbers.
-fn chart_corner_terms(a: f64, b: f64, h: f64, through_face: bool) -> [(f64, u8); 3] {
+pub(super) fn chart_corner_terms(a: f64, b: f64, h: f64, through_face: bool) -> [(f64, u8); 3] {
     let (a, b) = (a / h, b / h);
     if !through_face {
         // The triangle (own, beyond `corner`, beyond `corner - 1`) holds the whole square.
@@ -1688,9 +1692,9 @@ fn chart_corner_terms(a: f64, b: f64, h: f64, through_face: bool) -> [(f64, u8);
 /// cells `0..n-1` between dual points `(2i+1)/2n`) that [`in_cell`] interpolates in, and the
 /// fraction in it; and where `t` lies in the side strips' scaled coordinates ([`linear_terms`]).
 /// A scan computes it once per row and column of samples.
-struct AxisPlace {
+pub(super) struct AxisPlace {
     /// The parameter.
-    t: f64,
+    pub(super) t: f64,
     cell: usize,
     fraction: f64,
     /// Whether `t` lies in `[h, 1-h]` (`h = 1/2n`), in `[0, h]`, in `[1-h, 1]`.
@@ -1761,15 +1765,15 @@ impl AxisPlace {
 
     /// The corner square that holds the sample at places `self` (along `u`) and `v`, if any
     /// ([`corner_square`]).
-    fn corner_with(&self, v: &AxisPlace) -> Option<usize> {
+    pub(super) fn corner_with(&self, v: &AxisPlace) -> Option<usize> {
         corner_of([self.low, self.high], [v.low, v.high])
     }
 }
 
 /// The samples' parameters along either axis ([`selection_axes`]) placed against the dual grid
 /// at one rate, with the columns whose samples may lie in the interior: the same for every face.
-struct AxisPlaces {
-    places: Vec<AxisPlace>,
+pub(super) struct AxisPlaces {
+    pub(super) places: Vec<AxisPlace>,
     /// The columns whose parameter lies in `[h, 1-h]`, and those in `(h, 1-h)`: contiguous,
     /// the parameters ascending.
     inside: std::ops::Range<usize>,
@@ -1813,7 +1817,7 @@ impl AxisPlaces {
 
 /// The sample grids' axes placed at rate `n`: the same for every face and selection, made
 /// once per process.
-fn placed_axes(n: usize) -> Result<&'static [AxisPlaces; 2], RuntimeError> {
+pub(super) fn placed_axes(n: usize) -> Result<&'static [AxisPlaces; 2], RuntimeError> {
     static PLACES: OnceLock<Vec<[AxisPlaces; 2]>> = OnceLock::new();
     let places = PLACES.get_or_init(|| {
         (1..=MAX_SELECTED_RATE as usize)
@@ -1943,6 +1947,60 @@ fn sector(mesh: &Mesh, h: usize) -> (Vec<usize>, bool) {
         .unwrap_or(me);
     let len = (1..n).find(|&d| cut((start + d) % n)).unwrap_or(n);
     ((0..len).map(|d| fan[(start + d) % n]).collect(), false)
+}
+
+/// The face across side `side` of face `f` and that side's number in it, or `None` where the
+/// side is cut (a boundary or an infinitely sharp edge: a limit curve lies beyond it in
+/// `L_{f,n}`).
+pub(super) fn across(mesh: &Mesh, f: usize, side: usize) -> Option<(usize, usize)> {
+    let h = mesh.face_halfedges(f).start + side;
+    if mesh.cut(h, false) != Cut::None {
+        return None;
+    }
+    let t = *mesh.twin.get(h)? as usize;
+    let g = *mesh.face_of.get(t)? as usize;
+    Some((g, t.checked_sub(mesh.face_halfedges(g).start)?))
+}
+
+/// Dual-grid index (in the neighbour's own indices) of point `t` of the row beyond a side, in
+/// the side's direction, the neighbour's side being its side `other`: the neighbour's row runs
+/// the other way along the shared edge.
+pub(super) fn beyond_index(other: usize, t: usize, n: usize) -> (usize, usize) {
+    row_index(other, n - 1 - t, n)
+}
+
+/// A corner's regular chart at rate `n` ([`chart_corner_terms`]): whether the fan's diagonal runs
+/// through the face, and the four faces' corner dual points (face, dual index in its own
+/// indices): the face's own, beyond side `corner`, beyond side `corner - 1`, the face opposite.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct ChartCorner {
+    pub(super) through_face: bool,
+    pub(super) points: [(usize, (usize, usize)); 4],
+}
+
+/// Corner `corner` of face `f`'s chart at rate `n`, where the corner is an interior vertex of four
+/// faces and the two sides at it have neighbours' rows beyond them; `None` elsewhere (an
+/// extraordinary vertex, a boundary or a cut): there the fan has no planar chart.
+pub(super) fn chart_corner(mesh: &Mesh, f: usize, corner: usize, n: usize) -> Option<ChartCorner> {
+    let own = mesh.face_halfedges(f).start + corner;
+    let (fan, closed) = sector(mesh, own);
+    let me = fan.iter().position(|&h| h == own)?;
+    if !closed || fan.len() != 4 {
+        return None;
+    }
+    let (next, next_side) = across(mesh, f, corner)?;
+    let (previous, previous_side) = across(mesh, f, (corner + 3) % 4)?;
+    let h = fan[(me + 2) % 4];
+    let g = mesh.face_of[h] as usize;
+    Some(ChartCorner {
+        through_face: me % 2 == 0,
+        points: [
+            (f, row_index(corner, 0, n)),
+            (next, beyond_index(next_side, 0, n)),
+            (previous, beyond_index(previous_side, n - 1, n)),
+            (g, row_index(h - mesh.face_halfedges(g).start, 0, n)),
+        ],
+    })
 }
 
 fn combine(terms: &[(f64, [f64; 3])]) -> [f64; 3] {
@@ -2086,19 +2144,26 @@ pub(crate) fn with_selection<R>(
                         sample: samples.start.get(),
                         deviation: worst,
                     });
-                } else if regular && worst <= tolerance {
-                    if let Some(corners) = local.corner_chart_deviation(samples, tolerance)? {
-                        samples.chart.set(Some(worst.max(corners)));
+                } else if worst <= tolerance && ctx.face(f)?.is_table() {
+                    if let Some((charted, fans)) =
+                        local.corner_chart_deviation(samples, tolerance)?
+                    {
+                        samples.chart.set(Some((worst.max(charted), fans)));
                     }
                 }
                 Ok(worst)
             },
         )?;
         choice.refutations = samples.refutations.take();
-        if let (true, Some(deviation)) = (choice.met, samples.chart.get()) {
+        if let (true, Some((deviation, fans))) = (choice.met, samples.chart.get()) {
             choice.chart = Some(ChartBound {
                 deviation,
-                norm: chart_norm(choice.rate)?,
+                fans,
+                norm: if regular {
+                    Some(chart_norm(choice.rate)?)
+                } else {
+                    None
+                },
             });
         }
         Ok(choice)
@@ -2227,8 +2292,8 @@ pub(crate) struct FaceChoice {
     /// Each smaller candidate's refutation, in order, where the selection recorded them (the
     /// quad one does): what lets a later frame look at those samples alone.
     pub(crate) refutations: Vec<Refutation>,
-    /// Where the face's neighbourhood is regular and `rate` met the tolerance, the chart's
-    /// bound of `e_f(rate)` ([`ChartBound`]).
+    /// Where the face is a table face and `rate` met the tolerance, the chart's bound of
+    /// `e_f(rate)` ([`ChartBound`]).
     pub(crate) chart: Option<ChartBound>,
 }
 
@@ -2242,15 +2307,20 @@ pub(crate) struct Refutation {
     pub(crate) deviation: f64,
 }
 
-/// A bound of a regular face's deviation at its rate that motion moves little: the largest
+/// A bound of a table face's deviation at its rate that motion moves little: the largest
 /// distance from a sample to the point of `L_{f,n}` at the sample's own parameters
-/// (`deviation`, at least `e_f(n)`: those points lie on `L_{f,n}`; in a corner square the fan's
-/// point, [`chart_corner_terms`]), and the norm of the stencils of those differences
-/// ([`chart_norm`]).
+/// (`deviation`, at least those samples' deviations: the points lie on `L_{f,n}`; in a corner
+/// square the fan's point in the corner's regular chart, [`chart_corner_terms`]) over the
+/// samples outside the corner squares of corners without a chart ([`chart_corner`]:
+/// extraordinary vertices, boundaries), the largest deviation in those (`fans`, `None` where
+/// every corner has a chart), and the norm of the stencils of the differences: [`chart_norm`] where
+/// the face's neighbourhood is regular (the same for every such face), `None` where it is the
+/// face's own ([`super::difference_norm`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct ChartBound {
     pub(crate) deviation: f64,
-    pub(crate) norm: f64,
+    pub(crate) fans: Option<f64>,
+    pub(crate) norm: Option<f64>,
 }
 
 impl ToleranceRates {
@@ -2621,6 +2691,100 @@ mod tests {
         }
     }
 
+    /// [`super::super::difference_norm`] against the scans' own evaluation: `S_f(s) - x_s` is
+    /// linear in the control points, so with unit control points (three at a time, one per
+    /// coordinate, the others at the origin) the position path gives the difference stencil's
+    /// weights one by one; its largest norm over the samples outside the uncharted corners is
+    /// the stencils' (up to the closed-form regular samples' `f32` rounding). On an isolated
+    /// octahedron (valence-3 vertices) and an isolated open box (boundary curves).
+    #[test]
+    #[cfg(feature = "catmull-clark")]
+    fn difference_norms_are_the_position_paths() {
+        use crate::scheme::catmull_clark::isolate::isolate;
+        use crate::tessellate::difference_norm::difference_norm;
+        let table = StencilTable::default_catmull_clark().expect("embedded table");
+        let cube = crate::mesh::test_meshes::cube();
+        let lid = [4, 5, 6, 7];
+        let box_faces: Vec<Vec<i64>> = (0..cube.faces())
+            .map(|f| cube.face(f).iter().map(|&v| i64::from(v)).collect())
+            .filter(|corners: &Vec<i64>| corners.as_slice() != lid)
+            .collect();
+        let open = Mesh::new(
+            cube.positions.clone(),
+            &box_faces,
+            &[],
+            schemes::BoundaryMode::EdgeOnly,
+        )
+        .expect("an open box");
+        let (mut with_curves, mut with_fans) = (0, 0);
+        for input in [crate::mesh::test_meshes::octahedron(), open] {
+            let (mesh, patches, _) = isolate(&input).expect("isolates");
+            let adaptive = adaptive_face_list(&table, &mesh, &patches).expect("adaptive faces");
+            for f in (0..patches.len()).step_by(5) {
+                for n in 1..=3 {
+                    let Some(norm) =
+                        difference_norm(&table, &mesh, &patches, &adaptive, f, n).expect("norm")
+                    else {
+                        continue;
+                    };
+                    // Every point of the faces sharing a vertex with `f`: more than it reads.
+                    let mut points: Vec<u32> = mesh
+                        .face(f)
+                        .iter()
+                        .flat_map(|&v| mesh.fan_iter(v as usize).map(|h| mesh.face_of[h]))
+                        .flat_map(|g| patches[g as usize].points.iter().copied())
+                        .collect();
+                    points.sort_unstable();
+                    points.dedup();
+                    let mut sums: Vec<f64> = Vec::new();
+                    for three in points.chunks(3) {
+                        let mut unit = mesh.clone();
+                        unit.positions.fill([0.0; 3]);
+                        for (c, &p) in three.iter().enumerate() {
+                            unit.positions[p as usize][c] = 1.0;
+                        }
+                        let grids = adaptive_grids(&unit, &adaptive);
+                        let ctx = Context::new(&table, &unit, &patches, &grids).expect("context");
+                        let samples = Samples::new(ctx.face(f).expect("points"), SELECTION_GRID)
+                            .expect("samples");
+                        let local = FaceLocal::new(&ctx, f, n).expect("local tessellation");
+                        let charts = local.corner_charts().expect("charts");
+                        sums.resize(samples.positions.len(), 0.0);
+                        for (k, &p) in samples.positions.iter().enumerate() {
+                            let [u, v] = samples.uv(k).expect("parameters");
+                            let x = match corner_square(u, v, n as usize) {
+                                Some(_) => local.chart_point(&charts, u, v),
+                                None => {
+                                    let m = n as usize;
+                                    let at = local.at(&AxisPlace::new(u, m), &AxisPlace::new(v, m));
+                                    Some(at.expect("a point of L"))
+                                }
+                            };
+                            if let Some(x) = x {
+                                sums[k] += sub(p, x).iter().map(|c| c.abs()).sum::<f64>();
+                            }
+                        }
+                    }
+                    let expected = sums.iter().fold(0.0f64, |m, &x| m.max(x));
+                    let measured = norm - 2f64.powi(-20);
+                    assert!(
+                        (measured - expected).abs() <= 1e-6,
+                        "face {f}, rate {n}: {measured} against {expected}"
+                    );
+                    assert!(expected > 0.0, "face {f}, rate {n}: no difference");
+                    with_curves += usize::from((0..4).any(|side| across(&mesh, f, side).is_none()));
+                    with_fans += usize::from(
+                        (0..4).any(|c| chart_corner(&mesh, f, c, n as usize).is_none()),
+                    );
+                }
+            }
+        }
+        assert!(
+            with_curves > 0 && with_fans > 0,
+            "{with_curves} with curves, {with_fans} with fans"
+        );
+    }
+
     /// A face the mesh does not have is an error, not a panic.
     #[test]
     #[cfg(feature = "catmull-clark")]
@@ -2693,7 +2857,11 @@ mod tests {
                     Samples::new(ctx.face(f).expect("points"), SELECTION_GRID).expect("samples");
                 for n in 1..=5 {
                     let local = FaceLocal::new(&ctx, f, n).expect("local tessellation");
-                    let charts = local.corner_charts().expect("charts").expect("regular");
+                    let charts = local.corner_charts().expect("charts");
+                    assert!(
+                        charts.iter().all(Option::is_some),
+                        "face {f}: a corner without a chart"
+                    );
                     for (k, &p) in samples.positions.iter().enumerate() {
                         let [u, v] = samples.uv(k).expect("parameters");
                         let Some(x) = local.chart_point(&charts, u, v) else {

@@ -1,0 +1,213 @@
+//! The norm of the stencils of a table face's deviations: what lets a face around an
+//! extraordinary vertex keep its tolerance rate while its neighbourhood bends a little
+//! ([`super::rate_memory`]).
+//!
+//! At a sample `s` outside the corner squares of corners without a regular chart, the selection
+//! measures `|S_f(s) - x_s|`, `x_s` the point of `L_{f,n}` at the sample's own parameters
+//! ([`super::rates::ChartBound`]). Both ends are affine combinations of the isolated control
+//! points, so the difference is one stencil `c_s` over them: the sample's table stencil less the
+//! weighted stencils of the three dual points (or boundary-curve points) that `x_s` combines.
+//! If every control point moves by at most `delta` after a rigid map, the difference moves by
+//! at most `|c_s|_1 delta`.
+//!
+//! `c_s` annihilates every control net whose limit surface is affine in the face's parameters
+//! over the part of `L_{f,n}` that `x_s` reads, so `|c_s|_1` is second order in `1/n` as for a
+//! regular grid ([`super::rates::chart_norm`]), where the table's stencils are smooth
+//! functions of the parameters: everywhere but at an extraordinary vertex, whose corner square
+//! the bound leaves to the two-ended norm `C_f`.
+
+use table_format::{PointSet, StencilKind};
+
+use crate::mesh::topology::Mesh;
+use crate::scheme::patch::FacePatch;
+use crate::stencil_table::StencilTable;
+use crate::tessellate::rates::{
+    across, beyond_index, chart_corner, chart_corner_terms, corner_square, curve_index, grid_row,
+    grid_side, linear_terms, placed_axes, ChartCorner, Vertex, SELECTION_GRID,
+};
+use crate::RuntimeError;
+
+/// The largest `|c_s|_1` over face `f`'s samples at rate `n` outside the corner squares of
+/// corners without a chart ([`chart_corner`]), plus `2^-20` for the `f32` rounding of the
+/// stencils (a regular patch's samples are the bicubic B-spline in closed form, whose table
+/// stencils are rounded to within `2^-24` of weights of norm one). `None` where a point `x_s`
+/// reads is not a table face's (faces sampled adaptively, listed ascending in `adaptive`, and
+/// holes).
+pub(crate) fn difference_norm(
+    table: &StencilTable,
+    mesh: &Mesh,
+    patches: &[FacePatch],
+    adaptive: &[usize],
+    f: usize,
+    n: u32,
+) -> Result<Option<f64>, RuntimeError> {
+    let m = n as usize;
+    let charts: [Option<ChartCorner>; 4] =
+        std::array::from_fn(|corner| chart_corner(mesh, f, corner, m));
+    // Every face whose dual points `x_s` reads: the face, those across its sides and the
+    // charts' faces, all from the table.
+    let mut read: Vec<usize> = (0..4)
+        .filter_map(|side| across(mesh, f, side).map(|(g, _)| g))
+        .chain(
+            charts
+                .iter()
+                .flatten()
+                .flat_map(|c| c.points.map(|(g, _)| g)),
+        )
+        .chain([f])
+        .collect();
+    read.sort_unstable();
+    read.dedup();
+    let table_face = |g: usize| {
+        g < patches.len()
+            && !mesh.holes.get(g).copied().unwrap_or(true)
+            && adaptive.binary_search(&g).is_err()
+    };
+    if !read.iter().all(|&g| table_face(g)) {
+        return Ok(None);
+    }
+    let mut stencil = Stencil::default();
+    let samples = [
+        stencil.section(table, &patches[f], PointSet::Primal, SELECTION_GRID)?,
+        stencil.section(table, &patches[f], PointSet::Dual, SELECTION_GRID)?,
+    ];
+    let duals = read
+        .iter()
+        .map(|&g| Ok((g, stencil.section(table, &patches[g], PointSet::Dual, n)?)))
+        .collect::<Result<Vec<_>, RuntimeError>>()?;
+    let curves = match (0..4).any(|side| across(mesh, f, side).is_none()) {
+        true => Some(stencil.section(table, &patches[f], PointSet::Primal, n)?),
+        false => None,
+    };
+    let h = 0.5 / m as f64;
+    let mut largest = 0.0f64;
+    for (sample_rows, axis) in samples.iter().zip(placed_axes(m)?) {
+        for (j, v) in axis.places.iter().enumerate() {
+            for (i, u) in axis.places.iter().enumerate() {
+                let terms: [(f64, Source); 3] = match u.corner_with(v) {
+                    Some(corner) => {
+                        let (Some(chart), Some((_, a, b))) =
+                            (charts[corner], corner_square(u.t, v.t, m))
+                        else {
+                            continue;
+                        };
+                        chart_corner_terms(a, b, h, chart.through_face)
+                            .map(|(w, k)| (w, Source::Dual(chart.points[usize::from(k)])))
+                    }
+                    None => linear_terms(u, v, m, |side| Ok(across(mesh, f, side).is_none()))?.map(
+                        |(w, vertex)| {
+                            let source = match vertex {
+                                Vertex::Dual(i, j) => Source::Dual((f, (i, j))),
+                                Vertex::Beyond(side, t) => match across(mesh, f, side) {
+                                    Some((g, other)) => {
+                                        Source::Dual((g, beyond_index(other, t, m)))
+                                    }
+                                    None => Source::Curve(curve_index(side, t, m)),
+                                },
+                            };
+                            (w, source)
+                        },
+                    ),
+                };
+                stencil.add(1.0, sample_rows, (i, j));
+                for (w, source) in terms {
+                    let (rows, ij) = match source {
+                        Source::Dual((g, ij)) => (duals.iter().find(|(e, _)| *e == g), ij),
+                        Source::Curve(ij) => (None, ij),
+                    };
+                    match (source, rows, &curves) {
+                        (Source::Dual(_), Some((_, rows)), _) => stencil.add(-w, rows, ij),
+                        (Source::Curve(_), _, Some(rows)) => stencil.add(-w, rows, ij),
+                        // Read above: every source has its rows.
+                        _ => return Ok(None),
+                    }
+                }
+                largest = largest.max(stencil.take_norm());
+            }
+        }
+    }
+    Ok(Some(largest + 2f64.powi(-20)))
+}
+
+/// A vertex of `L_{f,n}` that `x_s` reads: dual point `(i, j)` of a face (its own indices), or
+/// primal point `(i, j)` of the face itself (a boundary curve's).
+#[derive(Clone, Copy)]
+enum Source {
+    Dual((usize, (usize, usize))),
+    Curve((usize, usize)),
+}
+
+/// A table section of one face's position stencils, and where each of its patch's points
+/// lies in a [`Stencil`].
+struct Rows<'t> {
+    weights: &'t [f32],
+    side: usize,
+    corner: usize,
+    slots: Vec<usize>,
+}
+
+/// A stencil over the control points that the faces read, summed from table rows.
+#[derive(Default)]
+struct Stencil {
+    /// The control points seen, and the stencil's weight on each.
+    points: Vec<u32>,
+    weights: Vec<f64>,
+}
+
+impl Stencil {
+    /// `patch`'s grid `set` at rate `n`, its points given their slots here.
+    fn section<'t>(
+        &mut self,
+        table: &'t StencilTable,
+        patch: &FacePatch,
+        set: PointSet,
+        n: u32,
+    ) -> Result<Rows<'t>, RuntimeError> {
+        let key = patch.kind.section(StencilKind::Position, set, n);
+        let weights = table.weights(&key)?;
+        let side = grid_side(set == PointSet::Primal, n) as usize;
+        let k = patch.points.len();
+        if weights.len() != side * side * k {
+            return Err(RuntimeError::LayoutMismatch {
+                key,
+                table: weights.len() / (side * side).max(1),
+                patch: k,
+            });
+        }
+        let slots = patch
+            .points
+            .iter()
+            .map(|&p| {
+                self.points.iter().position(|&q| q == p).unwrap_or_else(|| {
+                    self.points.push(p);
+                    self.weights.push(0.0);
+                    self.points.len() - 1
+                })
+            })
+            .collect();
+        Ok(Rows {
+            weights,
+            side,
+            corner: patch.corner,
+            slots,
+        })
+    }
+
+    /// Add `w` times the stencil of point `ij` (the face's own indices) of `rows`.
+    fn add(&mut self, w: f64, rows: &Rows, ij: (usize, usize)) {
+        let row = grid_row(rows.weights, rows.side, rows.corner, rows.slots.len(), ij);
+        for (&x, &slot) in row.iter().zip(&rows.slots) {
+            if let Some(c) = self.weights.get_mut(slot) {
+                *c += w * f64::from(x);
+            }
+        }
+    }
+
+    /// `|c|_1` of the stencil summed so far, which starts again from zero.
+    fn take_norm(&mut self) -> f64 {
+        self.weights
+            .iter_mut()
+            .map(|w| std::mem::take(w).abs())
+            .sum()
+    }
+}
