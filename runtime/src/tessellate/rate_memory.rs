@@ -322,15 +322,17 @@ impl RateMemory {
                     let change = bound.norm * moved.residual + margin;
                     let mut deviation = choice.deviation + change;
                     // The chart's bound: its norm read where it is the same for every face, made
-                    // once per face and rate where it is the face's own and the plain one fails.
+                    // once per face and rate where it is the face's own, the plain bound fails
+                    // and the chart's might not (with no norm at all).
                     if let Some(chart) = choice.chart {
+                        let fans = chart.fans.map_or(0.0, |d| d + bound.norm * moved.residual);
                         let norm = chart.norm.or_else(|| {
-                            (deviation > tolerance)
+                            let hopeful = chart.deviation.max(fans) + margin <= tolerance;
+                            (deviation > tolerance && hopeful)
                                 .then(|| near.difference_norm(f, choice.rate, selection))
                                 .flatten()
                         });
                         if let Some(norm) = norm {
-                            let fans = chart.fans.map_or(0.0, |d| d + bound.norm * moved.residual);
                             let charted = (chart.deviation + norm * moved.residual).max(fans);
                             deviation = deviation.min(charted + margin);
                         }
