@@ -1571,17 +1571,21 @@ pub fn tessellate(
 #[cfg(test)]
 mod tests {
     use super::*;
+    #[cfg(feature = "catmull-clark")]
     use crate::mesh::test_meshes::cube;
+    #[cfg(feature = "catmull-clark")]
     use crate::scheme::catmull_clark::isolate::isolate;
     use crate::tessellate::kernel::{cross, unit};
     use crate::tessellate::lane_stencils::test_numbers;
 
     /// The pentagonal bipyramid: poles of valence 5 over a ring of five triangles each.
+    #[cfg(feature = "catmull-clark")]
     fn bipyramid() -> Mesh {
         bipyramid_of(5)
     }
 
     /// The bipyramid over a ring of `sides` vertices: poles of valence `sides`.
+    #[cfg(feature = "catmull-clark")]
     fn bipyramid_of(sides: i64) -> Mesh {
         let mut p: Vec<[f64; 3]> = (0..sides)
             .map(|k| {
@@ -1604,6 +1608,7 @@ mod tests {
 
     /// `mesh` with face `f`'s corners turned by `(f + f / 4) % 4` (isolation puts every extraordinary
     /// vertex at its faces' corner 0), its sharp edges kept; and its patches.
+    #[cfg(feature = "catmull-clark")]
     fn rotated(mesh: &Mesh) -> (Mesh, Vec<FacePatch>) {
         let faces: Vec<Vec<i64>> = (0..mesh.faces())
             .map(|f| {
@@ -1634,6 +1639,7 @@ mod tests {
     /// that `which` picks, evaluated at each of `rates` with every face's corners turned
     /// ([`rotated`]), and their table stencils summed in f64 (every point a weighted sum of the
     /// patch's control points); such faces must come from three corners at least.
+    #[cfg(feature = "catmull-clark")]
     fn table_stencil_errors(
         meshes: &[(&str, Mesh)],
         rates: &[u32],
@@ -1709,6 +1715,7 @@ mod tests {
     /// 2.7e-7 (the meshes are about 1 across), normals within 3.8e-7 rad; with the sub-patches'
     /// nets left unturned, 0.26 and 0.64.
     #[test]
+    #[cfg(feature = "catmull-clark")]
     fn split_faces_are_their_table_stencils() {
         let mut open_box = cube();
         let top = (0..open_box.faces()).position(|f| open_box.face(f).iter().all(|&v| v >= 4));
@@ -1749,6 +1756,7 @@ mod tests {
     /// face corner, at rates 5, 6, 7 and 8. Measured: positions within 2.4e-7 (the meshes are
     /// about 1 across), normals within 3.4e-7 rad; with the mirror's tangents swapped, pi.
     #[test]
+    #[cfg(feature = "catmull-clark")]
     fn mirrored_faces_are_their_table_stencils() {
         let meshes = [
             ("cube", cube()),
