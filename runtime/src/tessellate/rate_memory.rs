@@ -115,8 +115,13 @@ pub(crate) trait Selection: Sync {
     /// ([`StencilBound::NONE`] where the face cannot be kept).
     #[allow(clippy::type_complexity)]
     fn neighbourhoods(&self) -> Result<Vec<(Vec<u32>, Vec<StencilBound>)>, RuntimeError>;
-    /// The choices of `faces` at the current positions.
-    fn choose(&self, faces: &[usize]) -> Result<Vec<FaceChoice>, RuntimeError>;
+    /// The choices of `faces` at the current positions; `previous`, where given, every face's
+    /// last choice, whose refutations the quad selection scans from.
+    fn choose(
+        &self,
+        faces: &[usize],
+        previous: Option<&[FaceChoice]>,
+    ) -> Result<Vec<FaceChoice>, RuntimeError>;
     /// The deviations at the current positions of `(face, rate, sample)` (a sample's index as in
     /// [`super::rates::Refutation`]): the samples that refuted a face's smaller rates, looked
     /// at again. Only selections that record their refutations are asked.
@@ -256,7 +261,7 @@ impl RateMemory {
             }
             _ => {
                 let faces: Vec<usize> = (0..selection.faces()).collect();
-                let choices = selection.choose(&faces)?;
+                let choices = selection.choose(&faces, None)?;
                 let rates = ToleranceRates::from_choices(&choices);
                 *memory = Some(RateMemory {
                     tolerance,
@@ -411,7 +416,7 @@ impl RateMemory {
         let fresh = if resample.is_empty() {
             Vec::new()
         } else {
-            selection.choose(&resample)?
+            selection.choose(&resample, Some(&self.choices))?
         };
         for (&f, choice) in resample.iter().zip(fresh) {
             self.choices[f] = choice;
@@ -511,7 +516,11 @@ impl Selection for QuadSelection<'_> {
         self.mesh.holes[f]
     }
 
-    fn choose(&self, faces: &[usize]) -> Result<Vec<FaceChoice>, RuntimeError> {
+    fn choose(
+        &self,
+        faces: &[usize],
+        previous: Option<&[FaceChoice]>,
+    ) -> Result<Vec<FaceChoice>, RuntimeError> {
         with_selection(
             self.table,
             self.mesh,
@@ -522,7 +531,12 @@ impl Selection for QuadSelection<'_> {
             |choose| {
                 faces
                     .par_iter()
-                    .map(|&f| choose(f))
+                    .map(|&f| {
+                        let hints = previous
+                            .and_then(|p| p.get(f))
+                            .map_or(&[][..], |c| &c.refutations);
+                        choose(f, hints)
+                    })
                     .collect::<Result<Vec<_>, _>>()
             },
         )

@@ -2087,7 +2087,7 @@ pub fn tolerance_rates_among(
         |choose| {
             let choices = (0..patches.len())
                 .into_par_iter()
-                .map(choose)
+                .map(|f| choose(f, &[]))
                 .collect::<Result<Vec<_>, _>>()?;
             Ok(ToleranceRates::from_choices(&choices))
         },
@@ -2095,8 +2095,10 @@ pub fn tolerance_rates_among(
 }
 
 /// Runs `body` with the selection of [`tolerance_rates_among`] for one face at a time
-/// (`choose(f)`, from the mesh's current positions): what a full selection and a partial one
-/// ([`super::rate_memory`]) share.
+/// (`choose(f, hints)`, from the mesh's current positions; `hints`: the face's refutations when
+/// it was last sampled, where each rate's scan starts, or none): what a full selection and a
+/// partial one ([`super::rate_memory`]) share. The hints change where a refuted rate is found
+/// refuted, never whether.
 pub(crate) fn with_selection<R>(
     table: &StencilTable,
     mesh: &Mesh,
@@ -2105,7 +2107,7 @@ pub(crate) fn with_selection<R>(
     tolerance: f64,
     candidates: &[u32],
     body: impl FnOnce(
-        &(dyn Fn(usize) -> Result<FaceChoice, RuntimeError> + Sync),
+        &(dyn Fn(usize, &[Refutation]) -> Result<FaceChoice, RuntimeError> + Sync),
     ) -> Result<R, RuntimeError>,
 ) -> Result<R, RuntimeError> {
     check_tolerance(tolerance)?;
@@ -2114,7 +2116,7 @@ pub(crate) fn with_selection<R>(
     // A rate below the largest is only compared with the tolerance; the largest's deviation is
     // reported when no rate meets it, so it is measured in full.
     let largest = sorted.last().copied().unwrap_or(0);
-    let choose = |f: usize| {
+    let choose = |f: usize, hints: &[Refutation]| {
         let regular = ctx.regular(f);
         let (mut choice, samples) = choose_rate(
             f,
@@ -2136,6 +2138,14 @@ pub(crate) fn with_selection<R>(
                     tolerance
                 };
                 let local = FaceLocal::new(&ctx, f, n)?;
+                // A rate refuted when the face was last sampled is mostly refuted at the same
+                // sample again: scanned from there, it costs one sample.
+                if let Some(hint) = hints.iter().find(|r| r.rate == n) {
+                    if let Some([u, v]) = samples.uv(hint.sample) {
+                        samples.start.set(hint.sample);
+                        samples.outside_first.set(!local.is_interior(u, v));
+                    }
+                }
                 let worst = scan(&local, samples, stop)?;
                 if worst > stop {
                     // The scan stopped at the refuting sample.

@@ -735,7 +735,9 @@ pub fn triangle_tolerance_rates_among(
 ) -> Result<ToleranceRates, RuntimeError> {
     let selection = TriangleSelection::new(table, iso, tolerance, candidates)?;
     let faces: Vec<usize> = (0..iso.patches.len()).collect();
-    Ok(ToleranceRates::from_choices(&selection.choose(&faces)?))
+    Ok(ToleranceRates::from_choices(
+        &selection.choose(&faces, None)?,
+    ))
 }
 
 /// The selection of [`triangle_tolerance_rates_among`] at the isolated mesh's current
@@ -932,7 +934,11 @@ impl Selection for TriangleSelection<'_> {
         )))
     }
 
-    fn choose(&self, faces: &[usize]) -> Result<Vec<FaceChoice>, RuntimeError> {
+    fn choose(
+        &self,
+        faces: &[usize],
+        _previous: Option<&[FaceChoice]>,
+    ) -> Result<Vec<FaceChoice>, RuntimeError> {
         if faces.is_empty() {
             return Ok(Vec::new());
         }
