@@ -14,16 +14,18 @@
 //! over the part of `L_{f,n}` that `x_s` reads, so `|c_s|_1` is second order in `1/n` as for a
 //! regular grid ([`super::rates::chart_norm`]), where the table's stencils are smooth
 //! functions of the parameters: everywhere but at an extraordinary vertex, whose corner square
-//! the bound leaves to the two-ended norm `C_f`.
+//! the bound leaves to the two-ended norm `C_f`. On the isolated Spot the faces around its
+//! extraordinary vertices come out as the regular grid's: 0.18 at rate 2, 0.081-0.087 at 3,
+//! 0.047-0.052 at 4 (docs/benchmarks.md), where `C_f` is about 2.1.
 
-use table_format::{PointSet, StencilKind};
+use table_format::PointSet;
 
 use crate::mesh::topology::Mesh;
 use crate::scheme::patch::FacePatch;
 use crate::stencil_table::StencilTable;
 use crate::tessellate::rates::{
     across, beyond_index, chart_corner, chart_corner_terms, corner_square, curve_index, grid_row,
-    grid_side, linear_terms, placed_axes, ChartCorner, Vertex, SELECTION_GRID,
+    grid_side, linear_terms, placed_axes, position_weights, ChartCorner, Vertex, SELECTION_GRID,
 };
 use crate::RuntimeError;
 
@@ -163,17 +165,8 @@ impl Stencil {
         set: PointSet,
         n: u32,
     ) -> Result<Rows<'t>, RuntimeError> {
-        let key = patch.kind.section(StencilKind::Position, set, n);
-        let weights = table.weights(&key)?;
         let side = grid_side(set == PointSet::Primal, n) as usize;
-        let k = patch.points.len();
-        if weights.len() != side * side * k {
-            return Err(RuntimeError::LayoutMismatch {
-                key,
-                table: weights.len() / (side * side).max(1),
-                patch: k,
-            });
-        }
+        let weights = position_weights(table, patch, set, n, side)?;
         let slots = patch
             .points
             .iter()

@@ -66,7 +66,7 @@
 //! is the same for every face ([`super::rates::chart_norm`]: 0.50 at rate 1, 0.18 at 2, 0.047
 //! at 4) and there are no such corners; elsewhere it is the face's own
 //! ([`super::difference_norm`], made the first time a frame needs it, per face and rate).
-
+//!
 //! # Refuting samples looked at again
 //!
 //! A rate is refuted by one sample beyond `T`, often by little (the scan stops at the first), so

@@ -265,18 +265,8 @@ impl<'a> PatchPoints<'a> {
                 })
             }
         };
-        let key = patch.kind.section(StencilKind::Position, points, n);
-        let weights = table.weights(&key)?;
-        let k = patch.points.len();
-        if weights.len() != side * side * k {
-            return Err(RuntimeError::LayoutMismatch {
-                key,
-                table: weights.len() / (side * side).max(1),
-                patch: k,
-            });
-        }
         Ok(Grid::Weights {
-            weights,
+            weights: position_weights(table, patch, points, n, side)?,
             side,
             corner: patch.corner,
         })
@@ -387,6 +377,28 @@ impl<'a> PatchPoints<'a> {
         );
         Ok(out)
     }
+}
+
+/// The position stencils of `patch`'s grid `points` at rate `n`, `side x side` points of one
+/// weight per patch point, or the error that names a table whose section does not fit.
+pub(super) fn position_weights<'t>(
+    table: &'t StencilTable,
+    patch: &FacePatch,
+    points: PointSet,
+    n: u32,
+    side: usize,
+) -> Result<&'t [f32], RuntimeError> {
+    let key = patch.kind.section(StencilKind::Position, points, n);
+    let weights = table.weights(&key)?;
+    let k = patch.points.len();
+    if weights.len() != side * side * k {
+        return Err(RuntimeError::LayoutMismatch {
+            key,
+            table: weights.len() / (side * side).max(1),
+            patch: k,
+        });
+    }
+    Ok(weights)
 }
 
 /// The weights of point `(i, j)` (the face's own indices) of a table section of `side x side`
@@ -715,10 +727,7 @@ fn axis_parameter(primal: bool, grid: u32, i: u32) -> f64 {
 
 /// Sample `index` of a face at rate `grid` (the primal grid's `(grid + 1)^2` samples, then the
 /// dual grid's `grid^2`, each `j` outer): its grid, its indices there and its parameters.
-pub(super) fn sample_place(
-    grid: u32,
-    index: usize,
-) -> Option<(PointSet, (usize, usize), [f64; 2])> {
+fn sample_place(grid: u32, index: usize) -> Option<(PointSet, (usize, usize), [f64; 2])> {
     let primal = grid_side(true, grid) as usize;
     let (set, side, k) = if index < primal * primal {
         (PointSet::Primal, primal, index)
@@ -798,7 +807,7 @@ fn sample_at(
 /// Dual-grid index `(i, j)` of point `t` of the row next to side `side` of a face at rate `n`,
 /// in the side's direction (sides run counter-clockwise: 0 `v = 0`, 1 `u = 1`, 2 `v = 1`,
 /// 3 `u = 0`); `t = 0` is the point nearest corner `side`.
-pub(super) fn row_index(side: usize, t: usize, n: usize) -> (usize, usize) {
+fn row_index(side: usize, t: usize, n: usize) -> (usize, usize) {
     let last = n - 1;
     match side {
         0 => (t, 0),
