@@ -18,10 +18,13 @@
 //! extraordinary vertices come out as the regular grid's: 0.18 at rate 2, 0.081-0.087 at 3,
 //! 0.047-0.052 at 4 (docs/benchmarks.md), where `C_f` is about 2.1.
 
+use std::collections::HashMap;
+use std::sync::Mutex;
+
 use table_format::PointSet;
 
 use crate::mesh::topology::Mesh;
-use crate::scheme::patch::FacePatch;
+use crate::scheme::patch::{FacePatch, PatchKind};
 use crate::stencil_table::StencilTable;
 use crate::tessellate::rates::{
     across, beyond_index, chart_corner, chart_corner_terms, corner_square, curve_index, grid_row,
@@ -35,6 +38,9 @@ use crate::RuntimeError;
 /// stencils are rounded to within `2^-24` of weights of norm one). `None` where a point `x_s`
 /// reads is not a table face's (faces sampled adaptively, listed ascending in `adaptive`, and
 /// holes).
+///
+/// A face whose neighbourhood has the shape of one measured before ([`Norms`]) takes that
+/// norm.
 pub(crate) fn difference_norm(
     table: &StencilTable,
     mesh: &Mesh,
@@ -42,24 +48,26 @@ pub(crate) fn difference_norm(
     adaptive: &[usize],
     f: usize,
     n: u32,
+    norms: &Norms,
 ) -> Result<Option<f64>, RuntimeError> {
     let m = n as usize;
     let charts: [Option<ChartCorner>; 4] =
         std::array::from_fn(|corner| chart_corner(mesh, f, corner, m));
-    // Every face whose dual points `x_s` reads: the face, those across its sides and the
-    // charts' faces, all from the table.
-    let mut read: Vec<usize> = (0..4)
-        .filter_map(|side| across(mesh, f, side).map(|(g, _)| g))
-        .chain(
-            charts
-                .iter()
-                .flatten()
-                .flat_map(|c| c.points.map(|(g, _)| g)),
-        )
-        .chain([f])
-        .collect();
-    read.sort_unstable();
-    read.dedup();
+    let sides: [Option<(usize, usize)>; 4] = std::array::from_fn(|side| across(mesh, f, side));
+    // Every face whose dual points `x_s` reads, each once, in the order of their roles: the
+    // face, those across its sides, the charts' faces; all from the table.
+    let mut read: Vec<usize> = vec![f];
+    let roles = sides.iter().flatten().map(|&(g, _)| g).chain(
+        charts
+            .iter()
+            .flatten()
+            .flat_map(|c| c.points.map(|(g, _)| g)),
+    );
+    for g in roles {
+        if !read.contains(&g) {
+            read.push(g);
+        }
+    }
     let table_face = |g: usize| {
         g < patches.len()
             && !mesh.holes.get(g).copied().unwrap_or(true)
@@ -77,10 +85,25 @@ pub(crate) fn difference_norm(
         .iter()
         .map(|&g| Ok((g, stencil.section(table, &patches[g], PointSet::Dual, n)?)))
         .collect::<Result<Vec<_>, RuntimeError>>()?;
-    let curves = match (0..4).any(|side| across(mesh, f, side).is_none()) {
+    let curves = match sides.iter().any(Option::is_none) {
         true => Some(stencil.section(table, &patches[f], PointSet::Primal, n)?),
         false => None,
     };
+    // What the sums below read, faces by their roles: all their value depends on.
+    let role = |g: usize| read.iter().position(|&e| e == g);
+    let shape = Shape {
+        n,
+        faces: duals
+            .iter()
+            .map(|(g, rows)| (patches[*g].kind, rows.corner, rows.slots.clone()))
+            .collect(),
+        sides: sides.map(|side| side.map(|(g, other)| (role(g), other))),
+        charts: charts
+            .map(|chart| chart.map(|c| (c.through_face, c.points.map(|(g, ij)| (role(g), ij))))),
+    };
+    if let Some(&norm) = norms.lock().get(&shape) {
+        return Ok(Some(norm));
+    }
     let h = 0.5 / m as f64;
     let mut largest = 0.0f64;
     for (sample_rows, axis) in samples.iter().zip(placed_axes(m)?) {
@@ -96,11 +119,11 @@ pub(crate) fn difference_norm(
                         chart_corner_terms(a, b, h, chart.through_face)
                             .map(|(w, k)| (w, Source::Dual(chart.points[usize::from(k)])))
                     }
-                    None => linear_terms(u, v, m, |side| Ok(across(mesh, f, side).is_none()))?.map(
+                    None => linear_terms(u, v, m, |side| Ok(sides[side].is_none()))?.map(
                         |(w, vertex)| {
                             let source = match vertex {
                                 Vertex::Dual(i, j) => Source::Dual((f, (i, j))),
-                                Vertex::Beyond(side, t) => match across(mesh, f, side) {
+                                Vertex::Beyond(side, t) => match sides[side] {
                                     Some((g, other)) => {
                                         Source::Dual((g, beyond_index(other, t, m)))
                                     }
@@ -128,7 +151,44 @@ pub(crate) fn difference_norm(
             }
         }
     }
-    Ok(Some(largest + 2f64.powi(-20)))
+    let norm = largest + 2f64.powi(-20);
+    norms.lock().insert(shape, norm);
+    Ok(Some(norm))
+}
+
+/// The norms made so far, by the shape of what they read ([`Shape`]): the faces around
+/// extraordinary vertices of one valence are mostly alike, so a mesh has far fewer shapes
+/// than faces.
+#[derive(Debug, Default)]
+pub(crate) struct Norms(Mutex<HashMap<Shape, f64>>);
+
+impl Norms {
+    /// How many shapes were measured.
+    #[cfg(all(test, feature = "catmull-clark"))]
+    pub(crate) fn shapes(&self) -> usize {
+        self.lock().len()
+    }
+
+    /// The map, whether or not another thread panicked holding it (a norm is inserted whole).
+    fn lock(&self) -> std::sync::MutexGuard<'_, HashMap<Shape, f64>> {
+        self.0
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+}
+
+/// Everything a face's norm depends on at rate `n`, its faces numbered by role (the face, then
+/// those across its sides, then its charts' faces, each once): per face its patch kind, the
+/// corner its patch starts at and where its points lie among all those read (the points the
+/// faces share); per side the face across and its side there, or a boundary curve; per corner
+/// its chart.
+#[derive(Debug, PartialEq, Eq, Hash)]
+pub(crate) struct Shape {
+    n: u32,
+    faces: Vec<(PatchKind, usize, Vec<usize>)>,
+    sides: [Option<(Option<usize>, usize)>; 4],
+    #[allow(clippy::type_complexity)]
+    charts: [Option<(bool, [(Option<usize>, (usize, usize)); 4])>; 4],
 }
 
 /// A vertex of `L_{f,n}` that `x_s` reads: dual point `(i, j)` of a face (its own indices), or

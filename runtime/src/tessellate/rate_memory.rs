@@ -86,7 +86,7 @@ use crate::mesh::geometry::{cross, dot, norm, sub};
 use crate::mesh::topology::Mesh;
 use crate::scheme::patch::{FacePatch, PatchKind};
 use crate::stencil_table::StencilTable;
-use crate::tessellate::difference_norm::difference_norm;
+use crate::tessellate::difference_norm::{difference_norm, Norms};
 use crate::tessellate::rates::{
     adaptive_face_list, adaptive_faces, adaptive_grids, check_tolerance, sample_deviations,
     sorted_candidates, with_selection, AdaptiveGrids, FaceChoice, ToleranceRates,
@@ -128,8 +128,9 @@ pub(crate) trait Selection: Sync {
     fn sample_deviations(&self, checks: &[(usize, u32, usize)]) -> Result<Vec<f64>, RuntimeError>;
     /// Where face `f`'s deviations at rate `n` outside its uncharted corners have a stencil of
     /// their own ([`super::rates::ChartBound`] without a norm), the largest norm of those
-    /// stencils ([`super::difference_norm`]); `None` where there is none to use.
-    fn difference_norm(&self, _f: usize, _n: u32) -> Option<f64> {
+    /// stencils ([`super::difference_norm`], taken from `norms` where a face of the same shape
+    /// made it); `None` where there is none to use.
+    fn difference_norm(&self, _f: usize, _n: u32, _norms: &Norms) -> Option<f64> {
         None
     }
 }
@@ -154,7 +155,7 @@ pub(crate) struct RateMemory {
 #[derive(Debug)]
 enum SampledAt {
     First(Vec<[f64; 3]>),
-    Faces(Neighbourhoods),
+    Faces(Box<Neighbourhoods>),
 }
 
 /// What stencils can do to a distance: the largest `|w|_1` of a set of stencils, and the largest
@@ -229,6 +230,8 @@ struct Neighbourhoods {
     /// stencils ([`Selection::difference_norm`]), made when a frame first needs it: it depends
     /// on the topology alone.
     differences: Vec<OnceLock<Option<f64>>>,
+    /// Those norms by the shape of the neighbourhood they read, made once per shape.
+    norms: Norms,
     /// Per face, as it was sampled: its neighbourhood's points relative to its corner centre
     /// (in `points`' order), that centre and its corner frame.
     sampled: Vec<[f32; 3]>,
@@ -298,7 +301,7 @@ impl RateMemory {
                     now.len()
                 )));
             }
-            self.sampled_at = SampledAt::Faces(Neighbourhoods::new(selection, first)?);
+            self.sampled_at = SampledAt::Faces(Box::new(Neighbourhoods::new(selection, first)?));
         }
         let SampledAt::Faces(near) = &mut self.sampled_at else {
             return Err(RuntimeError::Unsupported(
@@ -554,11 +557,19 @@ impl Selection for QuadSelection<'_> {
 
     /// Where the norm cannot be made (a table that lacks a grid), the face has none and is
     /// sampled again: the selection reports the error itself.
-    fn difference_norm(&self, f: usize, n: u32) -> Option<f64> {
+    fn difference_norm(&self, f: usize, n: u32, norms: &Norms) -> Option<f64> {
         let adaptive = self.adaptive().ok()?;
-        difference_norm(self.table, self.mesh, self.patches, &adaptive.faces, f, n)
-            .ok()
-            .flatten()
+        difference_norm(
+            self.table,
+            self.mesh,
+            self.patches,
+            &adaptive.faces,
+            f,
+            n,
+            norms,
+        )
+        .ok()
+        .flatten()
     }
 
     /// The control points of every face sharing a vertex with the face (the samples read the
@@ -623,6 +634,7 @@ impl Neighbourhoods {
             differences: (0..faces * (MAX_SELECTED_RATE as usize + 1))
                 .map(|_| OnceLock::new())
                 .collect(),
+            norms: Norms::default(),
             sampled: vec![[0.0; 3]; points.len()],
             offsets,
             points,
@@ -644,7 +656,7 @@ impl Neighbourhoods {
             .checked_mul(MAX_SELECTED_RATE as usize + 1)
             .and_then(|k| k.checked_add(n as usize))
             .and_then(|k| self.differences.get(k))?;
-        *slot.get_or_init(|| selection.difference_norm(f, n))
+        *slot.get_or_init(|| selection.difference_norm(f, n, &self.norms))
     }
 
     /// Face `f` (its corners `corners`) sampled at `positions`: where its neighbourhood is.
