@@ -2715,7 +2715,8 @@ mod tests {
     /// coordinate, the others at the origin) the position path gives the difference stencil's
     /// weights one by one; its largest norm over the samples outside the uncharted corners is
     /// the stencils' (up to the closed-form regular samples' `f32` rounding). On an isolated
-    /// octahedron (valence-3 vertices) and an isolated open box (boundary curves).
+    /// octahedron (valence-3 vertices), an isolated open box (boundary curves) and a cube whose
+    /// lid is split in two triangles (faces of many shapes).
     #[test]
     #[cfg(feature = "catmull-clark")]
     fn difference_norms_are_the_position_paths() {
@@ -2735,8 +2736,22 @@ mod tests {
             schemes::BoundaryMode::EdgeOnly,
         )
         .expect("an open box");
+        // The cube with its lid split into two triangles: valences 3 and 4 next to each other,
+        // no symmetry that turns every face into every other.
+        let split_faces: Vec<Vec<i64>> = box_faces
+            .iter()
+            .cloned()
+            .chain([vec![4, 5, 6], vec![4, 6, 7]])
+            .collect();
+        let split = Mesh::new(
+            cube.positions.clone(),
+            &split_faces,
+            &[],
+            schemes::BoundaryMode::EdgeOnly,
+        )
+        .expect("a cube with a split lid");
         let (mut with_curves, mut with_fans) = (0, 0);
-        for input in [crate::mesh::test_meshes::octahedron(), open] {
+        for input in [crate::mesh::test_meshes::octahedron(), open, split] {
             let (mesh, patches, _) = isolate(&input).expect("isolates");
             let adaptive = adaptive_face_list(&table, &mesh, &patches).expect("adaptive faces");
             // Shared by every face: most take the norm of an alike face measured before, and
