@@ -630,10 +630,13 @@ impl Neighbourhoods {
             bounds.push(b);
         }
         let faces = bounds.len();
+        let slots = faces
+            .checked_mul(MAX_SELECTED_RATE as usize + 1)
+            .ok_or_else(|| {
+                RuntimeError::Unsupported(format!("rates kept for {faces} faces: too many"))
+            })?;
         let mut near = Neighbourhoods {
-            differences: (0..faces * (MAX_SELECTED_RATE as usize + 1))
-                .map(|_| OnceLock::new())
-                .collect(),
+            differences: (0..slots).map(|_| OnceLock::new()).collect(),
             norms: Norms::default(),
             sampled: vec![[0.0; 3]; points.len()],
             offsets,

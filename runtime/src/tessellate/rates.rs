@@ -2729,13 +2729,16 @@ mod tests {
             .map(|f| cube.face(f).iter().map(|&v| i64::from(v)).collect())
             .filter(|corners: &Vec<i64>| corners.as_slice() != lid)
             .collect();
-        let open = Mesh::new(
-            cube.positions.clone(),
-            &box_faces,
-            &[],
-            schemes::BoundaryMode::EdgeOnly,
-        )
-        .expect("an open box");
+        let on_cube = |faces: &[Vec<i64>]| {
+            Mesh::new(
+                cube.positions.clone(),
+                faces,
+                &[],
+                schemes::BoundaryMode::EdgeOnly,
+            )
+            .expect("a mesh on the cube's vertices")
+        };
+        let open = on_cube(&box_faces);
         // The cube with its lid split into two triangles: valences 3 and 4 next to each other,
         // no symmetry that turns every face into every other.
         let split_faces: Vec<Vec<i64>> = box_faces
@@ -2743,13 +2746,7 @@ mod tests {
             .cloned()
             .chain([vec![4, 5, 6], vec![4, 6, 7]])
             .collect();
-        let split = Mesh::new(
-            cube.positions.clone(),
-            &split_faces,
-            &[],
-            schemes::BoundaryMode::EdgeOnly,
-        )
-        .expect("a cube with a split lid");
+        let split = on_cube(&split_faces);
         let (mut with_curves, mut with_fans) = (0, 0);
         for input in [crate::mesh::test_meshes::octahedron(), open, split] {
             let (mesh, patches, _) = isolate(&input).expect("isolates");
