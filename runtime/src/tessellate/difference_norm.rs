@@ -7,8 +7,9 @@
 //! ([`super::rates::ChartBound`]). Both ends are affine combinations of the isolated control
 //! points, so the difference is one stencil `c_s` over them: the sample's table stencil less the
 //! weighted stencils of the three dual points (or boundary-curve points) that `x_s` combines.
-//! If every control point moves by at most `delta` after a rigid map, the difference moves by
-//! at most `|c_s|_1 delta`.
+//! If every control point lies within `delta` of its image under an affine map (a rigid one, or
+//! [`super::rate_memory`]'s fit), the difference moves by at most `|c_s|_1 delta` from the map's
+//! image of it.
 //!
 //! `c_s` annihilates every control net whose limit surface is affine in the face's parameters
 //! over the part of `L_{f,n}` that `x_s` reads, so `|c_s|_1` is second order in `1/n` as for a

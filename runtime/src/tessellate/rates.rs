@@ -2367,8 +2367,9 @@ impl ToleranceRates {
 /// Why it is small: `c` annihilates every control net that is an affine function of the grid
 /// (the spline reproduces it, and so does linear interpolation between its points), so
 /// `|c|_1` is second order in the spacing `1/n`: 0.50 at rate 1, 0.18 at 2, 0.047 at 4, where
-/// `|w|_1 + |l|_1` of the two ends is 2. If every control point moves by at most `delta` after a
-/// rigid map, the distance moves by at most `|c|_1 delta` ([`super::rate_memory`]).
+/// `|w|_1 + |l|_1` of the two ends is 2. If every control point lies within `delta` of its image
+/// under an affine map, the distance moves by at most `|c|_1 delta` from the map's image of it
+/// ([`super::rate_memory`]).
 pub(crate) fn chart_norm(n: u32) -> Result<f64, RuntimeError> {
     static NORMS: [OnceLock<f64>; MAX_SELECTED_RATE as usize] =
         [const { OnceLock::new() }; MAX_SELECTED_RATE as usize];
