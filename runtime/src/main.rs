@@ -717,7 +717,13 @@ struct BenchArgs {
 fn bench_command(args: BenchArgs) -> Result<(), RuntimeError> {
     let mut input = load_mesh(&args.mesh)?;
     // The refined mesh and its plan, estimated before refining: the largest rate on every face.
-    let largest_rate = if args.mixed { 16 } else { args.rate };
+    // A tolerance chooses its rates after refining, and its plan checks its own estimate
+    // (`Surface::tessellator_within`): before refining, only the refined mesh at rate 1.
+    let largest_rate = match (args.tolerance, args.mixed) {
+        (Some(_), _) => 1,
+        (None, true) => 16,
+        (None, false) => args.rate,
+    };
     let face_sizes = input
         .face_offsets
         .windows(2)
