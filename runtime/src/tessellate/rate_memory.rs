@@ -812,7 +812,9 @@ impl Neighbourhoods {
         // `R` is orthogonal to 1e-14, which the last term covers with `E`'s rounding.
         let stretch = e.iter().flatten().map(|x| x * x).sum::<f64>().sqrt() * (1.0 + 1e-12) + 1e-13;
         Some(Motion {
-            residual: residual + self.radius[f] * 2f64.powi(-23),
+            // A stored point is within 2^-24 of its length of the f64 one, and `A` stretches
+            // that by at most `1 + stretch`.
+            residual: residual + self.radius[f] * 2f64.powi(-23) * (1.0 + stretch),
             translation: norm(sub(mean_now, carried)),
             scale,
             stretch,
