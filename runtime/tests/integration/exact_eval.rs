@@ -12,6 +12,7 @@
 
 use std::collections::HashMap;
 
+use crate::common::cube;
 use num_rational::BigRational;
 use num_traits::{ToPrimitive, Zero};
 use schemes::{BoundaryMode, QuadScheme};
@@ -541,28 +542,6 @@ fn shared_edges_agree_from_both_faces() {
         "cube (isolated): max deviation along shared edges {:.1e}",
         check_edges(&cube(), usize::MAX)
     );
-}
-
-fn cube() -> Mesh {
-    let p = vec![
-        [0.0, 0.0, 0.0],
-        [1.0, 0.0, 0.0],
-        [1.0, 1.0, 0.0],
-        [0.0, 1.0, 0.0],
-        [0.0, 0.0, 1.0],
-        [1.0, 0.0, 1.0],
-        [1.0, 1.0, 1.0],
-        [0.0, 1.0, 1.0],
-    ];
-    let f = vec![
-        vec![0, 3, 2, 1],
-        vec![4, 5, 6, 7],
-        vec![0, 1, 5, 4],
-        vec![1, 2, 6, 5],
-        vec![2, 3, 7, 6],
-        vec![3, 0, 4, 7],
-    ];
-    Mesh::new(p, &f, &[], BoundaryMode::EdgeOnly).expect("cube")
 }
 
 #[test]

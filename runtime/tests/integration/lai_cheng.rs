@@ -8,11 +8,12 @@
 
 use std::path::Path;
 
+use crate::common::load;
+
 use num_bigint::BigInt;
 use num_rational::BigRational;
 use schemes::BoundaryMode;
 use subtess::eval::exact_eval::ExactEvaluator;
-use subtess::io::obj::read_obj;
 use subtess::mesh::topology::Mesh;
 use subtess::scheme::catmull_clark::adaptive::{limit_stencils, LimitQuery};
 use subtess::scheme::catmull_clark::isolate::{isolate_with_origins, Isolation};
@@ -23,13 +24,6 @@ use subtess::tessellate::lai_cheng::{
 use subtess::tessellate::rates::{point_triangle_distance, table_positions};
 use subtess::RuntimeError;
 use table_format::PointSet;
-
-fn load(path: &Path) -> Mesh {
-    let obj = read_obj(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    Mesh::from_obj(&obj)
-        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-        .0
-}
 
 fn cube() -> Mesh {
     load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("data/cube.obj"))

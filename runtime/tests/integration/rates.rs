@@ -2,12 +2,11 @@
 //! monotone in the tolerance and minimal (checked against a closed form), flat regions get
 //! rate 1; view rates follow the pinhole formula.
 
-use crate::common;
+use crate::common::{self, load};
 
 use std::path::Path;
 use std::sync::OnceLock;
 
-use subtess::io::obj::read_obj;
 use subtess::mesh::topology::Mesh;
 use subtess::scheme::catmull_clark::adaptive::{limit_of, limit_stencils, LimitQuery};
 use subtess::scheme::catmull_clark::isolate::isolate;
@@ -25,11 +24,6 @@ use common::{brute_force_deviation, diagonal};
 fn table() -> &'static StencilTable {
     static TABLE: OnceLock<StencilTable> = OnceLock::new();
     TABLE.get_or_init(|| StencilTable::default_catmull_clark().expect("embedded table"))
-}
-
-fn load(path: &Path) -> Mesh {
-    let obj = read_obj(path).unwrap_or_else(|e| panic!("{e}"));
-    Mesh::from_obj(&obj).unwrap_or_else(|e| panic!("{e}")).0
 }
 
 /// The shipped cube.
@@ -118,7 +112,7 @@ fn check_tolerance_met(name: &str, mesh: &Mesh) {
 #[test]
 #[cfg(feature = "catmull-clark")]
 fn face_deviation_bounds_the_distance_to_the_uniform_output() {
-    let mesh = load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("data/cube.obj"));
+    let mesh = cube();
     let (isolated, patches, _) = isolate(&mesh).expect("isolates");
     for n in [1, 2, 5] {
         let (out, _) = tessellate_uniform(table(), &isolated, &patches, n).expect("tessellates");
@@ -274,7 +268,7 @@ fn a_flat_region_gets_rate_one_for_any_tolerance() {
 #[test]
 #[cfg(feature = "catmull-clark")]
 fn faces_that_cannot_meet_the_tolerance_get_the_largest_rate_and_are_reported() {
-    let mesh = load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("data/cube.obj"));
+    let mesh = cube();
     let (isolated, patches, _) = isolate(&mesh).expect("isolates");
     // 1e-9 of a unit cube is far below what rate 24 reaches (and below f32 precision).
     let chosen = tolerance_rates(table(), &isolated, &patches, 1e-9).expect("rates");
@@ -293,7 +287,7 @@ fn faces_that_cannot_meet_the_tolerance_get_the_largest_rate_and_are_reported() 
 #[test]
 #[cfg(feature = "catmull-clark")]
 fn primal_positions_agree_with_the_dual_reference() {
-    let mesh = load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("data/cube.obj"));
+    let mesh = cube();
     let (isolated, patches, _) = isolate(&mesh).expect("isolates");
     for m in [1usize, 3, 5, 12] {
         for patch in &patches {
@@ -369,7 +363,7 @@ fn view_rates_follow_the_pinhole_formula() {
 
 #[test]
 fn view_rates_grow_as_the_camera_approaches() {
-    let mesh = load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("data/cube.obj"));
+    let mesh = cube();
     let (isolated, _, _) = isolate(&mesh).expect("isolates");
     let mut previous: Option<Vec<u32>> = None;
     let mut grew = 0;
