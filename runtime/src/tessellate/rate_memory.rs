@@ -332,6 +332,18 @@ impl RateMemory {
                     return Test::Sample;
                 }
                 let test = |moved: &Motion| {
+                    // A NaN fails every comparison below, which would keep the rate where the
+                    // deviation or a refutation should have sent it to be sampled (the surface
+                    // refuses points that are not finite; this covers what overflows).
+                    let measured = [
+                        moved.residual,
+                        moved.stretch,
+                        moved.translation,
+                        moved.scale,
+                    ];
+                    if !measured.iter().all(|x| x.is_finite()) {
+                        return Test::Sample;
+                    }
                     // The weights' sums times the map's translation, and f64's rounding.
                     let margin = bound.sum_error * moved.translation
                         + 1e-12 * bound.norm * (near.scale[f] + moved.scale);
