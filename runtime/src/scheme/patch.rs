@@ -116,9 +116,8 @@ pub fn is_smooth_patch(mesh: &Mesh, face: usize) -> bool {
             && mesh.fan_iter(v).count() == 1;
         (mesh.vertex_sharpness[v] == 0.0 || pinned)
             && mesh
-                .vertex_edges(v)
-                .iter()
-                .all(|&h| mesh.twin[h] == NONE || mesh.edge_sharpness[h] == 0.0)
+                .vertex_edges_iter(v)
+                .all(|h| mesh.twin[h] == NONE || mesh.edge_sharpness[h] == 0.0)
     })
 }
 
@@ -143,9 +142,8 @@ fn smooth_regular(mesh: &Mesh, v: usize) -> bool {
         && mesh.fan_iter(v).count() == 4
         && mesh.vertex_sharpness[v] == 0.0
         && mesh
-            .vertex_edges(v)
-            .iter()
-            .all(|&h| mesh.edge_sharpness[h] == 0.0)
+            .vertex_edges_iter(v)
+            .all(|h| mesh.edge_sharpness[h] == 0.0)
 }
 
 /// The sharp edge of a dart at `v`, as its position in `v`'s fan: `v` is an interior vertex
