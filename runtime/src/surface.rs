@@ -106,6 +106,29 @@ pub struct Surface {
     /// topology's alone).
     triangle_sampling: OnceLock<TriangleSampling>,
     quad_adaptive_faces: OnceLock<Vec<usize>>,
+    /// The output buffers of the last [`Tessellator`] dropped, for the next plan to fill.
+    frame_buffers: Mutex<FrameBuffers>,
+}
+
+/// A tessellator's output buffers, kept by its surface when it is dropped ([`FrameBuffers::KEPT`]
+/// bytes at most): an animation at a tolerance plans every frame, and buffers of a frame's size
+/// allocated afresh each time had their pages faulted in and zeroed again every frame.
+#[derive(Debug, Default)]
+struct FrameBuffers {
+    positions: Vec<[f32; 3]>,
+    normals: Vec<[f32; 3]>,
+    triangles: Vec<[u32; 3]>,
+}
+
+impl FrameBuffers {
+    /// The most a surface keeps (a one-off tessellation larger than this returns its memory).
+    const KEPT: usize = 64 << 20;
+
+    /// Their capacity in bytes.
+    fn bytes(&self) -> usize {
+        std::mem::size_of::<[f32; 3]>() * (self.positions.capacity() + self.normals.capacity())
+            + std::mem::size_of::<[u32; 3]>() * self.triangles.capacity()
+    }
 }
 
 impl Surface {
@@ -158,6 +181,7 @@ impl Surface {
             isolated,
             adaptive_operators: Mutex::new(None),
             rate_memory: Mutex::new(None),
+            frame_buffers: Mutex::new(FrameBuffers::default()),
             triangle_sampling: OnceLock::new(),
             quad_adaptive_faces: OnceLock::new(),
         })
@@ -463,8 +487,24 @@ impl Surface {
             )?),
         };
         let vertices = grid.vertex_count();
-        let mut triangles = vec![[0u32; 3]; grid.triangle_count()];
+        // The last tessellator's buffers where it left them (none when a thread panicked with
+        // them: fresh ones then).
+        let FrameBuffers {
+            mut positions,
+            mut normals,
+            mut triangles,
+        } = self
+            .frame_buffers
+            .lock()
+            .map(|mut kept| std::mem::take(&mut *kept))
+            .unwrap_or_default();
+        triangles.clear();
+        triangles.resize(grid.triangle_count(), [0; 3]);
         grid.connect(&mut triangles);
+        for buffer in [&mut positions, &mut normals] {
+            buffer.clear();
+            buffer.resize(vertices, [0.0; 3]);
+        }
         // The channel's limit values read the points on the isolated faces; then every point
         // is mapped to its input face once, in place and in parallel, a map per face (mapped
         // twice, point by point, serially, these took a third of Spot's plan at rate 16).
@@ -490,8 +530,8 @@ impl Surface {
             faces_sampled,
             input: Vec::new(),
             control: Vec::new(),
-            positions: vec![[0.0; 3]; vertices],
-            normals: vec![[0.0; 3]; vertices],
+            positions,
+            normals,
             triangles,
             sources,
             uvs,
@@ -567,6 +607,22 @@ pub struct Tessellator<'s> {
     seam_copies: Vec<[u32; 2]>,
     rates_seconds: f64,
     plan_seconds: f64,
+}
+
+impl Drop for Tessellator<'_> {
+    /// The output buffers go back to the surface for its next plan, unless they are large.
+    fn drop(&mut self) {
+        let buffers = FrameBuffers {
+            positions: std::mem::take(&mut self.positions),
+            normals: std::mem::take(&mut self.normals),
+            triangles: std::mem::take(&mut self.triangles),
+        };
+        if buffers.bytes() <= FrameBuffers::KEPT {
+            if let Ok(mut kept) = self.surface.frame_buffers.lock() {
+                *kept = buffers;
+            }
+        }
+    }
 }
 
 impl<'s> Tessellator<'s> {
