@@ -586,7 +586,8 @@ impl Surface {
     }
 }
 
-/// A planned tessellation of a [`Surface`]: evaluate it once per frame.
+/// A planned tessellation of a [`Surface`]: evaluate it once per frame. Dropped, it leaves its
+/// output buffers (64 MiB at most) to the surface, whose next plan fills them.
 #[derive(Debug)]
 pub struct Tessellator<'s> {
     surface: &'s Surface,
