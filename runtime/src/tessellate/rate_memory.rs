@@ -716,12 +716,8 @@ impl Neighbourhoods {
         let (centre, frame) = corner_frame(corners, now);
         let from = &self.frames[f];
         // R = frame^T from (the frames' rows are their axes).
-        let mut rotation = [[0.0; 3]; 3];
-        for (r, row) in rotation.iter_mut().enumerate() {
-            for (c, x) in row.iter_mut().enumerate() {
-                *x = (0..3).map(|k| frame[k][r] * from[k][c]).sum();
-            }
-        }
+        let transposed = std::array::from_fn(|r| std::array::from_fn(|k| frame[k][r]));
+        let rotation = product(&transposed, from);
         let range = self.offsets[f]..self.offsets[f + 1];
         let mut squared = LargestSquares::default();
         for (kept, &i) in self.sampled[range.clone()].iter().zip(&self.points[range]) {
@@ -782,17 +778,15 @@ impl Neighbourhoods {
         }
         let rotation = polar_rotation(m)?;
         // E (C + lambda I) = M - R C, solved through the symmetric C + lambda I's inverse.
-        let leftover: [[f64; 3]; 3] = std::array::from_fn(|r| {
-            std::array::from_fn(|k| m[r][k] - (0..3).map(|j| rotation[r][j] * c[j][k]).sum::<f64>())
-        });
+        let turned = product(&rotation, &c);
+        let leftover: [[f64; 3]; 3] =
+            std::array::from_fn(|r| std::array::from_fn(|k| m[r][k] - turned[r][k]));
         let lambda = 1e-6 * (c[0][0] + c[1][1] + c[2][2]);
         for (k, row) in c.iter_mut().enumerate() {
             row[k] += lambda;
         }
         let inverse = inverse_transpose(c)?;
-        let e: [[f64; 3]; 3] = std::array::from_fn(|r| {
-            std::array::from_fn(|k| (0..3).map(|j| leftover[r][j] * inverse[j][k]).sum::<f64>())
-        });
+        let e = product(&leftover, &inverse);
         let map: [[f64; 3]; 3] =
             std::array::from_fn(|r| std::array::from_fn(|k| rotation[r][k] + e[r][k]));
         let residual_of = |kept: &[f32; 3], i: u32, shift: [f64; 3]| {
@@ -882,6 +876,11 @@ fn polar_rotation(m: [[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
     let orthogonal = (0..3)
         .all(|r| (0..3).all(|c| (dot(x[r], x[c]) - if r == c { 1.0 } else { 0.0 }).abs() <= 1e-14));
     (orthogonal && dot(cross(x[0], x[1]), x[2]) > 0.0).then_some(x)
+}
+
+/// The matrix product `a b`.
+fn product(a: &[[f64; 3]; 3], b: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    std::array::from_fn(|r| std::array::from_fn(|c| (0..3).map(|k| a[r][k] * b[k][c]).sum()))
 }
 
 /// `(a^-1)^T`, the cofactor matrix over the determinant; `None` for a singular `a`.

@@ -2864,6 +2864,18 @@ mod tests {
         assert!(chart_norm(0).is_err() && chart_norm(25).is_err());
     }
 
+    /// The distance from `p` to the nearest of `local`'s triangles around `corner`, found by
+    /// trying them all.
+    #[allow(dead_code)] // without the Catmull–Clark feature
+    fn nearest_corner_triangle(local: &FaceLocal, corner: usize, p: [f64; 3]) -> f64 {
+        local
+            .corner(corner)
+            .expect("corner triangles")
+            .iter()
+            .map(|t| point_triangle_distance(p, &t.triangle))
+            .fold(f64::INFINITY, f64::min)
+    }
+
     /// The corner squares' chart points ([`FaceLocal::chart_point`]) are points of `L_{f,n}`:
     /// on one of the corner's triangles, and so no nearer to a sample than its nearest one; on
     /// regular tori and at the valence-4 vertices of an isolated octahedron and cube (next to
@@ -2884,25 +2896,26 @@ mod tests {
             let (i, j) = ((k % m) as f64, (k / m) as f64);
             *p = [i + 0.3 * j, 0.5 * j - 0.2 * i, 0.2 * i - 0.1 * j];
         }
+        // Per mesh: its patches, and for a torus whether it is the affine image of the grid.
+        let torus = |mesh: Mesh, affine: bool| {
+            let patches = crate::scheme::patch::gather_patches(&mesh).expect("patches");
+            (mesh, patches, Some(affine))
+        };
         let isolated = |input: Mesh| {
             let (mesh, patches, _) =
                 crate::scheme::catmull_clark::isolate::isolate(&input).expect("isolates");
-            (mesh, Some(patches), None)
+            (mesh, patches, None)
         };
         let meshes = [
-            (bent, None, Some(false)),
-            (flat, None, Some(true)),
+            torus(bent, false),
+            torus(flat, true),
             isolated(crate::mesh::test_meshes::octahedron()),
             isolated(crate::mesh::test_meshes::cube()),
         ];
         for (mesh, patches, torus) in &meshes {
-            let patches = match patches {
-                Some(patches) => patches.clone(),
-                None => crate::scheme::patch::gather_patches(mesh).expect("patches"),
-            };
             let affine = *torus == Some(true);
-            let adaptive = adaptive_faces(&table, mesh, &patches).expect("adaptive faces");
-            let ctx = Context::new(&table, mesh, &patches, &adaptive).expect("context");
+            let adaptive = adaptive_faces(&table, mesh, patches).expect("adaptive faces");
+            let ctx = Context::new(&table, mesh, patches, &adaptive).expect("context");
             let mut checked = 0;
             for f in 0..patches.len() {
                 assert!(
@@ -2930,12 +2943,7 @@ mod tests {
                             continue;
                         };
                         let (corner, _, _) = corner_square(u, v, n as usize).expect("a corner");
-                        let on = local
-                            .corner(corner)
-                            .expect("triangles")
-                            .iter()
-                            .map(|t| point_triangle_distance(x, &t.triangle))
-                            .fold(f64::INFINITY, f64::min);
+                        let on = nearest_corner_triangle(&local, corner, x);
                         assert!(on < 1e-12, "face {f}, rate {n}, ({u}, {v}): {on} off L");
                         let nearest = local.deviation_at(u, v, p, 0.0).expect("deviation");
                         let chart = distance(p, x);
@@ -3028,12 +3036,7 @@ mod tests {
                             (false, false) => 2,
                             (true, false) => 3,
                         };
-                        let plain = local
-                            .corner(corner)
-                            .expect("corner")
-                            .iter()
-                            .map(|t| point_triangle_distance(p, &t.triangle))
-                            .fold(f64::INFINITY, f64::min);
+                        let plain = nearest_corner_triangle(&local, corner, p);
                         assert_eq!(deviation, plain, "face {f} n = {n} at ({u}, {v})");
                         for floor in [0.5 * plain, plain, 2.0 * plain] {
                             let d = local.deviation_at(u, v, p, floor).expect("deviation");
