@@ -124,10 +124,12 @@ impl FrameBuffers {
     /// The most a surface keeps (a one-off tessellation larger than this returns its memory).
     const KEPT: usize = 64 << 20;
 
-    /// Their capacity in bytes.
+    /// Their capacity in bytes (each buffer's within `isize::MAX`, their sum saturating).
     fn bytes(&self) -> usize {
-        std::mem::size_of::<[f32; 3]>() * (self.positions.capacity() + self.normals.capacity())
-            + std::mem::size_of::<[u32; 3]>() * self.triangles.capacity()
+        let point = std::mem::size_of::<[f32; 3]>();
+        (self.positions.capacity() * point)
+            .saturating_add(self.normals.capacity() * point)
+            .saturating_add(self.triangles.capacity() * std::mem::size_of::<[u32; 3]>())
     }
 }
 
