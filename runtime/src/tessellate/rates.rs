@@ -228,15 +228,15 @@ impl<'a> PatchPoints<'a> {
                 mesh_corners: corners,
             });
         }
-        let control = patch
-            .points
-            .iter()
-            .map(|&v| {
-                mesh.positions.get(v as usize).copied().ok_or_else(|| {
-                    RuntimeError::Unsupported(format!("patch control point {v} is not in the mesh"))
-                })
-            })
-            .collect::<Result<Vec<_>, _>>()?;
+        // Sized first: collecting through `Result` cannot, and grew the vector by doubling
+        // (1% of a bent frame's selection, which gathers a face's points for every face it
+        // reads).
+        let mut control = Vec::with_capacity(patch.points.len());
+        for &v in &patch.points {
+            control.push(mesh.positions.get(v as usize).copied().ok_or_else(|| {
+                RuntimeError::Unsupported(format!("patch control point {v} is not in the mesh"))
+            })?);
+        }
         Ok(PatchPoints::Table {
             table,
             patch,
@@ -872,6 +872,48 @@ struct FaceLocal<'p> {
     /// Per corner, the triangle nearest the last sample read there: where a corner square's
     /// search starts.
     nearest: [Cell<usize>; 4],
+    /// Vectors to fill, left by an earlier `L_{f,n}` ([`Spare`]).
+    spare: RefCell<Spare<'p>>,
+}
+
+/// The vectors an `L_{f,n}` leaves when dropped ([`FaceLocal::into_spare`]), for the next one to
+/// fill ([`FaceLocal::new_in`]): the selection makes one per face and rate tried, each with its
+/// dual points, sides' rows, strips and corners' triangles, and allocating them afresh every
+/// time was about 3% of a bent frame's selection (Spot, docs/benchmarks.md).
+#[derive(Default)]
+struct Spare<'p> {
+    dual: Vec<Cell<Option<[f64; 3]>>>,
+    neighbours: Vec<(usize, Grid<'p>)>,
+    points: Vec<Vec<[f64; 3]>>,
+    triangles: Vec<Vec<[[f64; 3]; 3]>>,
+    corners: Vec<Vec<Corner>>,
+}
+
+/// The [`Spare`]s of a selection's threads: a face takes one while its rates are tried and gives
+/// it back after (a lock a face, against allocations a rate).
+struct SparePool<'p>(Mutex<Vec<Spare<'p>>>);
+
+impl<'p> SparePool<'p> {
+    fn new() -> Self {
+        SparePool(Mutex::new(Vec::new()))
+    }
+
+    fn take(&self) -> Spare<'p> {
+        // A poisoned lock only means another face's selection panicked: its spares are vectors
+        // still, to be cleared before use.
+        self.0
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
+            .pop()
+            .unwrap_or_default()
+    }
+
+    fn give(&self, spare: Spare<'p>) {
+        self.0
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
+            .push(spare);
+    }
 }
 
 /// A triangle around a corner, with a ball that holds it: `|p - centre| - radius` is a lower
@@ -988,12 +1030,18 @@ impl Corner {
 /// The triangles of a strip merging row `a` (`na` points at `(2i+1)/2na`) with row `b` (`nb`
 /// points at `(2j+1)/2nb`) along an edge, or with a boundary curve (`b` at `j/na`): the
 /// tessellator's merge order (dual_grid.rs).
-fn strip_triangles(a: &[[f64; 3]], b: &[[f64; 3]], curve: bool) -> Vec<[[f64; 3]; 3]> {
+fn strip_triangles(
+    a: &[[f64; 3]],
+    b: &[[f64; 3]],
+    curve: bool,
+    mut out: Vec<[[f64; 3]; 3]>,
+) -> Vec<[[f64; 3]; 3]> {
     let (na, nb) = (a.len(), b.len());
     let param_a = |i: usize| if curve { 2 * i + 1 } else { (2 * i + 1) * nb };
     let param_b = |j: usize| if curve { 2 * j } else { (2 * j + 1) * na };
     let (mut i, mut j) = (0, 0);
-    let mut out = Vec::with_capacity(na + nb);
+    out.clear();
+    out.reserve(na + nb);
     while i + 1 < na || j + 1 < nb {
         if j + 1 == nb || (i + 1 < na && param_a(i + 1) <= param_b(j + 1)) {
             out.push([b[j], a[i + 1], a[i]]);
@@ -1011,43 +1059,103 @@ impl<'p> FaceLocal<'p> {
     /// interior `[h, 1-h]^2`, [`FaceLocal::is_interior`]), what lies beyond each side and the
     /// triangles around each corner, each made when first read.
     fn new(ctx: &'p Context<'p>, f: usize, n: u32) -> Result<Self, RuntimeError> {
+        Self::new_in(ctx, f, n, Spare::default())
+    }
+
+    /// [`FaceLocal::new`], filling the vectors of `spare`.
+    fn new_in(
+        ctx: &'p Context<'p>,
+        f: usize,
+        n: u32,
+        mut spare: Spare<'p>,
+    ) -> Result<Self, RuntimeError> {
         let own = ctx.face(f)?;
         let grid = own.grid(PointSet::Dual, n)?;
         let count = grid.side() * grid.side();
+        let mut dual = std::mem::take(&mut spare.dual);
+        dual.clear();
+        dual.resize(count, Cell::new(None));
+        let mut neighbours = std::mem::take(&mut spare.neighbours);
+        neighbours.clear();
         Ok(FaceLocal {
             n: n as usize,
             own,
             grid,
-            dual: vec![Cell::new(None); count],
+            dual,
             ctx,
             f,
-            neighbours: RefCell::new(Vec::new()),
+            neighbours: RefCell::new(neighbours),
             primal: OnceCell::new(),
             beyond: Default::default(),
             strips: Default::default(),
             corners: Default::default(),
             nearest: Default::default(),
+            spare: RefCell::new(spare),
         })
     }
 
+    /// Every vector this `L_{f,n}` made, for the next one ([`FaceLocal::new_in`]).
+    fn into_spare(self) -> Spare<'p> {
+        let mut spare = self.spare.into_inner();
+        spare.dual = self.dual;
+        spare.neighbours = self.neighbours.into_inner();
+        for beyond in self.beyond {
+            if let Some(Beyond::Face(points) | Beyond::Curve(points)) = beyond.into_inner() {
+                spare.points.push(points);
+            }
+        }
+        spare
+            .triangles
+            .extend(self.strips.into_iter().filter_map(OnceCell::into_inner));
+        spare
+            .corners
+            .extend(self.corners.into_iter().filter_map(OnceCell::into_inner));
+        spare
+    }
+
+    /// An empty vector of points, a spare one if there is one.
+    fn points_vec(&self) -> Vec<[f64; 3]> {
+        let mut points = self.spare.borrow_mut().points.pop().unwrap_or_default();
+        points.clear();
+        points
+    }
+
+    /// An empty vector of triangles, a spare one if there is one.
+    fn triangles_vec(&self) -> Vec<[[f64; 3]; 3]> {
+        let mut triangles = self.spare.borrow_mut().triangles.pop().unwrap_or_default();
+        triangles.clear();
+        triangles
+    }
+
+    /// A vector of points made here and no longer read, for the next to fill.
+    fn give_points(&self, points: Vec<[f64; 3]>) {
+        self.spare.borrow_mut().points.push(points);
+    }
+
     /// Every dual point, those not read yet evaluated four at a time ([`PatchPoints::extend`]):
-    /// what a scan that is not refuted at once reads anyway.
+    /// what a scan that is not refuted at once reads anyway. (Give the vector back with
+    /// [`FaceLocal::give_points`].)
     fn filled(&self) -> Vec<[f64; 3]> {
-        let mut missing = Vec::with_capacity(self.dual.len());
-        missing.extend((0..self.dual.len()).filter(|&k| self.dual[k].get().is_none()));
-        let mut points = Vec::with_capacity(missing.len());
+        let mut missing = self.points_vec();
         self.own.extend(
             &self.grid,
-            missing.iter().map(|&k| (k % self.n, k / self.n)),
-            &mut points,
+            (0..self.dual.len())
+                .filter(|&k| self.dual[k].get().is_none())
+                .map(|k| (k % self.n, k / self.n)),
+            &mut missing,
         );
-        for (&k, p) in missing.iter().zip(points) {
-            self.dual[k].set(Some(p));
-        }
-        self.dual
-            .iter()
-            .map(|c| c.get().unwrap_or_default())
-            .collect()
+        // The cells still empty, in the same order.
+        let mut fresh = missing.iter().copied();
+        let mut all = self.points_vec();
+        all.extend(self.dual.iter().map(|cell| {
+            cell.get().unwrap_or_else(|| {
+                let p = fresh.next().unwrap_or_default();
+                cell.set(Some(p));
+                p
+            })
+        }));
+        self.give_points(missing);
+        all
     }
 
     /// The dual grid of face `g` at rate `n`.
@@ -1080,7 +1188,7 @@ impl<'p> FaceLocal<'p> {
         let m = self.n;
         let Some((g, other)) = across(ctx.mesh, f, side) else {
             let primal = self.primal()?;
-            let mut curve = Vec::with_capacity(m + 1);
+            let mut curve = self.points_vec();
             self.own.extend(
                 &primal,
                 (0..=m).map(|t| curve_index(side, t, m)),
@@ -1089,7 +1197,7 @@ impl<'p> FaceLocal<'p> {
             return Ok(Beyond::Curve(curve));
         };
         let grid = self.neighbour_grid(g)?;
-        let mut row = Vec::with_capacity(m);
+        let mut row = self.points_vec();
         ctx.face(g)?
             .extend(&grid, (0..m).map(|t| beyond_index(other, t, m)), &mut row);
         Ok(Beyond::Face(row))
@@ -1098,11 +1206,13 @@ impl<'p> FaceLocal<'p> {
     /// The strip along side `side`, in the tessellator's merge order.
     fn strip(&self, side: usize) -> Result<&[[[f64; 3]; 3]], RuntimeError> {
         once(&self.strips[side], || {
-            let row: Vec<[f64; 3]> = (0..self.n).map(|t| self.row(side, t)).collect();
-            Ok(match self.beyond(side)? {
-                Beyond::Face(other) => strip_triangles(&row, other, false),
-                Beyond::Curve(curve) => strip_triangles(&row, curve, true),
-            })
+            let mut row = self.points_vec();
+            row.extend((0..self.n).map(|t| self.row(side, t)));
+            let (Beyond::Face(other) | Beyond::Curve(other)) = self.beyond(side)?;
+            let curve = matches!(self.beyond(side)?, Beyond::Curve(_));
+            let strip = strip_triangles(&row, other, curve, self.triangles_vec());
+            self.give_points(row);
+            Ok(strip)
         })
         .map(Vec::as_slice)
     }
@@ -1119,7 +1229,7 @@ impl<'p> FaceLocal<'p> {
         let m = self.n;
         let mesh = ctx.mesh;
         let (fan, closed) = sector(mesh, mesh.face_halfedges(f).start + corner);
-        let mut ring = Vec::with_capacity(fan.len() + 1);
+        let mut ring = self.points_vec();
         if !closed {
             let primal = self.primal()?;
             let (i, j) = curve_index(corner, 0, m);
@@ -1135,7 +1245,7 @@ impl<'p> FaceLocal<'p> {
             });
         }
         // The polygon's fan, two triangles of each strip and the corner cell's two.
-        let mut triangles: Vec<[[f64; 3]; 3]> = Vec::with_capacity(ring.len() + 6);
+        let mut triangles = self.triangles_vec();
         triangles
             .extend((1..ring.len().saturating_sub(1)).map(|i| [ring[0], ring[i], ring[i + 1]]));
         // Side `corner` starts at this corner, side `corner - 1` ends at it.
@@ -1152,7 +1262,12 @@ impl<'p> FaceLocal<'p> {
             );
             triangles.extend([[p, q, r], [p, r, s]]);
         }
-        Ok(triangles.into_iter().map(Corner::new).collect())
+        let mut corners = self.spare.borrow_mut().corners.pop().unwrap_or_default();
+        corners.clear();
+        corners.extend(triangles.iter().copied().map(Corner::new));
+        self.give_points(ring);
+        self.spare.borrow_mut().triangles.push(triangles);
+        Ok(corners)
     }
 
     /// Dual point `(i, j)`, evaluated the first time it is read.
@@ -1394,8 +1509,26 @@ impl<'p> FaceLocal<'p> {
         let dual = if wants_interior {
             self.filled()
         } else {
-            Vec::new()
+            self.points_vec()
         };
+        let scanned = self.scan_rows(samples, stop, &keep, &dual, worst);
+        self.give_points(dual);
+        scanned
+    }
+
+    /// [`FaceLocal::deviation_up_to`] after its first sample (`worst`): every sample row by row,
+    /// the interior's read from `dual` (every dual point, or none where the interior is not
+    /// scanned).
+    fn scan_rows(
+        &self,
+        samples: &Samples,
+        stop: f64,
+        keep: &impl Fn(bool) -> bool,
+        dual: &[[f64; 3]],
+        worst: f64,
+    ) -> Result<f64, RuntimeError> {
+        let n = self.n;
+        let wants_interior = n >= 2 && keep(true);
         let mut largest = Largest::new(worst);
         let mut offset = 0;
         for axis in placed_axes(n)? {
@@ -2125,8 +2258,10 @@ pub(crate) fn with_selection<R>(
     // A rate below the largest is only compared with the tolerance; the largest's deviation is
     // reported when no rate meets it, so it is measured in full.
     let largest = sorted.last().copied().unwrap_or(0);
+    let pool = SparePool::new();
     let choose = |f: usize, hints: &[Refutation]| {
         let regular = ctx.regular(f);
+        let spare = RefCell::new(pool.take());
         let (mut choice, samples) = choose_rate(
             f,
             tolerance,
@@ -2146,7 +2281,7 @@ pub(crate) fn with_selection<R>(
                 } else {
                     tolerance
                 };
-                let local = FaceLocal::new(&ctx, f, n)?;
+                let local = FaceLocal::new_in(&ctx, f, n, spare.take())?;
                 // A rate refuted when the face was last sampled is mostly refuted at the same
                 // sample again: scanned from there, it costs one sample.
                 if let Some(hint) = hints.iter().find(|r| r.rate == n) {
@@ -2170,9 +2305,11 @@ pub(crate) fn with_selection<R>(
                         samples.chart.set(Some((worst.max(charted), fans)));
                     }
                 }
+                spare.replace(local.into_spare());
                 Ok(worst)
             },
         )?;
+        pool.give(spare.into_inner());
         choice.refutations = samples.refutations.take();
         if let (true, Some((deviation, fans))) = (choice.met, samples.chart.get()) {
             choice.chart = Some(ChartBound {
@@ -2227,9 +2364,12 @@ pub(crate) fn sample_deviations(
     let ctx = Context::new(table, mesh, patches, adaptive)?;
     checks
         .par_iter()
-        .map(|&(f, n, sample)| {
+        .map_init(Spare::default, |spare, &(f, n, sample)| {
             let ([u, v], p) = sample_at(ctx.face(f)?, SELECTION_GRID, sample)?;
-            FaceLocal::new(&ctx, f, n)?.deviation_at(u, v, p, 0.0)
+            let local = FaceLocal::new_in(&ctx, f, n, std::mem::take(spare))?;
+            let deviation = local.deviation_at(u, v, p, 0.0);
+            *spare = local.into_spare();
+            deviation
         })
         .collect()
 }
