@@ -1302,7 +1302,10 @@ impl<'p> FaceLocal<'p> {
     /// The distance from `p` to the nearest of corner `corner`'s `triangles`, or any value at
     /// most `floor` where that is at most `floor` ([`FaceLocal::deviation_at`]). Most samples of
     /// a scan lie nearer the last sample's triangle than the largest deviation so far, which its
-    /// bound shows without the exact search.
+    /// bound shows without the exact search; most of the others nearer another triangle, whose
+    /// bound, a third of an exact distance, shows it (a sample crossing into the next triangle
+    /// of a fan: at rate 1, whose samples are all in corner squares, the exact searches were
+    /// 7% of a bent frame's selection on Spot).
     #[inline(always)]
     fn corner_deviation(
         &self,
@@ -1317,8 +1320,15 @@ impl<'p> FaceLocal<'p> {
         let Some(t) = triangles.get(first) else {
             return f64::INFINITY;
         };
-        if floor > 0.0 && t.bound_within(p, floor) {
-            return floor;
+        if floor > 0.0 {
+            if t.bound_within(p, floor) {
+                return floor;
+            }
+            // `first` again among them: one bound, against a branch per triangle.
+            if let Some(k) = triangles.iter().position(|t| t.bound_within(p, floor)) {
+                self.nearest[corner].set(k);
+                return floor;
+            }
         }
         self.nearest_triangle(corner, triangles, first, p, floor)
     }
