@@ -110,14 +110,16 @@ pub struct Surface {
     frame_buffers: Mutex<FrameBuffers>,
 }
 
-/// A tessellator's output buffers, kept by its surface when it is dropped ([`FrameBuffers::KEPT`]
-/// bytes at most): an animation at a tolerance plans every frame, and buffers of a frame's size
-/// allocated afresh each time had their pages faulted in and zeroed again every frame.
+/// A tessellator's output buffers and its vertices' sources, kept by its surface when it is
+/// dropped ([`FrameBuffers::KEPT`] bytes at most): an animation at a tolerance plans every
+/// frame, and buffers of a frame's size allocated afresh each time had their pages faulted in
+/// and zeroed again every frame.
 #[derive(Debug, Default)]
 struct FrameBuffers {
     positions: Vec<[f32; 3]>,
     normals: Vec<[f32; 3]>,
     triangles: Vec<[u32; 3]>,
+    sources: Vec<VertexSource>,
 }
 
 impl FrameBuffers {
@@ -130,6 +132,7 @@ impl FrameBuffers {
         (self.positions.capacity() * point)
             .saturating_add(self.normals.capacity() * point)
             .saturating_add(self.triangles.capacity() * std::mem::size_of::<[u32; 3]>())
+            .saturating_add(self.sources.capacity() * std::mem::size_of::<VertexSource>())
     }
 }
 
@@ -495,6 +498,7 @@ impl Surface {
             mut positions,
             mut normals,
             mut triangles,
+            mut sources,
         } = self
             .frame_buffers
             .lock()
@@ -510,7 +514,7 @@ impl Surface {
         // The channel's limit values read the points on the isolated faces; then every point
         // is mapped to its input face once, in place and in parallel, a map per face (mapped
         // twice, point by point, serially, these took a third of Spot's plan at rate 16).
-        let mut sources = grid.sources();
+        grid.sources_into(&mut sources);
         let limit_uvs = match &self.channel {
             Some(channel) if channel.mode() != FaceVaryingMode::All => {
                 Some(channel.limit_values(&sources)?)
@@ -589,7 +593,8 @@ impl Surface {
 }
 
 /// A planned tessellation of a [`Surface`]: evaluate it once per frame. Dropped, it leaves its
-/// output buffers (64 MiB at most) to the surface, whose next plan fills them.
+/// output buffers and its vertices' sources (64 MiB at most) to the surface, whose next plan
+/// fills them.
 #[derive(Debug)]
 pub struct Tessellator<'s> {
     surface: &'s Surface,
@@ -619,6 +624,7 @@ impl Drop for Tessellator<'_> {
             positions: std::mem::take(&mut self.positions),
             normals: std::mem::take(&mut self.normals),
             triangles: std::mem::take(&mut self.triangles),
+            sources: std::mem::take(&mut self.sources),
         };
         if buffers.bytes() <= FrameBuffers::KEPT {
             if let Ok(mut kept) = self.surface.frame_buffers.lock() {

@@ -933,6 +933,9 @@ impl DualGrid {
         // boundary, a hole or a crease from each surface face's half-edge, the curve points
         // made once (by the crease's lower half-edge) and shared.
         let mut curve_of = vec![(0u32, 0u32); mesh.face_vertices.len()];
+        // At most a strip a half-edge: reserved, not grown (each doubling copied the strips into
+        // fresh pages, faulted in every plan; untouched, the reserve costs no pages).
+        self.strips.reserve(mesh.face_vertices.len());
         for h in 0..mesh.face_vertices.len() {
             let t = mesh.twin[h];
             let f = mesh.face_of[h] as usize;
@@ -1138,8 +1141,9 @@ impl GridPlan for DualGrid {
     }
 
     /// Where every output vertex is evaluated, in output order.
-    fn sources(&self) -> Vec<VertexSource> {
-        let mut out = Vec::with_capacity(self.vertex_count);
+    fn sources_into(&self, out: &mut Vec<VertexSource>) {
+        out.clear();
+        out.reserve(self.vertex_count);
         for (f, &n) in self.rates.iter().enumerate() {
             if let FaceEval::Hole = self.faces[f] {
                 continue;
@@ -1157,7 +1161,6 @@ impl GridPlan for DualGrid {
             }
         }
         out.extend_from_slice(self.boundary_groups.sources());
-        out
     }
 
     /// Evaluate every output vertex from the control points `control` (the mesh's vertex

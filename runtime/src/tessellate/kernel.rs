@@ -386,8 +386,17 @@ pub trait GridPlan: Sync + Send + std::fmt::Debug {
     /// Output triangles per frame.
     fn triangle_count(&self) -> usize;
 
-    /// Where every output vertex is evaluated, in output order, in the tessellated mesh's faces.
-    fn sources(&self) -> Vec<VertexSource>;
+    /// Where every output vertex is evaluated, in output order, in the tessellated mesh's faces:
+    /// `out`'s contents replaced (a surface fills the vector of its last frame,
+    /// [`crate::Surface::tessellator`]).
+    fn sources_into(&self, out: &mut Vec<VertexSource>);
+
+    /// [`GridPlan::sources_into`] a new vector.
+    fn sources(&self) -> Vec<VertexSource> {
+        let mut out = Vec::new();
+        self.sources_into(&mut out);
+        out
+    }
 
     /// Evaluate every output vertex from the control points `control` (the tessellated mesh's
     /// vertex positions): limit positions and unit normals, `vertex_count()` each.

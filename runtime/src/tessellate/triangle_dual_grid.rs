@@ -660,8 +660,9 @@ impl GridPlan for TriangleDualGrid {
 
     /// Where every output vertex is evaluated, in output order, in the tessellated mesh's
     /// triangles: dual points over `3n`, primal points over `n`.
-    fn sources(&self) -> Vec<VertexSource> {
-        let mut out = Vec::with_capacity(self.vertex_count);
+    fn sources_into(&self, out: &mut Vec<VertexSource>) {
+        out.clear();
+        out.reserve(self.vertex_count);
         for (f, &n) in self.rates.iter().enumerate() {
             let source = |u, v, denominator| VertexSource {
                 face: f as u32,
@@ -685,7 +686,6 @@ impl GridPlan for TriangleDualGrid {
             }
         }
         out.extend_from_slice(self.point_groups.sources());
-        out
     }
 
     /// Evaluate every output vertex from the control points `control` (the mesh's vertex

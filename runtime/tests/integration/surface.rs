@@ -284,7 +284,9 @@ fn check_moved_rates(label: &str, mesh: &Mesh, scheme: Scheme, relative: f64) {
         .map(|p| p.map(|c| 2.0 * c))
         .collect();
     surface.set_positions(&deformed).expect("moved");
-    let (rates, positions, triangles) = {
+    // This plan fills the buffers the rest plan left to the surface (another size: the rates
+    // differ), its sources' among them.
+    let (rates, positions, triangles, sources) = {
         let mut tessellator = surface.tessellator(&tolerance).expect("moved plan");
         let rates = tessellator.rates().to_vec();
         let frame = tessellator.evaluate(&deformed).expect("moved frame");
@@ -292,6 +294,7 @@ fn check_moved_rates(label: &str, mesh: &Mesh, scheme: Scheme, relative: f64) {
             rates,
             frame.positions().to_vec(),
             frame.triangles().to_vec(),
+            frame.sources().to_vec(),
         )
     };
 
@@ -303,6 +306,7 @@ fn check_moved_rates(label: &str, mesh: &Mesh, scheme: Scheme, relative: f64) {
     assert_ne!(rest_rates, rates, "{label}: the deformation moves no rate");
     let reference = fresh_tessellator.evaluate(&deformed).expect("fresh frame");
     assert_eq!(reference.triangles(), &triangles[..], "{label}: topology");
+    assert_eq!(reference.sources(), &sources[..], "{label}: sources");
     let worst = positions
         .iter()
         .zip(reference.positions())
