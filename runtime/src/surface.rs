@@ -106,20 +106,36 @@ pub struct Surface {
     /// topology's alone).
     triangle_sampling: OnceLock<TriangleSampling>,
     quad_adaptive_faces: OnceLock<Vec<usize>>,
-    /// The output buffers of the last [`Tessellator`] dropped, for the next plan to fill.
+    /// The output buffers and the plan of the last [`Tessellator`] dropped, for the next plan to
+    /// fill or, at the same rates, to take whole.
     frame_buffers: Mutex<FrameBuffers>,
 }
 
 /// A tessellator's output buffers and its vertices' sources, kept by its surface when it is
-/// dropped ([`FrameBuffers::KEPT`] bytes at most): an animation at a tolerance plans every
-/// frame, and buffers of a frame's size allocated afresh each time had their pages faulted in
-/// and zeroed again every frame.
+/// dropped ([`FrameBuffers::KEPT`] bytes at most), with its plan where that is small enough
+/// too: an animation at a tolerance plans every frame, and buffers of a frame's size allocated
+/// afresh each time had their pages faulted in and zeroed again every frame; and most frames of
+/// a mesh at rest, moving rigidly or bending a little keep every face's rate, and so the plan.
 #[derive(Debug, Default)]
 struct FrameBuffers {
     positions: Vec<[f32; 3]>,
     normals: Vec<[f32; 3]>,
     triangles: Vec<[u32; 3]>,
     sources: Vec<VertexSource>,
+    /// The plan whose triangles and sources these are.
+    plan: Option<KeptPlan>,
+}
+
+/// A plan kept for the next tessellator at the same rates. The plan, its triangles, sources,
+/// texture coordinates and seam copies depend on the rates, the topology and the table alone,
+/// none of which a surface changes after it is made ([`Surface::set_positions`] moves points
+/// only): the same rates, the same plan.
+#[derive(Debug)]
+struct KeptPlan {
+    rates: Vec<u32>,
+    grid: Box<dyn GridPlan>,
+    uvs: Vec<[f32; 2]>,
+    seam_copies: Vec<[u32; 2]>,
 }
 
 impl FrameBuffers {
@@ -441,6 +457,8 @@ impl Surface {
     /// (the topology does not change between frames), built once. Refused before anything of
     /// the output's size is allocated when its estimate exceeds
     /// [`crate::DEFAULT_MAX_TRIANGLES`] ([`Surface::tessellator_within`] takes another limit).
+    /// Where the rates (chosen now, for a tolerance or a camera) are those of the last
+    /// tessellator dropped, its plan is taken whole instead of made again.
     pub fn tessellator(&self, rates: &Rates) -> Result<Tessellator<'_>, RuntimeError> {
         self.tessellator_within(rates, crate::DEFAULT_MAX_TRIANGLES)
     }
@@ -462,7 +480,44 @@ impl Surface {
         let rates_seconds = started.elapsed().as_secs_f64();
         self.estimate_rates(&rates)
             .check("the tessellation", max_triangles)?;
-        let grid: Box<dyn GridPlan + '_> = match &self.isolated {
+        // The last tessellator's buffers where it left them (none when a thread panicked with
+        // them: fresh ones then), and its plan if it was made at these rates.
+        let mut kept = self
+            .frame_buffers
+            .lock()
+            .map(|mut kept| std::mem::take(&mut *kept))
+            .unwrap_or_default();
+        if let Some(plan) = kept.plan.take().filter(|plan| plan.rates == rates) {
+            let FrameBuffers {
+                mut positions,
+                mut normals,
+                triangles,
+                sources,
+                ..
+            } = kept;
+            let vertices = plan.grid.vertex_count();
+            for buffer in [&mut positions, &mut normals] {
+                buffer.resize(vertices, [0.0; 3]);
+            }
+            return Ok(Tessellator {
+                surface: self,
+                grid: Some(plan.grid),
+                rates,
+                faces_over_tolerance,
+                faces_sampled,
+                input: Vec::new(),
+                control: Vec::new(),
+                positions,
+                normals,
+                triangles,
+                sources,
+                uvs: plan.uvs,
+                seam_copies: plan.seam_copies,
+                rates_seconds,
+                plan_seconds: started.elapsed().as_secs_f64(),
+            });
+        }
+        let grid: Box<dyn GridPlan> = match &self.isolated {
             Isolated::Quad(iso) => Box::new(DualGrid::with_channel(
                 &self.table,
                 &iso.mesh,
@@ -492,18 +547,13 @@ impl Surface {
             )?),
         };
         let vertices = grid.vertex_count();
-        // The last tessellator's buffers where it left them (none when a thread panicked with
-        // them: fresh ones then).
         let FrameBuffers {
             mut positions,
             mut normals,
             mut triangles,
             mut sources,
-        } = self
-            .frame_buffers
-            .lock()
-            .map(|mut kept| std::mem::take(&mut *kept))
-            .unwrap_or_default();
+            ..
+        } = kept;
         triangles.clear();
         triangles.resize(grid.triangle_count(), [0; 3]);
         grid.connect(&mut triangles);
@@ -530,7 +580,7 @@ impl Surface {
         let seam_copies = grid.seam_copies().to_vec();
         Ok(Tessellator {
             surface: self,
-            grid,
+            grid: Some(grid),
             rates,
             faces_over_tolerance,
             faces_sampled,
@@ -594,11 +644,13 @@ impl Surface {
 
 /// A planned tessellation of a [`Surface`]: evaluate it once per frame. Dropped, it leaves its
 /// output buffers and its vertices' sources (64 MiB at most) to the surface, whose next plan
-/// fills them.
+/// fills them, and its plan (64 MiB at most), which the surface's next tessellator at the same
+/// rates takes whole.
 #[derive(Debug)]
 pub struct Tessellator<'s> {
     surface: &'s Surface,
-    grid: Box<dyn GridPlan + 's>,
+    /// The plan (`None` once it has gone back to the surface, on drop).
+    grid: Option<Box<dyn GridPlan>>,
     rates: Vec<u32>,
     faces_over_tolerance: Option<usize>,
     faces_sampled: Option<usize>,
@@ -618,13 +670,25 @@ pub struct Tessellator<'s> {
 }
 
 impl Drop for Tessellator<'_> {
-    /// The output buffers go back to the surface for its next plan, unless they are large.
+    /// The output buffers go back to the surface for its next plan, unless they are large, and
+    /// the plan with them, unless it is large.
     fn drop(&mut self) {
+        let plan = self
+            .grid
+            .take()
+            .filter(|grid| grid.heap_bytes() <= FrameBuffers::KEPT)
+            .map(|grid| KeptPlan {
+                rates: std::mem::take(&mut self.rates),
+                grid,
+                uvs: std::mem::take(&mut self.uvs),
+                seam_copies: std::mem::take(&mut self.seam_copies),
+            });
         let buffers = FrameBuffers {
             positions: std::mem::take(&mut self.positions),
             normals: std::mem::take(&mut self.normals),
             triangles: std::mem::take(&mut self.triangles),
             sources: std::mem::take(&mut self.sources),
+            plan,
         };
         if buffers.bytes() <= FrameBuffers::KEPT {
             if let Ok(mut kept) = self.surface.frame_buffers.lock() {
@@ -648,8 +712,13 @@ impl<'s> Tessellator<'s> {
         } else {
             self.input.as_slice()
         };
-        self.grid
-            .evaluate(control, &mut self.positions, &mut self.normals);
+        // Taken only by the tessellator's drop.
+        let Some(grid) = &self.grid else {
+            return Err(RuntimeError::Unsupported(
+                "internal: the tessellator's plan is gone".to_owned(),
+            ));
+        };
+        grid.evaluate(control, &mut self.positions, &mut self.normals);
         Ok(Frame {
             positions: &self.positions,
             normals: &self.normals,
@@ -698,14 +767,14 @@ impl<'s> Tessellator<'s> {
     /// How many faces take a polynomial fast path: quads the separable (tensor-product)
     /// bicubic, Loop triangles one quartic per face (0 for the other triangle schemes).
     pub fn separable_faces(&self) -> usize {
-        self.grid.separable_faces()
+        self.grid.as_ref().map_or(0, |grid| grid.separable_faces())
     }
 
     /// How many faces are evaluated by feature-adaptive refinement: next to sharp features the
     /// tables do not describe (semi-sharp ones, a crease that turns between two irregular
     /// corners, ...) or at a valence beyond the table (0 for the triangle schemes).
     pub fn refined_faces(&self) -> usize {
-        self.grid.refined_faces()
+        self.grid.as_ref().map_or(0, |grid| grid.refined_faces())
     }
 
     /// Seconds spent planning (rates, table lookups, connectivity, triangles, sources).
@@ -820,5 +889,93 @@ impl<'a> Frame<'a> {
             uvs: self.uvs.to_vec(),
             seam_copies: self.seam_copies.to_vec(),
         }
+    }
+}
+
+#[cfg(all(test, feature = "catmull-clark"))]
+mod tests {
+    use super::*;
+
+    /// The cube with a texture atlas (every edge a seam): its plan has texture coordinates and
+    /// seam copies to keep too.
+    fn cube_uv() -> Mesh {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/cube_uv.obj");
+        Mesh::read_obj(path).expect("cube_uv.obj")
+    }
+
+    /// Turned about the z axis and moved: every face keeps its rate.
+    fn turned(points: &[[f32; 3]]) -> Vec<[f32; 3]> {
+        let (s, c) = 0.3f32.sin_cos();
+        points
+            .iter()
+            .map(|p| {
+                [
+                    c * p[0] - s * p[1] + 0.5,
+                    s * p[0] + c * p[1] - 0.25,
+                    p[2] + 2.0,
+                ]
+            })
+            .collect()
+    }
+
+    fn kept_rates(surface: &Surface) -> Option<Vec<u32>> {
+        let kept = surface.frame_buffers.lock().expect("buffers");
+        kept.plan.as_ref().map(|plan| plan.rates.clone())
+    }
+
+    #[test]
+    fn a_plan_at_the_same_rates_is_kept_and_frames_as_a_fresh_one() {
+        let mesh = cube_uv();
+        let tolerance = Rates::Tolerance(2e-3);
+        let mut surface = Surface::new(&mesh, Scheme::CatmullClark).expect("surface");
+        let first = surface
+            .tessellator(&tolerance)
+            .expect("plan")
+            .rates()
+            .to_vec();
+        assert!(first.iter().any(|&n| n > 1), "rates {first:?}");
+        assert_eq!(kept_rates(&surface), Some(first.clone()), "kept on drop");
+
+        let moved = turned(&mesh.positions_f32());
+        surface.set_positions(&moved).expect("moved");
+        let mut tessellator = surface.tessellator(&tolerance).expect("kept plan");
+        assert_eq!(tessellator.rates(), &first[..]);
+        assert_eq!(
+            kept_rates(&surface),
+            None,
+            "the plan at the same rates is taken"
+        );
+        let frame = tessellator.evaluate(&moved).expect("frame");
+
+        let mut fresh_mesh = mesh.clone();
+        fresh_mesh.positions = moved.iter().map(|p| p.map(f64::from)).collect();
+        let fresh = Surface::new(&fresh_mesh, Scheme::CatmullClark).expect("fresh surface");
+        let mut fresh_tessellator = fresh.tessellator(&tolerance).expect("fresh plan");
+        assert_eq!(fresh_tessellator.rates(), &first[..]);
+        let reference = fresh_tessellator.evaluate(&moved).expect("fresh frame");
+        assert_eq!(frame.triangles(), reference.triangles());
+        assert_eq!(frame.sources(), reference.sources());
+        assert_eq!(frame.uvs(), reference.uvs());
+        assert!(frame.uvs().is_some());
+        assert_eq!(frame.seam_copies(), reference.seam_copies());
+        let worst = frame
+            .positions()
+            .iter()
+            .zip(reference.positions())
+            .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs()))
+            .fold(0.0f32, f32::max);
+        assert!(worst <= 1e-5, "positions off by {worst}");
+        drop(tessellator);
+
+        // Other rates: a plan of their own, and that plan kept in turn.
+        let uniform = surface.tessellator(&Rates::Uniform(3)).expect("uniform");
+        assert!(uniform.rates().iter().all(|&n| n == 3));
+        let fresh_uniform = fresh
+            .tessellator(&Rates::Uniform(3))
+            .expect("fresh uniform");
+        assert_eq!(uniform.triangle_count(), fresh_uniform.triangle_count());
+        let uniform_rates = uniform.rates().to_vec();
+        drop(uniform);
+        assert_eq!(kept_rates(&surface), Some(uniform_rates));
     }
 }

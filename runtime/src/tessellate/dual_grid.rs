@@ -43,7 +43,7 @@ use crate::stencil_table::StencilTable;
 pub use crate::tessellate::kernel::TessellationTime;
 use crate::tessellate::kernel::{
     append_control, for_each_range, merge_rows, patch_origin, relative, table_may_describe,
-    unless_absent, Connectivity, GridPlan, PointPlan, Stencils, MAX_PATCH,
+    unless_absent, vec_bytes, Connectivity, GridPlan, PointPlan, Stencils, MAX_PATCH,
 };
 use crate::tessellate::lane_stencils::{
     store_points, unit_cross_x4, LaneStencils, PointGroups, LANES,
@@ -1141,6 +1141,39 @@ impl GridPlan for DualGrid {
     }
 
     /// Where every output vertex is evaluated, in output order.
+    fn heap_bytes(&self) -> usize {
+        // The separable bases, a few rows of `n + 1` weights per rate, are left out.
+        let deep = [
+            self.lanes
+                .iter()
+                .map(LaneStencils::heap_bytes)
+                .sum::<usize>(),
+            self.splits.iter().map(SubPatchPlan::heap_bytes).sum(),
+            self.mirrors.iter().map(MirrorStencils::heap_bytes).sum(),
+            self.boundary_points.iter().map(PointPlan::heap_bytes).sum(),
+            self.boundary_groups.heap_bytes(),
+            self.connectivity.heap_bytes(),
+        ];
+        let shallow = [
+            vec_bytes(&self.rates),
+            vec_bytes(&self.first),
+            vec_bytes(&self.face_ends),
+            vec_bytes(&self.faces),
+            vec_bytes(&self.bases),
+            vec_bytes(&self.lanes),
+            vec_bytes(&self.splits),
+            vec_bytes(&self.mirrors),
+            vec_bytes(&self.control),
+            vec_bytes(&self.boundary_points),
+            vec_bytes(&self.local_points),
+            vec_bytes(&self.strips),
+            vec_bytes(&self.seam_copies),
+        ];
+        deep.into_iter()
+            .chain(shallow)
+            .fold(0, usize::saturating_add)
+    }
+
     fn sources_into(&self, out: &mut Vec<VertexSource>) {
         out.clear();
         out.reserve(self.vertex_count);

@@ -66,7 +66,18 @@ pub(crate) struct PointPlan {
     pub(crate) source: VertexSource,
 }
 
+/// The heap bytes of `v`'s buffer: its capacity, not its length (a plan's weight,
+/// [`GridPlan::heap_bytes`]).
+pub(crate) fn vec_bytes<T>(v: &Vec<T>) -> usize {
+    v.capacity().saturating_mul(std::mem::size_of::<T>())
+}
+
 impl PointPlan {
+    /// Its weights' heap bytes.
+    pub(crate) fn heap_bytes(&self) -> usize {
+        vec_bytes(&self.weights)
+    }
+
     /// The point of row `row` of `s` (a patch of `k` control points).
     pub(crate) fn from_row(
         s: &Stencils,
@@ -315,6 +326,19 @@ impl Default for Connectivity {
 }
 
 impl Connectivity {
+    /// Its vectors' heap bytes.
+    pub(crate) fn heap_bytes(&self) -> usize {
+        [
+            vec_bytes(&self.polygons),
+            vec_bytes(&self.polygon_offsets),
+            vec_bytes(&self.face_triangles),
+            vec_bytes(&self.strip_triangles),
+            vec_bytes(&self.polygon_triangles),
+        ]
+        .into_iter()
+        .fold(0, usize::saturating_add)
+    }
+
     /// Close the plan: the triangles of every face and every strip (the polygons' follow from
     /// their lengths, a `k`-gon giving `k - 2`).
     pub(crate) fn count(
@@ -421,6 +445,11 @@ pub trait GridPlan: Sync + Send + std::fmt::Debug {
     fn refined_faces(&self) -> usize {
         0
     }
+
+    /// About the plan's heap memory (its vectors' capacities, the stencils' weights included):
+    /// what a surface weighs before keeping the plan for its next frame
+    /// ([`crate::Surface::tessellator`]).
+    fn heap_bytes(&self) -> usize;
 
     /// Output vertices repeating another's position across a face-varying seam, `[copy,
     /// original]` (none unless the plan has a face-varying channel).

@@ -26,7 +26,7 @@ use std::ops::Range;
 
 use crate::mesh::triangle_mesh::VertexSource;
 use crate::tessellate::kernel::{
-    cross, for_each_range, patch_origin, relative, unit, PointPlan, Stencils, MAX_PATCH,
+    cross, for_each_range, patch_origin, relative, unit, vec_bytes, PointPlan, Stencils, MAX_PATCH,
 };
 use crate::RuntimeError;
 
@@ -55,6 +55,11 @@ pub(crate) struct LaneStencils {
 }
 
 impl LaneStencils {
+    /// Its weights' heap bytes.
+    pub(crate) fn heap_bytes(&self) -> usize {
+        vec_bytes(&self.weights)
+    }
+
     /// The stencils of the face's `points` points, point `t` being row `row(t).1` of the
     /// stencils `row(t).0` (`k` weights a row); `None` if a row is out of range.
     pub(crate) fn new<'a>(
@@ -243,6 +248,16 @@ pub(crate) struct PointGroups {
 }
 
 impl PointGroups {
+    /// Its runs', ends' and sources' heap bytes.
+    pub(crate) fn heap_bytes(&self) -> usize {
+        self.runs
+            .iter()
+            .map(|(_, lanes)| lanes.heap_bytes())
+            .fold(vec_bytes(&self.runs), usize::saturating_add)
+            .saturating_add(vec_bytes(&self.ends))
+            .saturating_add(vec_bytes(&self.sources))
+    }
+
     /// The runs of `plans` (point `i` over `indices[plans[i].control]`, its position, d/du and
     /// d/dv weights one block after the other); an error if a plan's weights are not three
     /// blocks as long as its control points.

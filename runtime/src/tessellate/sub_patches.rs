@@ -28,7 +28,7 @@ use wide::f32x4;
 
 use crate::scheme::patch::{dual_index_in_patch, PatchKind};
 use crate::stencil_table::StencilTable;
-use crate::tessellate::kernel::MAX_PATCH;
+use crate::tessellate::kernel::{vec_bytes, MAX_PATCH};
 use crate::RuntimeError;
 
 /// Whether a face at rate `n` is split: a multiple of 8 from 16 on, so that the quarter's and
@@ -65,6 +65,13 @@ pub(crate) struct SubPatchPlan {
 }
 
 impl SubPatchPlan {
+    /// Its vectors' heap bytes.
+    pub(crate) fn heap_bytes(&self) -> usize {
+        vec_bytes(&self.ends)
+            .saturating_add(vec_bytes(&self.terms))
+            .saturating_add(vec_bytes(&self.quarter))
+    }
+
     /// The split of a face of patch `kind` (`k` control points, the vertex at the face's corner
     /// `corner`) at rate `n`, or `None` where the table has no pieces for it (a table of grids,
     /// a one-face boundary corner, whose stencils depend on the mesh's boundary mode), `n` is

@@ -46,8 +46,8 @@ use crate::scheme::triangle::patch::{
 };
 pub use crate::stencil_table::TriangleStencils;
 use crate::tessellate::kernel::{
-    append_control, for_each_range, merge_rows, patch_origin, relative, Connectivity, GridPlan,
-    PointPlan, Stencils, TessellationTime,
+    append_control, for_each_range, merge_rows, patch_origin, relative, vec_bytes, Connectivity,
+    GridPlan, PointPlan, Stencils, TessellationTime,
 };
 use crate::tessellate::lane_stencils::{LaneStencils, PointGroups};
 use crate::tessellate::loop_quartic::{self, QuarticBasis};
@@ -660,6 +660,35 @@ impl GridPlan for TriangleDualGrid {
 
     /// Where every output vertex is evaluated, in output order, in the tessellated mesh's
     /// triangles: dual points over `3n`, primal points over `n`.
+    fn heap_bytes(&self) -> usize {
+        let deep = [
+            self.lanes
+                .iter()
+                .map(LaneStencils::heap_bytes)
+                .sum::<usize>(),
+            self.params.iter().map(vec_bytes).sum(),
+            self.points.iter().map(PointPlan::heap_bytes).sum(),
+            self.point_groups.heap_bytes(),
+            self.connectivity.heap_bytes(),
+        ];
+        let shallow = [
+            vec_bytes(&self.rates),
+            vec_bytes(&self.first),
+            vec_bytes(&self.ends),
+            vec_bytes(&self.faces),
+            vec_bytes(&self.lanes),
+            vec_bytes(&self.params),
+            vec_bytes(&self.quartic_rates),
+            vec_bytes(&self.control),
+            vec_bytes(&self.points),
+            vec_bytes(&self.strips),
+            vec_bytes(&self.limit_points),
+        ];
+        deep.into_iter()
+            .chain(shallow)
+            .fold(0, usize::saturating_add)
+    }
+
     fn sources_into(&self, out: &mut Vec<VertexSource>) {
         out.clear();
         out.reserve(self.vertex_count);
