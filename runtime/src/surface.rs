@@ -482,102 +482,49 @@ impl Surface {
             .check("the tessellation", max_triangles)?;
         // The last tessellator's buffers where it left them (none when a thread panicked with
         // them: fresh ones then), and its plan if it was made at these rates.
-        let mut kept = self
-            .frame_buffers
-            .lock()
-            .map(|mut kept| std::mem::take(&mut *kept))
-            .unwrap_or_default();
-        if let Some(plan) = kept.plan.take().filter(|plan| plan.rates == rates) {
-            let FrameBuffers {
-                mut positions,
-                mut normals,
-                triangles,
-                sources,
-                ..
-            } = kept;
-            let vertices = plan.grid.vertex_count();
-            for buffer in [&mut positions, &mut normals] {
-                buffer.resize(vertices, [0.0; 3]);
-            }
-            return Ok(Tessellator {
-                surface: self,
-                grid: Some(plan.grid),
-                rates,
-                faces_over_tolerance,
-                faces_sampled,
-                input: Vec::new(),
-                control: Vec::new(),
-                positions,
-                normals,
-                triangles,
-                sources,
-                uvs: plan.uvs,
-                seam_copies: plan.seam_copies,
-                rates_seconds,
-                plan_seconds: started.elapsed().as_secs_f64(),
-            });
-        }
-        let grid: Box<dyn GridPlan> = match &self.isolated {
-            Isolated::Quad(iso) => Box::new(DualGrid::with_channel(
-                &self.table,
-                &iso.mesh,
-                &iso.patches,
-                &rates,
-                self.channel
-                    .as_ref()
-                    .map(|c| c.mesh.face_vertices.as_slice()),
-            )?),
-            Isolated::Triangle(iso)
-                if iso.patches.iter().any(|p| p.kind.boundary) && self.scheme == Scheme::Sqrt3 =>
-            {
-                // √3's boundary patches: their grids are made now, from the table's basis.
-                let stencils = Sqrt3BoundaryStencils::new(&self.table, &iso.patches, &rates)?;
-                Box::new(TriangleDualGrid::new(
-                    &stencils,
-                    &iso.mesh,
-                    &iso.patches,
-                    &rates,
-                )?)
-            }
-            Isolated::Triangle(iso) => Box::new(TriangleDualGrid::new(
-                &self.table,
-                &iso.mesh,
-                &iso.patches,
-                &rates,
-            )?),
-        };
-        let vertices = grid.vertex_count();
         let FrameBuffers {
             mut positions,
             mut normals,
             mut triangles,
             mut sources,
-            ..
-        } = kept;
-        triangles.clear();
-        triangles.resize(grid.triangle_count(), [0; 3]);
-        grid.connect(&mut triangles);
-        for buffer in [&mut positions, &mut normals] {
-            buffer.clear();
-            buffer.resize(vertices, [0.0; 3]);
-        }
-        // The channel's limit values read the points on the isolated faces; then every point
-        // is mapped to its input face once, in place and in parallel, a map per face (mapped
-        // twice, point by point, serially, these took a third of Spot's plan at rate 16).
-        grid.sources_into(&mut sources);
-        let limit_uvs = match &self.channel {
-            Some(channel) if channel.mode() != FaceVaryingMode::All => {
-                Some(channel.limit_values(&sources)?)
+            plan,
+        } = self
+            .frame_buffers
+            .lock()
+            .map(|mut kept| std::mem::take(&mut *kept))
+            .unwrap_or_default();
+        let (grid, uvs, seam_copies) = match plan.filter(|plan| plan.rates == rates) {
+            Some(plan) => (plan.grid, plan.uvs, plan.seam_copies),
+            None => {
+                let grid = self.plan(&rates)?;
+                triangles.clear();
+                triangles.resize(grid.triangle_count(), [0; 3]);
+                grid.connect(&mut triangles);
+                // The channel's limit values read the points on the isolated faces; then every
+                // point is mapped to its input face once, in place and in parallel, a map per
+                // face (mapped twice, point by point, serially, these took a third of Spot's
+                // plan at rate 16).
+                grid.sources_into(&mut sources);
+                let limit_uvs = match &self.channel {
+                    Some(channel) if channel.mode() != FaceVaryingMode::All => {
+                        Some(channel.limit_values(&sources)?)
+                    }
+                    _ => None,
+                };
+                self.map_to_input(&mut sources);
+                let uvs = match (&self.channel, limit_uvs) {
+                    (_, Some(uvs)) => uvs,
+                    (Some(channel), None) => channel.linear_values(&sources),
+                    (None, None) => Vec::new(),
+                };
+                let seam_copies = grid.seam_copies().to_vec();
+                (grid, uvs, seam_copies)
             }
-            _ => None,
         };
-        self.map_to_input(&mut sources);
-        let uvs = match (&self.channel, limit_uvs) {
-            (_, Some(uvs)) => uvs,
-            (Some(channel), None) => channel.linear_values(&sources),
-            (None, None) => Vec::new(),
-        };
-        let seam_copies = grid.seam_copies().to_vec();
+        // Every point is written by `evaluate` before a frame shows it.
+        let vertices = grid.vertex_count();
+        positions.resize(vertices, [0.0; 3]);
+        normals.resize(vertices, [0.0; 3]);
         Ok(Tessellator {
             surface: self,
             grid: Some(grid),
@@ -594,6 +541,39 @@ impl Surface {
             seam_copies,
             rates_seconds,
             plan_seconds: started.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// The dual grid's plan at `rates` (one per isolated face), for either family of schemes.
+    fn plan(&self, rates: &[u32]) -> Result<Box<dyn GridPlan>, RuntimeError> {
+        Ok(match &self.isolated {
+            Isolated::Quad(iso) => Box::new(DualGrid::with_channel(
+                &self.table,
+                &iso.mesh,
+                &iso.patches,
+                rates,
+                self.channel
+                    .as_ref()
+                    .map(|c| c.mesh.face_vertices.as_slice()),
+            )?),
+            Isolated::Triangle(iso)
+                if iso.patches.iter().any(|p| p.kind.boundary) && self.scheme == Scheme::Sqrt3 =>
+            {
+                // √3's boundary patches: their grids are made now, from the table's basis.
+                let stencils = Sqrt3BoundaryStencils::new(&self.table, &iso.patches, rates)?;
+                Box::new(TriangleDualGrid::new(
+                    &stencils,
+                    &iso.mesh,
+                    &iso.patches,
+                    rates,
+                )?)
+            }
+            Isolated::Triangle(iso) => Box::new(TriangleDualGrid::new(
+                &self.table,
+                &iso.mesh,
+                &iso.patches,
+                rates,
+            )?),
         })
     }
 
