@@ -278,19 +278,14 @@ impl Surface {
     pub fn set_positions(&mut self, positions: &[[f32; 3]]) -> Result<(), RuntimeError> {
         check_positions(positions, self.input_vertices)?;
         let input: Vec<[f64; 3]> = positions.iter().map(|p| p.map(f64::from)).collect();
-        let mut refined = Vec::new();
-        let moved = if self.control_points(&input, &mut refined) {
-            refined
-        } else {
-            input
-        };
-        let mesh = match &mut self.isolated {
-            Isolated::Quad(iso) => &mut iso.mesh,
-            Isolated::Triangle(iso) => &mut iso.mesh,
-        };
-        // The map has a row per isolated vertex (and no map, the input is the control).
-        debug_assert_eq!(moved.len(), mesh.positions.len());
-        mesh.positions = moved;
+        // The isolated points are written over the last frame's, in their vector: one of the
+        // isolated mesh's size allocated afresh had its pages faulted in every frame.
+        let mut moved = std::mem::take(&mut self.mesh_mut().positions);
+        if !self.control_points(&input, &mut moved) {
+            // No map: the input is the control.
+            moved = input;
+        }
+        self.mesh_mut().positions = moved;
         Ok(())
     }
 
@@ -309,6 +304,14 @@ impl Surface {
         match &self.isolated {
             Isolated::Quad(iso) => &iso.mesh,
             Isolated::Triangle(iso) => &iso.mesh,
+        }
+    }
+
+    /// [`Surface::mesh`], to move its points.
+    fn mesh_mut(&mut self) -> &mut Mesh {
+        match &mut self.isolated {
+            Isolated::Quad(iso) => &mut iso.mesh,
+            Isolated::Triangle(iso) => &mut iso.mesh,
         }
     }
 
