@@ -879,7 +879,7 @@ struct FaceLocal<'p> {
 /// The vectors an `L_{f,n}` leaves when dropped ([`FaceLocal::into_spare`]), for the next one to
 /// fill ([`FaceLocal::new_in`]): the selection makes one per face and rate tried, each with its
 /// dual points, sides' rows, strips and corners' triangles, and allocating them afresh every
-/// time was about 3% of a bent frame's selection (Spot, docs/benchmarks.md).
+/// time was about 2% of a bent frame's selection (Spot, docs/benchmarks.md).
 #[derive(Default)]
 struct Spare<'p> {
     dual: Vec<Cell<Option<[f64; 3]>>>,
@@ -887,6 +887,13 @@ struct Spare<'p> {
     points: Vec<Vec<[f64; 3]>>,
     triangles: Vec<Vec<[[f64; 3]; 3]>>,
     corners: Vec<Vec<Corner>>,
+}
+
+/// One of `spares`, emptied, or a new vector.
+fn emptied<T>(spares: &mut Vec<Vec<T>>) -> Vec<T> {
+    let mut spare = spares.pop().unwrap_or_default();
+    spare.clear();
+    spare
 }
 
 /// The [`Spare`]s of a selection's threads: a face takes one while its rates are tried and gives
@@ -1115,16 +1122,12 @@ impl<'p> FaceLocal<'p> {
 
     /// An empty vector of points, a spare one if there is one.
     fn points_vec(&self) -> Vec<[f64; 3]> {
-        let mut points = self.spare.borrow_mut().points.pop().unwrap_or_default();
-        points.clear();
-        points
+        emptied(&mut self.spare.borrow_mut().points)
     }
 
     /// An empty vector of triangles, a spare one if there is one.
     fn triangles_vec(&self) -> Vec<[[f64; 3]; 3]> {
-        let mut triangles = self.spare.borrow_mut().triangles.pop().unwrap_or_default();
-        triangles.clear();
-        triangles
+        emptied(&mut self.spare.borrow_mut().triangles)
     }
 
     /// A vector of points made here and no longer read, for the next to fill.
@@ -1208,8 +1211,9 @@ impl<'p> FaceLocal<'p> {
         once(&self.strips[side], || {
             let mut row = self.points_vec();
             row.extend((0..self.n).map(|t| self.row(side, t)));
-            let (Beyond::Face(other) | Beyond::Curve(other)) = self.beyond(side)?;
-            let curve = matches!(self.beyond(side)?, Beyond::Curve(_));
+            let beyond = self.beyond(side)?;
+            let (Beyond::Face(other) | Beyond::Curve(other)) = beyond;
+            let curve = matches!(beyond, Beyond::Curve(_));
             let strip = strip_triangles(&row, other, curve, self.triangles_vec());
             self.give_points(row);
             Ok(strip)
@@ -1262,8 +1266,7 @@ impl<'p> FaceLocal<'p> {
             );
             triangles.extend([[p, q, r], [p, r, s]]);
         }
-        let mut corners = self.spare.borrow_mut().corners.pop().unwrap_or_default();
-        corners.clear();
+        let mut corners = emptied(&mut self.spare.borrow_mut().corners);
         corners.extend(triangles.iter().copied().map(Corner::new));
         self.give_points(ring);
         self.spare.borrow_mut().triangles.push(triangles);
