@@ -43,7 +43,7 @@ use crate::stencil_table::StencilTable;
 pub use crate::tessellate::kernel::TessellationTime;
 use crate::tessellate::kernel::{
     append_control, for_each_range, merge_rows, patch_origin, relative, table_may_describe,
-    unless_absent, vec_bytes, Connectivity, GridPlan, PointPlan, Stencils, MAX_PATCH,
+    total_bytes, unless_absent, vec_bytes, Connectivity, GridPlan, PointPlan, Stencils, MAX_PATCH,
 };
 use crate::tessellate::lane_stencils::{
     store_points, unit_cross_x4, LaneStencils, PointGroups, LANES,
@@ -1140,17 +1140,14 @@ impl GridPlan for DualGrid {
         self.connectivity.triangle_count()
     }
 
-    /// Where every output vertex is evaluated, in output order.
+    /// About the plan's heap memory: its vectors' capacities, the stencils' weights included.
     fn heap_bytes(&self) -> usize {
         // The separable bases, a few rows of `n + 1` weights per rate, are left out.
         let deep = [
-            self.lanes
-                .iter()
-                .map(LaneStencils::heap_bytes)
-                .sum::<usize>(),
-            self.splits.iter().map(SubPatchPlan::heap_bytes).sum(),
-            self.mirrors.iter().map(MirrorStencils::heap_bytes).sum(),
-            self.boundary_points.iter().map(PointPlan::heap_bytes).sum(),
+            total_bytes(self.lanes.iter().map(LaneStencils::heap_bytes)),
+            total_bytes(self.splits.iter().map(SubPatchPlan::heap_bytes)),
+            total_bytes(self.mirrors.iter().map(MirrorStencils::heap_bytes)),
+            total_bytes(self.boundary_points.iter().map(PointPlan::heap_bytes)),
             self.boundary_groups.heap_bytes(),
             self.connectivity.heap_bytes(),
         ];
@@ -1169,11 +1166,10 @@ impl GridPlan for DualGrid {
             vec_bytes(&self.strips),
             vec_bytes(&self.seam_copies),
         ];
-        deep.into_iter()
-            .chain(shallow)
-            .fold(0, usize::saturating_add)
+        total_bytes(deep.into_iter().chain(shallow))
     }
 
+    /// Where every output vertex is evaluated, in output order.
     fn sources_into(&self, out: &mut Vec<VertexSource>) {
         out.clear();
         out.reserve(self.vertex_count);

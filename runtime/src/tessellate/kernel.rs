@@ -72,6 +72,11 @@ pub(crate) fn vec_bytes<T>(v: &Vec<T>) -> usize {
     v.capacity().saturating_mul(std::mem::size_of::<T>())
 }
 
+/// The sum of `parts` (heap bytes), saturating.
+pub(crate) fn total_bytes(parts: impl IntoIterator<Item = usize>) -> usize {
+    parts.into_iter().fold(0, usize::saturating_add)
+}
+
 impl PointPlan {
     /// Its weights' heap bytes.
     pub(crate) fn heap_bytes(&self) -> usize {
@@ -328,15 +333,13 @@ impl Default for Connectivity {
 impl Connectivity {
     /// Its vectors' heap bytes.
     pub(crate) fn heap_bytes(&self) -> usize {
-        [
+        total_bytes([
             vec_bytes(&self.polygons),
             vec_bytes(&self.polygon_offsets),
             vec_bytes(&self.face_triangles),
             vec_bytes(&self.strip_triangles),
             vec_bytes(&self.polygon_triangles),
-        ]
-        .into_iter()
-        .fold(0, usize::saturating_add)
+        ])
     }
 
     /// Close the plan: the triangles of every face and every strip (the polygons' follow from

@@ -22,7 +22,7 @@
 use wide::f32x4;
 
 use crate::scheme::patch::dual_index_in_patch;
-use crate::tessellate::kernel::{patch_origin, relative, vec_bytes, Stencils};
+use crate::tessellate::kernel::{patch_origin, relative, total_bytes, vec_bytes, Stencils};
 use crate::tessellate::lane_stencils::{
     chunk_sums_fixed, unit_cross_x4, LaneSums, LaneWeights, Splat, CHUNK, LANES,
 };
@@ -62,14 +62,12 @@ const MIN_RATE: usize = 5;
 impl MirrorStencils {
     /// Its vectors' heap bytes.
     pub(crate) fn heap_bytes(&self) -> usize {
-        [
+        total_bytes([
             vec_bytes(&self.even),
             vec_bytes(&self.groups),
             vec_bytes(&self.even_weights),
             vec_bytes(&self.odd_weights),
-        ]
-        .into_iter()
-        .fold(0, usize::saturating_add)
+        ])
     }
 
     /// The pairs of a patch's dual stencils `s` at rate `n` (`k` weights a row, the patch's own

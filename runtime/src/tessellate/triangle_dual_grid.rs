@@ -46,8 +46,8 @@ use crate::scheme::triangle::patch::{
 };
 pub use crate::stencil_table::TriangleStencils;
 use crate::tessellate::kernel::{
-    append_control, for_each_range, merge_rows, patch_origin, relative, vec_bytes, Connectivity,
-    GridPlan, PointPlan, Stencils, TessellationTime,
+    append_control, for_each_range, merge_rows, patch_origin, relative, total_bytes, vec_bytes,
+    Connectivity, GridPlan, PointPlan, Stencils, TessellationTime,
 };
 use crate::tessellate::lane_stencils::{LaneStencils, PointGroups};
 use crate::tessellate::loop_quartic::{self, QuarticBasis};
@@ -658,16 +658,12 @@ impl GridPlan for TriangleDualGrid {
         self.connectivity.triangle_count()
     }
 
-    /// Where every output vertex is evaluated, in output order, in the tessellated mesh's
-    /// triangles: dual points over `3n`, primal points over `n`.
+    /// About the plan's heap memory: its vectors' capacities, the stencils' weights included.
     fn heap_bytes(&self) -> usize {
         let deep = [
-            self.lanes
-                .iter()
-                .map(LaneStencils::heap_bytes)
-                .sum::<usize>(),
-            self.params.iter().map(vec_bytes).sum(),
-            self.points.iter().map(PointPlan::heap_bytes).sum(),
+            total_bytes(self.lanes.iter().map(LaneStencils::heap_bytes)),
+            total_bytes(self.params.iter().map(vec_bytes)),
+            total_bytes(self.points.iter().map(PointPlan::heap_bytes)),
             self.point_groups.heap_bytes(),
             self.connectivity.heap_bytes(),
         ];
@@ -684,11 +680,11 @@ impl GridPlan for TriangleDualGrid {
             vec_bytes(&self.strips),
             vec_bytes(&self.limit_points),
         ];
-        deep.into_iter()
-            .chain(shallow)
-            .fold(0, usize::saturating_add)
+        total_bytes(deep.into_iter().chain(shallow))
     }
 
+    /// Where every output vertex is evaluated, in output order, in the tessellated mesh's
+    /// triangles: dual points over `3n`, primal points over `n`.
     fn sources_into(&self, out: &mut Vec<VertexSource>) {
         out.clear();
         out.reserve(self.vertex_count);
