@@ -33,6 +33,7 @@ pub mod error;
 pub mod eval;
 pub mod io;
 pub mod mesh;
+mod once;
 pub mod render;
 pub mod scheme;
 pub mod stencil_table;

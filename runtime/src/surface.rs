@@ -19,6 +19,7 @@ use crate::budget::OutputEstimate;
 use crate::mesh::face_varying::FaceVaryingMode;
 use crate::mesh::triangle_mesh::TriangleMesh;
 use crate::mesh::{Mesh, VertexSource};
+use crate::once::TryOnce;
 use crate::scheme::catmull_clark::face_varying::ChannelIsolation;
 use crate::scheme::catmull_clark::isolate::{isolate_with_origins, Isolation};
 use crate::scheme::loop_scheme::isolate::isolate_loop;
@@ -412,14 +413,9 @@ impl Surface {
                 })?;
                 let chosen = match &self.isolated {
                     Isolated::Quad(iso) => {
-                        let adaptive = match self.quad_adaptive_faces.get() {
-                            Some(faces) => faces,
-                            None => {
-                                let faces =
-                                    adaptive_face_list(&self.table, &iso.mesh, &iso.patches)?;
-                                self.quad_adaptive_faces.get_or_init(|| faces)
-                            }
-                        };
+                        let adaptive = self.quad_adaptive_faces.get_or_try(|| {
+                            adaptive_face_list(&self.table, &iso.mesh, &iso.patches)
+                        })?;
                         let selection = QuadSelection::new(
                             &self.table,
                             &iso.mesh,
@@ -432,13 +428,9 @@ impl Surface {
                     }
                     Isolated::Triangle(iso) => {
                         let rates = triangle_table_rates(&self.table);
-                        let sampling = match self.triangle_sampling.get() {
-                            Some(sampling) => sampling,
-                            None => {
-                                let sampling = TriangleSampling::new(&self.table)?;
-                                self.triangle_sampling.get_or_init(|| sampling)
-                            }
-                        };
+                        let sampling = self
+                            .triangle_sampling
+                            .get_or_try(|| TriangleSampling::new(&self.table))?;
                         let selection =
                             TriangleSelection::sharing(&self.table, iso, *t, &rates, sampling)?;
                         RateMemory::rates(&mut memory, &selection)?

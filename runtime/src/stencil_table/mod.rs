@@ -175,22 +175,6 @@ impl GridSlots {
     }
 }
 
-/// The grids in `slot`, expanded by `expand` on the first request. Two threads asking at once
-/// may both expand; the first to finish is kept (both computed the same bytes), so no lock is
-/// held while expanding. (`OnceLock::get_or_try_init` would say this, but is not stable.)
-fn expanded_once(
-    slot: &OnceLock<Grids>,
-    expand: impl FnOnce() -> Result<Grids, RuntimeError>,
-) -> Result<&Grids, RuntimeError> {
-    match slot.get() {
-        Some(grids) => Ok(grids),
-        None => {
-            let grids = expand()?;
-            Ok(slot.get_or_init(|| grids))
-        }
-    }
-}
-
 /// The expansion of a compact table, by patch family.
 #[derive(Debug)]
 enum Expansion {

@@ -27,9 +27,8 @@
 
 use table_format::{PointSet, SectionKey, StencilKind, TableIndex};
 
-use super::{
-    check_patch_pieces, compact_pieces, expanded_once, GridSlots, Grids, PatchId, MAX_COMPACT_RATE,
-};
+use super::{check_patch_pieces, compact_pieces, GridSlots, Grids, PatchId, MAX_COMPACT_RATE};
+use crate::once::TryOnce;
 use crate::RuntimeError;
 
 /// What a compact table's grids are expanded from, and the grids once a plan asked for them.
@@ -108,7 +107,8 @@ impl QuadExpansion {
         };
         let slot = self.slots.slot(key)?;
         Some(
-            expanded_once(slot.grids, || expand(index, bytes, key, slot.k))
+            slot.grids
+                .get_or_try(|| expand(index, bytes, key, slot.k))
                 .map(|grids| &*grids[usize::from(!primal)]),
         )
     }

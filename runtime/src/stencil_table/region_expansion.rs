@@ -48,7 +48,8 @@ use schemes::lattice_symmetry::{quarter_points, reflect, rotate, support_box, we
 use schemes::TriangleScheme;
 use table_format::{PointSet, SchemeId, SectionKey, StencilKind, TableIndex};
 
-use super::{compact_pieces, expanded_once, GridSlots, Grids, PatchId, MAX_COMPACT_RATE};
+use super::{compact_pieces, GridSlots, Grids, PatchId, MAX_COMPACT_RATE};
+use crate::once::TryOnce;
 use crate::RuntimeError;
 
 /// The regular basis of one rate on its whole support box, spread once from the stored
@@ -496,43 +497,33 @@ impl RegionExpansion {
         // together, sharing the tile search, the basis lookups and the pass over the rows.
         let kinds = KINDS.map(|kind| self.slots.slot(&SectionKey { kind, ..*key }));
         Some(
-            expanded_once(slot.grids, || {
-                let regions = match geometry.get() {
-                    Some(regions) => regions,
-                    None => {
-                        let shared = cone_regions(self.name, key.faces)?;
-                        geometry.get_or_init(|| shared)
+            slot.grids
+                .get_or_try(|| {
+                    let regions = geometry.get_or_try(|| cone_regions(self.name, key.faces))?;
+                    let basis = self.bases[slot.rate]
+                        .get_or_try(|| self.rate_basis(index, bytes, key.n))?;
+                    let [position, du, dv] = Region::read(
+                        index,
+                        bytes,
+                        key,
+                        slot.k,
+                        regions,
+                        &self.rows[slot.patch],
+                        basis,
+                    )?
+                    .grids(key.n, &self.buffers)?;
+                    let mut asked = None;
+                    for (grids, kind) in [position, du, dv].into_iter().zip(KINDS) {
+                        if kind == key.kind {
+                            asked = Some(grids);
+                        } else if let Some(other) = &kinds[kind as usize] {
+                            // Another thread may have filled it: the same bytes.
+                            let _ = other.grids.get_or_init(|| grids);
+                        }
                     }
-                };
-                let basis = match self.bases[slot.rate].get() {
-                    Some(basis) => basis,
-                    None => {
-                        let basis = self.rate_basis(index, bytes, key.n)?;
-                        self.bases[slot.rate].get_or_init(|| basis)
-                    }
-                };
-                let [position, du, dv] = Region::read(
-                    index,
-                    bytes,
-                    key,
-                    slot.k,
-                    regions,
-                    &self.rows[slot.patch],
-                    basis,
-                )?
-                .grids(key.n, &self.buffers)?;
-                let mut asked = None;
-                for (grids, kind) in [position, du, dv].into_iter().zip(KINDS) {
-                    if kind == key.kind {
-                        asked = Some(grids);
-                    } else if let Some(other) = &kinds[kind as usize] {
-                        // Another thread may have filled it: the same bytes.
-                        let _ = other.grids.get_or_init(|| grids);
-                    }
-                }
-                asked.ok_or_else(|| incomplete(format!("{key} is of no kind expanded")))
-            })
-            .map(|grids| &*grids[usize::from(!primal)]),
+                    asked.ok_or_else(|| incomplete(format!("{key} is of no kind expanded")))
+                })
+                .map(|grids| &*grids[usize::from(!primal)]),
         )
     }
 
@@ -548,13 +539,7 @@ impl RegionExpansion {
             Some(&i) if i != u32::MAX => i as usize,
             _ => return None,
         };
-        let slot = &self.bases[rate];
-        Some(match slot.get() {
-            Some(basis) => Ok(basis),
-            None => self
-                .rate_basis(index, bytes, n)
-                .map(|basis| slot.get_or_init(|| basis)),
-        })
+        Some(self.bases[rate].get_or_try(|| self.rate_basis(index, bytes, n)))
     }
 
     /// Rate `n`'s regular basis spread on its support box from the table's canonical values.
@@ -638,13 +623,7 @@ impl<'a> Region<'a> {
             ))
         })?;
         // Read (and its shape checked against the geometry) before the masks' widths are.
-        let rows = match rows.get() {
-            Some(rows) => rows,
-            None => {
-                let read = Self::read_rows(index, bytes, key, k, region)?;
-                rows.get_or_init(|| read)
-            }
-        };
+        let rows = rows.get_or_try(|| Self::read_rows(index, bytes, key, k, region))?;
         let mut vertex = [&[][..]; 3];
         if region.is_corner() {
             for (mask, kind) in vertex.iter_mut().zip(KINDS) {

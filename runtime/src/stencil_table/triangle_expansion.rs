@@ -36,9 +36,8 @@ use std::sync::OnceLock;
 use schemes::triangle_local::{sub_triangle_points, SUB_TRIANGLES};
 use table_format::{PointSet, SchemeId, SectionKey, StencilKind, TableIndex};
 
-use super::{
-    check_patch_pieces, compact_pieces, expanded_once, GridSlots, Grids, PatchId, MAX_COMPACT_RATE,
-};
+use super::{check_patch_pieces, compact_pieces, GridSlots, Grids, PatchId, MAX_COMPACT_RATE};
+use crate::once::TryOnce;
 use crate::RuntimeError;
 
 /// The denominator of the lattice the basis is stored on: the pieces' degree.
@@ -181,14 +180,15 @@ impl TriangleExpansion {
         let basis =
             |dual: usize| &self.basis[(slot.rate * 2 + dual) * KINDS.len() + key.kind as usize];
         Some(
-            expanded_once(slot.grids, || {
-                Pieces::read(index, bytes, key, slot.k, &self.points)?.grids(
-                    key.kind,
-                    key.n,
-                    [basis(0), basis(1)],
-                )
-            })
-            .map(|grids| &*grids[usize::from(!primal)]),
+            slot.grids
+                .get_or_try(|| {
+                    Pieces::read(index, bytes, key, slot.k, &self.points)?.grids(
+                        key.kind,
+                        key.n,
+                        [basis(0), basis(1)],
+                    )
+                })
+                .map(|grids| &*grids[usize::from(!primal)]),
         )
     }
 }

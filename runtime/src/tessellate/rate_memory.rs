@@ -92,6 +92,7 @@ use table_format::{PointSet, StencilKind};
 
 use crate::mesh::geometry::{cross, dot, norm, sub};
 use crate::mesh::topology::Mesh;
+use crate::once::TryOnce;
 use crate::scheme::patch::{FacePatch, PatchKind};
 use crate::stencil_table::StencilTable;
 use crate::tessellate::difference_norm::{difference_norm, Norms};
@@ -509,14 +510,10 @@ impl<'a> QuadSelection<'a> {
 impl<'a> QuadSelection<'a> {
     /// [`QuadSelection::adaptive`], found the first time.
     fn adaptive(&self) -> Result<&AdaptiveGrids<'a>, RuntimeError> {
-        if let Some(grids) = self.adaptive.get() {
-            return Ok(grids);
-        }
-        let grids = match self.adaptive_faces {
-            Some(faces) => adaptive_grids(self.mesh, faces),
-            None => adaptive_faces(self.table, self.mesh, self.patches)?,
-        };
-        Ok(self.adaptive.get_or_init(|| grids))
+        self.adaptive.get_or_try(|| match self.adaptive_faces {
+            Some(faces) => Ok(adaptive_grids(self.mesh, faces)),
+            None => adaptive_faces(self.table, self.mesh, self.patches),
+        })
     }
 }
 

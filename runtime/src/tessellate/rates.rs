@@ -91,6 +91,7 @@ use table_format::{PointSet, StencilKind};
 use crate::mesh::topology::{Cut, Mesh};
 use crate::mesh::triangle_grid::TriangleGrid;
 use crate::mesh::triangle_mesh::TriangleMesh;
+use crate::once::TryOnce;
 use crate::scheme::catmull_clark::adaptive::{bspline, limit_points, LimitQuery};
 use crate::scheme::patch::{dual_index_in_patch, FacePatch};
 use crate::stencil_table::StencilTable;
@@ -1173,15 +1174,14 @@ impl<'p> FaceLocal<'p> {
 
     /// The face's primal grid at rate `n`, looked up once for all its sides and corners.
     fn primal(&self) -> Result<Grid<'p>, RuntimeError> {
-        once(&self.primal, || {
-            self.own.grid(PointSet::Primal, self.n as u32)
-        })
-        .copied()
+        self.primal
+            .get_or_try(|| self.own.grid(PointSet::Primal, self.n as u32))
+            .copied()
     }
 
     /// What lies beyond side `side`: the neighbour's row, or the boundary curve.
     fn beyond(&self, side: usize) -> Result<&Beyond, RuntimeError> {
-        once(&self.beyond[side], || self.make_beyond(side))
+        self.beyond[side].get_or_try(|| self.make_beyond(side))
     }
 
     /// [`FaceLocal::beyond`], made (apart, so that the scans' loops stay small).
@@ -1208,22 +1208,25 @@ impl<'p> FaceLocal<'p> {
 
     /// The strip along side `side`, in the tessellator's merge order.
     fn strip(&self, side: usize) -> Result<&[[[f64; 3]; 3]], RuntimeError> {
-        once(&self.strips[side], || {
-            let mut row = self.points_vec();
-            row.extend((0..self.n).map(|t| self.row(side, t)));
-            let beyond = self.beyond(side)?;
-            let (Beyond::Face(other) | Beyond::Curve(other)) = beyond;
-            let curve = matches!(beyond, Beyond::Curve(_));
-            let strip = strip_triangles(&row, other, curve, self.triangles_vec());
-            self.give_points(row);
-            Ok(strip)
-        })
-        .map(Vec::as_slice)
+        self.strips[side]
+            .get_or_try(|| {
+                let mut row = self.points_vec();
+                row.extend((0..self.n).map(|t| self.row(side, t)));
+                let beyond = self.beyond(side)?;
+                let (Beyond::Face(other) | Beyond::Curve(other)) = beyond;
+                let curve = matches!(beyond, Beyond::Curve(_));
+                let strip = strip_triangles(&row, other, curve, self.triangles_vec());
+                self.give_points(row);
+                Ok(strip)
+            })
+            .map(Vec::as_slice)
     }
 
     /// The triangles around corner `corner`.
     fn corner(&self, corner: usize) -> Result<&[Corner], RuntimeError> {
-        once(&self.corners[corner], || self.make_corner(corner)).map(Vec::as_slice)
+        self.corners[corner]
+            .get_or_try(|| self.make_corner(corner))
+            .map(Vec::as_slice)
     }
 
     /// [`FaceLocal::corner`], made (apart, so that the scans' loops stay small).
@@ -1630,18 +1633,6 @@ impl Largest {
     }
 }
 
-/// The value of `cell`, made by `make` the first time.
-fn once<T>(
-    cell: &OnceCell<T>,
-    make: impl FnOnce() -> Result<T, RuntimeError>,
-) -> Result<&T, RuntimeError> {
-    if let Some(value) = cell.get() {
-        return Ok(value);
-    }
-    let value = make()?;
-    Ok(cell.get_or_init(|| value))
-}
-
 /// `L_{f,n}` in the interior: the dual grid's cell that holds the sample with places `u` and `v`,
 /// split along `a = b` (the tessellator's diagonal), the dual point `(i, j)` read by `at`.
 fn in_cell(at: impl Fn(usize, usize) -> [f64; 3], u: &AxisPlace, v: &AxisPlace) -> [f64; 3] {
@@ -2042,11 +2033,7 @@ impl<'a> Context<'a> {
                 reason: format!("{f} (the mesh has {} faces)", self.points.len()),
             });
         };
-        if let Some(points) = cell.get() {
-            return Ok(points);
-        }
-        let points = PatchPoints::of_face(self.table, self.mesh, patch, f, self.adaptive)?;
-        Ok(cell.get_or_init(|| points))
+        cell.get_or_try(|| PatchPoints::of_face(self.table, self.mesh, patch, f, self.adaptive))
     }
 
     /// Whether face `f` is a hole: it has no surface, no samples and no deviation.

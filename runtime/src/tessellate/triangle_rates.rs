@@ -80,6 +80,7 @@ use table_format::{PointSet, StencilKind};
 use crate::mesh::topology::NONE;
 use crate::mesh::triangle_grid::TriangleGrid;
 use crate::mesh::triangle_mesh::TriangleMesh;
+use crate::once::TryOnce;
 use crate::scheme::patch::PatchKind;
 use crate::scheme::triangle::isolation::TriangleIsolation;
 use crate::scheme::triangle::patch::{dual_in_patch, dual_index, primal_in_patch, primal_index};
@@ -847,22 +848,19 @@ impl<'a> TriangleSelection<'a> {
     /// first time a face is sampled (a frame that keeps every rate samples none).
     fn templates(&self) -> Result<&HashMap<(u32, u8), Template>, RuntimeError> {
         let sampling = self.sampling.get();
-        if let Some(templates) = sampling.templates.get() {
-            return Ok(templates);
-        }
-        let masks: BTreeSet<u8> = (0..self.faces())
-            .map(|f| self.ctx.boundary_mask(f))
-            .collect();
-        let keys: Vec<(u32, u8)> = self
-            .candidates
-            .iter()
-            .flat_map(|&n| masks.iter().map(move |&m| (n, m)))
-            .collect();
-        let templates = keys
-            .par_iter()
-            .map(|&(n, m)| Ok(((n, m), Template::new(n, m, &sampling.grid)?)))
-            .collect::<Result<_, RuntimeError>>()?;
-        Ok(sampling.templates.get_or_init(|| templates))
+        sampling.templates.get_or_try(|| {
+            let masks: BTreeSet<u8> = (0..self.faces())
+                .map(|f| self.ctx.boundary_mask(f))
+                .collect();
+            let keys: Vec<(u32, u8)> = self
+                .candidates
+                .iter()
+                .flat_map(|&n| masks.iter().map(move |&m| (n, m)))
+                .collect();
+            keys.par_iter()
+                .map(|&(n, m)| Ok(((n, m), Template::new(n, m, &sampling.grid)?)))
+                .collect::<Result<_, RuntimeError>>()
+        })
     }
 
     /// The bounds of a patch kind's position stencils: its samples', and per candidate rate
