@@ -41,7 +41,7 @@ use crate::tessellate::triangle_dual_grid::TriangleDualGrid;
 use crate::tessellate::triangle_rates::{
     triangle_table_rates, TriangleSampling, TriangleSelection,
 };
-use crate::tessellate::GridPlan;
+use crate::tessellate::{total_bytes, vec_bytes, GridPlan};
 use crate::RuntimeError;
 
 /// How finely to tessellate: points per face side, on every face or chosen per face.
@@ -142,6 +142,19 @@ struct KeptPlan {
 impl FrameBuffers {
     /// The most a surface keeps (a one-off tessellation larger than this returns its memory).
     const KEPT: usize = 64 << 20;
+
+    /// The buffers' and the plan's heap bytes.
+    fn kept_bytes(&self) -> usize {
+        let plan = self.plan.as_ref().map_or(0, |plan| {
+            total_bytes([
+                vec_bytes(&plan.rates),
+                plan.grid.heap_bytes(),
+                vec_bytes(&plan.uvs),
+                vec_bytes(&plan.seam_copies),
+            ])
+        });
+        self.bytes().saturating_add(plan)
+    }
 
     /// Their capacity in bytes (each buffer's within `isize::MAX`, their sum saturating).
     fn bytes(&self) -> usize {
@@ -264,6 +277,34 @@ impl Surface {
     /// per-frame cost isolation adds.
     pub fn refinement_weights(&self) -> usize {
         self.refinement().map_or(0, Stencil::entries)
+    }
+
+    /// The heap bytes the surface keeps from its last dropped [`Tessellator`] for the next
+    /// one: the output buffers and vertex sources, which the next plan fills, and the plan,
+    /// which the next tessellator at the same rates takes whole (64 MiB at most each; none
+    /// after [`Surface::trim`]).
+    pub fn kept_bytes(&self) -> usize {
+        self.frame_buffers
+            .lock()
+            .map_or(0, |kept| kept.kept_bytes())
+    }
+
+    /// Free what the surface keeps from one frame to the next to make the next one faster: the
+    /// last dropped tessellator's buffers and plan ([`Surface::kept_bytes`]) and the last
+    /// tolerance selection (the next [`Rates::Tolerance`] samples every face again). What
+    /// depends on the topology and the table alone stays (the isolation, the table's expanded
+    /// grids, Lai–Cheng's operators). For a surface that sits idle between bursts of frames:
+    /// the next frame then costs what the first did, and gives the same output.
+    pub fn trim(&self) {
+        let free = |buffers: &mut FrameBuffers| *buffers = FrameBuffers::default();
+        match self.frame_buffers.lock() {
+            Ok(mut kept) => free(&mut kept),
+            Err(poisoned) => free(&mut poisoned.into_inner()),
+        }
+        match self.rate_memory.lock() {
+            Ok(mut memory) => *memory = None,
+            Err(poisoned) => *poisoned.into_inner() = None,
+        }
     }
 
     /// Move the control points: `positions`, one per **input** vertex in OBJ order, replace
@@ -952,5 +993,51 @@ mod tests {
         let uniform_rates = uniform.rates().to_vec();
         drop(uniform);
         assert_eq!(kept_rates(&surface), Some(uniform_rates));
+    }
+
+    #[test]
+    fn a_trimmed_surface_keeps_nothing_and_frames_as_before() {
+        let mesh = cube_uv();
+        let tolerance = Rates::Tolerance(2e-3);
+        let surface = Surface::new(&mesh, Scheme::CatmullClark).expect("surface");
+        assert_eq!(surface.kept_bytes(), 0, "nothing kept before a tessellator");
+        let positions = mesh.positions_f32();
+        let mut tessellator = surface.tessellator(&tolerance).expect("plan");
+        let all = surface.faces();
+        assert_eq!(tessellator.faces_sampled(), Some(all));
+        let before = tessellator
+            .evaluate(&positions)
+            .expect("frame")
+            .to_triangle_mesh();
+        drop(tessellator);
+        let kept = surface.kept_bytes();
+        // At least the output buffers: a position, a normal and a source per vertex.
+        assert!(kept >= before.positions.len() * 24, "{kept} bytes kept");
+        // Kept, the next selection samples no face.
+        assert_eq!(
+            surface
+                .tessellator(&tolerance)
+                .expect("kept")
+                .faces_sampled(),
+            Some(0)
+        );
+
+        surface.trim();
+        assert_eq!(surface.kept_bytes(), 0);
+        let mut tessellator = surface.tessellator(&tolerance).expect("plan again");
+        assert_eq!(kept_rates(&surface), None);
+        assert_eq!(
+            tessellator.faces_sampled(),
+            Some(all),
+            "the selection forgotten"
+        );
+        let after = tessellator
+            .evaluate(&positions)
+            .expect("frame")
+            .to_triangle_mesh();
+        assert_eq!(after.triangles, before.triangles);
+        assert_eq!(after.sources, before.sources);
+        assert_eq!(after.positions, before.positions);
+        assert_eq!(after.normals, before.normals);
     }
 }

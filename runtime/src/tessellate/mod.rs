@@ -18,3 +18,4 @@ pub mod triangle_dual_grid;
 pub mod triangle_rates;
 
 pub use kernel::GridPlan;
+pub(crate) use kernel::{total_bytes, vec_bytes};
