@@ -661,7 +661,7 @@ impl Surface {
 /// A planned tessellation of a [`Surface`]: evaluate it once per frame. Dropped, it leaves its
 /// output buffers and its vertices' sources (64 MiB at most) to the surface, whose next plan
 /// fills them, and its plan (64 MiB at most), which the surface's next tessellator at the same
-/// rates takes whole.
+/// rates takes whole ([`Surface::kept_bytes`] says how much; [`Surface::trim`] frees it).
 #[derive(Debug)]
 pub struct Tessellator<'s> {
     surface: &'s Surface,
