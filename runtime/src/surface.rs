@@ -10,7 +10,7 @@
 //! on every patch's control points relative to one of them, so that tangents and normals do
 //! not depend on where the mesh sits: docs/reliability.md, *Precision*).
 
-use std::sync::{Arc, Mutex, OnceLock};
+use std::sync::{Arc, Mutex, OnceLock, PoisonError};
 use std::time::Instant;
 
 use rayon::prelude::*;
@@ -156,13 +156,14 @@ impl FrameBuffers {
         self.bytes().saturating_add(plan)
     }
 
-    /// Their capacity in bytes (each buffer's within `isize::MAX`, their sum saturating).
+    /// The buffers' capacity in bytes.
     fn bytes(&self) -> usize {
-        let point = std::mem::size_of::<[f32; 3]>();
-        (self.positions.capacity() * point)
-            .saturating_add(self.normals.capacity() * point)
-            .saturating_add(self.triangles.capacity() * std::mem::size_of::<[u32; 3]>())
-            .saturating_add(self.sources.capacity() * std::mem::size_of::<VertexSource>())
+        total_bytes([
+            vec_bytes(&self.positions),
+            vec_bytes(&self.normals),
+            vec_bytes(&self.triangles),
+            vec_bytes(&self.sources),
+        ])
     }
 }
 
@@ -296,15 +297,15 @@ impl Surface {
     /// grids, Lai–Cheng's operators). For a surface that sits idle between bursts of frames:
     /// the next frame then costs what the first did, and gives the same output.
     pub fn trim(&self) {
-        let free = |buffers: &mut FrameBuffers| *buffers = FrameBuffers::default();
-        match self.frame_buffers.lock() {
-            Ok(mut kept) => free(&mut kept),
-            Err(poisoned) => free(&mut poisoned.into_inner()),
-        }
-        match self.rate_memory.lock() {
-            Ok(mut memory) => *memory = None,
-            Err(poisoned) => *poisoned.into_inner() = None,
-        }
+        // A lock poisoned by a panicking frame still guards what is to be freed.
+        *self
+            .frame_buffers
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner) = FrameBuffers::default();
+        *self
+            .rate_memory
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner) = None;
     }
 
     /// Move the control points: `positions`, one per **input** vertex in OBJ order, replace
@@ -1024,8 +1025,8 @@ mod tests {
 
         surface.trim();
         assert_eq!(surface.kept_bytes(), 0);
+        assert_eq!(kept_rates(&surface), None, "the plan freed");
         let mut tessellator = surface.tessellator(&tolerance).expect("plan again");
-        assert_eq!(kept_rates(&surface), None);
         assert_eq!(
             tessellator.faces_sampled(),
             Some(all),

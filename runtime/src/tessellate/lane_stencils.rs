@@ -26,7 +26,8 @@ use std::ops::Range;
 
 use crate::mesh::triangle_mesh::VertexSource;
 use crate::tessellate::kernel::{
-    cross, for_each_range, patch_origin, relative, unit, vec_bytes, PointPlan, Stencils, MAX_PATCH,
+    cross, for_each_range, patch_origin, relative, total_bytes, unit, vec_bytes, PointPlan,
+    Stencils, MAX_PATCH,
 };
 use crate::RuntimeError;
 
@@ -250,12 +251,16 @@ pub(crate) struct PointGroups {
 impl PointGroups {
     /// Its runs', ends' and sources' heap bytes.
     pub(crate) fn heap_bytes(&self) -> usize {
-        self.runs
-            .iter()
-            .map(|(_, lanes)| lanes.heap_bytes())
-            .fold(vec_bytes(&self.runs), usize::saturating_add)
-            .saturating_add(vec_bytes(&self.ends))
-            .saturating_add(vec_bytes(&self.sources))
+        total_bytes(
+            self.runs
+                .iter()
+                .map(|(_, lanes)| lanes.heap_bytes())
+                .chain([
+                    vec_bytes(&self.runs),
+                    vec_bytes(&self.ends),
+                    vec_bytes(&self.sources),
+                ]),
+        )
     }
 
     /// The runs of `plans` (point `i` over `indices[plans[i].control]`, its position, d/du and

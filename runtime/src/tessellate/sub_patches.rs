@@ -28,7 +28,7 @@ use wide::f32x4;
 
 use crate::scheme::patch::{dual_index_in_patch, PatchKind};
 use crate::stencil_table::StencilTable;
-use crate::tessellate::kernel::{vec_bytes, MAX_PATCH};
+use crate::tessellate::kernel::{total_bytes, vec_bytes, MAX_PATCH};
 use crate::RuntimeError;
 
 /// Whether a face at rate `n` is split: a multiple of 8 from 16 on, so that the quarter's and
@@ -67,9 +67,11 @@ pub(crate) struct SubPatchPlan {
 impl SubPatchPlan {
     /// Its vectors' heap bytes.
     pub(crate) fn heap_bytes(&self) -> usize {
-        vec_bytes(&self.ends)
-            .saturating_add(vec_bytes(&self.terms))
-            .saturating_add(vec_bytes(&self.quarter))
+        total_bytes([
+            vec_bytes(&self.ends),
+            vec_bytes(&self.terms),
+            vec_bytes(&self.quarter),
+        ])
     }
 
     /// The split of a face of patch `kind` (`k` control points, the vertex at the face's corner
