@@ -488,6 +488,13 @@ fn bench(c: &mut Criterion) {
             rates: &[4, 8],
         });
     }
+    if let Some(mesh) = shared_mesh("odedstein/sword-quad-dominant.obj", 0) {
+        cases.push(Case {
+            name: "sword, quad-dominant (isolation)".to_owned(),
+            mesh,
+            rates: &[4],
+        });
+    }
     for case in &cases {
         compare(c, &two_threads, case);
     }

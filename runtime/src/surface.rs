@@ -584,15 +584,24 @@ impl Surface {
     /// The dual grid's plan at `rates` (one per isolated face), for either family of schemes.
     fn plan(&self, rates: &[u32]) -> Result<Box<dyn GridPlan>, RuntimeError> {
         Ok(match &self.isolated {
-            Isolated::Quad(iso) => Box::new(DualGrid::with_channel(
-                &self.table,
-                &iso.mesh,
-                &iso.patches,
-                rates,
-                self.channel
-                    .as_ref()
-                    .map(|c| c.mesh.face_vertices.as_slice()),
-            )?),
+            Isolated::Quad(iso) => Box::new(
+                DualGrid::with_channel(
+                    &self.table,
+                    &iso.mesh,
+                    &iso.patches,
+                    rates,
+                    self.channel
+                        .as_ref()
+                        .map(|c| c.mesh.face_vertices.as_slice()),
+                )?
+                .with_input_patches(
+                    iso.steps,
+                    &iso.input_nets,
+                    &iso.origin,
+                    |f| iso.placement(f),
+                    &iso.refinement,
+                )?,
+            ),
             Isolated::Triangle(iso)
                 if iso.patches.iter().any(|p| p.kind.boundary) && self.scheme == Scheme::Sqrt3 =>
             {
@@ -724,16 +733,22 @@ impl<'s> Tessellator<'s> {
         self.input.clear();
         self.input
             .extend(positions.iter().map(|p| p.map(f64::from)));
-        let control = if self.surface.control_points(&self.input, &mut self.control) {
-            self.control.as_slice()
-        } else {
-            self.input.as_slice()
-        };
         // Taken only by the tessellator's drop.
         let Some(grid) = &self.grid else {
             return Err(RuntimeError::Unsupported(
                 "internal: the tessellator's plan is gone".to_owned(),
             ));
+        };
+        let control = if let Some(map) = grid.control_map() {
+            // The plan's own rows, then the input points it reads itself.
+            self.control.resize(map.rows(), [0.0; 3]);
+            map.apply_into(&self.input, &mut self.control);
+            self.control.extend_from_slice(&self.input);
+            self.control.as_slice()
+        } else if self.surface.control_points(&self.input, &mut self.control) {
+            self.control.as_slice()
+        } else {
+            self.input.as_slice()
         };
         grid.evaluate(control, &mut self.positions, &mut self.normals);
         Ok(Frame {
@@ -938,6 +953,90 @@ mod tests {
     fn kept_rates(surface: &Surface) -> Option<Vec<u32>> {
         let kept = surface.frame_buffers.lock().expect("buffers");
         kept.plan.as_ref().map(|plan| plan.rates.clone())
+    }
+
+    /// A wavy torus of 12 x 8 quads with one quad cut into two triangles: isolation takes two
+    /// steps, and the input faces away from the triangles are regular.
+    fn torus_with_triangles() -> Mesh {
+        let (m, n) = (12usize, 8usize);
+        let mut positions = Vec::new();
+        for j in 0..n {
+            for i in 0..m {
+                let (a, b) = (
+                    std::f64::consts::TAU * i as f64 / m as f64,
+                    std::f64::consts::TAU * j as f64 / n as f64,
+                );
+                let r = 3.0 + b.cos() + 0.2 * (3.0 * a).sin();
+                positions.push([r * a.cos(), r * a.sin(), b.sin() + 0.3 * (2.0 * a).cos()]);
+            }
+        }
+        let at = |i: usize, j: usize| ((j % n) * m + i % m) as i64;
+        let mut faces: Vec<Vec<i64>> = Vec::new();
+        for k in 0..m * n {
+            let (i, j) = (k % m, k / m);
+            let quad = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
+            if k == 0 {
+                faces.push(vec![quad[0], quad[1], quad[2]]);
+                faces.push(vec![quad[0], quad[2], quad[3]]);
+            } else {
+                faces.push(quad.to_vec());
+            }
+        }
+        Mesh::new(positions, &faces, &[], schemes::BoundaryMode::EdgeOnly).expect("a torus")
+    }
+
+    /// The regular input faces evaluated whole from the input points (every turn of their
+    /// pieces met) give the points face by face from the isolated points gives (the table's
+    /// stencils after the refinement map) to f32 rounding, and the map keeps fewer rows.
+    #[test]
+    fn whole_input_faces_are_their_pieces_face_by_face() {
+        let mesh = torus_with_triangles();
+        let surface = Surface::new(&mesh, Scheme::CatmullClark).expect("a surface");
+        let Isolated::Quad(iso) = &surface.isolated else {
+            panic!("a quad isolation");
+        };
+        assert_eq!(iso.steps, 2);
+        let turns: std::collections::HashSet<u8> = (0..iso.mesh.faces())
+            .filter_map(|f| iso.placement(f).map(|p| p.turns))
+            .collect();
+        assert_eq!(turns.len(), 4);
+        for rate in [3, 4, 5] {
+            let mut tessellator = surface.tessellator(&Rates::Uniform(rate)).expect("a plan");
+            let grid = tessellator.grid.as_ref().expect("a plan");
+            let rows = grid.control_map().map(Stencil::rows);
+            let frame = tessellator
+                .evaluate(&mesh.positions_f32())
+                .expect("a frame");
+            let rates = vec![rate; iso.mesh.faces()];
+            let reference = DualGrid::new(&surface.table, &iso.mesh, &iso.patches, &rates)
+                .expect("a plan")
+                .tessellate(&iso.mesh);
+            assert_eq!(frame.triangles(), reference.triangles.as_slice());
+            for (p, q) in frame.positions().iter().zip(&reference.positions) {
+                let d = (0..3).map(|c| (p[c] - q[c]).abs()).fold(0.0, f32::max);
+                assert!(d < 2e-6, "positions {p:?} and {q:?} at rate {rate}");
+            }
+            // The input's rounding to f32 (the frame's) moves the points by about 1e-7.
+            for (a, b) in frame.normals().iter().zip(&reference.normals) {
+                let sine = [
+                    a[1] * b[2] - a[2] * b[1],
+                    a[2] * b[0] - a[0] * b[2],
+                    a[0] * b[1] - a[1] * b[0],
+                ]
+                .map(|c| c * c)
+                .iter()
+                .sum::<f32>()
+                .sqrt();
+                assert!(sine < 1e-5, "normals {a:?} and {b:?} at rate {rate}");
+            }
+            // Rate 4 takes the whole faces and reads fewer isolated points; 3 and 5 do not.
+            if rate == 4 {
+                let rows = rows.expect("whole input faces at rate 4");
+                assert!(rows < iso.mesh.positions.len() / 4, "{rows} rows kept");
+            } else {
+                assert_eq!(rows, None);
+            }
+        }
     }
 
     #[test]

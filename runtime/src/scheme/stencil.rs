@@ -89,6 +89,13 @@ impl<W: Weight> Stencil<W> {
         }
     }
 
+    /// About the heap bytes of its rows (their vectors' capacities).
+    pub fn heap_bytes(&self) -> usize {
+        self.offsets.capacity() * std::mem::size_of::<u32>()
+            + self.indices.capacity() * std::mem::size_of::<u32>()
+            + self.weights.capacity() * std::mem::size_of::<W>()
+    }
+
     /// The map of rows `rows` of this one, in that order (a row may repeat).
     pub fn select(&self, rows: &[u32]) -> Self {
         let mut out = Stencil::new(self.columns);

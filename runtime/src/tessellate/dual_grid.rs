@@ -39,11 +39,13 @@ use crate::scheme::catmull_clark::adaptive::{
     limit_stencils, phantom_grid, LimitQuery, LimitStencil,
 };
 use crate::scheme::patch::{dual_index_in_patch, FacePatch, PatchKind};
+use crate::scheme::stencil::Stencil;
 use crate::stencil_table::StencilTable;
 pub use crate::tessellate::kernel::TessellationTime;
 use crate::tessellate::kernel::{
-    append_control, for_each_range, merge_rows, patch_origin, relative, table_may_describe,
-    total_bytes, unless_absent, vec_bytes, Connectivity, GridPlan, PointPlan, Stencils, MAX_PATCH,
+    append_control, for_each_range, for_each_range_with, merge_rows, patch_origin, relative,
+    table_may_describe, total_bytes, unless_absent, vec_bytes, Connectivity, GridPlan, PointPlan,
+    Stencils, MAX_PATCH,
 };
 use crate::tessellate::lane_stencils::{
     store_points, unit_cross_x4, LaneStencils, PointGroups, LANES,
@@ -51,7 +53,10 @@ use crate::tessellate::lane_stencils::{
 use crate::tessellate::mirror_stencils::MirrorStencils;
 use crate::tessellate::sub_patches::{SubPatchPlan, MAX_LEVEL_ONE};
 use crate::RuntimeError;
+use input_patches::InputPatches;
 use wide::f32x4;
+
+mod input_patches;
 
 /// The largest rate of the tables the evaluator takes.
 pub const MAX_RATE: u32 = 64;
@@ -243,6 +248,9 @@ enum FaceEval {
     /// in the face's own parameters, over its own control points (the union of its points'
     /// supports, any number), in lanes of their own (`DualGrid::lanes[lanes]`).
     Local { control: Range<u32>, lanes: u32 },
+    /// A piece of a regular input face evaluated whole, with its other pieces, from the input
+    /// points ([`input_patches`]).
+    Input,
     /// A hole: no points, no triangles.
     Hole,
 }
@@ -319,6 +327,9 @@ pub struct DualGrid {
     /// Output vertices that repeat another's position on the other side of a face-varying
     /// seam, `[copy, original]`: the same stencil, another source.
     seam_copies: Vec<[u32; 2]>,
+    /// The regular input faces evaluated whole ([`DualGrid::with_input_patches`]), and the map
+    /// that makes the control points the other faces read.
+    input: Option<InputPatches>,
 }
 
 fn section(patch: &FacePatch, kind: StencilKind, points: PointSet, n: u32) -> SectionKey {
@@ -479,6 +490,7 @@ impl DualGrid {
             vertex_count: 0,
             boundary: false,
             seam_copies: Vec::new(),
+            input: None,
         };
         // A valence-4 dart is not the regular patch: its crease refines by other rules.
         let regular = |p: &FacePatch| {
@@ -1107,7 +1119,7 @@ impl DualGrid {
                     }
                 }
             }
-            FaceEval::Hole => {}
+            FaceEval::Input | FaceEval::Hole => {}
         }
     }
 
@@ -1150,6 +1162,7 @@ impl GridPlan for DualGrid {
             total_bytes(self.boundary_points.iter().map(PointPlan::heap_bytes)),
             self.boundary_groups.heap_bytes(),
             self.connectivity.heap_bytes(),
+            self.input.as_ref().map_or(0, InputPatches::heap_bytes),
         ];
         let shallow = [
             vec_bytes(&self.rates),
@@ -1198,11 +1211,19 @@ impl GridPlan for DualGrid {
         let dual = self.first[self.rates.len()] as usize;
         let (face_positions, curve_positions) = positions.split_at_mut(dual);
         let (face_normals, curve_normals) = normals.split_at_mut(dual);
-        for_each_range(
-            &self.face_ends,
-            (face_positions, face_normals),
-            |f, (p, q)| self.evaluate_face(f, control, p, q),
-        );
+        match &self.input {
+            Some(input) => for_each_range_with(
+                input.unit_ends(),
+                (face_positions, face_normals),
+                InputPatches::buffer,
+                |buffer, u, out| input.evaluate_unit(self, u, control, out, buffer),
+            ),
+            None => for_each_range(
+                &self.face_ends,
+                (face_positions, face_normals),
+                |f, (p, q)| self.evaluate_face(f, control, p, q),
+            ),
+        }
         self.boundary_groups
             .evaluate(&self.control, control, curve_positions, curve_normals);
     }
@@ -1220,11 +1241,20 @@ impl GridPlan for DualGrid {
         &self.seam_copies
     }
 
+    fn control_map(&self) -> Option<&Stencil<f64>> {
+        self.input.as_ref().map(InputPatches::map)
+    }
+
     /// How many faces take the separable (tensor-product) path.
     fn separable_faces(&self) -> usize {
         self.faces
             .iter()
-            .filter(|f| matches!(f, FaceEval::Separable { .. } | FaceEval::Phantom { .. }))
+            .filter(|f| {
+                matches!(
+                    f,
+                    FaceEval::Separable { .. } | FaceEval::Phantom { .. } | FaceEval::Input
+                )
+            })
             .count()
     }
 
@@ -1455,18 +1485,7 @@ fn evaluate_separable(
     };
     let origin = origin.map(f32x4::splat);
     for (k, (x, dx)) in xs.iter().zip(dxs).enumerate() {
-        // q[b][c] = sum_a x_a g[a][b][c], dq the same with dx: the group's columns in the lanes.
-        let mut q = [[f32x4::ZERO; 3]; 4];
-        let mut dq = [[f32x4::ZERO; 3]; 4];
-        for b in 0..4 {
-            for c in 0..3 {
-                for a in 0..4 {
-                    let point = f32x4::splat(g[a][b][c]);
-                    q[b][c] += x[a] * point;
-                    dq[b][c] += dx[a] * point;
-                }
-            }
-        }
+        let (q, dq) = contract_columns(g, x, dx);
         let at = k * LANES;
         let end = n.min(at + LANES);
         // Rows by pairs (`paired`: the caller found them) only at rate 4, where a face's block
@@ -1490,25 +1509,61 @@ fn evaluate_separable(
             (positions, normals),
         );
         for j in rows {
-            let (y, dy) = (&ys[j], &dys[j]);
-            let mut p = origin;
-            let mut du: [f32x4; 3] = std::array::from_fn(|c| y[0] * dq[0][c]);
-            let mut dv: [f32x4; 3] = std::array::from_fn(|c| dy[0] * q[0][c]);
-            for c in 0..3 {
-                p[c] += y[0] * q[0][c];
-            }
-            for b in 1..4 {
-                for c in 0..3 {
-                    p[c] += y[b] * q[b][c];
-                    du[c] += y[b] * dq[b][c];
-                    dv[c] += dy[b] * q[b][c];
-                }
-            }
+            let (p, normal) = row_points(&q, &dq, &ys[j], &dys[j], origin);
             let row = j * stride;
             store_points(p, &mut positions[row + at..row + end]);
-            store_points(unit_cross_x4(du, dv), &mut normals[row + at..row + end]);
+            store_points(normal, &mut normals[row + at..row + end]);
         }
     }
+}
+
+/// A group of columns' contraction along `u` ([`evaluate_separable`]): `q[b][c] = sum_a x_a
+/// g[a][b][c]`, `dq` the same with `dx`, the group's columns in the lanes.
+#[inline(always)]
+fn contract_columns(
+    g: &[[[f32; 3]; 4]; 4],
+    x: &[f32x4; 4],
+    dx: &[f32x4; 4],
+) -> ([[f32x4; 3]; 4], [[f32x4; 3]; 4]) {
+    let mut q = [[f32x4::ZERO; 3]; 4];
+    let mut dq = [[f32x4::ZERO; 3]; 4];
+    for b in 0..4 {
+        for c in 0..3 {
+            for a in 0..4 {
+                let point = f32x4::splat(g[a][b][c]);
+                q[b][c] += x[a] * point;
+                dq[b][c] += dx[a] * point;
+            }
+        }
+    }
+    (q, dq)
+}
+
+/// One row of a group of columns ([`evaluate_separable`]): the positions `O + sum_b y_b q[b]`
+/// and the unit normals of `P_u = sum_b y_b q'[b]` and `P_v = sum_b y'_b q[b]`, every sum from
+/// its first term in the order of `b`.
+#[inline(always)]
+fn row_points(
+    q: &[[f32x4; 3]; 4],
+    dq: &[[f32x4; 3]; 4],
+    y: &[f32x4; 4],
+    dy: &[f32x4; 4],
+    origin: [f32x4; 3],
+) -> ([f32x4; 3], [f32x4; 3]) {
+    let mut p = origin;
+    let mut du: [f32x4; 3] = std::array::from_fn(|c| y[0] * dq[0][c]);
+    let mut dv: [f32x4; 3] = std::array::from_fn(|c| dy[0] * q[0][c]);
+    for c in 0..3 {
+        p[c] += y[0] * q[0][c];
+    }
+    for b in 1..4 {
+        for c in 0..3 {
+            p[c] += y[b] * q[b][c];
+            du[c] += y[b] * dq[b][c];
+            dv[c] += dy[b] * q[b][c];
+        }
+    }
+    (p, unit_cross_x4(du, dv))
 }
 
 /// Rows `j` and `n - 1 - j` of a group ([`evaluate_separable`]) for every `j` of `pairs`
@@ -1534,40 +1589,60 @@ fn rows_by_pairs<'a>(
     columns: std::ops::Range<usize>,
     (positions, normals): (&mut [[f32; 3]], &mut [[f32; 3]]),
 ) {
-    let even_odd = |q: &[[f32x4; 3]; 4]| -> [[f32x4; 3]; 4] {
-        [
-            std::array::from_fn(|c| q[0][c] + q[3][c]),
-            std::array::from_fn(|c| q[1][c] + q[2][c]),
-            std::array::from_fn(|c| q[0][c] - q[3][c]),
-            std::array::from_fn(|c| q[1][c] - q[2][c]),
-        ]
-    };
     let (sq, sdq) = (even_odd(q), even_odd(dq));
     for (j, w) in pairs.enumerate() {
-        let mut p = [[f32x4::ZERO; 3]; 2];
-        let mut du = [[f32x4::ZERO; 3]; 2];
-        let mut dv = [[f32x4::ZERO; 3]; 2];
-        for c in 0..3 {
-            let e = origin[c] + w[0] * sq[0][c] + w[1] * sq[1][c];
-            let o = w[2] * sq[2][c] + w[3] * sq[3][c];
-            p[0][c] = e + o;
-            p[1][c] = e - o;
-            let e = w[0] * sdq[0][c] + w[1] * sdq[1][c];
-            let o = w[2] * sdq[2][c] + w[3] * sdq[3][c];
-            du[0][c] = e + o;
-            du[1][c] = e - o;
-            let e = w[4] * sq[0][c] + w[5] * sq[1][c];
-            let o = w[6] * sq[2][c] + w[7] * sq[3][c];
-            dv[0][c] = e + o;
-            dv[1][c] = o - e;
-        }
+        let (p, normal) = pair_points(&sq, &sdq, w, origin);
         for (r, row) in [j, n - 1 - j].into_iter().enumerate() {
             let row = row * stride;
             let out = row + columns.start..row + columns.end;
             store_points(p[r], &mut positions[out.clone()]);
-            store_points(unit_cross_x4(du[r], dv[r]), &mut normals[out]);
+            store_points(normal[r], &mut normals[out]);
         }
     }
+}
+
+/// A group's even and odd sums `q_0 + q_3`, `q_1 + q_2`, `q_0 - q_3`, `q_1 - q_2`
+/// ([`rows_by_pairs`]).
+#[inline(always)]
+fn even_odd(q: &[[f32x4; 3]; 4]) -> [[f32x4; 3]; 4] {
+    [
+        std::array::from_fn(|c| q[0][c] + q[3][c]),
+        std::array::from_fn(|c| q[1][c] + q[2][c]),
+        std::array::from_fn(|c| q[0][c] - q[3][c]),
+        std::array::from_fn(|c| q[1][c] - q[2][c]),
+    ]
+}
+
+/// A row `j` and its mirror `n - 1 - j` from the group's even and odd sums and the row's pair
+/// of weights ([`rows_by_pairs`]): their positions and unit normals.
+#[inline(always)]
+fn pair_points(
+    sq: &[[f32x4; 3]; 4],
+    sdq: &[[f32x4; 3]; 4],
+    w: &[f32x4; 8],
+    origin: [f32x4; 3],
+) -> ([[f32x4; 3]; 2], [[f32x4; 3]; 2]) {
+    let mut p = [[f32x4::ZERO; 3]; 2];
+    let mut du = [[f32x4::ZERO; 3]; 2];
+    let mut dv = [[f32x4::ZERO; 3]; 2];
+    for c in 0..3 {
+        let e = origin[c] + w[0] * sq[0][c] + w[1] * sq[1][c];
+        let o = w[2] * sq[2][c] + w[3] * sq[3][c];
+        p[0][c] = e + o;
+        p[1][c] = e - o;
+        let e = w[0] * sdq[0][c] + w[1] * sdq[1][c];
+        let o = w[2] * sdq[2][c] + w[3] * sdq[3][c];
+        du[0][c] = e + o;
+        du[1][c] = e - o;
+        let e = w[4] * sq[0][c] + w[5] * sq[1][c];
+        let o = w[6] * sq[2][c] + w[7] * sq[3][c];
+        dv[0][c] = e + o;
+        dv[1][c] = o - e;
+    }
+    (
+        p,
+        [unit_cross_x4(du[0], dv[0]), unit_cross_x4(du[1], dv[1])],
+    )
 }
 
 /// Tessellate an isolated mesh at rate `n` on every face.

@@ -12,6 +12,7 @@ pub(crate) use crate::mesh::geometry::{cross, normalize as unit};
 use crate::mesh::triangle_mesh::{TriangleMesh, VertexSource};
 use crate::mesh::Mesh;
 use crate::scheme::patch::{is_table_patch, FacePatch};
+use crate::scheme::stencil::Stencil;
 use crate::RuntimeError;
 use table_format::TableError;
 
@@ -112,6 +113,17 @@ pub(crate) fn for_each_range<T: SplitSlices + Send>(
     out: T,
     work: impl Fn(usize, T) + Sync + Send,
 ) {
+    for_each_range_with(ends, out, || (), |(), i, slice| work(i, slice));
+}
+
+/// [`for_each_range`] with a scratch value made once per chunk of items (`make`) and lent to
+/// every item of the chunk: what a buffer cleared per item would cost, paid a few dozen times.
+pub(crate) fn for_each_range_with<T: SplitSlices + Send, S>(
+    ends: &[usize],
+    out: T,
+    make: impl Fn() -> S + Sync + Send,
+    work: impl Fn(&mut S, usize, T) + Sync + Send,
+) {
     let total = ends.last().copied().unwrap_or(0);
     let chunks = (rayon::current_num_threads() * 16).max(1);
     let target = total.div_ceil(chunks).max(1);
@@ -134,12 +146,13 @@ pub(crate) fn for_each_range<T: SplitSlices + Send>(
     pieces
         .into_par_iter()
         .for_each(|(items, start, mut piece)| {
+            let mut scratch = make();
             let mut at = start;
             for i in items {
                 let (mine, tail) = piece.split_at(ends[i] - at);
                 piece = tail;
                 at = ends[i];
-                work(i, mine);
+                work(&mut scratch, i, mine);
             }
         });
 }
@@ -458,6 +471,14 @@ pub trait GridPlan: Sync + Send + std::fmt::Debug {
     /// original]` (none unless the plan has a face-varying channel).
     fn seam_copies(&self) -> &[[u32; 2]] {
         &[]
+    }
+
+    /// The plan's own map from the input points to the control points its
+    /// [`GridPlan::evaluate`] reads, where it has one: the map's rows, then the input points
+    /// themselves (which the regular input faces it evaluates whole read). `None`: it reads the
+    /// isolated mesh's points, all of them.
+    fn control_map(&self) -> Option<&Stencil<f64>> {
+        None
     }
 
     /// Evaluate and connect in one go into a fresh [`TriangleMesh`] (with sources in the

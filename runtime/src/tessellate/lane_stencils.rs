@@ -443,6 +443,21 @@ pub(crate) fn store_points(v: [f32x4; 3], out: &mut [[f32; 3]]) {
     }
 }
 
+/// [`store_points`] with the lanes in reverse order: lane 3 at `out[0]`, ..., lane 0 at
+/// `out[3]` (`out` holds all four), the same four stores (the lanes reversed before the store
+/// went through the stack in pieces, as above).
+#[inline(always)]
+pub(crate) fn store_points_reversed(v: [f32x4; 3], out: &mut [[f32; 3]]) {
+    let t = f32x4::transpose([v[0], v[1], v[2], f32x4::ZERO]).map(f32x4::to_array);
+    if let Ok(out) = <&mut [[f32; 3]; LANES]>::try_from(&mut *out) {
+        let flat = out.as_flattened_mut();
+        flat[0..4].copy_from_slice(&t[3]);
+        flat[3..7].copy_from_slice(&t[2]);
+        flat[6..10].copy_from_slice(&t[1]);
+        flat[9..12].copy_from_slice(&t[0][..3]);
+    }
+}
+
 /// Deterministic pseudo-random numbers in `[-1/2, 1/2)` (a linear congruential sequence from
 /// `seed`), for the tests that compare lanes with scalar sums.
 #[cfg(test)]

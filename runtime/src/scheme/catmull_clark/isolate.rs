@@ -9,6 +9,7 @@ use rayon::prelude::*;
 
 use crate::mesh::topology::Mesh;
 use crate::mesh::VertexSource;
+use crate::scheme::catmull_clark::adaptive::bspline_patch;
 use crate::scheme::catmull_clark::refine::refine;
 use crate::scheme::patch::gather_patches;
 use crate::scheme::patch::FacePatch;
@@ -38,6 +39,11 @@ pub struct Isolation {
     /// steps composed, so a moved input maps to the isolated control points without refining
     /// again (the identity when no step was taken and no vertex was split).
     pub refinement: Stencil<f64>,
+    /// Every input face's 16 input vertices (`net[a][b]` at `(a - 1, b - 1)` of its grid, `a`
+    /// along its `u`) where it is a bicubic B-spline patch of plain vertices: a quad, no hole,
+    /// no sharp feature or boundary that reflects a point ([`bspline_patch`]); empty when
+    /// isolation took no step. Its isolated faces are pieces of that one patch.
+    pub input_nets: Vec<Option<[[u32; 4]; 4]>>,
 }
 
 impl Isolation {
@@ -105,6 +111,50 @@ impl Isolation {
     }
 }
 
+/// Where an isolated face lies in its input quad ([`Isolation::placement`]): the cell
+/// `(a, b)` of the input face's `2^steps x 2^steps` grid of cells (`a` along the input face's
+/// `u`), and the quarter turns `turns` from the input face's `(u, v)` axes to the isolated
+/// face's own (its `u` axis along the input face's `u`, `v`, `-u`, `-v` for 0..=3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Placement {
+    /// Quarter turns, `0..4`.
+    pub turns: u8,
+    /// The cell along the input face's `u`.
+    pub a: u32,
+    /// The cell along the input face's `v`.
+    pub b: u32,
+}
+
+impl Isolation {
+    /// Where isolated face `face` lies in its input face, if that is a quad
+    /// ([`Isolation::input_map`]'s affine map read as a cell and a rotation: the children of a
+    /// quad are its corner quarters turned by their corner, so every step composes a turn).
+    pub fn placement(&self, face: usize) -> Option<Placement> {
+        if self.input_sides.get(*self.origin.get(face)? as usize) != Some(&4) {
+            return None;
+        }
+        let [u, v, _] = self.input_map(face).rows;
+        // The face's own axes and origin in the input face, in cells (the last column is the
+        // origin's numerator over the denominator's factor `2^steps`).
+        let (axis_u, axis_v, origin) = ((u[0], v[0]), (u[1], v[1]), (u[2], v[2]));
+        let turns = match axis_u {
+            (1, 0) => 0,
+            (0, 1) => 1,
+            (-1, 0) => 2,
+            (0, -1) => 3,
+            _ => return None,
+        };
+        // The cell's lower corner: the origin moved back along whichever axis points down.
+        let a = origin.0 + axis_u.0.min(0) + axis_v.0.min(0);
+        let b = origin.1 + axis_u.1.min(0) + axis_v.1.min(0);
+        Some(Placement {
+            turns,
+            a: u32::try_from(a).ok()?,
+            b: u32::try_from(b).ok()?,
+        })
+    }
+}
+
 /// The map from the points of one isolated face to its input face ([`Isolation::input_map`]):
 /// the input face, the sub-face of a non-quad, and the integer linear map on `(u, v, d)`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -154,7 +204,13 @@ pub fn isolate_with_origins(mesh: &Mesh) -> Result<Isolation, MeshError> {
     for steps in 0..=MAX_STEPS {
         match gather_patches(&current) {
             Ok(patches) => {
+                let input_nets = if steps == 0 {
+                    Vec::new()
+                } else {
+                    (0..mesh.faces()).map(|f| input_net(mesh, f)).collect()
+                };
                 return Ok(Isolation {
+                    input_nets,
                     mesh: current,
                     patches,
                     steps,
@@ -162,7 +218,7 @@ pub fn isolate_with_origins(mesh: &Mesh) -> Result<Isolation, MeshError> {
                     corners,
                     input_sides,
                     refinement,
-                })
+                });
             }
             Err(e) if steps == MAX_STEPS => return Err(e),
             Err(_) => {
@@ -187,6 +243,37 @@ pub fn isolate_with_origins(mesh: &Mesh) -> Result<Isolation, MeshError> {
         }
     }
     unreachable!("the loop returns at its last step")
+}
+
+/// Face `f`'s B-spline net as input vertices ([`Isolation::input_nets`]): split copies of a
+/// non-manifold vertex are their input vertex (the same point).
+fn input_net(mesh: &Mesh, f: usize) -> Option<[[u32; 4]; 4]> {
+    if mesh.holes.get(f).copied().unwrap_or(true) {
+        return None;
+    }
+    // `bspline_patch` reads a refined mesh, all quads: here the faces around the corners must
+    // be quads for its walk to find the net.
+    let quad = |h: usize| mesh.face_halfedges(mesh.face_of[h] as usize).len() == 4;
+    if !mesh
+        .face(f)
+        .iter()
+        .all(|&v| mesh.fan_iter(v as usize).all(quad))
+    {
+        return None;
+    }
+    let net = bspline_patch::<f64>(mesh, f)?;
+    let mut out = [[0u32; 4]; 4];
+    for (column, cells) in out.iter_mut().zip(&net) {
+        for (v, combo) in column.iter_mut().zip(cells) {
+            match combo.as_slice() {
+                [(vertex, w)] if *w == 1.0 => {
+                    *v = u32::try_from(mesh.origin(*vertex as usize)).ok()?
+                }
+                _ => return None,
+            }
+        }
+    }
+    Some(out)
 }
 
 /// The isolated mesh, its patches and the number of refinement steps taken.
@@ -251,6 +338,47 @@ mod tests {
             denominator: d,
             subface,
         }
+    }
+
+    /// The placements of a cube's isolated faces tile each input face once, and each face's
+    /// cell and turns carry its own corners to the cell's corners as [`Isolation::input_map`]
+    /// maps them.
+    #[test]
+    fn placements_tile_their_input_faces() {
+        let iso = isolate_with_origins(&cube()).expect("isolates");
+        let cells = 1u32 << iso.steps;
+        let mut seen = std::collections::HashSet::new();
+        for face in 0..iso.mesh.faces() {
+            let p = iso.placement(face).expect("a quad's face has a placement");
+            assert!(p.turns < 4 && p.a < cells && p.b < cells);
+            assert!(
+                seen.insert((iso.origin[face], p.a, p.b)),
+                "one face per cell"
+            );
+            // The face's corner (0, 0) turned `turns` times about the cell's centre.
+            let corner = [(0, 0), (1, 0), (1, 1), (0, 1)][usize::from(p.turns)];
+            let source = VertexSource {
+                face: face as u32,
+                u: 0,
+                v: 0,
+                denominator: 1,
+                subface: 0,
+            };
+            let mapped = iso.input_source(source);
+            assert_eq!(mapped.denominator, cells);
+            assert_eq!((mapped.u, mapped.v), (p.a + corner.0, p.b + corner.1));
+            // Its `u` axis: the corner (1, 0) one cell along the turned axis.
+            let axis = [(1, 0), (0, 1), (-1, 0), (0, -1)][usize::from(p.turns)];
+            let mapped = iso.input_source(VertexSource { u: 1, ..source });
+            assert_eq!(
+                (i64::from(mapped.u), i64::from(mapped.v)),
+                (
+                    i64::from(p.a + corner.0) + axis.0,
+                    i64::from(p.b + corner.1) + axis.1
+                )
+            );
+        }
+        assert_eq!(seen.len(), iso.mesh.faces());
     }
 
     /// Every face's map gives the steps' point for points across the face (corners, sides,
