@@ -9,8 +9,13 @@
 //! * Crane's triangulated Spot (`spot_triangulated.obj`, 5,856 triangles: every face needs
 //!   isolation, two Catmull–Clark steps, 70,272 faces), n = 4, 8 (OpenSubdiv's table at n = 16,
 //!   18 M points, would not fit this machine's memory).
+//! * the quad-dominant sword (`../shared/models/odedstein/sword-quad-dominant.obj`, 22,117
+//!   quads and 348 triangles: two isolating steps, 358,048 faces, most of them pieces of
+//!   regular input quads), n = 4, 8 (OpenSubdiv's table at n = 8, 22.9 M points, took the
+//!   process to 16 GB).
 //!
-//! The Spot meshes are skipped, with a message, when `../shared/models` is absent.
+//! The Spot meshes and the sword are skipped, with a message, when `../shared/models` is
+//! absent.
 //!
 //! `scripts/install-opensubdiv-deps.sh && cargo bench -p subtess --features opensubdiv
 //! --bench opensubdiv` (the feature builds OpenSubdiv from C++ source; docs/benchmarks.md).
@@ -492,7 +497,7 @@ fn bench(c: &mut Criterion) {
         cases.push(Case {
             name: "sword, quad-dominant (isolation)".to_owned(),
             mesh,
-            rates: &[4],
+            rates: &[4, 8],
         });
     }
     for case in &cases {

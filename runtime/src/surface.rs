@@ -6,7 +6,9 @@
 //! The per-frame path never refines. Isolation's refinement steps are linear in the control
 //! points, so they are composed once into one sparse map from the input vertices to the isolated
 //! mesh's vertices ([`crate::scheme::stencil::Stencil`]); a frame applies that map (a few dozen
-//! multiply-adds per isolated vertex, in f64) and then the table stencils of the plan (in f32,
+//! multiply-adds per isolated vertex, in f64; at rate 4 only the rows of the faces that the
+//! plan does not evaluate from their input face's own points) and then the table stencils of
+//! the plan (in f32,
 //! on every patch's control points relative to one of them, so that tangents and normals do
 //! not depend on where the mesh sits: docs/reliability.md, *Precision*).
 
@@ -955,34 +957,27 @@ mod tests {
         kept.plan.as_ref().map(|plan| plan.rates.clone())
     }
 
-    /// A wavy torus of 12 x 8 quads with one quad cut into two triangles: isolation takes two
-    /// steps, and the input faces away from the triangles are regular.
+    /// A torus of 12 x 8 quads (`test_meshes::quad_torus`) with its first quad cut into two
+    /// triangles: isolation takes two steps, and the input faces away from them are regular.
     fn torus_with_triangles() -> Mesh {
-        let (m, n) = (12usize, 8usize);
-        let mut positions = Vec::new();
-        for j in 0..n {
-            for i in 0..m {
-                let (a, b) = (
-                    std::f64::consts::TAU * i as f64 / m as f64,
-                    std::f64::consts::TAU * j as f64 / n as f64,
-                );
-                let r = 3.0 + b.cos() + 0.2 * (3.0 * a).sin();
-                positions.push([r * a.cos(), r * a.sin(), b.sin() + 0.3 * (2.0 * a).cos()]);
-            }
-        }
-        let at = |i: usize, j: usize| ((j % n) * m + i % m) as i64;
+        let torus = crate::mesh::test_meshes::quad_torus(12, 8);
         let mut faces: Vec<Vec<i64>> = Vec::new();
-        for k in 0..m * n {
-            let (i, j) = (k % m, k / m);
-            let quad = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
-            if k == 0 {
-                faces.push(vec![quad[0], quad[1], quad[2]]);
-                faces.push(vec![quad[0], quad[2], quad[3]]);
+        for f in 0..torus.faces() {
+            let q: Vec<i64> = torus.face(f).iter().map(|&v| i64::from(v)).collect();
+            if f == 0 {
+                faces.push(vec![q[0], q[1], q[2]]);
+                faces.push(vec![q[0], q[2], q[3]]);
             } else {
-                faces.push(quad.to_vec());
+                faces.push(q);
             }
         }
-        Mesh::new(positions, &faces, &[], schemes::BoundaryMode::EdgeOnly).expect("a torus")
+        Mesh::new(
+            torus.positions,
+            &faces,
+            &[],
+            schemes::BoundaryMode::EdgeOnly,
+        )
+        .expect("a torus")
     }
 
     /// The regular input faces evaluated whole from the input points (every turn of their

@@ -1215,8 +1215,8 @@ impl GridPlan for DualGrid {
             Some(input) => for_each_range_with(
                 input.unit_ends(),
                 (face_positions, face_normals),
-                InputPatches::buffer,
-                |buffer, u, out| input.evaluate_unit(self, u, control, out, buffer),
+                InputPatches::scratch,
+                |scratch, u, out| input.evaluate_unit(self, u, control, out, scratch),
             ),
             None => for_each_range(
                 &self.face_ends,

@@ -429,18 +429,7 @@ pub(crate) fn unit_cross_x4(a: [f32x4; 3], b: [f32x4; 3]) -> [f32x4; 3] {
 /// spilling onto the next point's first coordinate, which that point's own store then writes.
 #[inline(always)]
 pub(crate) fn store_points(v: [f32x4; 3], out: &mut [[f32; 3]]) {
-    let t = f32x4::transpose([v[0], v[1], v[2], f32x4::ZERO]).map(f32x4::to_array);
-    if let Ok(out) = <&mut [[f32; 3]; LANES]>::try_from(&mut *out) {
-        let flat = out.as_flattened_mut();
-        flat[0..4].copy_from_slice(&t[0]);
-        flat[3..7].copy_from_slice(&t[1]);
-        flat[6..10].copy_from_slice(&t[2]);
-        flat[9..12].copy_from_slice(&t[3][..3]);
-    } else {
-        for (o, t) in out.iter_mut().zip(&t) {
-            *o = [t[0], t[1], t[2]];
-        }
-    }
+    store_lanes::<false>(v, out);
 }
 
 /// [`store_points`] with the lanes in reverse order: lane 3 at `out[0]`, ..., lane 0 at
@@ -448,13 +437,24 @@ pub(crate) fn store_points(v: [f32x4; 3], out: &mut [[f32; 3]]) {
 /// went through the stack in pieces, as above).
 #[inline(always)]
 pub(crate) fn store_points_reversed(v: [f32x4; 3], out: &mut [[f32; 3]]) {
+    store_lanes::<true>(v, out);
+}
+
+/// [`store_points`], lane `k` at `out[k]`, or at `out[3 - k]` when `REVERSED`.
+#[inline(always)]
+fn store_lanes<const REVERSED: bool>(v: [f32x4; 3], out: &mut [[f32; 3]]) {
     let t = f32x4::transpose([v[0], v[1], v[2], f32x4::ZERO]).map(f32x4::to_array);
+    let lane = |k: usize| if REVERSED { LANES - 1 - k } else { k };
     if let Ok(out) = <&mut [[f32; 3]; LANES]>::try_from(&mut *out) {
         let flat = out.as_flattened_mut();
-        flat[0..4].copy_from_slice(&t[3]);
-        flat[3..7].copy_from_slice(&t[2]);
-        flat[6..10].copy_from_slice(&t[1]);
-        flat[9..12].copy_from_slice(&t[0][..3]);
+        flat[0..4].copy_from_slice(&t[lane(0)]);
+        flat[3..7].copy_from_slice(&t[lane(1)]);
+        flat[6..10].copy_from_slice(&t[lane(2)]);
+        flat[9..12].copy_from_slice(&t[lane(3)][..3]);
+    } else if !REVERSED {
+        for (o, t) in out.iter_mut().zip(&t) {
+            *o = [t[0], t[1], t[2]];
+        }
     }
 }
 

@@ -41,7 +41,7 @@ pub struct Isolation {
     pub refinement: Stencil<f64>,
     /// Every input face's 16 input vertices (`net[a][b]` at `(a - 1, b - 1)` of its grid, `a`
     /// along its `u`) where it is a bicubic B-spline patch of plain vertices: a quad, no hole,
-    /// no sharp feature or boundary that reflects a point ([`bspline_patch`]); empty when
+    /// no sharp feature or boundary that reflects a point (`adaptive::bspline_patch`); empty when
     /// isolation took no step. Its isolated faces are pieces of that one patch.
     pub input_nets: Vec<Option<[[u32; 4]; 4]>>,
 }
