@@ -981,8 +981,8 @@ mod tests {
     }
 
     /// The regular input faces evaluated whole from the input points (every turn of their
-    /// pieces met) give the points face by face from the isolated points gives (the table's
-    /// stencils after the refinement map) to f32 rounding, and the map keeps fewer rows.
+    /// pieces met) give what the plan of the isolated mesh gives face by face (the table's
+    /// stencils on the refined points) to f32 rounding, and the map keeps fewer rows.
     #[test]
     fn whole_input_faces_are_their_pieces_face_by_face() {
         // With an infinitely sharp edge too (a dart at both ends): the faces beside it, and
