@@ -401,9 +401,17 @@ impl DualGrid {
         for v in &mut self.control {
             *v = moved(*v);
         }
-        let base = u32::try_from(rows.len()).map_err(|_| {
-            RuntimeError::Unsupported("more control points than u32 indices".to_owned())
-        })?;
+        // The input points follow the rows: every index must fit in u32.
+        let too_many =
+            || RuntimeError::Unsupported("more control points than u32 indices".to_owned());
+        let base = u32::try_from(rows.len()).map_err(|_| too_many())?;
+        let last = patches
+            .iter()
+            .flat_map(|patch| patch.net.iter().flatten())
+            .max()
+            .copied()
+            .unwrap_or(0);
+        base.checked_add(last).ok_or_else(too_many)?;
         for patch in &mut patches {
             patch.net = patch.net.map(|column| column.map(|v| base + v));
         }
