@@ -985,9 +985,8 @@ mod tests {
     /// stencils on the refined points) to f32 rounding, and the map keeps fewer rows.
     #[test]
     fn whole_input_faces_are_their_pieces_face_by_face() {
-        // With an infinitely sharp edge too (a dart at both ends): the faces beside it, and
-        // those that only touch it at a corner (its point of the first step lies in their
-        // nets), are no whole faces.
+        // With an infinitely sharp edge too (a dart at both ends), whose faces and those that
+        // touch it at a corner must not be evaluated as plain B-spline patches.
         let mut dart = torus_with_triangles();
         dart.set_edge_sharpness(54, 55, schemes::crease::INFINITE)
             .expect("an edge of the torus");

@@ -14,7 +14,7 @@
 //! Why: the map cost the quad-dominant sword (`../shared/models/odedstein`, 348 of its 22,465
 //! faces triangles) an eighth of its frame, and a tensor product contracts its columns once per
 //! group of four where `4^s` pieces contracted theirs once each: at rate 4 the sword's frame
-//! went from 41 to 35 ms on one thread (docs/benchmarks.md).
+//! went from 41.6 to 37.6 ms on one thread (docs/benchmarks.md).
 //!
 //! Each piece's points stay in its own order: piece `k` is turned by a quarter `turns` times
 //! from the input face's axes ([`Placement`]). Every group of four columns of the input face
@@ -63,10 +63,13 @@ pub(super) struct Scratch {
 pub(super) type Points = ([f32x4; 3], [f32x4; 3]);
 
 /// One input face evaluated whole: its isolated faces `faces` (contiguous, one block of `n^2`
-/// points each, in face order), their placements, its 16 input points and its rate.
+/// points each, in face order), where they lie, its 16 input points and its rate.
 #[derive(Clone, Debug)]
 struct InputPatch {
     faces: Range<u32>,
+    /// `pieces[a][b]`: the face in cell `(a, b)` ([`Placement`]), as its index from
+    /// `faces.start`, and its quarter turns.
+    pieces: [[(u8, u8); MAX_CELLS]; MAX_CELLS],
     /// `net[a][b]` at `(a - 1, b - 1)` of the input face's grid, as indices into the frame's
     /// control points (the input points follow the map's rows).
     net: [[u32; 4]; 4],
@@ -87,8 +90,6 @@ enum Unit {
 #[derive(Clone, Debug)]
 pub(super) struct InputPatches {
     patches: Vec<InputPatch>,
-    /// Every isolated face's placement in its input face (read for the patches' faces).
-    placements: Vec<Placement>,
     /// Cells per side of an input face (`2^steps`).
     cells: usize,
     /// The B-spline factors at the rates `2^steps n` met, with those rates.
@@ -117,7 +118,6 @@ impl InputPatches {
     pub(super) fn heap_bytes(&self) -> usize {
         total_bytes([
             vec_bytes(&self.patches),
-            vec_bytes(&self.placements),
             vec_bytes(&self.bases),
             self.map.heap_bytes(),
             vec_bytes(&self.units),
@@ -183,19 +183,13 @@ impl InputPatches {
             .net
             .map(|column| column.map(|v| relative(control[v as usize], origin)));
         let origin = origin.map(|c| f32x4::splat(c as f32));
-        // The piece at every cell and its turns.
-        let mut at = [[(0usize, 0u8); MAX_CELLS]; MAX_CELLS];
-        let faces = patch.faces.start as usize..patch.faces.end as usize;
-        for (k, p) in self.placements[faces].iter().enumerate() {
-            at[p.a as usize][p.b as usize] = (k, p.turns);
-        }
         let rows = cells * n;
         if rows > MAX_ROWS || buffer.len() < rows {
             return;
         }
         // Columns and rows walk cell by cell, four at a time.
         let mut columns = basis.x_lanes.iter().zip(&basis.dx_lanes);
-        for pieces in &at[..cells] {
+        for pieces in &patch.pieces[..cells] {
             for i in (0..n).step_by(LANES) {
                 let Some((x, dx)) = columns.next() else {
                     return;
@@ -209,6 +203,7 @@ impl InputPatches {
                 }
                 let mut runs = buffer[..rows].chunks_exact(LANES);
                 for &(k, turns) in &pieces[..cells] {
+                    let k = usize::from(k);
                     let block = k * n * n..(k + 1) * n * n;
                     for j in (0..n).step_by(LANES) {
                         let Some(Ok(run)) = runs.next().map(<&[_; LANES]>::try_from) else {
@@ -296,6 +291,26 @@ fn bspline_basis(n: usize) -> SeparableBasis {
     SeparableBasis::from_factors(x.clone(), dx.clone(), x, dx)
 }
 
+/// The faces `run` of one input face by cell ([`InputPatch::pieces`]), or `None` unless they
+/// tile its `cells x cells` cells once each.
+fn cells_of(
+    run: Range<usize>,
+    placement: impl Fn(usize) -> Option<Placement>,
+    cells: usize,
+) -> Option<[[(u8, u8); MAX_CELLS]; MAX_CELLS]> {
+    let mut pieces = [[(0u8, 0u8); MAX_CELLS]; MAX_CELLS];
+    let mut seen = [[false; MAX_CELLS]; MAX_CELLS];
+    for (k, f) in run.enumerate() {
+        let p = placement(f)?;
+        let (a, b) = (p.a as usize, p.b as usize);
+        if a >= cells || b >= cells || std::mem::replace(&mut seen[a][b], true) {
+            return None;
+        }
+        pieces[a][b] = (u8::try_from(k).ok()?, p.turns);
+    }
+    Some(pieces)
+}
+
 impl DualGrid {
     /// Evaluate the regular input faces whole from the input points ([`InputPatches`]), where
     /// isolation took `steps` steps: `nets[F]` is input face `F`'s 16 input points when it is a
@@ -321,14 +336,6 @@ impl DualGrid {
         let pieces = cells * cells;
         let faces = self.faces.len();
         let mut patches = Vec::new();
-        let mut placements = vec![
-            Placement {
-                turns: 0,
-                a: 0,
-                b: 0
-            };
-            faces
-        ];
         let mut bases: Vec<(usize, SeparableBasis)> = Vec::new();
         let mut f = 0;
         while f < faces {
@@ -343,9 +350,10 @@ impl DualGrid {
                         && self.rates[g] == n
                         && matches!(self.faces[g], FaceEval::Separable { .. })
                 });
-            let net = nets.get(input).copied().flatten().filter(|_| whole);
-            let found: Option<Vec<Placement>> = net.and(run.clone().map(&placement).collect());
-            let (Some(net), Some(found)) = (net, found) else {
+            let found = nets.get(input).copied().flatten().filter(|_| whole);
+            let Some((net, pieces)) =
+                found.and_then(|net| Some((net, cells_of(run.clone(), &placement, cells)?)))
+            else {
                 f += 1;
                 continue;
             };
@@ -357,12 +365,12 @@ impl DualGrid {
                     bases.len() - 1
                 }
             };
-            for (g, p) in run.clone().zip(found) {
-                placements[g] = p;
+            for g in run.clone() {
                 self.faces[g] = FaceEval::Input;
             }
             patches.push(InputPatch {
                 faces: run.start as u32..run.end as u32,
+                pieces,
                 net,
                 n,
                 basis: basis as u32,
@@ -436,7 +444,6 @@ impl DualGrid {
         }
         self.input = Some(InputPatches {
             patches,
-            placements,
             cells,
             bases,
             map: map.select(&rows),
