@@ -84,6 +84,8 @@ impl SideEdge {
 struct FacePoints {
     /// Index into the face's marked points of each point's first mark.
     first: Vec<u32>,
+    /// Per mark, its point (an index into `first`).
+    point_of_mark: Vec<u32>,
     /// Per side, the canonical parameters of the points the face marked inside it, ascending.
     sides: [Vec<u32>; 4],
 }
@@ -91,22 +93,35 @@ struct FacePoints {
 /// A face's distinct marked points (by exact `(u, v)`; the first mark of each is the one whose
 /// evaluation counts) and the canonical parameters of those inside its sides.
 fn face_points(marked: &[Marked], edges: &[SideEdge; 4]) -> FacePoints {
-    let mut order: Vec<(u64, u32)> = marked
-        .iter()
-        .enumerate()
-        .map(|(i, m)| ((u64::from(m.u) << 32) | u64::from(m.v), i as u32))
+    // Place and mark in one integer (`u`, `v`, mark index), compared in two instructions.
+    let mut order: Vec<u128> = (0u32..)
+        .zip(marked)
+        .map(|(i, m)| (u128::from(pack(m.u, m.v)) << 32) | u128::from(i))
         .collect();
     order.sort_unstable();
+    let same_place = |a: &u128, b: &u128| a >> 32 == b >> 32;
+    let mark = |x: u128| x as u32 as usize;
     // Sorted by place, then mark: each run's head is the place's first mark; flagged, then
-    // listed in mark order (a pass, where sorting them again took a tenth of pass 2).
+    // numbered in mark order (a pass, where sorting them again took a tenth of pass 2), and
+    // every mark of the run given its head's number.
     let mut is_first = vec![false; marked.len()];
-    for run in order.chunk_by(|a, b| a.0 == b.0) {
-        is_first[run[0].1 as usize] = true;
+    for run in order.chunk_by(same_place) {
+        is_first[mark(run[0])] = true;
     }
-    let first: Vec<u32> = (0u32..)
-        .zip(&is_first)
-        .filter_map(|(i, &head)| head.then_some(i))
-        .collect();
+    let mut first = Vec::new();
+    let mut point_of_mark = vec![NONE; marked.len()];
+    for (i, (point, &head)) in (0u32..).zip(point_of_mark.iter_mut().zip(&is_first)) {
+        if head {
+            *point = first.len() as u32;
+            first.push(i);
+        }
+    }
+    for run in order.chunk_by(same_place) {
+        let point = point_of_mark[mark(run[0])];
+        for &x in &run[1..] {
+            point_of_mark[mark(x)] = point;
+        }
+    }
     let mut sides: [Vec<u32>; 4] = Default::default();
     for &i in &first {
         let m = &marked[i as usize];
@@ -117,7 +132,11 @@ fn face_points(marked: &[Marked], edges: &[SideEdge; 4]) -> FacePoints {
     for list in &mut sides {
         list.sort_unstable();
     }
-    FacePoints { first, sides }
+    FacePoints {
+        first,
+        point_of_mark,
+        sides,
+    }
 }
 
 /// `more` after `list`'s items: `more` itself when `list` is empty (no copy).
@@ -129,11 +148,31 @@ fn append<T: Copy>(list: &mut Vec<T>, more: Vec<T>) {
     }
 }
 
-/// A sorted list's pairs `(key, id)` with keys strictly between `lo` and `hi`.
-fn between<K: Ord + Copy>(sorted: &[(K, u32)], lo: K, hi: K) -> &[(K, u32)] {
-    let a = sorted.partition_point(|x| x.0 <= lo);
-    let b = sorted.partition_point(|x| x.0 < hi);
-    &sorted[a..b.max(a)]
+/// A sorted list's pairs `(key, id)` with keys strictly between `lo` and `hi`, each given with
+/// its own entry's index in the list ([`NONE`] where it has none): the pairs are then the run
+/// between the two entries, and a binary search is needed only where neither end is listed.
+/// `None` where an index is past the list (a broken invariant).
+fn between<K: Ord + Copy>(
+    sorted: &[(K, u32)],
+    (lo, lo_at): (K, u32),
+    (hi, hi_at): (K, u32),
+) -> Option<&[(K, u32)]> {
+    let (lo_at, hi_at) = (lo_at as usize, hi_at as usize);
+    let listed = NONE as usize;
+    let start = if lo_at != listed {
+        lo_at + 1
+    } else if hi_at != listed {
+        let above = sorted.get(..hi_at)?;
+        hi_at - above.iter().rev().take_while(|x| x.0 > lo).count()
+    } else {
+        sorted.partition_point(|x| x.0 <= lo)
+    };
+    let end = if hi_at != listed {
+        hi_at
+    } else {
+        start + sorted.get(start..)?.iter().take_while(|x| x.0 < hi).count()
+    };
+    sorted.get(start..end.max(start))
 }
 
 /// The id paired with `key` in a sorted list.
@@ -144,12 +183,33 @@ fn find<K: Ord + Copy>(sorted: &[(K, u32)], key: K) -> Option<u32> {
         .map(|k| sorted[k].1)
 }
 
+/// The key of `(a, b)` in a list sorted by `a`, then `b`.
+fn pack(a: u32, b: u32) -> u64 {
+    (u64::from(a) << 32) | u64::from(b)
+}
+
+/// Where a point of a face is listed in its [`FaceIds`]: its index in `rows` and `columns` (an
+/// interior point) or in the `edges` list of its side (a point inside a side), [`NONE`] where
+/// it is not listed.
+#[derive(Clone, Copy, Debug)]
+struct Listed {
+    row: u32,
+    column: u32,
+    edge: u32,
+}
+
 /// The ids of one face's marked points, by place.
 struct FaceIds {
-    /// Interior points by `(v, u)`: the horizontal lines.
-    rows: Vec<((u32, u32), u32)>,
-    /// Interior points by `(u, v)`: the vertical lines.
-    columns: Vec<((u32, u32), u32)>,
+    /// Per point of the face ([`FacePoints`]), its id.
+    ids: Vec<u32>,
+    /// Per point, where it is listed.
+    listed: Vec<Listed>,
+    /// Per leaf, its corners' points counter-clockwise from `(u0, v0)`.
+    corners: Vec<[u32; 4]>,
+    /// Interior points by `(v, u)` ([`pack`]ed): the horizontal lines.
+    rows: Vec<(u64, u32)>,
+    /// Interior points by `(u, v)` ([`pack`]ed): the vertical lines.
+    columns: Vec<(u64, u32)>,
     /// Per side, every point marked inside it by this face or the face across it, by the
     /// side's own parameter.
     edges: [Vec<(u32, u32)>; 4],
@@ -157,8 +217,6 @@ struct FaceIds {
 
 /// The global ids of a tessellation's marked points.
 pub(super) struct GlobalIds {
-    /// Per mesh vertex its id ([`NONE`] when no face marked it).
-    vertices: Vec<u32>,
     faces: Vec<FaceIds>,
 }
 
@@ -343,19 +401,56 @@ pub(super) fn assign(
     let faces: Vec<FaceIds> = (0..work.len())
         .into_par_iter()
         .map(|f| -> Result<FaceIds, RuntimeError> {
-            let marked = &work[f].1;
+            let (leaves, marked) = &work[f];
+            let points = &points[f];
+            let no_id =
+                |m: &Marked| internal(format!("face {f} point ({}, {}) has no id", m.u, m.v));
+            let mut ids = Vec::with_capacity(points.first.len());
             let mut rows = Vec::new();
-            let mut columns = Vec::new();
-            for (&i, &r) in points[f].first.iter().zip(&ranks[f]) {
+            for (p, (&i, &r)) in (0u32..).zip(points.first.iter().zip(&ranks[f])) {
                 let m = &marked[i as usize];
-                if place(m.u, m.v) == Place::Interior {
-                    rows.push(((m.v, m.u), base[f] + r));
-                    columns.push(((m.u, m.v), base[f] + r));
+                let place = place(m.u, m.v);
+                let id = if r != NONE {
+                    base[f] + r
+                } else {
+                    match place {
+                        Place::Corner(k) => vertices[mesh.face(f)[k] as usize],
+                        Place::Side(s, t) => find(&marked_sides[f][s], edges[f][s].canonical(t))
+                            .ok_or_else(|| no_id(m))?,
+                        Place::Interior => NONE,
+                    }
+                };
+                if id == NONE {
+                    return Err(no_id(m));
+                }
+                ids.push(id);
+                if place == Place::Interior {
+                    rows.push((pack(m.v, m.u), p));
                 }
             }
-            rows.sort_unstable();
-            columns.sort_unstable();
-            let edges = std::array::from_fn(|s| {
+            let unlisted = Listed {
+                row: NONE,
+                column: NONE,
+                edge: NONE,
+            };
+            let mut listed = vec![unlisted; ids.len()];
+            // The columns' keys are the rows' with their halves swapped; once both are sorted,
+            // each point learns its indices and its entries take its id.
+            let mut columns: Vec<(u64, u32)> = rows
+                .iter()
+                .map(|&(key, p)| (key.rotate_left(32), p))
+                .collect();
+            rows.sort_unstable_by_key(|x| x.0);
+            columns.sort_unstable_by_key(|x| x.0);
+            for (k, entry) in (0u32..).zip(&mut rows) {
+                listed[entry.1 as usize].row = k;
+                entry.1 = ids[entry.1 as usize];
+            }
+            for (k, entry) in (0u32..).zip(&mut columns) {
+                listed[entry.1 as usize].column = k;
+                entry.1 = ids[entry.1 as usize];
+            }
+            let edges: [Vec<(u32, u32)>; 4] = std::array::from_fn(|s| {
                 let edge = edges[f][s];
                 let mut all = marked_sides[f][s].clone();
                 if let Some((g, side)) = edge.twin {
@@ -369,109 +464,121 @@ pub(super) fn assign(
                 all.dedup_by_key(|x| x.0);
                 all
             });
+            for (&i, at) in points.first.iter().zip(&mut listed) {
+                let m = &marked[i as usize];
+                if let Place::Side(s, t) = place(m.u, m.v) {
+                    let k = edges[s].partition_point(|x| x.0 < t);
+                    if edges[s].get(k).map(|x| x.0) != Some(t) {
+                        return Err(no_id(m));
+                    }
+                    at.edge = k as u32;
+                }
+            }
+            let corners = leaves
+                .iter()
+                .zip(marked.chunks_exact(4))
+                .zip(points.point_of_mark.chunks_exact(4))
+                .map(|((leaf, marks), points)| leaf_corners(leaf, marks, points))
+                .collect::<Option<Vec<[u32; 4]>>>()
+                .ok_or_else(|| internal(format!("face {f}: a leaf's marks are not its corners")))?;
             Ok(FaceIds {
+                ids,
+                listed,
+                corners,
                 rows,
                 columns,
                 edges,
             })
         })
         .collect::<Result<_, _>>()?;
-    Ok(GlobalIds { vertices, faces })
+    Ok(GlobalIds { faces })
+}
+
+/// A leaf's corner points counter-clockwise from `(u0, v0)`, from its four marks (in the order
+/// of the patch's corners) and their points; `None` unless the marks are the four corners.
+fn leaf_corners(leaf: &Leaf, marks: &[Marked], points: &[u32]) -> Option<[u32; 4]> {
+    let mut corners = [NONE; 4];
+    for (m, &p) in marks.iter().zip(points) {
+        let right = m.u.checked_sub(leaf.u0)? == leaf.size;
+        let up = m.v.checked_sub(leaf.v0)? == leaf.size;
+        if !(right || m.u == leaf.u0) || !(up || m.v == leaf.v0) {
+            return None;
+        }
+        corners[usize::from(right ^ up) + 2 * usize::from(up)] = p;
+    }
+    (!corners.contains(&NONE)).then_some(corners)
 }
 
 impl GlobalIds {
-    /// The id of the marked point `(u, v)` of face `face`.
-    fn id(&self, mesh: &Mesh, face: usize, u: u32, v: u32) -> Option<u32> {
-        let ids = self.faces.get(face)?;
-        let id = match place(u, v) {
-            Place::Corner(k) => *self.vertices.get(*mesh.face(face).get(k)? as usize)?,
-            Place::Side(s, t) => find(&ids.edges[s], t)?,
-            Place::Interior => find(&ids.rows, (v, u))?,
-        };
-        (id != NONE).then_some(id)
-    }
-
-    /// The ring of marked points around a leaf, face grid points and ids, into `ring`: its corners and
-    /// every marked point on its sides, counter-clockwise (section 5: "output in order all the
-    /// marked points between corners of the base quadrilateral").
+    /// The ring of marked points around leaf `index` of `face`, face grid points and ids, into
+    /// `ring`: its corners and every marked point on its sides, counter-clockwise (section 5:
+    /// "output in order all the marked points between corners of the base quadrilateral").
     pub(super) fn leaf_ring(
         &self,
-        mesh: &Mesh,
         face: usize,
+        index: usize,
         leaf: &Leaf,
         ring: &mut Vec<((u32, u32), u32)>,
     ) -> Result<(), RuntimeError> {
-        let ids = self
-            .faces
-            .get(face)
-            .ok_or_else(|| internal(format!("face {face} has no ids")))?;
+        let broken = || internal(format!("face {face} leaf {index} has no ring"));
+        let ids = self.faces.get(face).ok_or_else(broken)?;
+        let corners = ids.corners.get(index).ok_or_else(broken)?;
+        let at = |k: usize| {
+            ids.listed
+                .get(corners[k] as usize)
+                .copied()
+                .ok_or_else(broken)
+        };
+        let id = |k: usize| ids.ids.get(corners[k] as usize).copied().ok_or_else(broken);
+        let [a0, a1, a2, a3] = [at(0)?, at(1)?, at(2)?, at(3)?];
         let (u0, v0) = (leaf.u0, leaf.v0);
         let (u1, v1) = (u0 + leaf.size, v0 + leaf.size);
         ring.clear();
-        let corner = |ring: &mut Vec<((u32, u32), u32)>, u: u32, v: u32| {
-            let id = self.id(mesh, face, u, v).ok_or_else(|| {
-                internal(format!("face {face} point ({u}, {v}) / {GRID} has no id"))
-            })?;
-            ring.push(((u, v), id));
-            Ok::<(), RuntimeError>(())
-        };
-        corner(ring, u0, v0)?;
+        ring.push(((u0, v0), id(0)?));
         if v0 == 0 {
-            ring.extend(
-                between(&ids.edges[0], u0, u1)
-                    .iter()
-                    .map(|&(t, id)| ((t, 0), id)),
-            );
+            let side = between(&ids.edges[0], (u0, a0.edge), (u1, a1.edge)).ok_or_else(broken)?;
+            ring.extend(side.iter().map(|&(t, id)| ((t, 0), id)));
         } else {
-            ring.extend(
-                between(&ids.rows, (v0, u0), (v0, u1))
-                    .iter()
-                    .map(|&((_, u), id)| ((u, v0), id)),
-            );
+            let side = between(&ids.rows, (pack(v0, u0), a0.row), (pack(v0, u1), a1.row))
+                .ok_or_else(broken)?;
+            ring.extend(side.iter().map(|&(key, id)| ((key as u32, v0), id)));
         }
-        corner(ring, u1, v0)?;
+        ring.push(((u1, v0), id(1)?));
         if u1 == GRID {
-            ring.extend(
-                between(&ids.edges[1], v0, v1)
-                    .iter()
-                    .map(|&(t, id)| ((GRID, t), id)),
-            );
+            let side = between(&ids.edges[1], (v0, a1.edge), (v1, a2.edge)).ok_or_else(broken)?;
+            ring.extend(side.iter().map(|&(t, id)| ((GRID, t), id)));
         } else {
-            ring.extend(
-                between(&ids.columns, (u1, v0), (u1, v1))
-                    .iter()
-                    .map(|&((_, v), id)| ((u1, v), id)),
-            );
+            let side = between(
+                &ids.columns,
+                (pack(u1, v0), a1.column),
+                (pack(u1, v1), a2.column),
+            )
+            .ok_or_else(broken)?;
+            ring.extend(side.iter().map(|&(key, id)| ((u1, key as u32), id)));
         }
-        corner(ring, u1, v1)?;
+        ring.push(((u1, v1), id(2)?));
         if v1 == GRID {
-            ring.extend(
-                between(&ids.edges[2], GRID - u1, GRID - u0)
-                    .iter()
-                    .map(|&(t, id)| ((GRID - t, GRID), id)),
-            );
+            let side = between(&ids.edges[2], (GRID - u1, a2.edge), (GRID - u0, a3.edge))
+                .ok_or_else(broken)?;
+            ring.extend(side.iter().map(|&(t, id)| ((GRID - t, GRID), id)));
         } else {
-            ring.extend(
-                between(&ids.rows, (v1, u0), (v1, u1))
-                    .iter()
-                    .rev()
-                    .map(|&((_, u), id)| ((u, v1), id)),
-            );
+            let side = between(&ids.rows, (pack(v1, u0), a3.row), (pack(v1, u1), a2.row))
+                .ok_or_else(broken)?;
+            ring.extend(side.iter().rev().map(|&(key, id)| ((key as u32, v1), id)));
         }
-        corner(ring, u0, v1)?;
+        ring.push(((u0, v1), id(3)?));
         if u0 == 0 {
-            ring.extend(
-                between(&ids.edges[3], GRID - v1, GRID - v0)
-                    .iter()
-                    .map(|&(t, id)| ((0, GRID - t), id)),
-            );
+            let side = between(&ids.edges[3], (GRID - v1, a3.edge), (GRID - v0, a0.edge))
+                .ok_or_else(broken)?;
+            ring.extend(side.iter().map(|&(t, id)| ((0, GRID - t), id)));
         } else {
-            ring.extend(
-                between(&ids.columns, (u0, v0), (u0, v1))
-                    .iter()
-                    .rev()
-                    .map(|&((_, v), id)| ((u0, v), id)),
-            );
+            let side = between(
+                &ids.columns,
+                (pack(u0, v0), a0.column),
+                (pack(u0, v1), a3.column),
+            )
+            .ok_or_else(broken)?;
+            ring.extend(side.iter().rev().map(|&(key, id)| ((u0, key as u32), id)));
         }
         Ok(())
     }

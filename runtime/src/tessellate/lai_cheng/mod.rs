@@ -705,13 +705,11 @@ impl PolygonBuffers {
     fn polygon(
         &mut self,
         ids: &global_ids::GlobalIds,
-        mesh: &Mesh,
         positions: &[Point],
-        face: usize,
-        leaf: &Leaf,
+        (face, index, leaf): (usize, usize, &Leaf),
         run: &mut PolygonRun,
     ) -> Result<(), RuntimeError> {
-        ids.leaf_ring(mesh, face, leaf, &mut self.ring)?;
+        ids.leaf_ring(face, index, leaf, &mut self.ring)?;
         let count = u32::try_from(self.ring.len())
             .map_err(|_| RuntimeError::Unsupported("a polygon of 2^32 vertices".to_owned()))?;
         self.params.clear();
@@ -1189,20 +1187,25 @@ pub(crate) fn tessellate_adaptive_with(
     // in runs of leaves, then copied into the output's flat arrays run by run in parallel
     // (gathering them on one thread was a serial copy of 36 MB, 23 ms for Spot's 356,467
     // polygons at `8.248e-5`).
-    let jobs: Vec<(usize, &Leaf)> = work
+    let jobs: Vec<(usize, usize, &Leaf)> = work
         .iter()
         .enumerate()
-        .flat_map(|(face, (leaves, _))| leaves.iter().map(move |leaf| (face, leaf)))
+        .flat_map(|(face, (leaves, _))| {
+            leaves
+                .iter()
+                .enumerate()
+                .map(move |(index, leaf)| (face, index, leaf))
+        })
         .collect();
     jobs.par_iter()
-        .map(|&(face, leaf)| leaf.region(face))
+        .map(|&(face, _, leaf)| leaf.region(face))
         .collect_into_vec(&mut out.regions);
     let runs = jobs
         .par_chunks(LEAVES_PER_RUN)
         .map_init(PolygonBuffers::default, |buffers, leaves| {
             let mut run = PolygonRun::default();
-            for &(face, leaf) in leaves {
-                buffers.polygon(&ids, mesh, &out.positions, face, leaf, &mut run)?;
+            for &job in leaves {
+                buffers.polygon(&ids, &out.positions, job, &mut run)?;
             }
             Ok(run)
         })

@@ -38,9 +38,25 @@ pub(crate) fn triangulate(
     ring: &mut Vec<usize>,
     out: &mut Vec<[usize; 3]>,
 ) {
+    match quad(params, positions) {
+        Some(pair) => {
+            out.clear();
+            out.extend_from_slice(&pair);
+        }
+        None => clip_ears(params, positions, ring, out),
+    }
+}
+
+/// [`triangulate`]'s ear clipping, for any polygon of its shape (`out` cleared).
+fn clip_ears(
+    params: &[(i64, i64)],
+    positions: &[Point],
+    ring: &mut Vec<usize>,
+    out: &mut Vec<[usize; 3]>,
+) {
+    out.clear();
     ring.clear();
     ring.extend(0..params.len());
-    out.clear();
     while ring.len() > 3 {
         let m = ring.len();
         let mut best: Option<(f64, usize)> = None;
@@ -74,6 +90,34 @@ pub(crate) fn triangulate(
     if ring.len() == 3 {
         out.push([ring[0], ring[1], ring[2]]);
     }
+}
+
+/// [`triangulate`]'s two triangles for a strictly convex quadrilateral (most polygons: a leaf
+/// with no marked point inside its sides), without its loop: every ear is admissible, the ears
+/// at corners 2 and 3 have the new diagonals of those at 1 and 0 (the same lengths to the bit),
+/// so the ear at corner 0 is cut where its diagonal `3-1` is at most the other, `0-2`, else the
+/// ear at corner 1. `None` for any other polygon, or a diagonal's length that is NaN (where
+/// the loop's comparisons order the ears otherwise).
+fn quad(params: &[(i64, i64)], positions: &[Point]) -> Option<[[usize; 3]; 2]> {
+    let &[a, b, c, d] = params else {
+        return None;
+    };
+    let &[p0, p1, p2, p3] = positions else {
+        return None;
+    };
+    let convex = area2(d, a, b) > 0 && area2(a, b, c) > 0 && area2(b, c, d) > 0;
+    if !convex || area2(c, d, a) <= 0 {
+        return None;
+    }
+    let (l31, l02) = (norm(sub(p3, p1)), norm(sub(p0, p2)));
+    if l31.is_nan() || l02.is_nan() {
+        return None;
+    }
+    Some(if l31 <= l02 {
+        [[3, 0, 1], [1, 2, 3]]
+    } else {
+        [[0, 1, 2], [0, 2, 3]]
+    })
 }
 
 /// Write the polygons (not triangulated) as OBJ: `v`, `vn`, then one `f a//a b//b ...` line
@@ -147,5 +191,46 @@ mod tests {
             }
             assert_eq!(area, 2 * 16);
         }
+    }
+
+    #[test]
+    fn a_quadrilateral_gets_the_ear_clipping_triangles() {
+        // Squares of the grid with their corners moved off the plane (and one diagonal pair
+        // exactly as long as the other): the shortcut must cut the ears the loop cuts.
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let square = [(0, 0), (8, 0), (8, 8), (0, 8)];
+        let (mut ring, mut by_loop) = (Vec::new(), Vec::new());
+        let mut cuts = [0; 2];
+        for case in 0..2000 {
+            let mut positions: Vec<Point> = square
+                .iter()
+                .map(|&(u, v)| [u as f64 + next(), v as f64 + next(), 4.0 * next()])
+                .collect();
+            if case % 10 == 0 {
+                positions = vec![[0.0; 3], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
+            }
+            let shortcut = quad(&square, &positions).expect("a square is strictly convex");
+            clip_ears(&square, &positions, &mut ring, &mut by_loop);
+            assert_eq!(by_loop, shortcut, "{positions:?}");
+            cuts[usize::from(shortcut[0][0] == 0)] += 1;
+        }
+        // Both ears were cut (0 at the corner's tie and where its diagonal is shorter).
+        assert!(cuts[0] > 100 && cuts[1] > 100, "{cuts:?}");
+        // Not a strictly convex quadrilateral: a corner on a side, or a NaN position.
+        let flat = [(0, 0), (8, 0), (8, 8), (8, 16)];
+        assert!(quad(&flat, &[[0.0; 3]; 4]).is_none());
+        let nan = [
+            [f64::NAN; 3],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+        ];
+        assert!(quad(&square, &nan).is_none());
     }
 }
