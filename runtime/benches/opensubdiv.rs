@@ -7,12 +7,16 @@
 //! * Crane's Spot refined three times (`../shared/models/crane/spot_control_mesh.obj`, 11,712
 //!   quads, extraordinary vertices far apart: no isolation), n = 4, 8, 16;
 //! * Crane's triangulated Spot (`spot_triangulated.obj`, 5,856 triangles: every face needs
-//!   isolation, two Catmull–Clark steps, 70,272 faces), n = 4, 8 (OpenSubdiv's table at n = 16,
-//!   18 M points, would not fit this machine's memory).
+//!   isolation, two Catmull–Clark steps, 70,272 faces), n = 4, 8, 16.
 //! * the quad-dominant sword (`../shared/models/odedstein/sword-quad-dominant.obj`, 22,117
 //!   quads and 348 triangles: two isolating steps, 358,048 faces, most of them pieces of
-//!   regular input quads), n = 4, 8 (OpenSubdiv's table at n = 8, 22.9 M points, took the
-//!   process to 16 GB).
+//!   regular input quads), n = 4, 8, 16.
+//!
+//! OpenSubdiv's table for more than [`BATCH_POINTS`] points (the sword at n = 8 and 16, the
+//! triangulated Spot at n = 16: one table for the sword's 22.9 M points at n = 8 took the
+//! process to 16 GB) is built in batches of consecutive points, one table at a time, each
+//! checked and timed (the median of [`BATCH_RUNS`] applications) and dropped; its frame is the
+//! sum of the batches' medians, printed as a line of its own beside criterion's groups.
 //!
 //! The Spot meshes and the sword are skipped, with a message, when `../shared/models` is
 //! absent.
@@ -200,6 +204,30 @@ fn max_angle(a: &[[f32; 3]], b: &[[f32; 3]]) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// The most points one OpenSubdiv table is built for. OpenSubdiv's table for the sword at n = 8
+/// (22.9 M points) took the process to 16.3 GB; beyond this many points the points are split
+/// into consecutive batches of at most this many, one table each, built, checked and timed one
+/// after another, and OpenSubdiv's frame is the sum of the batches' median times (the same
+/// stencils applied to the same points, a table at a time).
+const BATCH_POINTS: usize = 6_000_000;
+
+/// Applications timed per batch (after one untimed) when OpenSubdiv's table is built in batches.
+const BATCH_RUNS: usize = 7;
+
+/// The median wall time of `runs` calls of `f`, after one call not timed.
+fn median_seconds(runs: usize, mut f: impl FnMut()) -> f64 {
+    f();
+    let mut seconds: Vec<f64> = (0..runs)
+        .map(|_| {
+            let started = Instant::now();
+            f();
+            started.elapsed().as_secs_f64()
+        })
+        .collect();
+    seconds.sort_by(f64::total_cmp);
+    seconds[runs / 2]
+}
+
 /// One mesh of the comparison.
 struct Case {
     name: String,
@@ -364,27 +392,48 @@ fn compare(c: &mut Criterion, two_threads: &rayon::ThreadPool, case: &Case) {
             surface.faces()
         );
 
-        let started = Instant::now();
-        let limit = limit_stencil_table(&refiner, &points);
+        // OpenSubdiv's table in batches of consecutive points where one table for all of them
+        // would not fit in memory; each batch is built, checked and timed, then dropped.
+        let batches = points.len().div_ceil(BATCH_POINTS);
+        let mut position_error = 0.0f64;
+        let mut normal_error = 0.0f64;
+        let mut build_seconds = 0.0;
+        let mut weights = 0usize;
+        let mut batch_seconds = Vec::with_capacity(batches);
+        let mut single = None;
+        for batch in 0..batches {
+            let range = batch * points.len() / batches..(batch + 1) * points.len() / batches;
+            let started = Instant::now();
+            let limit = limit_stencil_table(&refiner, &points[range.clone()]);
+            build_seconds += started.elapsed().as_secs_f64();
+            weights += limit.weights().len();
+            let stencils = LimitStencils::new(&limit);
+            let mut osd_p = vec![[0.0f32; 3]; range.len()];
+            let mut osd_du = osd_p.clone();
+            let mut osd_dv = osd_p.clone();
+            stencils.apply(&control, &mut osd_p, &mut osd_du, &mut osd_dv);
+            let osd_n: Vec<[f32; 3]> = osd_du
+                .iter()
+                .zip(&osd_dv)
+                .map(|(&u, &v)| unit_normal(u, v))
+                .collect();
+            position_error =
+                position_error.max(max_difference(&osd_p, &ours_p[range.clone()]) / size);
+            normal_error = normal_error.max(max_angle(&osd_n, &ours_n[range.clone()]));
+            if batches == 1 {
+                single = Some((limit, osd_p, osd_du, osd_dv));
+            } else {
+                batch_seconds.push(median_seconds(BATCH_RUNS, || {
+                    stencils.apply(&control, &mut osd_p, &mut osd_du, &mut osd_dv)
+                }));
+            }
+        }
         eprintln!(
-            "{}, n = {n}: OpenSubdiv LimitStencilTable built in {:.2} s ({:.1} weights per \
-             point and quantity)",
+            "{}, n = {n}: OpenSubdiv LimitStencilTable built in {build_seconds:.2} s, {batches} \
+             batch(es) ({:.1} weights per point and quantity)",
             case.name,
-            started.elapsed().as_secs_f64(),
-            limit.weights().len() as f64 / points.len() as f64
+            weights as f64 / points.len() as f64
         );
-        let stencils = LimitStencils::new(&limit);
-        let mut osd_p = vec![[0.0f32; 3]; points.len()];
-        let mut osd_du = osd_p.clone();
-        let mut osd_dv = osd_p.clone();
-        stencils.apply(&control, &mut osd_p, &mut osd_du, &mut osd_dv);
-        let osd_n: Vec<[f32; 3]> = osd_du
-            .iter()
-            .zip(&osd_dv)
-            .map(|(&u, &v)| unit_normal(u, v))
-            .collect();
-        let position_error = max_difference(&osd_p, &ours_p) / size;
-        let normal_error = max_angle(&osd_n, &ours_n);
         let mut bfr_error = 0.0f64;
         if all_quads {
             let sample: Vec<(usize, f32, f32)> = points.iter().copied().step_by(97).collect();
@@ -409,6 +458,18 @@ fn compare(c: &mut Criterion, two_threads: &rayon::ThreadPool, case: &Case) {
         if case.name == "torus" {
             assert!(bfr_error < 1e-5, "Bfr positions differ");
         }
+        if batches > 1 {
+            let seconds: f64 = batch_seconds.iter().sum();
+            eprintln!(
+                "{}, n = {n}: OpenSubdiv LimitStencilTable (P, du, dv), 1 thread, {batches} \
+                 batches: {:.2} ms a frame (the sum of each batch's median of {BATCH_RUNS} \
+                 applications), {:.1} M triangles/s",
+                case.name,
+                seconds * 1e3,
+                triangles as f64 / seconds / 1e6
+            );
+        }
+        drop((ours_p, ours_n));
 
         let mut group = c.benchmark_group(format!(
             "{}, n = {n}, {} points, {triangles} triangles",
@@ -428,14 +489,17 @@ fn compare(c: &mut Criterion, two_threads: &rayon::ThreadPool, case: &Case) {
                 two_threads.install(|| tessellator.evaluate(&control).map(|f| f.positions().len()))
             })
         });
-        group.bench_function("OpenSubdiv LimitStencilTable (P, du, dv), 1 thread", |b| {
-            b.iter(|| stencils.apply(&control, &mut osd_p, &mut osd_du, &mut osd_dv))
-        });
-        if all_quads {
-            group.bench_function(
-                "OpenSubdiv Bfr::Surface (P only, crate API), 1 thread",
-                |b| b.iter(|| bfr_points(&surfaces, &points, &control, &mut osd_p)),
-            );
+        if let Some((limit, mut osd_p, mut osd_du, mut osd_dv)) = single {
+            let stencils = LimitStencils::new(&limit);
+            group.bench_function("OpenSubdiv LimitStencilTable (P, du, dv), 1 thread", |b| {
+                b.iter(|| stencils.apply(&control, &mut osd_p, &mut osd_du, &mut osd_dv))
+            });
+            if all_quads {
+                group.bench_function(
+                    "OpenSubdiv Bfr::Surface (P only, crate API), 1 thread",
+                    |b| b.iter(|| bfr_points(&surfaces, &points, &control, &mut osd_p)),
+                );
+            }
         }
         group.finish();
     }
@@ -490,14 +554,14 @@ fn bench(c: &mut Criterion) {
         cases.push(Case {
             name: "Spot triangulated (isolation)".to_owned(),
             mesh,
-            rates: &[4, 8],
+            rates: &[4, 8, 16],
         });
     }
     if let Some(mesh) = shared_mesh("odedstein/sword-quad-dominant.obj", 0) {
         cases.push(Case {
             name: "sword, quad-dominant (isolation)".to_owned(),
             mesh,
-            rates: &[4, 8],
+            rates: &[4, 8, 16],
         });
     }
     for case in &cases {
