@@ -86,6 +86,8 @@ struct FacePoints {
     first: Vec<u32>,
     /// Per mark, its point (an index into `first`).
     point_of_mark: Vec<u32>,
+    /// Per point, its `(u, v)`: the later stages read these, not the 64-byte marks.
+    places: Vec<(u32, u32)>,
     /// Per side, the canonical parameters of the points the face marked inside it, ascending.
     sides: [Vec<u32>; 4],
 }
@@ -98,19 +100,20 @@ struct FacePoints {
 fn face_points(marked: &[Marked], edges: &[SideEdge; 4]) -> Result<FacePoints, RuntimeError> {
     let mut table = PlaceTable::with_room(marked.len())?;
     let mut first = Vec::new();
+    let mut places = Vec::new();
     let mut point_of_mark = Vec::with_capacity(marked.len());
     for (i, m) in (0u32..).zip(marked) {
         let next = first.len() as u32;
         let point = table.get_or_insert(pack(m.u, m.v), next);
         if point == next {
             first.push(i);
+            places.push((m.u, m.v));
         }
         point_of_mark.push(point);
     }
     let mut sides: [Vec<u32>; 4] = Default::default();
-    for &i in &first {
-        let m = &marked[i as usize];
-        if let Place::Side(s, t) = place(m.u, m.v) {
+    for &(u, v) in &places {
+        if let Place::Side(s, t) = place(u, v) {
             sides[s].push(edges[s].canonical(t));
         }
     }
@@ -120,6 +123,7 @@ fn face_points(marked: &[Marked], edges: &[SideEdge; 4]) -> Result<FacePoints, R
     Ok(FacePoints {
         first,
         point_of_mark,
+        places,
         sides,
     })
 }
@@ -296,14 +300,12 @@ pub(super) fn assign(
     let ranks: Vec<Vec<u32>> = (0..work.len())
         .into_par_iter()
         .map(|f| {
-            let marked = &work[f].1;
             let mut next = 0;
             points[f]
-                .first
+                .places
                 .iter()
-                .map(|&i| {
-                    let m = &marked[i as usize];
-                    let owned = match place(m.u, m.v) {
+                .map(|&(u, v)| {
+                    let owned = match place(u, v) {
                         Place::Interior => true,
                         Place::Corner(k) => vertex_owner[mesh.face(f)[k] as usize] == f as u32,
                         Place::Side(s, t) => match edges[f][s].twin {
@@ -436,31 +438,30 @@ pub(super) fn assign(
     let faces: Vec<FaceIds> = (0..work.len())
         .into_par_iter()
         .map(|f| -> Result<FaceIds, RuntimeError> {
-            let (leaves, marked) = &work[f];
+            let leaves = &work[f].0;
             let points = &points[f];
             let no_id =
-                |m: &Marked| internal(format!("face {f} point ({}, {}) has no id", m.u, m.v));
+                |(u, v): (u32, u32)| internal(format!("face {f} point ({u}, {v}) has no id"));
             let mut ids = Vec::with_capacity(points.first.len());
             let mut rows = Vec::new();
-            for (p, (&i, &r)) in (0u32..).zip(points.first.iter().zip(&ranks[f])) {
-                let m = &marked[i as usize];
-                let place = place(m.u, m.v);
+            for (p, (&(u, v), &r)) in (0u32..).zip(points.places.iter().zip(&ranks[f])) {
+                let place = place(u, v);
                 let id = if r != NONE {
                     base[f] + r
                 } else {
                     match place {
                         Place::Corner(k) => vertices[mesh.face(f)[k] as usize],
                         Place::Side(s, t) => find(&marked_sides[f][s], edges[f][s].canonical(t))
-                            .ok_or_else(|| no_id(m))?,
+                            .ok_or_else(|| no_id((u, v)))?,
                         Place::Interior => NONE,
                     }
                 };
                 if id == NONE {
-                    return Err(no_id(m));
+                    return Err(no_id((u, v)));
                 }
                 ids.push(id);
                 if place == Place::Interior {
-                    rows.push((pack(m.v, m.u), p));
+                    rows.push((pack(v, u), p));
                 }
             }
             let unlisted = Listed {
@@ -499,21 +500,19 @@ pub(super) fn assign(
                 all.dedup_by_key(|x| x.0);
                 all
             });
-            for (&i, at) in points.first.iter().zip(&mut listed) {
-                let m = &marked[i as usize];
-                if let Place::Side(s, t) = place(m.u, m.v) {
+            for (&(u, v), at) in points.places.iter().zip(&mut listed) {
+                if let Place::Side(s, t) = place(u, v) {
                     let k = edges[s].partition_point(|x| x.0 < t);
                     if edges[s].get(k).map(|x| x.0) != Some(t) {
-                        return Err(no_id(m));
+                        return Err(no_id((u, v)));
                     }
                     at.edge = k as u32;
                 }
             }
             let corners = leaves
                 .iter()
-                .zip(marked.chunks_exact(4))
                 .zip(points.point_of_mark.chunks_exact(4))
-                .map(|((leaf, marks), points)| leaf_corners(leaf, marks, points))
+                .map(|(leaf, marks)| leaf_corners(leaf, marks, &points.places))
                 .collect::<Option<Vec<[u32; 4]>>>()
                 .ok_or_else(|| internal(format!("face {f}: a leaf's marks are not its corners")))?;
             Ok(FaceIds {
@@ -529,14 +528,16 @@ pub(super) fn assign(
     Ok(GlobalIds { faces })
 }
 
-/// A leaf's corner points counter-clockwise from `(u0, v0)`, from its four marks (in the order
-/// of the patch's corners) and their points; `None` unless the marks are the four corners.
-fn leaf_corners(leaf: &Leaf, marks: &[Marked], points: &[u32]) -> Option<[u32; 4]> {
+/// A leaf's corner points counter-clockwise from `(u0, v0)`, from the points of its four marks
+/// (in the order of the patch's corners) and the face's points' `places`; `None` unless the
+/// marks are the four corners.
+fn leaf_corners(leaf: &Leaf, marks: &[u32], places: &[(u32, u32)]) -> Option<[u32; 4]> {
     let mut corners = [NONE; 4];
-    for (m, &p) in marks.iter().zip(points) {
-        let right = m.u.checked_sub(leaf.u0)? == leaf.size;
-        let up = m.v.checked_sub(leaf.v0)? == leaf.size;
-        if !(right || m.u == leaf.u0) || !(up || m.v == leaf.v0) {
+    for &p in marks {
+        let &(u, v) = places.get(p as usize)?;
+        let right = u.checked_sub(leaf.u0)? == leaf.size;
+        let up = v.checked_sub(leaf.v0)? == leaf.size;
+        if !(right || u == leaf.u0) || !(up || v == leaf.v0) {
             return None;
         }
         corners[usize::from(right ^ up) + 2 * usize::from(up)] = p;
