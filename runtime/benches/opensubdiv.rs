@@ -232,8 +232,10 @@ fn median_seconds(runs: usize, mut f: impl FnMut()) -> f64 {
 struct Case {
     name: String,
     mesh: Mesh,
-    rates: &'static [u32],
 }
+
+/// The rates `n` every mesh is compared at.
+const RATES: [u32; 3] = [4, 8, 16];
 
 /// The mesh's input faces in OpenSubdiv's terms: vertices per face, face-vertex indices, and
 /// every face's first Ptex face (a quad is one Ptex face, an `m`-gon `m`, one per corner).
@@ -373,7 +375,7 @@ fn compare(c: &mut Criterion, two_threads: &rayon::ThreadPool, case: &Case) {
         Vec::new()
     };
 
-    for &n in case.rates {
+    for n in RATES {
         let mut tessellator = surface
             .tessellator(&Rates::Uniform(n))
             .unwrap_or_else(|e| panic!("{e}"));
@@ -541,28 +543,31 @@ fn bench(c: &mut Criterion) {
     let mut cases = vec![Case {
         name: "torus".to_owned(),
         mesh: torus,
-        rates: &[4, 8, 16],
     }];
-    if let Some(mesh) = shared_mesh("crane/spot_control_mesh.obj", 3) {
-        cases.push(Case {
-            name: "Spot refined 3x (no isolation)".to_owned(),
-            mesh,
-            rates: &[4, 8, 16],
-        });
-    }
-    if let Some(mesh) = shared_mesh("crane/spot_triangulated.obj", 0) {
-        cases.push(Case {
-            name: "Spot triangulated (isolation)".to_owned(),
-            mesh,
-            rates: &[4, 8, 16],
-        });
-    }
-    if let Some(mesh) = shared_mesh("odedstein/sword-quad-dominant.obj", 0) {
-        cases.push(Case {
-            name: "sword, quad-dominant (isolation)".to_owned(),
-            mesh,
-            rates: &[4, 8, 16],
-        });
+    let shared = [
+        (
+            "crane/spot_control_mesh.obj",
+            3,
+            "Spot refined 3x (no isolation)",
+        ),
+        (
+            "crane/spot_triangulated.obj",
+            0,
+            "Spot triangulated (isolation)",
+        ),
+        (
+            "odedstein/sword-quad-dominant.obj",
+            0,
+            "sword, quad-dominant (isolation)",
+        ),
+    ];
+    for (path, steps, name) in shared {
+        if let Some(mesh) = shared_mesh(path, steps) {
+            cases.push(Case {
+                name: name.to_owned(),
+                mesh,
+            });
+        }
     }
     for case in &cases {
         compare(c, &two_threads, case);
