@@ -105,8 +105,13 @@ fn quad(params: &[(i64, i64)], positions: &[Point]) -> Option<[[usize; 3]; 2]> {
     let &[p0, p1, p2, p3] = positions else {
         return None;
     };
-    let convex = area2(d, a, b) > 0 && area2(a, b, c) > 0 && area2(b, c, d) > 0;
-    if !convex || area2(c, d, a) <= 0 {
+    let ears = [
+        area2(d, a, b),
+        area2(a, b, c),
+        area2(b, c, d),
+        area2(c, d, a),
+    ];
+    if ears.iter().any(|&area| area <= 0) {
         return None;
     }
     let (l31, l02) = (norm(sub(p3, p1)), norm(sub(p0, p2)));
@@ -220,7 +225,7 @@ mod tests {
             assert_eq!(by_loop, shortcut, "{positions:?}");
             cuts[usize::from(shortcut[0][0] == 0)] += 1;
         }
-        // Both ears were cut (0 at the corner's tie and where its diagonal is shorter).
+        // Both ears were cut: at corner 0 (its diagonal shorter, or as long) and at corner 1.
         assert!(cuts[0] > 100 && cuts[1] > 100, "{cuts:?}");
         // Not a strictly convex quadrilateral: a corner on a side, or a NaN position.
         let flat = [(0, 0), (8, 0), (8, 8), (8, 16)];
