@@ -380,9 +380,21 @@ struct FaceWork<'a> {
     corner: usize,
     leaves: Vec<Leaf>,
     marked: Vec<Marked>,
-    /// Leaves made so far by all faces together.
+    /// Leaves made so far by all faces together, as far as they have been told
+    /// ([`FaceWork::count_leaf`]).
     polygons: &'a AtomicUsize,
+    /// This face's leaves not yet added to `polygons`.
+    unpublished: usize,
+    /// `polygons` when this face last added to it.
+    seen: usize,
 }
+
+/// How many leaves a face makes between its additions to the shared count: one atomic addition
+/// a leaf, on a cache line that both threads write, made the squares of the marking pass up to
+/// twice as slow on two threads as on one (the cage, docs/benchmarks.md). The budget may
+/// then be exceeded by this many leaves a thread before a face sees it, which changes no result:
+/// the pass fails once the total is over, and a total under it was never seen over.
+const LEAVES_PER_COUNT: usize = 256;
 
 /// A thread's buffers for the faces' leaves and marks, each sized by the face before: a face
 /// then grows its vectors rarely, where they grew by doubling from empty (a tenth of the
@@ -407,13 +419,33 @@ impl<'a> FaceWork<'a> {
             leaves,
             marked,
             polygons,
+            unpublished: 0,
+            seen: polygons.load(Ordering::Relaxed),
         }
+    }
+
+    /// Count one more leaf, adding the face's leaves to the shared count every
+    /// [`LEAVES_PER_COUNT`] of them.
+    fn count_leaf(&mut self) {
+        self.unpublished += 1;
+        if self.unpublished >= LEAVES_PER_COUNT {
+            self.publish();
+        }
+    }
+
+    /// Add the face's uncounted leaves to the shared count.
+    fn publish(&mut self) {
+        self.seen = (self.polygons)
+            .fetch_add(self.unpublished, Ordering::Relaxed)
+            .saturating_add(self.unpublished);
+        self.unpublished = 0;
     }
 
     /// The face's leaves and marks (none when the polygon budget is spent), their buffers
     /// shrunk to their length (in place, not copied); `scratch` gets new buffers of that
     /// length, about what the next face needs.
-    fn finish(self, scratch: &mut Scratch) -> (Vec<Leaf>, Vec<Marked>) {
+    fn finish(mut self, scratch: &mut Scratch) -> (Vec<Leaf>, Vec<Marked>) {
+        self.publish();
         if self.over_budget() {
             *scratch = (self.leaves, self.marked);
             return (Vec::new(), Vec::new());
@@ -456,8 +488,9 @@ impl FaceWork<'_> {
                 && (bound <= tolerance || depth >= self.options.max_depth)
     }
 
+    /// Whether the leaves counted so far, as far as this face knows them, exceed the budget.
     fn over_budget(&self) -> bool {
-        self.polygons.load(Ordering::Relaxed) > self.options.max_polygons
+        self.seen.saturating_add(self.unpublished) > self.options.max_polygons
     }
 
     /// Whether a square at `depth` may still be split (below `max_depth`, budget left): then
@@ -489,7 +522,7 @@ impl FaceWork<'_> {
         tolerance: f64,
         extraordinary: bool,
     ) {
-        self.polygons.fetch_add(1, Ordering::Relaxed);
+        self.count_leaf();
         let size = GRID >> depth;
         let patch_corners = [
             (p0, q0),
@@ -526,7 +559,7 @@ impl FaceWork<'_> {
     /// Record a hull square (at a feature, [`feature`]) with face frame `frame`; its corners are
     /// evaluated after the marking, its diagonal then.
     fn pending_leaf(&mut self, frame: &feature::Frame, depth: u32, bound: f64, tolerance: f64) {
-        self.polygons.fetch_add(1, Ordering::Relaxed);
+        self.count_leaf();
         for &(u, v) in frame {
             self.marked.push(Marked {
                 u,
