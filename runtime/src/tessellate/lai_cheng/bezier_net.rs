@@ -97,13 +97,19 @@ pub fn corners(net: &Net) -> [Point; 4] {
 
 /// Unit normals at the four corners, from the net's first differences (zero where degenerate).
 pub fn corner_normals(net: &Net) -> [Point; 4] {
+    std::array::from_fn(|k| corner_normal(net, k))
+}
+
+/// The unit normal at corner `k` (modulo 4) of [`corners`] ([`corner_normals`]), alone: a
+/// corner that an earlier square already gave a normal needs none.
+pub fn corner_normal(net: &Net, k: usize) -> Point {
     let d = |a: usize, b: usize| sub(net[b], net[a]);
-    [
-        unit(cross(d(0, 1), d(0, 4))),
-        unit(cross(d(2, 3), d(3, 7))),
-        unit(cross(d(14, 15), d(11, 15))),
-        unit(cross(d(12, 13), d(8, 12))),
-    ]
+    match k % 4 {
+        0 => unit(cross(d(0, 1), d(0, 4))),
+        1 => unit(cross(d(2, 3), d(3, 7))),
+        2 => unit(cross(d(14, 15), d(11, 15))),
+        _ => unit(cross(d(12, 13), d(8, 12))),
+    }
 }
 
 /// The longer diagonal `max{D_1, D_2}` of the base quadrilateral (Lai–Cheng section 6).

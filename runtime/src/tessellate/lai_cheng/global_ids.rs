@@ -13,7 +13,8 @@
 
 use rayon::prelude::*;
 
-use super::{Leaf, Marked, GRID};
+use super::marks::{pack, FaceMarks};
+use super::{Leaf, GRID};
 use crate::mesh::topology::{Mesh, NONE};
 use crate::mesh::triangle_mesh::VertexSource;
 use crate::tessellate::kernel::for_each_range;
@@ -80,39 +81,11 @@ impl SideEdge {
     }
 }
 
-/// One face's marked points, each once, in the order the face first marked them.
-struct FacePoints {
-    /// Index into the face's marked points of each point's first mark.
-    first: Vec<u32>,
-    /// Per mark, its point (an index into `first`).
-    point_of_mark: Vec<u32>,
-    /// Per point, its `(u, v)`: the later stages read these, not the 64-byte marks.
-    places: Vec<(u32, u32)>,
-    /// Per side, the canonical parameters of the points the face marked inside it, ascending.
-    sides: [Vec<u32>; 4],
-}
-
-/// A face's distinct marked points (by exact `(u, v)`; the first mark of each is the one whose
-/// evaluation counts) and the canonical parameters of those inside its sides. The marks are
-/// visited in order and each place is numbered when first met (a hash table of places, made
-/// and dropped here: sorting the marks by place took a third of pass 2, 11 of 33 ms on Spot at
-/// `2.749e-4`).
-fn face_points(marked: &[Marked], edges: &[SideEdge; 4]) -> Result<FacePoints, RuntimeError> {
-    let mut table = PlaceTable::with_room(marked.len())?;
-    let mut first = Vec::new();
-    let mut places = Vec::new();
-    let mut point_of_mark = Vec::with_capacity(marked.len());
-    for (i, m) in (0u32..).zip(marked) {
-        let next = first.len() as u32;
-        let point = table.get_or_insert(pack(m.u, m.v), next);
-        if point == next {
-            first.push(i);
-            places.push((m.u, m.v));
-        }
-        point_of_mark.push(point);
-    }
+/// Per side of a face, the canonical parameters of the points the face marked inside it,
+/// ascending.
+fn side_points(marks: &FaceMarks, edges: &[SideEdge; 4]) -> [Vec<u32>; 4] {
     let mut sides: [Vec<u32>; 4] = Default::default();
-    for &(u, v) in &places {
+    for &(u, v) in &marks.places {
         if let Place::Side(s, t) = place(u, v) {
             sides[s].push(edges[s].canonical(t));
         }
@@ -120,62 +93,7 @@ fn face_points(marked: &[Marked], edges: &[SideEdge; 4]) -> Result<FacePoints, R
     for list in &mut sides {
         list.sort_unstable();
     }
-    Ok(FacePoints {
-        first,
-        point_of_mark,
-        places,
-        sides,
-    })
-}
-
-/// A face's points by place: open addressing, linear probing, from a point's [`pack`]ed
-/// `(u, v)` to its number, in more slots than marks (a power of two: a new place always finds
-/// an empty slot; a face of more than one leaf has at most about half as many points as marks,
-/// most faces a quarter), a slot's key and point side by side so that a probe reads one cache
-/// line.
-struct PlaceTable {
-    slots: Vec<(u64, u32)>,
-    /// `64 - log2(slots)`: a key's slot is the top bits of its product with an odd constant.
-    shift: u32,
-}
-
-/// An empty slot's key: no place packs to it (`u, v <= GRID < 2^32 - 1`).
-const EMPTY: u64 = u64::MAX;
-
-impl PlaceTable {
-    /// A table with room for the places of `marks` marks.
-    fn with_room(marks: usize) -> Result<Self, RuntimeError> {
-        let slots = marks
-            .checked_add(1)
-            .and_then(|n| n.max(4).checked_next_power_of_two())
-            .ok_or_else(|| internal(format!("{marks} marks in one face")))?;
-        Ok(PlaceTable {
-            slots: vec![(EMPTY, NONE); slots],
-            shift: 64 - slots.trailing_zeros(),
-        })
-    }
-
-    /// The first slot to probe for `key` (Fibonacci hashing).
-    fn slot(&self, key: u64) -> usize {
-        (key.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> self.shift) as usize
-    }
-
-    /// The point at `key`, or `new` where there is none yet (then it is the point at `key`).
-    fn get_or_insert(&mut self, key: u64, new: u32) -> u32 {
-        let mask = self.slots.len() - 1;
-        let mut i = self.slot(key);
-        loop {
-            let slot = &mut self.slots[i];
-            if slot.0 == key {
-                return slot.1;
-            }
-            if slot.0 == EMPTY {
-                *slot = (key, new);
-                return new;
-            }
-            i = (i + 1) & mask;
-        }
-    }
+    sides
 }
 
 /// `more` after `list`'s items: `more` itself when `list` is empty (no copy).
@@ -222,11 +140,6 @@ fn find<K: Ord + Copy>(sorted: &[(K, u32)], key: K) -> Option<u32> {
         .map(|k| sorted[k].1)
 }
 
-/// The key of `(a, b)` in a list sorted by `a`, then `b`.
-fn pack(a: u32, b: u32) -> u64 {
-    (u64::from(a) << 32) | u64::from(b)
-}
-
 /// Where a point of a face is listed in its [`FaceIds`]: its index in `rows` and `columns` (an
 /// interior point) or in the `edges` list of its side (a point inside a side), [`NONE`] where
 /// it is not listed.
@@ -239,7 +152,7 @@ struct Listed {
 
 /// The ids of one face's marked points, by place.
 struct FaceIds {
-    /// Per point of the face ([`FacePoints`]), its id.
+    /// Per point of the face ([`FaceMarks::places`]), its id.
     ids: Vec<u32>,
     /// Per point, where it is listed.
     listed: Vec<Listed>,
@@ -268,7 +181,7 @@ fn internal(what: String) -> RuntimeError {
 /// the points to `positions`, `normals` and `sources` in id order (module documentation).
 pub(super) fn assign(
     mesh: &Mesh,
-    work: &[(Vec<Leaf>, Vec<Marked>)],
+    work: &[FaceMarks],
     positions: &mut Vec<[f64; 3]>,
     normals: &mut Vec<[f64; 3]>,
     sources: &mut Vec<VertexSource>,
@@ -277,15 +190,15 @@ pub(super) fn assign(
         .into_par_iter()
         .map(|f| std::array::from_fn(|s| SideEdge::new(mesh, f, s)))
         .collect();
-    let points: Vec<FacePoints> = work
+    let sides: Vec<[Vec<u32>; 4]> = work
         .par_iter()
         .zip(&edges)
-        .map(|((_, marked), edges)| face_points(marked, edges))
-        .collect::<Result<_, _>>()?;
+        .map(|(marks, edges)| side_points(marks, edges))
+        .collect();
     // The lowest face marking each vertex (every face with leaves marks its four corners).
     let mut vertex_owner = vec![NONE; mesh.positions.len()];
-    for (f, (_, marked)) in work.iter().enumerate() {
-        if marked.is_empty() {
+    for (f, marks) in work.iter().enumerate() {
+        if marks.places.is_empty() {
             continue;
         }
         for &v in mesh.face(f) {
@@ -301,7 +214,7 @@ pub(super) fn assign(
         .into_par_iter()
         .map(|f| {
             let mut next = 0;
-            points[f]
+            work[f]
                 .places
                 .iter()
                 .map(|&(u, v)| {
@@ -309,7 +222,7 @@ pub(super) fn assign(
                         Place::Interior => true,
                         Place::Corner(k) => vertex_owner[mesh.face(f)[k] as usize] == f as u32,
                         Place::Side(s, t) => match edges[f][s].twin {
-                            Some((g, side)) if g < f => points[g].sides[side]
+                            Some((g, side)) if g < f => sides[g][side]
                                 .binary_search(&edges[f][s].canonical(t))
                                 .is_err(),
                             _ => true,
@@ -335,16 +248,14 @@ pub(super) fn assign(
             u32::try_from(r.iter().filter(|&&x| x != NONE).count()).map_err(|_| too_many())?;
         total = total.checked_add(owned).ok_or_else(too_many)?;
     }
-    // Per face, the points it owns: the index of the first mark of each and its id.
+    // Per face, the points it owns and their ids.
     let owned: Vec<Vec<(u32, u32)>> = (0..work.len())
         .into_par_iter()
         .map(|f| {
-            points[f]
-                .first
-                .iter()
+            (0u32..)
                 .zip(&ranks[f])
                 .filter(|(_, &r)| r != NONE)
-                .map(|(&i, &r)| (i, base[f] + r))
+                .map(|(p, &r)| (p, base[f] + r))
                 .collect()
         })
         .collect();
@@ -368,15 +279,17 @@ pub(super) fn assign(
         &mut new_sources[..],
     );
     for_each_range(&ends, out, |f, (p, n, s)| {
-        for (k, &(i, _)) in owned[f].iter().enumerate() {
-            let m = &work[f].1[i as usize];
-            p[k] = m.position;
-            n[k] = m.normal;
-            let shift = (m.u | m.v | GRID).trailing_zeros();
+        let marks = &work[f];
+        for (k, &(point, _)) in owned[f].iter().enumerate() {
+            let point = point as usize;
+            p[k] = marks.positions[point];
+            n[k] = marks.normals[point];
+            let (u, v) = marks.places[point];
+            let shift = (u | v | GRID).trailing_zeros();
             s[k] = VertexSource {
                 face: f as u32,
-                u: m.u >> shift,
-                v: m.v >> shift,
+                u: u >> shift,
+                v: v >> shift,
                 denominator: GRID >> shift,
                 subface: 0,
             };
@@ -387,9 +300,9 @@ pub(super) fn assign(
     append(sources, new_sources);
     let mut vertices = vec![NONE; mesh.positions.len()];
     for (f, list) in owned.iter().enumerate() {
-        for &(i, id) in list {
-            let m = &work[f].1[i as usize];
-            if let Place::Corner(k) = place(m.u, m.v) {
+        for &(p, id) in list {
+            let (u, v) = work[f].places[p as usize];
+            if let Place::Corner(k) = place(u, v) {
                 vertices[mesh.face(f)[k] as usize] = id;
             }
         }
@@ -401,9 +314,9 @@ pub(super) fn assign(
         .enumerate()
         .map(|(f, (list, edges))| {
             let mut sides: [Vec<(u32, u32)>; 4] = Default::default();
-            for &(i, id) in list {
-                let m = &work[f].1[i as usize];
-                if let Place::Side(s, t) = place(m.u, m.v) {
+            for &(p, id) in list {
+                let (u, v) = work[f].places[p as usize];
+                if let Place::Side(s, t) = place(u, v) {
                     sides[s].push((edges[s].canonical(t), id));
                 }
             }
@@ -417,9 +330,9 @@ pub(super) fn assign(
     let marked_sides: Vec<[Vec<(u32, u32)>; 4]> = (0..work.len())
         .into_par_iter()
         .map(|f| -> Result<[Vec<(u32, u32)>; 4], RuntimeError> {
-            let mut sides: [Vec<(u32, u32)>; 4] = Default::default();
-            for (s, list) in sides.iter_mut().enumerate() {
-                for &tc in &points[f].sides[s] {
+            let mut lists: [Vec<(u32, u32)>; 4] = Default::default();
+            for (s, list) in lists.iter_mut().enumerate() {
+                for &tc in &sides[f][s] {
                     let own = find(&owned_sides[f][s], tc);
                     let across = || {
                         edges[f][s]
@@ -432,19 +345,18 @@ pub(super) fn assign(
                     list.push((tc, id));
                 }
             }
-            Ok(sides)
+            Ok(lists)
         })
         .collect::<Result<_, _>>()?;
     let faces: Vec<FaceIds> = (0..work.len())
         .into_par_iter()
         .map(|f| -> Result<FaceIds, RuntimeError> {
-            let leaves = &work[f].0;
-            let points = &points[f];
+            let marks = &work[f];
             let no_id =
                 |(u, v): (u32, u32)| internal(format!("face {f} point ({u}, {v}) has no id"));
-            let mut ids = Vec::with_capacity(points.first.len());
+            let mut ids = Vec::with_capacity(marks.places.len());
             let mut rows = Vec::new();
-            for (p, (&(u, v), &r)) in (0u32..).zip(points.places.iter().zip(&ranks[f])) {
+            for (p, (&(u, v), &r)) in (0u32..).zip(marks.places.iter().zip(&ranks[f])) {
                 let place = place(u, v);
                 let id = if r != NONE {
                     base[f] + r
@@ -500,7 +412,7 @@ pub(super) fn assign(
                 all.dedup_by_key(|x| x.0);
                 all
             });
-            for (&(u, v), at) in points.places.iter().zip(&mut listed) {
+            for (&(u, v), at) in marks.places.iter().zip(&mut listed) {
                 if let Place::Side(s, t) = place(u, v) {
                     let k = edges[s].partition_point(|x| x.0 < t);
                     if edges[s].get(k).map(|x| x.0) != Some(t) {
@@ -509,10 +421,11 @@ pub(super) fn assign(
                     at.edge = k as u32;
                 }
             }
-            let corners = leaves
+            let corners = marks
+                .leaves
                 .iter()
-                .zip(points.point_of_mark.chunks_exact(4))
-                .map(|(leaf, marks)| leaf_corners(leaf, marks, &points.places))
+                .zip(marks.point_of_mark.chunks_exact(4))
+                .map(|(leaf, points)| leaf_corners(leaf, points, &marks.places))
                 .collect::<Option<Vec<[u32; 4]>>>()
                 .ok_or_else(|| internal(format!("face {f}: a leaf's marks are not its corners")))?;
             Ok(FaceIds {
@@ -617,35 +530,5 @@ impl GlobalIds {
             ring.extend(side.iter().rev().map(|&(key, id)| ((u0, key as u32), id)));
         }
         Ok(())
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use std::collections::HashMap;
-
-    #[test]
-    fn places_are_numbered_in_the_order_first_met() {
-        // The corners of a quadtree's squares (dyadic places, most met several times), and a
-        // face of one leaf (four marks, four places: the table still has an empty slot).
-        let mut marks = Vec::new();
-        for depth in 1..6u32 {
-            let size = GRID >> depth;
-            for k in 0..(1u32 << depth) {
-                let (u, v) = (k * size, (k * 7 % (1 << depth)) * size);
-                marks.extend([(u, v), (u + size, v), (u + size, v + size), (u, v + size)]);
-            }
-        }
-        for marks in [&marks[..], &marks[..4]] {
-            let mut table = PlaceTable::with_room(marks.len()).expect("room");
-            let mut expected: HashMap<(u32, u32), u32> = HashMap::new();
-            for &(u, v) in marks {
-                let next = expected.len() as u32;
-                let want = *expected.entry((u, v)).or_insert(next);
-                assert_eq!(table.get_or_insert(pack(u, v), next), want, "({u}, {v})");
-            }
-            assert!(expected.len() < marks.len() || marks.len() == 4);
-        }
     }
 }

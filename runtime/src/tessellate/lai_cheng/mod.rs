@@ -53,6 +53,7 @@
 pub mod bezier_net;
 mod feature;
 mod global_ids;
+mod marks;
 mod operators;
 mod polygons;
 
@@ -71,7 +72,8 @@ use crate::scheme::catmull_clark::adaptive::{limit_of, limit_stencils, LimitQuer
 use crate::scheme::patch::{is_table_patch, FacePatch, PatchKind};
 use crate::stencil_table::StencilTable;
 use crate::RuntimeError;
-use bezier_net::{corner_normals, corners, cross, longer_diagonal, unit, Deviation, Net, Point};
+use bezier_net::{corner_normal, corners, cross, longer_diagonal, unit, Deviation, Net, Point};
+use marks::{FaceMarks, PlaceTable};
 use operators::Operators;
 pub use polygons::write_obj_polygons;
 
@@ -361,25 +363,16 @@ struct Leaf {
     extraordinary: bool,
 }
 
-/// A corner of a leaf: a marked point (section 5), with its evaluated position and normal.
-#[derive(Clone, Copy, Debug)]
-struct Marked {
-    u: u32,
-    v: u32,
-    position: Point,
-    normal: Point,
-    /// Whether the position and normal are still to be evaluated (a hull square's corner next
-    /// to a feature: [`feature`]).
-    pending: bool,
-}
-
 /// The recursion over one face (section 5's `AdaptiveMarking`).
 struct FaceWork<'a> {
     options: &'a AdaptiveOptions,
     /// The face corner at the patch's `(0,0)`.
     corner: usize,
-    leaves: Vec<Leaf>,
-    marked: Vec<Marked>,
+    marks: FaceMarks,
+    /// The face's points by place.
+    table: &'a mut PlaceTable,
+    /// Why the face could not be marked (too many points), if it could not.
+    error: Option<RuntimeError>,
     /// Leaves made so far by all faces together, as far as they have been told
     /// ([`FaceWork::count_leaf`]).
     polygons: &'a AtomicUsize,
@@ -396,28 +389,27 @@ struct FaceWork<'a> {
 /// the pass fails once the total is over, and a total under it was never seen over.
 const LEAVES_PER_COUNT: usize = 256;
 
-/// A thread's buffers for the faces' leaves and marks, each sized by the face before: a face
-/// then grows its vectors rarely, where they grew by doubling from empty (a tenth of the
-/// adaptive pass's instructions went to `realloc` and its copies; docs/benchmarks.md).
-type Scratch = (Vec<Leaf>, Vec<Marked>);
+/// A thread's buffers for the faces' leaves and marks, each sized by the face before
+/// ([`FaceMarks::sized_like`]), and its table of places.
+type Scratch = (FaceMarks, PlaceTable);
 
 impl<'a> FaceWork<'a> {
     /// The work on a face whose patch has its `(0,0)` at face corner `corner`, growing its
-    /// leaves and marks in `scratch`'s buffers.
+    /// leaves and marks in `buffers` and its points in `table`.
     fn new(
         options: &'a AdaptiveOptions,
         corner: usize,
-        scratch: &mut Scratch,
+        (mut marks, table): (FaceMarks, &'a mut PlaceTable),
         polygons: &'a AtomicUsize,
     ) -> Self {
-        let (mut leaves, mut marked) = std::mem::take(scratch);
-        leaves.clear();
-        marked.clear();
+        table.reset(marks.places.capacity());
+        marks.clear();
         FaceWork {
             options,
             corner,
-            leaves,
-            marked,
+            marks,
+            table,
+            error: None,
             polygons,
             unpublished: 0,
             seen: polygons.load(Ordering::Relaxed),
@@ -441,23 +433,37 @@ impl<'a> FaceWork<'a> {
         self.unpublished = 0;
     }
 
+    /// Mark a face whose patch has its `(0,0)` at face corner `corner` by `body`, in the
+    /// thread's `scratch`, which it hands on to the next face sized by this one.
+    fn run(
+        options: &AdaptiveOptions,
+        corner: usize,
+        (buffers, table): &mut Scratch,
+        polygons: &AtomicUsize,
+        body: &mut dyn FnMut(&mut FaceWork),
+    ) -> Result<FaceMarks, RuntimeError> {
+        let mut face = FaceWork::new(options, corner, (std::mem::take(buffers), table), polygons);
+        body(&mut face);
+        let (marks, next) = face.finish();
+        *buffers = next;
+        marks
+    }
+
     /// The face's leaves and marks (none when the polygon budget is spent), their buffers
-    /// shrunk to their length (in place, not copied); `scratch` gets new buffers of that
-    /// length, about what the next face needs.
-    fn finish(mut self, scratch: &mut Scratch) -> (Vec<Leaf>, Vec<Marked>) {
+    /// shrunk to their length (in place, not copied), and buffers for the next face, of that
+    /// length.
+    fn finish(mut self) -> (Result<FaceMarks, RuntimeError>, FaceMarks) {
         self.publish();
-        if self.over_budget() {
-            *scratch = (self.leaves, self.marked);
-            return (Vec::new(), Vec::new());
+        if let Some(error) = self.error {
+            return (Err(error), self.marks);
         }
-        let (mut leaves, mut marked) = (self.leaves, self.marked);
-        *scratch = (
-            Vec::with_capacity(leaves.len()),
-            Vec::with_capacity(marked.len()),
-        );
-        leaves.shrink_to_fit();
-        marked.shrink_to_fit();
-        (leaves, marked)
+        if self.over_budget() {
+            return (Ok(FaceMarks::default()), self.marks);
+        }
+        let mut marks = self.marks;
+        let next = FaceMarks::sized_like(&marks);
+        marks.shrink_to_fit();
+        (Ok(marks), next)
     }
 }
 
@@ -488,9 +494,11 @@ impl FaceWork<'_> {
                 && (bound <= tolerance || depth >= self.options.max_depth)
     }
 
-    /// Whether the leaves counted so far, as far as this face knows them, exceed the budget.
+    /// Whether the leaves counted so far, as far as this face knows them, exceed the budget
+    /// (or the face cannot be marked: then it stops as soon).
     fn over_budget(&self) -> bool {
         self.seen.saturating_add(self.unpublished) > self.options.max_polygons
+            || self.error.is_some()
     }
 
     /// Whether a square at `depth` may still be split (below `max_depth`, budget left): then
@@ -510,14 +518,22 @@ impl FaceWork<'_> {
         }
     }
 
+    /// Mark the face grid point `(u, v)` ([`FaceMarks::mark`]), keeping the first error.
+    fn mark(&mut self, place: (u32, u32), position: Option<Point>, normal: impl FnOnce() -> Point) {
+        if let Err(error) = self.marks.mark(self.table, place, position, normal) {
+            self.error.get_or_insert(error);
+        }
+    }
+
     /// Record the leaf `[p0, p0 + size] x [q0, q0 + size]` (patch coordinates) and mark its
-    /// corners (`MarkBlack`).
+    /// corners (`MarkBlack`): their positions `points` and their normals `normal(k)`, made only
+    /// for a point not marked before.
     #[allow(clippy::too_many_arguments)]
     fn leaf(
         &mut self,
         (p0, q0, depth): (u32, u32, u32),
         points: [Point; 4],
-        normals: [Point; 4],
+        normal: impl Fn(usize) -> Point,
         bound: f64,
         tolerance: f64,
         extraordinary: bool,
@@ -536,15 +552,9 @@ impl FaceWork<'_> {
             let (u, v) = self.to_face(p, q);
             u0 = u0.min(u);
             v0 = v0.min(v);
-            self.marked.push(Marked {
-                u,
-                v,
-                position: points[k],
-                normal: normals[k],
-                pending: false,
-            });
+            self.mark((u, v), Some(points[k]), || normal(k));
         }
-        self.leaves.push(Leaf {
+        self.marks.leaves.push(Leaf {
             u0,
             v0,
             size,
@@ -560,16 +570,10 @@ impl FaceWork<'_> {
     /// evaluated after the marking, its diagonal then.
     fn pending_leaf(&mut self, frame: &feature::Frame, depth: u32, bound: f64, tolerance: f64) {
         self.count_leaf();
-        for &(u, v) in frame {
-            self.marked.push(Marked {
-                u,
-                v,
-                position: [0.0; 3],
-                normal: [0.0; 3],
-                pending: true,
-            });
+        for &place in frame {
+            self.mark(place, None, || [0.0; 3]);
         }
-        self.leaves.push(Leaf {
+        self.marks.leaves.push(Leaf {
             u0: frame.iter().map(|p| p.0).min().unwrap_or(0),
             v0: frame.iter().map(|p| p.1).min().unwrap_or(0),
             size: GRID >> depth,
@@ -614,7 +618,7 @@ impl FaceWork<'_> {
                 self.leaf(
                     (p0, q0, depth),
                     points,
-                    corner_normals(net),
+                    |k| corner_normal(net, k),
                     bound,
                     tolerance,
                     false,
@@ -634,10 +638,10 @@ impl FaceWork<'_> {
     ///
     /// The levels `k..=k + EV_ENCLOSURE_LEVELS` that the enclosure of level `k` needs are kept
     /// in a window and each is made once (the next level's enclosure shares all but one).
-    fn extraordinary(&mut self, ops: &Operators, points: Vec<Point>, vertex_normal: Point) {
+    fn extraordinary(&mut self, ops: &Operators, points: &[Point], vertex_normal: Point) {
         let mut depth = 0;
         let mut root_diagonal = 0.0;
-        let mut window = VecDeque::from([EvLevel::new(ops, points)]);
+        let mut window = VecDeque::from([EvLevel::new(ops, points.to_vec())]);
         // Without non-negative rules there is no enclosure, only the level itself.
         let wanted = if ops.nonnegative {
             EV_ENCLOSURE_LEVELS + 1
@@ -679,20 +683,11 @@ impl FaceWork<'_> {
                 f64::INFINITY
             };
             if self.done(depth, bound, tolerance) {
-                let normals = [
-                    vertex_normal,
-                    corner_normals(&nets[0])[1],
-                    corner_normals(&nets[1])[2],
-                    corner_normals(&nets[2])[3],
-                ];
-                self.leaf(
-                    (0, 0, depth),
-                    corner_points,
-                    normals,
-                    bound,
-                    tolerance,
-                    true,
-                );
+                let normal = |k: usize| match k {
+                    0 => vertex_normal,
+                    k => corner_normal(&nets[k - 1], k),
+                };
+                self.leaf((0, 0, depth), corner_points, normal, bound, tolerance, true);
                 return;
             }
             let half = (GRID >> depth) / 2;
@@ -1093,20 +1088,23 @@ pub(crate) fn tessellate_adaptive_with(
     }
     // Pass 1 (parallel): the adaptive marking of every face, within the polygon budget.
     let polygons = AtomicUsize::new(0);
-    let mut work: Vec<(Vec<Leaf>, Vec<Marked>)> = patches
+    let mut work: Vec<FaceMarks> = patches
         .par_iter()
         .enumerate()
         .map_init(
             Scratch::default,
-            |scratch, (f, patch)| -> Result<(Vec<Leaf>, Vec<Marked>), RuntimeError> {
+            |scratch, (f, patch)| -> Result<FaceMarks, RuntimeError> {
+                let run = |scratch, corner, body| {
+                    FaceWork::run(options, corner, scratch, &polygons, body)
+                };
                 match path[f] {
-                    Path::Hole => return Ok((Vec::new(), Vec::new())),
+                    Path::Hole => return Ok(FaceMarks::default()),
                     Path::Feature => {
-                        let mut face = FaceWork::new(options, 0, scratch, &polygons);
                         let (level, g) = feature::root(mesh, f);
                         let frame = [(0, 0), (GRID, 0), (GRID, GRID), (0, GRID)];
-                        face.feature(&level, g, frame, 0, true, root_diagonal[f]);
-                        return Ok(face.finish(scratch));
+                        return run(scratch, 0, &mut |face| {
+                            face.feature(&level, g, frame, 0, true, root_diagonal[f]);
+                        });
                     }
                     Path::Table => {}
                 }
@@ -1126,15 +1124,17 @@ pub(crate) fn tessellate_adaptive_with(
                     .iter()
                     .map(|&v| mesh.positions[v as usize])
                     .collect();
-                let mut face = FaceWork::new(options, patch.corner, scratch, &polygons);
                 match ops.regular_patch(&points) {
-                    Some(net) => face.regular(&net, 0, 0, 0),
+                    Some(net) => run(scratch, patch.corner, &mut |face| {
+                        face.regular(&net, 0, 0, 0);
+                    }),
                     None => {
                         let normal = vertex_normal(table, patch, &points).unwrap_or([0.0; 3]);
-                        face.extraordinary(ops, points, normal);
+                        run(scratch, patch.corner, &mut |face| {
+                            face.extraordinary(ops, &points, normal);
+                        })
                     }
                 }
-                Ok(face.finish(scratch))
             },
         )
         .collect::<Result<_, _>>()?;
@@ -1160,48 +1160,42 @@ pub(crate) fn tessellate_adaptive_with(
     }
     // Pass 1b: the corners of the hull squares, by feature-adaptive limit stencils (one batch),
     // and those squares' diagonals.
-    // Only the feature descent leaves corners pending: the other faces' marks are not read
-    // (reading all of them took 2–3 ms of Spot's pass at `2.749e-4`, serial).
-    let pending: Vec<(usize, usize)> = feature_faces
+    // Only the feature descent leaves points pending, each once.
+    let pending: Vec<(usize, u32)> = feature_faces
         .iter()
-        .flat_map(|&f| {
-            work[f]
-                .1
-                .iter()
-                .enumerate()
-                .filter(|(_, m)| m.pending)
-                .map(move |(k, _)| (f, k))
-        })
+        .flat_map(|&f| work[f].pending.iter().map(move |&p| (f, p)))
         .collect();
     let queries: Vec<LimitQuery> = pending
         .iter()
-        .map(|&(f, k)| {
-            let m = &work[f].1[k];
+        .map(|&(f, p)| {
+            let (u, v) = work[f].places[p as usize];
             LimitQuery {
                 face: f as u32,
-                u: f64::from(m.u) / f64::from(GRID),
-                v: f64::from(m.v) / f64::from(GRID),
+                u: f64::from(u) / f64::from(GRID),
+                v: f64::from(v) / f64::from(GRID),
             }
         })
         .collect();
     let stencils = limit_stencils(mesh, &queries)?;
-    for (&(f, k), stencil) in pending.iter().zip(&stencils) {
+    for (&(f, p), stencil) in pending.iter().zip(&stencils) {
         let [position, du, dv] = limit_of(stencil, mesh);
-        let m = &mut work[f].1[k];
-        m.position = position;
-        m.normal = unit(cross(du, dv));
-        m.pending = false;
+        work[f].positions[p as usize] = position;
+        work[f].normals[p as usize] = unit(cross(du, dv));
     }
-    work.par_iter_mut().for_each(|(leaves, marked)| {
-        for (i, leaf) in leaves.iter_mut().enumerate() {
-            if let Some(corners) = marked.get(4 * i..4 * i + 4) {
-                if leaf.extraordinary && leaf.diagonal == 0.0 {
-                    let p: [Point; 4] = std::array::from_fn(|c| corners[c].position);
-                    leaf.diagonal = longer_diagonal(&p);
-                }
+    for &f in &feature_faces {
+        let marks = &mut work[f];
+        marks.pending.clear();
+        for (leaf, corners) in marks
+            .leaves
+            .iter_mut()
+            .zip(marks.point_of_mark.chunks_exact(4))
+        {
+            if leaf.extraordinary && leaf.diagonal == 0.0 {
+                let p: [Point; 4] = std::array::from_fn(|c| marks.positions[corners[c] as usize]);
+                leaf.diagonal = longer_diagonal(&p);
             }
         }
-    });
+    }
     // Pass 2 (parallel): global ids (section 5), first evaluation wins, in face order.
     let mut out = AdaptiveMesh::default();
     let ids = global_ids::assign(
@@ -1211,10 +1205,11 @@ pub(crate) fn tessellate_adaptive_with(
         &mut out.normals,
         &mut out.sources,
     )?;
-    // The marks (four a leaf, 64 bytes each) are not read again: their memory goes before the
+    // The points' positions and normals are the output's now: their memory goes before the
     // polygons take theirs.
-    for (_, marked) in &mut work {
-        *marked = Vec::new();
+    for marks in &mut work {
+        marks.positions = Vec::new();
+        marks.normals = Vec::new();
     }
     // Pass 3 (parallel): the polygons (base quadrilateral replacement) and their triangles,
     // in runs of leaves, then copied into the output's flat arrays run by run in parallel
@@ -1223,8 +1218,9 @@ pub(crate) fn tessellate_adaptive_with(
     let jobs: Vec<(usize, usize, &Leaf)> = work
         .iter()
         .enumerate()
-        .flat_map(|(face, (leaves, _))| {
-            leaves
+        .flat_map(|(face, marks)| {
+            marks
+                .leaves
                 .iter()
                 .enumerate()
                 .map(move |(index, leaf)| (face, index, leaf))
