@@ -633,6 +633,20 @@ impl Surface {
         &self,
         options: &AdaptiveOptions,
     ) -> Result<(AdaptiveMesh, AdaptiveStats), RuntimeError> {
+        let mut out = AdaptiveMesh::default();
+        let stats = self.tessellate_adaptive_into(options, &mut out)?;
+        Ok((out, stats))
+    }
+
+    /// [`Surface::tessellate_adaptive`] into `out`, whose lists are emptied and refilled with
+    /// their memory kept: for a mesh that moves every frame, each frame writes the pages the
+    /// frame before wrote rather than memory fresh from the system (a tenth of a frame on two
+    /// threads, docs/benchmarks.md). On an error `out` holds no tessellation.
+    pub fn tessellate_adaptive_into(
+        &self,
+        options: &AdaptiveOptions,
+        out: &mut AdaptiveMesh,
+    ) -> Result<AdaptiveStats, RuntimeError> {
         let Isolated::Quad(iso) = &self.isolated else {
             return Err(RuntimeError::Unsupported(format!(
                 "--scheme {} tessellates with the dual grid (Lai–Cheng's adaptive method is for catmull-clark)",
@@ -657,16 +671,17 @@ impl Surface {
                 }
             }
         };
-        let (mut adaptive, stats) = tessellate_adaptive_with(
+        let stats = tessellate_adaptive_with(
             &self.table,
             &iso.mesh,
             &iso.patches,
             options,
             &operators,
             started,
+            out,
         )?;
-        iso.map_to_input(&mut adaptive.sources);
-        Ok((adaptive, stats))
+        iso.map_to_input(&mut out.sources);
+        Ok(stats)
     }
 }
 

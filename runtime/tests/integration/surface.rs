@@ -266,12 +266,17 @@ fn check_moved_rates(label: &str, mesh: &Mesh, scheme: Scheme, relative: f64) {
         triangulate: true,
         ..Default::default()
     };
+    // At rest first: the surface makes and keeps the patch kinds' operators, which the moved
+    // surface's adaptive tessellation below reuses, into an output it keeps.
+    let mut kept_adaptive = subtess::AdaptiveMesh::default();
     if scheme == Scheme::CatmullClark {
-        // At rest first: the surface makes and keeps the patch kinds' operators, which the
-        // moved surface's adaptive tessellation below reuses.
         surface
-            .tessellate_adaptive(&adaptive)
+            .tessellate_adaptive_into(&adaptive, &mut kept_adaptive)
             .expect("adaptive at rest");
+        assert!(
+            kept_adaptive.polygon_count() > 0,
+            "{label}: adaptive at rest"
+        );
     }
     let rest_rates = surface
         .tessellator(&tolerance)
@@ -315,12 +320,32 @@ fn check_moved_rates(label: &str, mesh: &Mesh, scheme: Scheme, relative: f64) {
     assert!(worst <= 1e-5 * extent, "{label}: frame off by {worst}");
 
     // Lai–Cheng's adaptive tessellation reads the surface's positions too (with the operators
-    // it kept from the rest positions, the fresh surface with its own).
+    // it kept from the rest positions, the fresh surface with its own); into the output kept
+    // from the rest tessellation, it is the fresh one's, every list; a refused tessellation
+    // leaves it empty.
     if scheme == Scheme::CatmullClark {
         let (moved, _) = surface.tessellate_adaptive(&adaptive).expect("adaptive");
         let (reference, _) = fresh
             .tessellate_adaptive(&adaptive)
             .expect("fresh adaptive");
+        surface
+            .tessellate_adaptive_into(&adaptive, &mut kept_adaptive)
+            .expect("adaptive into the kept output");
+        assert!(
+            kept_adaptive == reference,
+            "{label}: adaptive into a kept output"
+        );
+        let over = subtess::AdaptiveOptions {
+            max_polygons: 10,
+            ..adaptive
+        };
+        assert!(surface
+            .tessellate_adaptive_into(&over, &mut kept_adaptive)
+            .is_err());
+        assert!(
+            kept_adaptive == subtess::AdaptiveMesh::default(),
+            "{label}: a refused tessellation left polygons"
+        );
         assert_eq!(
             moved.triangles(),
             reference.triangles(),

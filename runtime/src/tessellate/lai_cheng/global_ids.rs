@@ -96,15 +96,6 @@ fn side_points(marks: &FaceMarks, edges: &[SideEdge; 4]) -> [Vec<u32>; 4] {
     sides
 }
 
-/// `more` after `list`'s items: `more` itself when `list` is empty (no copy).
-fn append<T: Copy>(list: &mut Vec<T>, more: Vec<T>) {
-    if list.is_empty() {
-        *list = more;
-    } else {
-        list.extend_from_slice(&more);
-    }
-}
-
 /// A sorted list's pairs `(key, id)` with keys strictly between `lo` and `hi`, each given with
 /// its own entry's index in the list ([`NONE`] where it has none): the pairs are then the run
 /// between the two entries, and a binary search is needed only where neither end is listed.
@@ -177,8 +168,8 @@ fn internal(what: String) -> RuntimeError {
     RuntimeError::Unsupported(format!("internal: {what}"))
 }
 
-/// Give every marked point of `work` (per face: leaves and their corners) its id, and append
-/// the points to `positions`, `normals` and `sources` in id order (module documentation).
+/// Give every marked point of `work` (per face: leaves and their corners) its id, from 0, and
+/// make `positions`, `normals` and `sources` the points' in id order (module documentation).
 pub(super) fn assign(
     mesh: &Mesh,
     work: &[FaceMarks],
@@ -241,7 +232,7 @@ pub(super) fn assign(
     // Ids are `u32`: the count is checked (the polygon budget keeps it far below).
     let too_many = || internal("more than u32::MAX marked points".to_owned());
     let mut base = Vec::with_capacity(work.len());
-    let mut total = u32::try_from(positions.len()).map_err(|_| too_many())?;
+    let mut total = 0u32;
     for r in &ranks {
         base.push(total);
         let owned =
@@ -269,15 +260,16 @@ pub(super) fn assign(
             Some(*end)
         })
         .collect();
+    // Into the output's lists, emptied and grown in place: a caller that keeps its lists from
+    // frame to frame (`Surface::tessellate_adaptive_into`) writes pages it has written before.
     let count = ends.last().copied().unwrap_or(0);
-    let mut new_positions = vec![[0.0; 3]; count];
-    let mut new_normals = vec![[0.0; 3]; count];
-    let mut new_sources = vec![VertexSource::default(); count];
-    let out = (
-        &mut new_positions[..],
-        &mut new_normals[..],
-        &mut new_sources[..],
-    );
+    for list in [&mut *positions, &mut *normals] {
+        list.clear();
+        list.resize(count, [0.0; 3]);
+    }
+    sources.clear();
+    sources.resize(count, VertexSource::default());
+    let out = (&mut positions[..], &mut normals[..], &mut sources[..]);
     for_each_range(&ends, out, |f, (p, n, s)| {
         let marks = &work[f];
         for (k, &(point, _)) in owned[f].iter().enumerate() {
@@ -295,9 +287,6 @@ pub(super) fn assign(
             };
         }
     });
-    append(positions, new_positions);
-    append(normals, new_normals);
-    append(sources, new_sources);
     let mut vertices = vec![NONE; mesh.positions.len()];
     for (f, list) in owned.iter().enumerate() {
         for &(p, id) in list {

@@ -216,6 +216,18 @@ impl Default for AdaptiveMesh {
 }
 
 impl AdaptiveMesh {
+    /// No vertices and no polygons, every list's memory kept.
+    pub(crate) fn clear(&mut self) {
+        self.positions.clear();
+        self.normals.clear();
+        self.sources.clear();
+        self.starts.clear();
+        self.starts.push(0);
+        self.vertices.clear();
+        self.triangles.clear();
+        self.regions.clear();
+    }
+
     /// How many polygons.
     pub fn polygon_count(&self) -> usize {
         self.regions.len()
@@ -989,7 +1001,10 @@ pub fn tessellate_adaptive(
     let started = Instant::now();
     check_input(mesh, patches, options)?;
     let operators = PatchOperators::new(mesh, patches)?;
-    tessellate_adaptive_with(table, mesh, patches, options, &operators, started)
+    let mut out = AdaptiveMesh::default();
+    let stats =
+        tessellate_adaptive_with(table, mesh, patches, options, &operators, started, &mut out)?;
+    Ok((out, stats))
 }
 
 /// The options valid and a patch per face: what [`tessellate_adaptive_with`] assumes, checked
@@ -1053,8 +1068,8 @@ impl PatchOperators {
 }
 
 /// [`tessellate_adaptive`] with the patch kinds' operators given (those of `mesh` and
-/// `patches`, [`PatchOperators::new`]), its statistics' seconds counted from `started`; the
-/// input passed [`check_input`].
+/// `patches`, [`PatchOperators::new`]), its statistics' seconds counted from `started`, into
+/// `out` (every list emptied first, its capacity kept); the input passed [`check_input`].
 pub(crate) fn tessellate_adaptive_with(
     table: &StencilTable,
     mesh: &Mesh,
@@ -1062,8 +1077,27 @@ pub(crate) fn tessellate_adaptive_with(
     options: &AdaptiveOptions,
     operators: &PatchOperators,
     started: Instant,
-) -> Result<(AdaptiveMesh, AdaptiveStats), RuntimeError> {
-    let operators = &operators.0;
+    out: &mut AdaptiveMesh,
+) -> Result<AdaptiveStats, RuntimeError> {
+    out.clear();
+    let result = passes(table, mesh, patches, options, &operators.0, out);
+    if result.is_err() {
+        out.clear();
+    }
+    result?;
+    Ok(statistics(out, mesh.faces(), options, started))
+}
+
+/// The marking, the global ids and the polygons of [`tessellate_adaptive_with`], into `out`,
+/// empty.
+fn passes(
+    table: &StencilTable,
+    mesh: &Mesh,
+    patches: &[FacePatch],
+    options: &AdaptiveOptions,
+    operators: &HashMap<PatchKind, Operators>,
+    out: &mut AdaptiveMesh,
+) -> Result<(), RuntimeError> {
     let path = face_paths(mesh);
     // The whole feature face's diagonal, for relative flatness at its hull squares (as the
     // extraordinary square uses its whole patch's).
@@ -1197,7 +1231,6 @@ pub(crate) fn tessellate_adaptive_with(
         }
     }
     // Pass 2 (parallel): global ids (section 5), first evaluation wins, in face order.
-    let mut out = AdaptiveMesh::default();
     let ids = global_ids::assign(
         mesh,
         &work,
@@ -1239,9 +1272,7 @@ pub(crate) fn tessellate_adaptive_with(
             Ok(run)
         })
         .collect::<Result<Vec<PolygonRun>, RuntimeError>>()?;
-    gather_polygons(&runs, &mut out)?;
-    let stats = statistics(&out, mesh.faces(), options, started);
-    Ok((out, stats))
+    gather_polygons(&runs, out)
 }
 
 /// Copy the runs of pass 3 into `out`'s flat arrays, each run into its own ranges, in parallel.
@@ -1251,9 +1282,13 @@ fn gather_polygons(runs: &[PolygonRun], out: &mut AdaptiveMesh) -> Result<(), Ru
     let vertices: usize = runs.iter().map(|r| r.vertices.len()).sum();
     let triangles: usize = runs.iter().map(|r| r.triangles.len()).sum();
     u32::try_from(vertices).map_err(|_| too_many())?;
-    out.starts = vec![0; polygons + 1];
-    out.vertices = vec![0; vertices];
-    out.triangles = vec![[0; 3]; triangles];
+    // Emptied and grown in place (pages written before, where the caller keeps `out`).
+    out.starts.clear();
+    out.starts.resize(polygons + 1, 0);
+    out.vertices.clear();
+    out.vertices.resize(vertices, 0);
+    out.triangles.clear();
+    out.triangles.resize(triangles, [0; 3]);
     // Each run's ranges of the three arrays, split off in order.
     let mut pieces = Vec::with_capacity(runs.len());
     let (mut starts, mut ids, mut triples) = (
