@@ -81,21 +81,6 @@ impl SideEdge {
     }
 }
 
-/// Per side of a face, the canonical parameters of the points the face marked inside it,
-/// ascending.
-fn side_points(marks: &FaceMarks, edges: &[SideEdge; 4]) -> [Vec<u32>; 4] {
-    let mut sides: [Vec<u32>; 4] = Default::default();
-    for &(u, v) in &marks.places {
-        if let Place::Side(s, t) = place(u, v) {
-            sides[s].push(edges[s].canonical(t));
-        }
-    }
-    for list in &mut sides {
-        list.sort_unstable();
-    }
-    sides
-}
-
 /// A sorted list's pairs `(key, id)` with keys strictly between `lo` and `hi`, each given with
 /// its own entry's index in the list ([`NONE`] where it has none): the pairs are then the run
 /// between the two entries, and a binary search is needed only where neither end is listed.
@@ -121,14 +106,6 @@ fn between<K: Ord + Copy>(
         start + sorted.get(start..)?.iter().take_while(|x| x.0 < hi).count()
     };
     sorted.get(start..end.max(start))
-}
-
-/// The id paired with `key` in a sorted list.
-fn find<K: Ord + Copy>(sorted: &[(K, u32)], key: K) -> Option<u32> {
-    sorted
-        .binary_search_by(|x| x.0.cmp(&key))
-        .ok()
-        .map(|k| sorted[k].1)
 }
 
 /// Where a point of a face is listed in its [`FaceIds`]: its index in `rows` and `columns` (an
@@ -168,8 +145,28 @@ fn internal(what: String) -> RuntimeError {
     RuntimeError::Unsupported(format!("internal: {what}"))
 }
 
+/// The end of each item's range in one list of all items' entries, from their counts (what
+/// [`for_each_range`] takes).
+fn ends(counts: impl Iterator<Item = usize>) -> Vec<usize> {
+    counts
+        .scan(0usize, |end, n| {
+            *end += n;
+            Some(*end)
+        })
+        .collect()
+}
+
+/// Where each face's range starts in a list ranged by `ends`.
+fn start(ends: &[usize], f: usize) -> usize {
+    f.checked_sub(1).map_or(0, |g| ends[g])
+}
+
 /// Give every marked point of `work` (per face: leaves and their corners) its id, from 0, and
 /// make `positions`, `normals` and `sources` the points' in id order (module documentation).
+///
+/// Every list of the stages is one flat list for all faces, ranged by face (a list a face and
+/// stage was some thirty allocations a face, and their frees at the end, on the thread that
+/// had not made them, took a quarter of the pass on two threads: docs/benchmarks.md).
 pub(super) fn assign(
     mesh: &Mesh,
     work: &[FaceMarks],
@@ -181,11 +178,48 @@ pub(super) fn assign(
         .into_par_iter()
         .map(|f| std::array::from_fn(|s| SideEdge::new(mesh, f, s)))
         .collect();
-    let sides: Vec<[Vec<u32>; 4]> = work
+    // Per face, how many points it marks inside each side, and its corners' points.
+    let outline: Vec<([usize; 4], [u32; 4])> = work
         .par_iter()
-        .zip(&edges)
-        .map(|(marks, edges)| side_points(marks, edges))
+        .map(|marks| {
+            let (mut counts, mut corners) = ([0; 4], [NONE; 4]);
+            for (p, &(u, v)) in (0u32..).zip(&marks.places) {
+                match place(u, v) {
+                    Place::Side(s, _) => counts[s] += 1,
+                    Place::Corner(k) => corners[k] = p,
+                    Place::Interior => {}
+                }
+            }
+            (counts, corners)
+        })
         .collect();
+    // Per face and side, the points marked inside it by canonical parameter: `(t, point)`
+    // here, `(t, id)` once the ids are known (`NONE` for a point a lower face owns).
+    let side_ends = ends(outline.iter().map(|(c, _)| c.iter().sum()));
+    let side_range = |f: usize, s: usize| {
+        let first = start(&side_ends, f) + outline[f].0[..s].iter().sum::<usize>();
+        first..first + outline[f].0[s]
+    };
+    let mut sides = vec![(0u32, 0u32); side_ends.last().copied().unwrap_or(0)];
+    for_each_range(&side_ends, &mut sides[..], |f, list| {
+        let counts = outline[f].0;
+        let mut next = [
+            0,
+            counts[0],
+            counts[0] + counts[1],
+            counts[0] + counts[1] + counts[2],
+        ];
+        let firsts = next;
+        for (p, &(u, v)) in (0u32..).zip(&work[f].places) {
+            if let Place::Side(s, t) = place(u, v) {
+                list[next[s]] = (edges[f][s].canonical(t), p);
+                next[s] += 1;
+            }
+        }
+        for s in 0..4 {
+            list[firsts[s]..next[s]].sort_unstable();
+        }
+    });
     // The lowest face marking each vertex (every face with leaves marks its four corners).
     let mut vertex_owner = vec![NONE; mesh.positions.len()];
     for (f, marks) in work.iter().enumerate() {
@@ -200,69 +234,54 @@ pub(super) fn assign(
             }
         }
     }
-    // Per face, its rank among the points it owns (NONE: owned by a lower face) of each point.
-    let ranks: Vec<Vec<u32>> = (0..work.len())
-        .into_par_iter()
-        .map(|f| {
-            let mut next = 0;
-            work[f]
-                .places
-                .iter()
-                .map(|&(u, v)| {
-                    let owned = match place(u, v) {
-                        Place::Interior => true,
-                        Place::Corner(k) => vertex_owner[mesh.face(f)[k] as usize] == f as u32,
-                        Place::Side(s, t) => match edges[f][s].twin {
-                            Some((g, side)) if g < f => sides[g][side]
-                                .binary_search(&edges[f][s].canonical(t))
-                                .is_err(),
-                            _ => true,
-                        },
-                    };
-                    if owned {
-                        next += 1;
-                        next - 1
-                    } else {
-                        NONE
-                    }
-                })
-                .collect()
-        })
-        .collect();
+    // Per point, its rank among the points its face owns (NONE: owned by a lower face).
+    let point_ends = ends(work.iter().map(|marks| marks.places.len()));
+    let mut ranks = vec![NONE; point_ends.last().copied().unwrap_or(0)];
+    for_each_range(&point_ends, &mut ranks[..], |f, ranks| {
+        let mut next = 0;
+        for (rank, &(u, v)) in ranks.iter_mut().zip(&work[f].places) {
+            let owned = match place(u, v) {
+                Place::Interior => true,
+                Place::Corner(k) => vertex_owner[mesh.face(f)[k] as usize] == f as u32,
+                Place::Side(s, t) => match edges[f][s].twin {
+                    Some((g, side)) if g < f => sides[side_range(g, side)]
+                        .binary_search_by_key(&edges[f][s].canonical(t), |x| x.0)
+                        .is_err(),
+                    _ => true,
+                },
+            };
+            if owned {
+                *rank = next;
+                next += 1;
+            }
+        }
+    });
+    let rank = |f: usize, p: u32| ranks[start(&point_ends, f) + p as usize];
     // Ids are `u32`: the count is checked (the polygon budget keeps it far below).
     let too_many = || internal("more than u32::MAX marked points".to_owned());
-    let mut base = Vec::with_capacity(work.len());
-    let mut total = 0u32;
-    for r in &ranks {
-        base.push(total);
-        let owned =
-            u32::try_from(r.iter().filter(|&&x| x != NONE).count()).map_err(|_| too_many())?;
-        total = total.checked_add(owned).ok_or_else(too_many)?;
-    }
-    // Per face, the points it owns and their ids.
-    let owned: Vec<Vec<(u32, u32)>> = (0..work.len())
+    let owned_counts: Vec<usize> = (0..work.len())
         .into_par_iter()
         .map(|f| {
-            (0u32..)
-                .zip(&ranks[f])
-                .filter(|(_, &r)| r != NONE)
-                .map(|(p, &r)| (p, base[f] + r))
-                .collect()
+            ranks[start(&point_ends, f)..point_ends[f]]
+                .iter()
+                .filter(|&&r| r != NONE)
+                .count()
         })
         .collect();
+    let mut base = Vec::with_capacity(work.len());
+    let mut total = 0u32;
+    for &owned in &owned_counts {
+        base.push(total);
+        let owned = u32::try_from(owned).map_err(|_| too_many())?;
+        total = total.checked_add(owned).ok_or_else(too_many)?;
+    }
     // The owned points' vertices, face by face in parallel into their places (ids are
     // consecutive within a face): the output's pages are first written on both threads, where
-    // pushing them one by one took 15 ms on one (Spot at `8.248e-5`, 359,558 points).
-    let ends: Vec<usize> = owned
-        .iter()
-        .scan(0, |end, list| {
-            *end += list.len();
-            Some(*end)
-        })
-        .collect();
-    // Into the output's lists, emptied and grown in place: a caller that keeps its lists from
-    // frame to frame (`Surface::tessellate_adaptive_into`) writes pages it has written before.
-    let count = ends.last().copied().unwrap_or(0);
+    // pushing them one by one took 15 ms on one (Spot at `8.248e-5`, 359,558 points). Into
+    // the output's lists, emptied and grown in place: a caller that keeps its lists from frame
+    // to frame (`Surface::tessellate_adaptive_into`) writes pages it has written before.
+    let owned_ends = ends(owned_counts.into_iter());
+    let count = owned_ends.last().copied().unwrap_or(0);
     for list in [&mut *positions, &mut *normals] {
         list.clear();
         list.resize(count, [0.0; 3]);
@@ -270,10 +289,11 @@ pub(super) fn assign(
     sources.clear();
     sources.resize(count, VertexSource::default());
     let out = (&mut positions[..], &mut normals[..], &mut sources[..]);
-    for_each_range(&ends, out, |f, (p, n, s)| {
+    for_each_range(&owned_ends, out, |f, (p, n, s)| {
         let marks = &work[f];
-        for (k, &(point, _)) in owned[f].iter().enumerate() {
-            let point = point as usize;
+        let first = start(&point_ends, f);
+        let owned = (0..marks.places.len()).filter(|&point| ranks[first + point] != NONE);
+        for (k, point) in owned.enumerate() {
             p[k] = marks.positions[point];
             n[k] = marks.normals[point];
             let (u, v) = marks.places[point];
@@ -287,90 +307,75 @@ pub(super) fn assign(
             };
         }
     });
+    // Each mesh vertex's id, from the face that owns it.
     let mut vertices = vec![NONE; mesh.positions.len()];
-    for (f, list) in owned.iter().enumerate() {
-        for &(p, id) in list {
-            let (u, v) = work[f].places[p as usize];
-            if let Place::Corner(k) = place(u, v) {
-                vertices[mesh.face(f)[k] as usize] = id;
+    for (f, (_, corners)) in outline.iter().enumerate() {
+        for (k, &p) in corners.iter().enumerate() {
+            if p != NONE && rank(f, p) != NONE {
+                vertices[mesh.face(f)[k] as usize] = base[f] + rank(f, p);
             }
         }
     }
-    // Per face and side, the ids of the side points it owns, by canonical parameter.
-    let owned_sides: Vec<[Vec<(u32, u32)>; 4]> = owned
-        .par_iter()
-        .zip(&edges)
-        .enumerate()
-        .map(|(f, (list, edges))| {
-            let mut sides: [Vec<(u32, u32)>; 4] = Default::default();
-            for &(p, id) in list {
-                let (u, v) = work[f].places[p as usize];
-                if let Place::Side(s, t) = place(u, v) {
-                    sides[s].push((edges[s].canonical(t), id));
-                }
-            }
-            for side in &mut sides {
-                side.sort_unstable();
-            }
-            sides
-        })
-        .collect();
-    // Per face and side, the ids of all the side points it marked, by canonical parameter.
-    let marked_sides: Vec<[Vec<(u32, u32)>; 4]> = (0..work.len())
-        .into_par_iter()
-        .map(|f| -> Result<[Vec<(u32, u32)>; 4], RuntimeError> {
-            let mut lists: [Vec<(u32, u32)>; 4] = Default::default();
-            for (s, list) in lists.iter_mut().enumerate() {
-                for &tc in &sides[f][s] {
-                    let own = find(&owned_sides[f][s], tc);
-                    let across = || {
-                        edges[f][s]
-                            .twin
-                            .and_then(|(g, side)| find(&owned_sides[g][side], tc))
-                    };
-                    let id = own.or_else(across).ok_or_else(|| {
-                        internal(format!("face {f} side {s} point {tc} / {GRID} has no id"))
-                    })?;
-                    list.push((tc, id));
-                }
-            }
-            Ok(lists)
-        })
-        .collect::<Result<_, _>>()?;
+    // The side lists' points to their ids.
+    for_each_range(&side_ends, &mut sides[..], |f, list| {
+        for entry in list {
+            let r = rank(f, entry.1);
+            entry.1 = if r == NONE { NONE } else { base[f] + r };
+        }
+    });
     let faces: Vec<FaceIds> = (0..work.len())
         .into_par_iter()
         .map(|f| -> Result<FaceIds, RuntimeError> {
             let marks = &work[f];
             let no_id =
                 |(u, v): (u32, u32)| internal(format!("face {f} point ({u}, {v}) has no id"));
-            let mut ids = Vec::with_capacity(marks.places.len());
-            let mut rows = Vec::new();
-            for (p, (&(u, v), &r)) in (0u32..).zip(marks.places.iter().zip(&ranks[f])) {
-                let place = place(u, v);
-                let id = if r != NONE {
-                    base[f] + r
-                } else {
-                    match place {
-                        Place::Corner(k) => vertices[mesh.face(f)[k] as usize],
-                        Place::Side(s, t) => find(&marked_sides[f][s], edges[f][s].canonical(t))
-                            .ok_or_else(|| no_id((u, v)))?,
-                        Place::Interior => NONE,
-                    }
-                };
-                if id == NONE {
-                    return Err(no_id((u, v)));
-                }
-                ids.push(id);
-                if place == Place::Interior {
-                    rows.push((pack(v, u), p));
-                }
-            }
+            // Per side, its points and those of the side across, in this side's parameter,
+            // each with the id of the face that owns it (the other entry has none: `NONE`
+            // sorts after it and the first of equal keys is kept).
+            let edges: [Vec<(u32, u32)>; 4] = std::array::from_fn(|s| {
+                let edge = edges[f][s];
+                let own = &sides[side_range(f, s)];
+                let across = edge
+                    .twin
+                    .map_or(&[][..], |(g, side)| &sides[side_range(g, side)]);
+                let mut all = Vec::with_capacity(own.len() + across.len());
+                all.extend(
+                    own.iter()
+                        .chain(across)
+                        .map(|&(tc, id)| (edge.canonical(tc), id)),
+                );
+                all.sort_unstable();
+                all.dedup_by_key(|x| x.0);
+                all
+            });
             let unlisted = Listed {
                 row: NONE,
                 column: NONE,
                 edge: NONE,
             };
-            let mut listed = vec![unlisted; ids.len()];
+            let mut listed = vec![unlisted; marks.places.len()];
+            let mut ids = Vec::with_capacity(marks.places.len());
+            let mut rows = Vec::new();
+            for (p, (&(u, v), at)) in (0u32..).zip(marks.places.iter().zip(&mut listed)) {
+                let r = rank(f, p);
+                let owned = (r != NONE).then(|| base[f] + r);
+                let id = match place(u, v) {
+                    Place::Interior => {
+                        rows.push((pack(v, u), p));
+                        owned
+                    }
+                    Place::Corner(k) => owned.or(Some(vertices[mesh.face(f)[k] as usize])),
+                    Place::Side(s, t) => {
+                        let k = edges[s].partition_point(|x| x.0 < t);
+                        let entry = edges[s].get(k).filter(|x| x.0 == t);
+                        let entry = entry.ok_or_else(|| no_id((u, v)))?;
+                        at.edge = k as u32;
+                        owned.or(Some(entry.1))
+                    }
+                };
+                let id = id.filter(|&id| id != NONE).ok_or_else(|| no_id((u, v)))?;
+                ids.push(id);
+            }
             // The columns' keys are the rows' with their halves swapped; once both are sorted,
             // each point learns its indices and its entries take its id.
             let mut columns: Vec<(u64, u32)> = rows
@@ -386,29 +391,6 @@ pub(super) fn assign(
             for (k, entry) in (0u32..).zip(&mut columns) {
                 listed[entry.1 as usize].column = k;
                 entry.1 = ids[entry.1 as usize];
-            }
-            let edges: [Vec<(u32, u32)>; 4] = std::array::from_fn(|s| {
-                let edge = edges[f][s];
-                let mut all = marked_sides[f][s].clone();
-                if let Some((g, side)) = edge.twin {
-                    all.extend_from_slice(&marked_sides[g][side]);
-                }
-                let mut all: Vec<(u32, u32)> = all
-                    .into_iter()
-                    .map(|(tc, id)| (edge.canonical(tc), id))
-                    .collect();
-                all.sort_unstable();
-                all.dedup_by_key(|x| x.0);
-                all
-            });
-            for (&(u, v), at) in marks.places.iter().zip(&mut listed) {
-                if let Place::Side(s, t) = place(u, v) {
-                    let k = edges[s].partition_point(|x| x.0 < t);
-                    if edges[s].get(k).map(|x| x.0) != Some(t) {
-                        return Err(no_id((u, v)));
-                    }
-                    at.edge = k as u32;
-                }
             }
             let corners = marks
                 .leaves
