@@ -52,41 +52,42 @@ pub fn bspline_to_bezier(spline: &Net) -> Net {
     map_lines(&map_lines(spline, true, convert), false, convert)
 }
 
-/// de Casteljau at `t = 1/2`: the two halves of a cubic Bézier segment.
-fn halve(p: [Point; 4]) -> ([Point; 4], [Point; 4]) {
+/// de Casteljau at `t = 1/2`: the two halves of a cubic Bézier segment, as seven points (the
+/// first half's four and the second's, sharing the middle point).
+fn halve(p: [Point; 4]) -> [Point; 7] {
     let a = lerp(p[0], p[1], 0.5);
     let b = lerp(p[1], p[2], 0.5);
     let c = lerp(p[2], p[3], 0.5);
     let ab = lerp(a, b, 0.5);
     let bc = lerp(b, c, 0.5);
     let m = lerp(ab, bc, 0.5);
-    ([p[0], a, ab, m], [m, bc, c, p[3]])
+    [p[0], a, ab, m, bc, c, p[3]]
 }
 
 /// The four quarter nets of a midpoint subdivision of the parameter square (Lai–Cheng
 /// section 2), in the order `[0,1/2]^2`, `[1/2,1] x [0,1/2]`, `[1/2,1]^2`, `[0,1/2] x [1/2,1]`.
 /// Exact subdivision of the polynomial (up to f64 rounding).
+///
+/// De Casteljau at `1/2` on each row gives seven points a row (the two halves share their
+/// middle), then on each of those seven columns seven points: the quarters are the four
+/// corner blocks of that 7 x 7 grid, each entry written once (the halves made as whole nets
+/// and then halved again were ten copies of a net a split, a tenth of the adaptive pass's
+/// instructions in `memcpy`). The arithmetic is the halves': rows first, the same `lerp`s.
 pub fn split(net: &Net) -> [Net; 4] {
-    let (left, right) = halves(net, true);
-    let (low_left, high_left) = halves(&left, false);
-    let (low_right, high_right) = halves(&right, false);
-    [low_left, low_right, high_right, high_left]
-}
-
-/// The two halves of a net at `1/2` along `u` (`along_u`) or `v`: [`halve`] on each of the
-/// four rows or columns, both halves from one de Casteljau pass.
-fn halves(net: &Net, along_u: bool) -> (Net, Net) {
-    let mut low = *net;
-    let mut high = *net;
-    for line in 0..4 {
-        let at = |k: usize| if along_u { 4 * line + k } else { 4 * k + line };
-        let (a, b) = halve(std::array::from_fn(|k| net[at(k)]));
-        for k in 0..4 {
-            low[at(k)] = a[k];
-            high[at(k)] = b[k];
+    let mut rows = [[[0.0; 3]; 7]; 4];
+    for (j, row) in rows.iter_mut().enumerate() {
+        *row = halve(std::array::from_fn(|i| net[4 * j + i]));
+    }
+    let mut grid = [[[0.0; 3]; 7]; 7];
+    for i in 0..7 {
+        let column = halve(std::array::from_fn(|j| rows[j][i]));
+        for (j, p) in column.into_iter().enumerate() {
+            grid[j][i] = p;
         }
     }
-    (low, high)
+    let block =
+        |i0: usize, j0: usize| -> Net { std::array::from_fn(|n| grid[j0 + n / 4][i0 + n % 4]) };
+    [block(0, 0), block(3, 0), block(3, 3), block(0, 3)]
 }
 
 /// The corners `V_1 = S(0,0)`, `V_2 = S(1,0)`, `V_3 = S(1,1)`, `V_4 = S(0,1)` of the patch

@@ -540,13 +540,13 @@ impl FaceWork<'_> {
     }
 
     /// Record the leaf `[p0, p0 + size] x [q0, q0 + size]` (patch coordinates) and mark its
-    /// corners (`MarkBlack`): their positions `points` and their normals `normal(k)`, made only
-    /// for a point not marked before.
+    /// corners (`MarkBlack`): their positions `points` (whose [`longer_diagonal`] is
+    /// `diagonal`) and their normals `normal(k)`, made only for a point not marked before.
     #[allow(clippy::too_many_arguments)]
     fn leaf(
         &mut self,
         (p0, q0, depth): (u32, u32, u32),
-        points: [Point; 4],
+        (points, diagonal): ([Point; 4], f64),
         normal: impl Fn(usize) -> Point,
         bound: f64,
         tolerance: f64,
@@ -575,7 +575,7 @@ impl FaceWork<'_> {
             depth,
             bound,
             tolerance,
-            diagonal: longer_diagonal(&points),
+            diagonal,
             extraordinary,
         });
     }
@@ -621,7 +621,8 @@ impl FaceWork<'_> {
     fn regular_below(&mut self, net: &Net, (p0, q0, depth): (u32, u32, u32), parent: f64) {
         let points = corners(net);
         let deviation = Deviation::new(net);
-        let tolerance = self.tolerance(longer_diagonal(&points));
+        let diagonal = longer_diagonal(&points);
+        let tolerance = self.tolerance(diagonal);
         let may_split = self.may_split(depth);
         let mut lower = if may_split && parent > 4.0 * tolerance {
             deviation.corner_bound()
@@ -642,7 +643,7 @@ impl FaceWork<'_> {
             if self.done(depth, bound, tolerance) {
                 self.leaf(
                     (p0, q0, depth),
-                    points,
+                    (points, diagonal),
                     |k| corner_normal(net, k),
                     bound,
                     tolerance,
@@ -712,7 +713,8 @@ impl FaceWork<'_> {
                     0 => vertex_normal,
                     k => corner_normal(&nets[k - 1], k),
                 };
-                self.leaf((0, 0, depth), corner_points, normal, bound, tolerance, true);
+                let square = (corner_points, diagonal);
+                self.leaf((0, 0, depth), square, normal, bound, tolerance, true);
                 return;
             }
             let half = (GRID >> depth) / 2;
