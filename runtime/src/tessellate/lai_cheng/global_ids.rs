@@ -17,7 +17,7 @@ use super::marks::{pack, FaceMarks};
 use super::{Leaf, GRID};
 use crate::mesh::topology::{Mesh, NONE};
 use crate::mesh::triangle_mesh::VertexSource;
-use crate::tessellate::kernel::for_each_range;
+use crate::tessellate::kernel::{for_each_range, prefix_sums};
 use crate::RuntimeError;
 
 /// Where a point of a face's grid lies.
@@ -145,17 +145,6 @@ fn internal(what: String) -> RuntimeError {
     RuntimeError::Unsupported(format!("internal: {what}"))
 }
 
-/// The end of each item's range in one list of all items' entries, from their counts (what
-/// [`for_each_range`] takes).
-fn ends(counts: impl Iterator<Item = usize>) -> Vec<usize> {
-    counts
-        .scan(0usize, |end, n| {
-            *end += n;
-            Some(*end)
-        })
-        .collect()
-}
-
 /// Where each face's range starts in a list ranged by `ends`.
 fn start(ends: &[usize], f: usize) -> usize {
     f.checked_sub(1).map_or(0, |g| ends[g])
@@ -195,7 +184,7 @@ pub(super) fn assign(
         .collect();
     // Per face and side, the points marked inside it by canonical parameter: `(t, point)`
     // here, `(t, id)` once the ids are known (`NONE` for a point a lower face owns).
-    let side_ends = ends(outline.iter().map(|(c, _)| c.iter().sum()));
+    let side_ends = prefix_sums(outline.iter().map(|(c, _)| c.iter().sum()));
     let side_range = |f: usize, s: usize| {
         let first = start(&side_ends, f) + outline[f].0[..s].iter().sum::<usize>();
         first..first + outline[f].0[s]
@@ -235,7 +224,7 @@ pub(super) fn assign(
         }
     }
     // Per point, its rank among the points its face owns (NONE: owned by a lower face).
-    let point_ends = ends(work.iter().map(|marks| marks.places.len()));
+    let point_ends = prefix_sums(work.iter().map(|marks| marks.places.len()));
     let mut ranks = vec![NONE; point_ends.last().copied().unwrap_or(0)];
     for_each_range(&point_ends, &mut ranks[..], |f, ranks| {
         let mut next = 0;
@@ -280,7 +269,7 @@ pub(super) fn assign(
     // pushing them one by one took 15 ms on one (Spot at `8.248e-5`, 359,558 points). Into
     // the output's lists, emptied and grown in place: a caller that keeps its lists from frame
     // to frame (`Surface::tessellate_adaptive_into`) writes pages it has written before.
-    let owned_ends = ends(owned_counts.into_iter());
+    let owned_ends = prefix_sums(owned_counts.into_iter());
     let count = owned_ends.last().copied().unwrap_or(0);
     for list in [&mut *positions, &mut *normals] {
         list.clear();

@@ -542,7 +542,6 @@ impl FaceWork<'_> {
     /// Record the leaf `[p0, p0 + size] x [q0, q0 + size]` (patch coordinates) and mark its
     /// corners (`MarkBlack`): their positions `points` (whose [`longer_diagonal`] is
     /// `diagonal`) and their normals `normal(k)`, made only for a point not marked before.
-    #[allow(clippy::too_many_arguments)]
     fn leaf(
         &mut self,
         (p0, q0, depth): (u32, u32, u32),
