@@ -638,8 +638,8 @@ impl Surface {
         Ok((out, stats))
     }
 
-    /// [`Surface::tessellate_adaptive`] into `out`, whose lists are emptied and refilled with
-    /// their memory kept: for a mesh that moves every frame, each frame writes the pages the
+    /// [`Surface::tessellate_adaptive`] into `out`, whose lists are resized in place and
+    /// overwritten, their memory kept: for a mesh that moves every frame, each frame writes the pages the
     /// frame before wrote rather than memory fresh from the system (a tenth of a frame on two
     /// threads, docs/benchmarks.md). On an error `out` holds no tessellation.
     pub fn tessellate_adaptive_into(

@@ -307,6 +307,15 @@ pub(crate) fn extend_weighted_sums<'w>(
     }
 }
 
+/// `list` made `len` entries long for a pass that overwrites every entry: only the entries
+/// beyond its current length are filled with `fill`. A list kept from frame to frame keeps its
+/// entries, stale until overwritten; emptying it first made each frame write all of it twice,
+/// a serial `memset` of the whole output (Lai–Cheng's vertices and polygons, docs/benchmarks.md).
+pub(crate) fn resize_to_overwrite<T: Clone>(list: &mut Vec<T>, len: usize, fill: T) {
+    list.truncate(len);
+    list.resize(len, fill);
+}
+
 /// Running totals of `counts`: item `i` owns `[ends[i-1], ends[i])`.
 pub(crate) fn prefix_sums(counts: impl Iterator<Item = usize>) -> Vec<usize> {
     let mut total = 0;

@@ -335,6 +335,21 @@ fn check_moved_rates(label: &str, mesh: &Mesh, scheme: Scheme, relative: f64) {
             kept_adaptive == reference,
             "{label}: adaptive into a kept output"
         );
+        // A coarser tessellation into the same output: its lists shrink, and no entry of
+        // the larger one before may be left.
+        let coarser = subtess::AdaptiveOptions {
+            tolerance: 4.0 * adaptive.tolerance,
+            ..adaptive
+        };
+        let (coarse_reference, _) = fresh.tessellate_adaptive(&coarser).expect("fresh coarser");
+        surface
+            .tessellate_adaptive_into(&coarser, &mut kept_adaptive)
+            .expect("coarser adaptive into the kept output");
+        assert!(
+            kept_adaptive.polygon_count() < reference.polygon_count()
+                && kept_adaptive == coarse_reference,
+            "{label}: a coarser adaptive tessellation into a kept output"
+        );
         let over = subtess::AdaptiveOptions {
             max_polygons: 10,
             ..adaptive

@@ -17,7 +17,7 @@ use super::marks::{pack, FaceMarks};
 use super::{Leaf, GRID};
 use crate::mesh::topology::{Mesh, NONE};
 use crate::mesh::triangle_mesh::VertexSource;
-use crate::tessellate::kernel::{for_each_range, prefix_sums};
+use crate::tessellate::kernel::{for_each_range, prefix_sums, resize_to_overwrite};
 use crate::RuntimeError;
 
 /// Where a point of a face's grid lies.
@@ -272,11 +272,9 @@ pub(super) fn assign(
     let owned_ends = prefix_sums(owned_counts.into_iter());
     let count = owned_ends.last().copied().unwrap_or(0);
     for list in [&mut *positions, &mut *normals] {
-        list.clear();
-        list.resize(count, [0.0; 3]);
+        resize_to_overwrite(list, count, [0.0; 3]);
     }
-    sources.clear();
-    sources.resize(count, VertexSource::default());
+    resize_to_overwrite(sources, count, VertexSource::default());
     let out = (&mut positions[..], &mut normals[..], &mut sources[..]);
     for_each_range(&owned_ends, out, |f, (p, n, s)| {
         let marks = &work[f];

@@ -71,6 +71,7 @@ use crate::mesh::watertight::DirectedEdges;
 use crate::scheme::catmull_clark::adaptive::{limit_of, limit_stencils, LimitQuery};
 use crate::scheme::patch::{is_table_patch, FacePatch, PatchKind};
 use crate::stencil_table::StencilTable;
+use crate::tessellate::kernel::resize_to_overwrite;
 use crate::RuntimeError;
 use bezier_net::{corner_normal, corners, cross, longer_diagonal, unit, Deviation, Net, Point};
 use marks::{FaceMarks, PlaceTable};
@@ -1083,7 +1084,8 @@ impl PatchOperators {
 
 /// [`tessellate_adaptive`] with the patch kinds' operators given (those of `mesh` and
 /// `patches`, [`PatchOperators::new`]), its statistics' seconds counted from `started`, into
-/// `out` (every list emptied first, its capacity kept); the input passed [`check_input`].
+/// `out` (every list resized in place and overwritten, its capacity kept; emptied on an error);
+/// the input passed [`check_input`].
 pub(crate) fn tessellate_adaptive_with(
     table: &StencilTable,
     mesh: &Mesh,
@@ -1093,7 +1095,6 @@ pub(crate) fn tessellate_adaptive_with(
     started: Instant,
     out: &mut AdaptiveMesh,
 ) -> Result<AdaptiveStats, RuntimeError> {
-    out.clear();
     let result = passes(table, mesh, patches, options, &operators.0, out);
     if result.is_err() {
         out.clear();
@@ -1103,7 +1104,8 @@ pub(crate) fn tessellate_adaptive_with(
 }
 
 /// The marking, the global ids and the polygons of [`tessellate_adaptive_with`], into `out`,
-/// empty.
+/// whose lists hold the frame before's (each is resized and every entry written: ids and
+/// positions in `global_ids::assign`, regions below, polygons in [`gather_polygons`]).
 fn passes(
     table: &StencilTable,
     mesh: &Mesh,
@@ -1296,13 +1298,12 @@ fn gather_polygons(runs: &[PolygonRun], out: &mut AdaptiveMesh) -> Result<(), Ru
     let vertices: usize = runs.iter().map(|r| r.vertices.len()).sum();
     let triangles: usize = runs.iter().map(|r| r.triangles.len()).sum();
     u32::try_from(vertices).map_err(|_| too_many())?;
-    // Emptied and grown in place (pages written before, where the caller keeps `out`).
-    out.starts.clear();
-    out.starts.resize(polygons + 1, 0);
-    out.vertices.clear();
-    out.vertices.resize(vertices, 0);
-    out.triangles.clear();
-    out.triangles.resize(triangles, [0; 3]);
+    // Sized in place, every entry written below (pages written before, where the caller keeps
+    // `out`).
+    resize_to_overwrite(&mut out.starts, polygons + 1, 0);
+    out.starts[0] = 0;
+    resize_to_overwrite(&mut out.vertices, vertices, 0);
+    resize_to_overwrite(&mut out.triangles, triangles, [0; 3]);
     // Each run's ranges of the three arrays, split off in order.
     let mut pieces = Vec::with_capacity(runs.len());
     let (mut starts, mut ids, mut triples) = (
