@@ -13,7 +13,7 @@
 
 use rayon::prelude::*;
 
-use super::marks::{pack, FaceMarks};
+use super::marks::FaceMarks;
 use super::{Leaf, GRID};
 use crate::mesh::topology::{Mesh, NONE};
 use crate::mesh::triangle_mesh::VertexSource;
@@ -108,30 +108,16 @@ fn between<K: Ord + Copy>(
     sorted.get(start..end.max(start))
 }
 
-/// Where a point of a face is listed in its [`FaceIds`]: its index in `rows` and `columns` (an
-/// interior point) or in the `edges` list of its side (a point inside a side), [`NONE`] where
-/// it is not listed.
-#[derive(Clone, Copy, Debug)]
-struct Listed {
-    row: u32,
-    column: u32,
-    edge: u32,
-}
-
-/// The ids of one face's marked points, by place.
+/// The ids of one face's marked points, and the points marked inside its sides by it and by
+/// the faces across.
 struct FaceIds {
     /// Per point of the face ([`FaceMarks::places`]), its id.
     ids: Vec<u32>,
-    /// Per point, where it is listed.
-    listed: Vec<Listed>,
-    /// Per leaf, its corners' points counter-clockwise from `(u0, v0)`.
-    corners: Vec<[u32; 4]>,
-    /// Interior points by `(v, u)` ([`pack`]ed): the horizontal lines.
-    rows: Vec<(u64, u32)>,
-    /// Interior points by `(u, v)` ([`pack`]ed): the vertical lines.
-    columns: Vec<(u64, u32)>,
+    /// Per point inside a side of the face, its index in that side's `edges` list; [`NONE`]
+    /// for the others.
+    at_edge: Vec<u32>,
     /// Per side, every point marked inside it by this face or the face across it, by the
-    /// side's own parameter.
+    /// side's own parameter, with its id.
     edges: [Vec<(u32, u32)>; 4],
 }
 
@@ -141,7 +127,7 @@ pub(super) struct GlobalIds {
 }
 
 /// A broken invariant of the marking (every marked point has an id), as an error, not a panic.
-fn internal(what: String) -> RuntimeError {
+pub(super) fn internal(what: String) -> RuntimeError {
     RuntimeError::Unsupported(format!("internal: {what}"))
 }
 
@@ -335,63 +321,28 @@ pub(super) fn assign(
                 all.dedup_by_key(|x| x.0);
                 all
             });
-            let unlisted = Listed {
-                row: NONE,
-                column: NONE,
-                edge: NONE,
-            };
-            let mut listed = vec![unlisted; marks.places.len()];
+            let mut at_edge = vec![NONE; marks.places.len()];
             let mut ids = Vec::with_capacity(marks.places.len());
-            let mut rows = Vec::new();
-            for (p, (&(u, v), at)) in (0u32..).zip(marks.places.iter().zip(&mut listed)) {
+            for (p, (&(u, v), at)) in (0u32..).zip(marks.places.iter().zip(&mut at_edge)) {
                 let r = rank(f, p);
                 let owned = (r != NONE).then(|| base[f] + r);
                 let id = match place(u, v) {
-                    Place::Interior => {
-                        rows.push((pack(v, u), p));
-                        owned
-                    }
+                    Place::Interior => owned,
                     Place::Corner(k) => owned.or(Some(vertices[mesh.face(f)[k] as usize])),
                     Place::Side(s, t) => {
                         let k = edges[s].partition_point(|x| x.0 < t);
                         let entry = edges[s].get(k).filter(|x| x.0 == t);
                         let entry = entry.ok_or_else(|| no_id((u, v)))?;
-                        at.edge = k as u32;
+                        *at = k as u32;
                         owned.or(Some(entry.1))
                     }
                 };
                 let id = id.filter(|&id| id != NONE).ok_or_else(|| no_id((u, v)))?;
                 ids.push(id);
             }
-            // The columns' keys are the rows' with their halves swapped; once both are sorted,
-            // each point learns its indices and its entries take its id.
-            let mut columns: Vec<(u64, u32)> = rows
-                .iter()
-                .map(|&(key, p)| (key.rotate_left(32), p))
-                .collect();
-            rows.sort_unstable_by_key(|x| x.0);
-            columns.sort_unstable_by_key(|x| x.0);
-            for (k, entry) in (0u32..).zip(&mut rows) {
-                listed[entry.1 as usize].row = k;
-                entry.1 = ids[entry.1 as usize];
-            }
-            for (k, entry) in (0u32..).zip(&mut columns) {
-                listed[entry.1 as usize].column = k;
-                entry.1 = ids[entry.1 as usize];
-            }
-            let corners = marks
-                .leaves
-                .iter()
-                .zip(marks.point_of_mark.chunks_exact(4))
-                .map(|(leaf, points)| leaf_corners(leaf, points, &marks.places))
-                .collect::<Option<Vec<[u32; 4]>>>()
-                .ok_or_else(|| internal(format!("face {f}: a leaf's marks are not its corners")))?;
             Ok(FaceIds {
                 ids,
-                listed,
-                corners,
-                rows,
-                columns,
+                at_edge,
                 edges,
             })
         })
@@ -399,93 +350,72 @@ pub(super) fn assign(
     Ok(GlobalIds { faces })
 }
 
-/// A leaf's corner points counter-clockwise from `(u0, v0)`, from the points of its four marks
-/// (in the order of the patch's corners) and the face's points' `places`; `None` unless the
-/// marks are the four corners.
-fn leaf_corners(leaf: &Leaf, marks: &[u32], places: &[(u32, u32)]) -> Option<[u32; 4]> {
-    let mut corners = [NONE; 4];
-    for &p in marks {
-        let &(u, v) = places.get(p as usize)?;
-        let right = u.checked_sub(leaf.u0)? == leaf.size;
-        let up = v.checked_sub(leaf.v0)? == leaf.size;
-        if !(right || u == leaf.u0) || !(up || v == leaf.v0) {
-            return None;
-        }
-        corners[usize::from(right ^ up) + 2 * usize::from(up)] = p;
-    }
-    (!corners.contains(&NONE)).then_some(corners)
-}
-
 impl GlobalIds {
-    /// The ring of marked points around leaf `index` of `face`, face grid points and ids, into
-    /// `ring`: its corners and every marked point on its sides, counter-clockwise (section 5:
-    /// "output in order all the marked points between corners of the base quadrilateral").
+    /// The ring of marked points around leaf `index` of `face`, whose marks are `marks`: face
+    /// grid points and ids, into `ring`: its corners and every marked point on its sides,
+    /// counter-clockwise (section 5: "output in order all the marked points between corners of
+    /// the base quadrilateral"). The points inside a side are the leaf's own side points
+    /// ([`FaceMarks::sides`]) where the side is inside the face, else those of the face side's
+    /// merged list between the leaf's corners.
     pub(super) fn leaf_ring(
         &self,
-        face: usize,
-        index: usize,
-        leaf: &Leaf,
+        (face, index, leaf): (usize, usize, &Leaf),
+        marks: &FaceMarks,
         ring: &mut Vec<((u32, u32), u32)>,
     ) -> Result<(), RuntimeError> {
         let broken = || internal(format!("face {face} leaf {index} has no ring"));
         let ids = self.faces.get(face).ok_or_else(broken)?;
-        let corners = ids.corners.get(index).ok_or_else(broken)?;
-        let at = |k: usize| {
-            ids.listed
+        let corners = marks.corners.get(index).ok_or_else(broken)?;
+        let ends = marks.side_ends.get(index).ok_or_else(broken)?;
+        let point = |p: u32| -> Result<((u32, u32), u32), RuntimeError> {
+            let place = marks.places.get(p as usize).ok_or_else(broken)?;
+            let id = ids.ids.get(p as usize).ok_or_else(broken)?;
+            Ok((*place, *id))
+        };
+        let at_edge = |k: usize| {
+            ids.at_edge
                 .get(corners[k] as usize)
                 .copied()
                 .ok_or_else(broken)
         };
-        let id = |k: usize| ids.ids.get(corners[k] as usize).copied().ok_or_else(broken);
-        let [a0, a1, a2, a3] = [at(0)?, at(1)?, at(2)?, at(3)?];
         let (u0, v0) = (leaf.u0, leaf.v0);
         let (u1, v1) = (u0 + leaf.size, v0 + leaf.size);
+        // Per side, its ends in the side's own parameter where it lies on the face's side.
+        let on_face_side = [
+            (v0 == 0).then_some((u0, u1)),
+            (u1 == GRID).then_some((v0, v1)),
+            (v1 == GRID).then_some((GRID - u1, GRID - u0)),
+            (u0 == 0).then_some((GRID - v1, GRID - v0)),
+        ];
+        let mut from = match index.checked_sub(1) {
+            Some(before) => marks.side_ends.get(before).ok_or_else(broken)?[3],
+            None => 0,
+        };
         ring.clear();
-        ring.push(((u0, v0), id(0)?));
-        if v0 == 0 {
-            let side = between(&ids.edges[0], (u0, a0.edge), (u1, a1.edge)).ok_or_else(broken)?;
-            ring.extend(side.iter().map(|&(t, id)| ((t, 0), id)));
-        } else {
-            let side = between(&ids.rows, (pack(v0, u0), a0.row), (pack(v0, u1), a1.row))
+        for s in 0..4 {
+            ring.push(point(corners[s])?);
+            let inside = marks
+                .side_points
+                .get(from as usize..ends[s] as usize)
                 .ok_or_else(broken)?;
-            ring.extend(side.iter().map(|&(key, id)| ((key as u32, v0), id)));
-        }
-        ring.push(((u1, v0), id(1)?));
-        if u1 == GRID {
-            let side = between(&ids.edges[1], (v0, a1.edge), (v1, a2.edge)).ok_or_else(broken)?;
-            ring.extend(side.iter().map(|&(t, id)| ((GRID, t), id)));
-        } else {
-            let side = between(
-                &ids.columns,
-                (pack(u1, v0), a1.column),
-                (pack(u1, v1), a2.column),
-            )
-            .ok_or_else(broken)?;
-            ring.extend(side.iter().map(|&(key, id)| ((u1, key as u32), id)));
-        }
-        ring.push(((u1, v1), id(2)?));
-        if v1 == GRID {
-            let side = between(&ids.edges[2], (GRID - u1, a2.edge), (GRID - u0, a3.edge))
-                .ok_or_else(broken)?;
-            ring.extend(side.iter().map(|&(t, id)| ((GRID - t, GRID), id)));
-        } else {
-            let side = between(&ids.rows, (pack(v1, u0), a3.row), (pack(v1, u1), a2.row))
-                .ok_or_else(broken)?;
-            ring.extend(side.iter().rev().map(|&(key, id)| ((key as u32, v1), id)));
-        }
-        ring.push(((u0, v1), id(3)?));
-        if u0 == 0 {
-            let side = between(&ids.edges[3], (GRID - v1, a3.edge), (GRID - v0, a0.edge))
-                .ok_or_else(broken)?;
-            ring.extend(side.iter().map(|&(t, id)| ((0, GRID - t), id)));
-        } else {
-            let side = between(
-                &ids.columns,
-                (pack(u0, v0), a0.column),
-                (pack(u0, v1), a3.column),
-            )
-            .ok_or_else(broken)?;
-            ring.extend(side.iter().rev().map(|&(key, id)| ((u0, key as u32), id)));
+            for &p in inside {
+                ring.push(point(p)?);
+            }
+            from = ends[s];
+            if let Some((lo, hi)) = on_face_side[s] {
+                let lo = (lo, at_edge(s)?);
+                let hi = (hi, at_edge((s + 1) % 4)?);
+                let side = between(&ids.edges[s], lo, hi).ok_or_else(broken)?;
+                ring.extend(side.iter().map(|&(t, id)| {
+                    let place = match s {
+                        0 => (t, 0),
+                        1 => (GRID, t),
+                        2 => (GRID - t, GRID),
+                        _ => (0, GRID - t),
+                    };
+                    (place, id)
+                }));
+            }
         }
         Ok(())
     }

@@ -65,7 +65,7 @@ use rayon::prelude::*;
 use serde_json::{json, Value};
 use table_format::{PointSet, StencilKind};
 
-use crate::mesh::topology::Mesh;
+use crate::mesh::topology::{Mesh, NONE};
 use crate::mesh::triangle_mesh::{TriangleMesh, VertexSource};
 use crate::mesh::watertight::DirectedEdges;
 use crate::scheme::catmull_clark::adaptive::{limit_of, limit_stencils, LimitQuery};
@@ -74,7 +74,7 @@ use crate::stencil_table::StencilTable;
 use crate::tessellate::kernel::resize_to_overwrite;
 use crate::RuntimeError;
 use bezier_net::{corner_normal, corners, cross, longer_diagonal, unit, Deviation, Net, Point};
-use marks::{FaceMarks, PlaceTable};
+use marks::{counter_clockwise, FaceMarks, PlaceTable};
 use operators::Operators;
 pub use polygons::write_obj_polygons;
 
@@ -464,9 +464,9 @@ impl<'a> FaceWork<'a> {
         marks
     }
 
-    /// The face's leaves and marks (none when the polygon budget is spent), their buffers
-    /// shrunk to their length (in place, not copied), and buffers for the next face, of that
-    /// length.
+    /// The face's leaves and marks with the leaves' side points (none when the polygon budget
+    /// is spent), their buffers shrunk to their length (in place, not copied), and buffers for
+    /// the next face, of that length.
     fn finish(mut self) -> (Result<FaceMarks, RuntimeError>, FaceMarks) {
         self.publish();
         if let Some(error) = self.error {
@@ -474,6 +474,9 @@ impl<'a> FaceWork<'a> {
         }
         if self.over_budget() {
             return (Ok(FaceMarks::default()), self.marks);
+        }
+        if let Err(error) = self.marks.sides(self.table) {
+            return (Err(error), self.marks);
         }
         let mut marks = self.marks;
         let next = FaceMarks::sized_like(&marks);
@@ -533,11 +536,36 @@ impl FaceWork<'_> {
         }
     }
 
-    /// Mark the face grid point `(u, v)` ([`FaceMarks::mark`]), keeping the first error.
-    fn mark(&mut self, place: (u32, u32), position: Option<Point>, normal: impl FnOnce() -> Point) {
-        if let Err(error) = self.marks.mark(self.table, place, position, normal) {
-            self.error.get_or_insert(error);
+    /// Mark the face grid point `(u, v)` ([`FaceMarks::mark`]), its point returned; on an
+    /// error `NONE`, the first error kept.
+    fn mark(
+        &mut self,
+        place: (u32, u32),
+        position: Option<Point>,
+        normal: impl FnOnce() -> Point,
+    ) -> u32 {
+        self.marks
+            .mark(self.table, place, position, normal)
+            .unwrap_or_else(|error| {
+                self.error.get_or_insert(error);
+                NONE
+            })
+    }
+
+    /// Record a leaf with face corners `places` (a square's, in any cyclic order) after
+    /// marking them, `mark(k)` marking corner `k` and returning its point.
+    fn push_leaf(
+        &mut self,
+        places: &[(u32, u32); 4],
+        mut mark: impl FnMut(&mut Self, usize) -> u32,
+        leaf: Leaf,
+    ) {
+        let mut corners = [NONE; 4];
+        for (k, &place) in places.iter().enumerate() {
+            corners[counter_clockwise(place, (leaf.u0, leaf.v0))] = mark(self, k);
         }
+        self.marks.corners.push(corners);
+        self.marks.leaves.push(leaf);
     }
 
     /// Record the leaf `[p0, p0 + size] x [q0, q0 + size]` (patch coordinates) and mark its
@@ -560,34 +588,26 @@ impl FaceWork<'_> {
             (p0 + size, q0 + size),
             (p0, q0 + size),
         ];
-        let mut u0 = GRID;
-        let mut v0 = GRID;
-        for (k, &(p, q)) in patch_corners.iter().enumerate() {
-            let (u, v) = self.to_face(p, q);
-            u0 = u0.min(u);
-            v0 = v0.min(v);
-            self.mark((u, v), Some(points[k]), || normal(k));
-        }
-        self.marks.leaves.push(Leaf {
-            u0,
-            v0,
+        let places = patch_corners.map(|(p, q)| self.to_face(p, q));
+        let leaf = Leaf {
+            u0: places.iter().map(|p| p.0).min().unwrap_or(0),
+            v0: places.iter().map(|p| p.1).min().unwrap_or(0),
             size,
             depth,
             bound,
             tolerance,
             diagonal,
             extraordinary,
-        });
+        };
+        let mark = |face: &mut Self, k: usize| face.mark(places[k], Some(points[k]), || normal(k));
+        self.push_leaf(&places, mark, leaf);
     }
 
     /// Record a hull square (at a feature, [`feature`]) with face frame `frame`; its corners are
     /// evaluated after the marking, its diagonal then.
     fn pending_leaf(&mut self, frame: &feature::Frame, depth: u32, bound: f64, tolerance: f64) {
         self.count_leaf();
-        for &place in frame {
-            self.mark(place, None, || [0.0; 3]);
-        }
-        self.marks.leaves.push(Leaf {
+        let leaf = Leaf {
             u0: frame.iter().map(|p| p.0).min().unwrap_or(0),
             v0: frame.iter().map(|p| p.1).min().unwrap_or(0),
             size: GRID >> depth,
@@ -596,7 +616,9 @@ impl FaceWork<'_> {
             tolerance,
             diagonal: 0.0,
             extraordinary: true,
-        });
+        };
+        let mark = |face: &mut Self, k: usize| face.mark(frame[k], None, || [0.0; 3]);
+        self.push_leaf(frame, mark, leaf);
     }
 
     /// A regular square with Bézier net `net` at patch coordinates `(p0, q0)`, depth `depth`.
@@ -755,16 +777,17 @@ struct PolygonRun {
 const LEAVES_PER_RUN: usize = 1024;
 
 impl PolygonBuffers {
-    /// Append to `run` the polygon of `leaf` of `face`: its ring of marked points (section 5)
-    /// and the ring's triangulation (`k - 2` triangles for `k` points).
+    /// Append to `run` the polygon of `leaf` of `face` (whose marks are `marks`): its ring of
+    /// marked points (section 5) and the ring's triangulation (`k - 2` triangles for `k`
+    /// points).
     fn polygon(
         &mut self,
-        ids: &global_ids::GlobalIds,
+        (ids, marks): (&global_ids::GlobalIds, &FaceMarks),
         positions: &[Point],
-        (face, index, leaf): (usize, usize, &Leaf),
+        leaf: (usize, usize, &Leaf),
         run: &mut PolygonRun,
     ) -> Result<(), RuntimeError> {
-        ids.leaf_ring(face, index, leaf, &mut self.ring)?;
+        ids.leaf_ring(leaf, marks, &mut self.ring)?;
         let count = u32::try_from(self.ring.len())
             .map_err(|_| RuntimeError::Unsupported("a polygon of 2^32 vertices".to_owned()))?;
         self.params.clear();
@@ -1235,13 +1258,14 @@ fn passes(
     for &f in &feature_faces {
         let marks = &mut work[f];
         marks.pending.clear();
-        for (leaf, corners) in marks
-            .leaves
-            .iter_mut()
-            .zip(marks.point_of_mark.chunks_exact(4))
-        {
+        for (leaf, corners) in marks.leaves.iter_mut().zip(&marks.corners) {
             if leaf.extraordinary && leaf.diagonal == 0.0 {
-                let p: [Point; 4] = std::array::from_fn(|c| marks.positions[corners[c] as usize]);
+                let mut p = [[0.0; 3]; 4];
+                for (p, &c) in p.iter_mut().zip(corners) {
+                    *p = *marks.positions.get(c as usize).ok_or_else(|| {
+                        global_ids::internal(format!("face {f}: a leaf's corner is not marked"))
+                    })?;
+                }
                 leaf.diagonal = longer_diagonal(&p);
             }
         }
@@ -1283,7 +1307,7 @@ fn passes(
         .map_init(PolygonBuffers::default, |buffers, leaves| {
             let mut run = PolygonRun::default();
             for &job in leaves {
-                buffers.polygon(&ids, &out.positions, job, &mut run)?;
+                buffers.polygon((&ids, &work[job.0]), &out.positions, job, &mut run)?;
             }
             Ok(run)
         })
