@@ -132,7 +132,7 @@ pub(super) fn internal(what: String) -> RuntimeError {
 }
 
 /// Where each face's range starts in a list ranged by `ends`.
-fn start(ends: &[usize], f: usize) -> usize {
+pub(super) fn start(ends: &[usize], f: usize) -> usize {
     f.checked_sub(1).map_or(0, |g| ends[g])
 }
 

@@ -71,7 +71,7 @@ use crate::mesh::watertight::DirectedEdges;
 use crate::scheme::catmull_clark::adaptive::{limit_of, limit_stencils, LimitQuery};
 use crate::scheme::patch::{is_table_patch, FacePatch, PatchKind};
 use crate::stencil_table::StencilTable;
-use crate::tessellate::kernel::resize_to_overwrite;
+use crate::tessellate::kernel::{prefix_sums, resize_to_overwrite};
 use crate::RuntimeError;
 use bezier_net::{corner_normal, corners, cross, longer_diagonal, unit, Deviation, Net, Point};
 use marks::{counter_clockwise, FaceMarks, PlaceTable};
@@ -764,12 +764,63 @@ struct PolygonBuffers {
 }
 
 /// The polygons of a run of leaves, flat as in [`AdaptiveMesh`]: each polygon's vertex count,
-/// then all their vertices and all their triangles.
+/// then all their vertices and all their triangles; and the leaves' statistics.
 #[derive(Default)]
 struct PolygonRun {
     counts: Vec<u32>,
     vertices: Vec<u32>,
     triangles: Vec<[u32; 3]>,
+    leaves: LeafStats,
+}
+
+/// The statistics of [`AdaptiveStats`] read from the leaves' regions, gathered per run of
+/// leaves in pass 3 (a serial pass over the regions after it took 1 ms of Spot's frame).
+#[derive(Clone, Copy, Default)]
+struct LeafStats {
+    max_depth: u32,
+    over_tolerance: usize,
+    max_bound: f64,
+    max_relative_bound: f64,
+    extraordinary: usize,
+}
+
+impl LeafStats {
+    fn add(&mut self, r: &PolygonRegion) {
+        self.max_depth = self.max_depth.max(r.depth);
+        self.over_tolerance += usize::from(r.bound > r.tolerance);
+        self.max_bound = self.max_bound.max(r.bound);
+        if r.extraordinary {
+            self.extraordinary += 1;
+        } else {
+            self.max_relative_bound = self.max_relative_bound.max(r.bound / r.diagonal);
+        }
+    }
+
+    /// Both runs' statistics (maxima and counts: the order of the runs does not matter).
+    fn merge(self, other: LeafStats) -> LeafStats {
+        LeafStats {
+            max_depth: self.max_depth.max(other.max_depth),
+            over_tolerance: self.over_tolerance + other.over_tolerance,
+            max_bound: self.max_bound.max(other.max_bound),
+            max_relative_bound: self.max_relative_bound.max(other.max_relative_bound),
+            extraordinary: self.extraordinary + other.extraordinary,
+        }
+    }
+}
+
+/// The leaves of `work` from leaf `index` of face `face` on, in face order: `(face, index,
+/// leaf)`.
+fn leaves_from(
+    work: &[FaceMarks],
+    face: usize,
+    index: usize,
+) -> impl Iterator<Item = (usize, usize, &Leaf)> {
+    work.get(face..)
+        .unwrap_or(&[])
+        .iter()
+        .zip(face..)
+        .flat_map(|(marks, f)| marks.leaves.iter().enumerate().map(move |(i, l)| (f, i, l)))
+        .skip(index)
 }
 
 /// Leaves per job of pass 3: enough that a job's three vectors grow a few times only, few
@@ -1122,8 +1173,7 @@ pub(crate) fn tessellate_adaptive_with(
     if result.is_err() {
         out.clear();
     }
-    result?;
-    Ok(statistics(out, mesh.faces(), options, started))
+    Ok(statistics(out, result?, mesh.faces(), options, started))
 }
 
 /// The marking, the global ids and the polygons of [`tessellate_adaptive_with`], into `out`,
@@ -1136,7 +1186,7 @@ fn passes(
     options: &AdaptiveOptions,
     operators: &HashMap<PatchKind, Operators>,
     out: &mut AdaptiveMesh,
-) -> Result<(), RuntimeError> {
+) -> Result<LeafStats, RuntimeError> {
     let path = face_paths(mesh);
     // The whole feature face's diagonal, for relative flatness at its hull squares (as the
     // extraordinary square uses its whole patch's).
@@ -1288,31 +1338,36 @@ fn passes(
     // in runs of leaves, then copied into the output's flat arrays run by run in parallel
     // (gathering them on one thread was a serial copy of 36 MB, 23 ms for Spot's 356,467
     // polygons at `8.248e-5`).
-    let jobs: Vec<(usize, usize, &Leaf)> = work
-        .iter()
+    // Each run's leaves are found from the faces' leaf counts (a list of every leaf, made on
+    // one thread, took a twentieth of the cage's frame on two).
+    let leaf_ends = prefix_sums(work.iter().map(|marks| marks.leaves.len()));
+    let leaves = leaf_ends.last().copied().unwrap_or(0);
+    resize_to_overwrite(&mut out.regions, leaves, PolygonRegion::default());
+    let positions = &out.positions;
+    let runs = out
+        .regions
+        .par_chunks_mut(LEAVES_PER_RUN)
         .enumerate()
-        .flat_map(|(face, marks)| {
-            marks
-                .leaves
-                .iter()
-                .enumerate()
-                .map(move |(index, leaf)| (face, index, leaf))
-        })
-        .collect();
-    jobs.par_iter()
-        .map(|&(face, _, leaf)| leaf.region(face))
-        .collect_into_vec(&mut out.regions);
-    let runs = jobs
-        .par_chunks(LEAVES_PER_RUN)
-        .map_init(PolygonBuffers::default, |buffers, leaves| {
+        .map_init(PolygonBuffers::default, |buffers, (chunk, regions)| {
+            let first = chunk * LEAVES_PER_RUN;
+            let face = leaf_ends.partition_point(|&end| end <= first);
             let mut run = PolygonRun::default();
-            for &job in leaves {
-                buffers.polygon((&ids, &work[job.0]), &out.positions, job, &mut run)?;
+            let leaves = leaves_from(&work, face, first - global_ids::start(&leaf_ends, face));
+            for (region, (face, index, leaf)) in regions.iter_mut().zip(leaves) {
+                *region = leaf.region(face);
+                run.leaves.add(region);
+                let marks = work.get(face).ok_or_else(|| {
+                    global_ids::internal(format!("a leaf of face {face}, past the faces"))
+                })?;
+                buffers.polygon((&ids, marks), positions, (face, index, leaf), &mut run)?;
             }
             Ok(run)
         })
         .collect::<Result<Vec<PolygonRun>, RuntimeError>>()?;
-    gather_polygons(&runs, out)
+    gather_polygons(&runs, out)?;
+    Ok(runs
+        .iter()
+        .fold(LeafStats::default(), |all, run| all.merge(run.leaves)))
 }
 
 /// Copy the runs of pass 3 into `out`'s flat arrays, each run into its own ranges, in parallel.
@@ -1359,31 +1414,27 @@ fn gather_polygons(runs: &[PolygonRun], out: &mut AdaptiveMesh) -> Result<(), Ru
     Ok(())
 }
 
+/// The tessellation's statistics: `out`'s counts, the leaves' (gathered in pass 3), the
+/// uniform tessellation compared with, and the seconds since `started`.
 fn statistics(
     out: &AdaptiveMesh,
+    leaves: LeafStats,
     faces: usize,
     options: &AdaptiveOptions,
     started: Instant,
 ) -> AdaptiveStats {
-    // One pass over the polygons (a pass per statistic took 9–13 ms on Spot's 356,467 polygons
-    // at `8.248e-5`, serial, a twentieth of the whole on one thread).
     let mut stats = AdaptiveStats {
         polygons: out.polygon_count(),
         vertices: out.positions.len(),
         triangles: out.triangle_count(),
         triangulated: options.triangulate,
+        max_depth: leaves.max_depth,
+        leaves_over_tolerance: leaves.over_tolerance,
+        max_bound: leaves.max_bound,
+        max_relative_bound: leaves.max_relative_bound,
+        extraordinary_leaves: leaves.extraordinary,
         ..AdaptiveStats::default()
     };
-    for r in &out.regions {
-        stats.max_depth = stats.max_depth.max(r.depth);
-        stats.leaves_over_tolerance += usize::from(r.bound > r.tolerance);
-        stats.max_bound = stats.max_bound.max(r.bound);
-        if r.extraordinary {
-            stats.extraordinary_leaves += 1;
-        } else {
-            stats.max_relative_bound = stats.max_relative_bound.max(r.bound / r.diagonal);
-        }
-    }
     stats.uniform_depth = stats.max_depth;
     stats.uniform_polygons = faces as f64 * 4f64.powi(stats.max_depth as i32);
     let primitives = if options.triangulate {
