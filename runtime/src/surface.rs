@@ -635,6 +635,7 @@ impl Surface {
     ) -> Result<(AdaptiveMesh, AdaptiveStats), RuntimeError> {
         let mut out = AdaptiveMesh::default();
         let stats = self.tessellate_adaptive_into(options, &mut out)?;
+        out.release_buffers();
         Ok((out, stats))
     }
 

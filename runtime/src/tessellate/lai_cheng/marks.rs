@@ -45,22 +45,6 @@ pub(super) struct FaceMarks {
 }
 
 impl FaceMarks {
-    /// Empty lists with the capacities of `other`'s lengths: a face's buffers sized by the face
-    /// before, so that a face grows its vectors rarely (they grew by doubling from empty, and a
-    /// tenth of the marking pass's instructions went to `realloc` and its copies).
-    pub(super) fn sized_like(other: &FaceMarks) -> Self {
-        FaceMarks {
-            leaves: Vec::with_capacity(other.leaves.len()),
-            corners: Vec::with_capacity(other.corners.len()),
-            side_ends: Vec::with_capacity(other.side_ends.len()),
-            side_points: Vec::with_capacity(other.side_points.len()),
-            places: Vec::with_capacity(other.places.len()),
-            positions: Vec::with_capacity(other.positions.len()),
-            normals: Vec::with_capacity(other.normals.len()),
-            pending: Vec::new(),
-        }
-    }
-
     /// Every list emptied, capacities kept.
     pub(super) fn clear(&mut self) {
         self.leaves.clear();
@@ -71,17 +55,6 @@ impl FaceMarks {
         self.positions.clear();
         self.normals.clear();
         self.pending.clear();
-    }
-
-    /// Every list shrunk to its length (in place: the allocator keeps the block where it can).
-    pub(super) fn shrink_to_fit(&mut self) {
-        self.leaves.shrink_to_fit();
-        self.corners.shrink_to_fit();
-        self.side_ends.shrink_to_fit();
-        self.side_points.shrink_to_fit();
-        self.places.shrink_to_fit();
-        self.positions.shrink_to_fit();
-        self.normals.shrink_to_fit();
     }
 
     /// Mark the place `(u, v)`, its point's number returned; where it is new, its position is

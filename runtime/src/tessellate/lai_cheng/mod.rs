@@ -202,6 +202,43 @@ pub struct AdaptiveMesh {
     triangles: Vec<[u32; 3]>,
     /// Every polygon's parameter square.
     regions: Vec<PolygonRegion>,
+    /// The passes' buffers, refilled by the next tessellation into this output.
+    workspace: Workspace,
+}
+
+/// The passes' per-face and per-run buffers, kept with an output that the caller keeps from
+/// frame to frame ([`crate::Surface::tessellate_adaptive_into`]): each face refills its own
+/// lists of the frame before, each run of pass 3 its own, so a frame of a moving mesh allocates
+/// and frees almost nothing (every face's lists made and freed each frame were some fifteen
+/// allocations a face, the frees on one thread at the end; docs/benchmarks.md).
+///
+/// Not part of the tessellation: outputs compare equal whatever their buffers hold, and a
+/// clone starts without them.
+#[derive(Default)]
+struct Workspace {
+    marks: Vec<FaceMarks>,
+    runs: Vec<PolygonRun>,
+}
+
+impl Clone for Workspace {
+    fn clone(&self) -> Self {
+        Workspace::default()
+    }
+}
+
+impl PartialEq for Workspace {
+    fn eq(&self, _: &Workspace) -> bool {
+        true
+    }
+}
+
+impl std::fmt::Debug for Workspace {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Workspace")
+            .field("faces", &self.marks.len())
+            .field("runs", &self.runs.len())
+            .finish()
+    }
 }
 
 impl Default for AdaptiveMesh {
@@ -214,6 +251,7 @@ impl Default for AdaptiveMesh {
             vertices: Vec::new(),
             triangles: Vec::new(),
             regions: Vec::new(),
+            workspace: Workspace::default(),
         }
     }
 }
@@ -229,6 +267,12 @@ impl AdaptiveMesh {
         self.vertices.clear();
         self.triangles.clear();
         self.regions.clear();
+    }
+
+    /// Free the passes' buffers ([`Workspace`]): a tessellation made once keeps none for a
+    /// next one.
+    pub(crate) fn release_buffers(&mut self) {
+        self.workspace = Workspace::default();
     }
 
     /// How many polygons.
@@ -404,13 +448,10 @@ struct FaceWork<'a> {
 /// the pass fails once the total is over, and a total under it was never seen over.
 const LEAVES_PER_COUNT: usize = 256;
 
-/// A thread's buffers for the faces' leaves and marks, each sized by the face before
-/// ([`FaceMarks::sized_like`]), and its table of places.
-type Scratch = (FaceMarks, PlaceTable);
-
 impl<'a> FaceWork<'a> {
-    /// The work on a face whose patch has its `(0,0)` at face corner `corner`, growing its
-    /// leaves and marks in `buffers` and its points in `table`.
+    /// The work on a face whose patch has its `(0,0)` at face corner `corner`, refilling its
+    /// leaves and marks in `marks` (the face's lists of the frame before) and its points in
+    /// `table`.
     fn new(
         options: &'a AdaptiveOptions,
         corner: usize,
@@ -448,40 +489,35 @@ impl<'a> FaceWork<'a> {
         self.unpublished = 0;
     }
 
-    /// Mark a face whose patch has its `(0,0)` at face corner `corner` by `body`, in the
-    /// thread's `scratch`, which it hands on to the next face sized by this one.
+    /// Mark a face whose patch has its `(0,0)` at face corner `corner` by `body` into
+    /// `marks`, with the thread's `table`.
     fn run(
         options: &AdaptiveOptions,
         corner: usize,
-        (buffers, table): &mut Scratch,
+        (marks, table): (&mut FaceMarks, &mut PlaceTable),
         polygons: &AtomicUsize,
         body: &mut dyn FnMut(&mut FaceWork),
-    ) -> Result<FaceMarks, RuntimeError> {
-        let mut face = FaceWork::new(options, corner, (std::mem::take(buffers), table), polygons);
+    ) -> Result<(), RuntimeError> {
+        let mut face = FaceWork::new(options, corner, (std::mem::take(marks), table), polygons);
         body(&mut face);
-        let (marks, next) = face.finish();
-        *buffers = next;
-        marks
+        let result;
+        (result, *marks) = face.finish();
+        result
     }
 
     /// The face's leaves and marks with the leaves' side points (none when the polygon budget
-    /// is spent), their buffers shrunk to their length (in place, not copied), and buffers for
-    /// the next face, of that length.
-    fn finish(mut self) -> (Result<FaceMarks, RuntimeError>, FaceMarks) {
+    /// is spent), or why the face could not be marked.
+    fn finish(mut self) -> (Result<(), RuntimeError>, FaceMarks) {
         self.publish();
         if let Some(error) = self.error {
             return (Err(error), self.marks);
         }
         if self.over_budget() {
-            return (Ok(FaceMarks::default()), self.marks);
+            self.marks.clear();
+            return (Ok(()), self.marks);
         }
-        if let Err(error) = self.marks.sides(self.table) {
-            return (Err(error), self.marks);
-        }
-        let mut marks = self.marks;
-        let next = FaceMarks::sized_like(&marks);
-        marks.shrink_to_fit();
-        (Ok(marks), next)
+        let sides = self.marks.sides(self.table);
+        (sides, self.marks)
     }
 }
 
@@ -771,6 +807,16 @@ struct PolygonRun {
     vertices: Vec<u32>,
     triangles: Vec<[u32; 3]>,
     leaves: LeafStats,
+}
+
+impl PolygonRun {
+    /// No polygons, the lists' memory kept.
+    fn clear(&mut self) {
+        self.counts.clear();
+        self.vertices.clear();
+        self.triangles.clear();
+        self.leaves = LeafStats::default();
+    }
 }
 
 /// The statistics of [`AdaptiveStats`] read from the leaves' regions, gathered per run of
@@ -1093,6 +1139,7 @@ pub fn tessellate_adaptive(
     let mut out = AdaptiveMesh::default();
     let stats =
         tessellate_adaptive_with(table, mesh, patches, options, &operators, started, &mut out)?;
+    out.release_buffers();
     Ok((out, stats))
 }
 
@@ -1180,7 +1227,7 @@ pub(crate) fn tessellate_adaptive_with(
 /// whose lists hold the frame before's (each is resized and every entry written: ids and
 /// positions in `global_ids::assign`, regions below, polygons in [`gather_polygons`]).
 fn passes(
-    table: &StencilTable,
+    stencils: &StencilTable,
     mesh: &Mesh,
     patches: &[FacePatch],
     options: &AdaptiveOptions,
@@ -1211,21 +1258,27 @@ fn passes(
     }
     // Pass 1 (parallel): the adaptive marking of every face, within the polygon budget.
     let polygons = AtomicUsize::new(0);
-    let mut work: Vec<FaceMarks> = patches
-        .par_iter()
+    let mut work = std::mem::take(&mut out.workspace.marks);
+    work.truncate(patches.len());
+    work.resize_with(patches.len(), FaceMarks::default);
+    work.par_iter_mut()
+        .zip(patches.par_iter())
         .enumerate()
         .map_init(
-            Scratch::default,
-            |scratch, (f, patch)| -> Result<FaceMarks, RuntimeError> {
-                let run = |scratch, corner, body| {
-                    FaceWork::run(options, corner, scratch, &polygons, body)
+            PlaceTable::default,
+            |table, (f, (marks, patch))| -> Result<(), RuntimeError> {
+                let mut run = |corner, body: &mut dyn FnMut(&mut FaceWork)| {
+                    FaceWork::run(options, corner, (&mut *marks, &mut *table), &polygons, body)
                 };
                 match path[f] {
-                    Path::Hole => return Ok(FaceMarks::default()),
+                    Path::Hole => {
+                        marks.clear();
+                        return Ok(());
+                    }
                     Path::Feature => {
                         let (level, g) = feature::root(mesh, f);
                         let frame = [(0, 0), (GRID, 0), (GRID, GRID), (0, GRID)];
-                        return run(scratch, 0, &mut |face| {
+                        return run(0, &mut |face| {
                             face.feature(&level, g, frame, 0, true, root_diagonal[f]);
                         });
                     }
@@ -1248,19 +1301,19 @@ fn passes(
                     .map(|&v| mesh.positions[v as usize])
                     .collect();
                 match ops.regular_patch(&points) {
-                    Some(net) => run(scratch, patch.corner, &mut |face| {
+                    Some(net) => run(patch.corner, &mut |face| {
                         face.regular(&net, 0, 0, 0);
                     }),
                     None => {
-                        let normal = vertex_normal(table, patch, &points).unwrap_or([0.0; 3]);
-                        run(scratch, patch.corner, &mut |face| {
+                        let normal = vertex_normal(stencils, patch, &points).unwrap_or([0.0; 3]);
+                        run(patch.corner, &mut |face| {
                             face.extraordinary(ops, &points, normal);
                         })
                     }
                 }
             },
         )
-        .collect::<Result<_, _>>()?;
+        .collect::<Result<(), _>>()?;
     if polygons.load(Ordering::Relaxed) > options.max_polygons {
         return Err(RuntimeError::OverBudget {
             what: format!(
@@ -1328,12 +1381,6 @@ fn passes(
         &mut out.normals,
         &mut out.sources,
     )?;
-    // The points' positions and normals are the output's now: their memory goes before the
-    // polygons take theirs.
-    for marks in &mut work {
-        marks.positions = Vec::new();
-        marks.normals = Vec::new();
-    }
     // Pass 3 (parallel): the polygons (base quadrilateral replacement) and their triangles,
     // in runs of leaves, then copied into the output's flat arrays run by run in parallel
     // (gathering them on one thread was a serial copy of 36 MB, 23 ms for Spot's 356,467
@@ -1344,30 +1391,39 @@ fn passes(
     let leaves = leaf_ends.last().copied().unwrap_or(0);
     resize_to_overwrite(&mut out.regions, leaves, PolygonRegion::default());
     let positions = &out.positions;
-    let runs = out
-        .regions
+    let mut runs = std::mem::take(&mut out.workspace.runs);
+    let chunks = leaves.div_ceil(LEAVES_PER_RUN);
+    runs.truncate(chunks);
+    runs.resize_with(chunks, PolygonRun::default);
+    out.regions
         .par_chunks_mut(LEAVES_PER_RUN)
+        .zip(runs.par_iter_mut())
         .enumerate()
-        .map_init(PolygonBuffers::default, |buffers, (chunk, regions)| {
-            let first = chunk * LEAVES_PER_RUN;
-            let face = leaf_ends.partition_point(|&end| end <= first);
-            let mut run = PolygonRun::default();
-            let leaves = leaves_from(&work, face, first - global_ids::start(&leaf_ends, face));
-            for (region, (face, index, leaf)) in regions.iter_mut().zip(leaves) {
-                *region = leaf.region(face);
-                run.leaves.add(region);
-                let marks = work.get(face).ok_or_else(|| {
-                    global_ids::internal(format!("a leaf of face {face}, past the faces"))
-                })?;
-                buffers.polygon((&ids, marks), positions, (face, index, leaf), &mut run)?;
-            }
-            Ok(run)
-        })
-        .collect::<Result<Vec<PolygonRun>, RuntimeError>>()?;
+        .map_init(
+            PolygonBuffers::default,
+            |buffers, (chunk, (regions, run))| {
+                let first = chunk * LEAVES_PER_RUN;
+                let face = leaf_ends.partition_point(|&end| end <= first);
+                run.clear();
+                let leaves = leaves_from(&work, face, first - global_ids::start(&leaf_ends, face));
+                for (region, (face, index, leaf)) in regions.iter_mut().zip(leaves) {
+                    *region = leaf.region(face);
+                    run.leaves.add(region);
+                    let marks = work.get(face).ok_or_else(|| {
+                        global_ids::internal(format!("a leaf of face {face}, past the faces"))
+                    })?;
+                    buffers.polygon((&ids, marks), positions, (face, index, leaf), run)?;
+                }
+                Ok(())
+            },
+        )
+        .collect::<Result<(), RuntimeError>>()?;
     gather_polygons(&runs, out)?;
-    Ok(runs
+    let stats = runs
         .iter()
-        .fold(LeafStats::default(), |all, run| all.merge(run.leaves)))
+        .fold(LeafStats::default(), |all, run| all.merge(run.leaves));
+    out.workspace = Workspace { marks: work, runs };
+    Ok(stats)
 }
 
 /// Copy the runs of pass 3 into `out`'s flat arrays, each run into its own ranges, in parallel.
