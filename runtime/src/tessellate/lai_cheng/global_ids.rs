@@ -110,7 +110,8 @@ fn between<K: Ord + Copy>(
 
 /// The ids of one face's marked points, and the points marked inside its sides by it and by
 /// the faces across.
-struct FaceIds {
+#[derive(Default)]
+pub(super) struct FaceIds {
     /// Per point of the face ([`FaceMarks::places`]), its id.
     ids: Vec<u32>,
     /// Per point inside a side of the face, its index in that side's `edges` list; [`NONE`]
@@ -123,7 +124,8 @@ struct FaceIds {
 
 /// The global ids of a tessellation's marked points.
 pub(super) struct GlobalIds {
-    faces: Vec<FaceIds>,
+    /// Per face, its points' ids (the lists of the frame before refilled, [`assign`]).
+    pub(super) faces: Vec<FaceIds>,
 }
 
 /// A broken invariant of the marking (every marked point has an id), as an error, not a panic.
@@ -137,7 +139,8 @@ pub(super) fn start(ends: &[usize], f: usize) -> usize {
 }
 
 /// Give every marked point of `work` (per face: leaves and their corners) its id, from 0, and
-/// make `positions`, `normals` and `sources` the points' in id order (module documentation).
+/// make `positions`, `normals` and `sources` the points' in id order (module documentation);
+/// the faces' ids refill `faces` (one a face, the lists of a frame before, their memory kept).
 ///
 /// Every list of the stages is one flat list for all faces, ranged by face (a list a face and
 /// stage was some thirty allocations a face, and their frees at the end, on the thread that
@@ -145,6 +148,7 @@ pub(super) fn start(ends: &[usize], f: usize) -> usize {
 pub(super) fn assign(
     mesh: &Mesh,
     work: &[FaceMarks],
+    mut faces: Vec<FaceIds>,
     positions: &mut Vec<[f64; 3]>,
     normals: &mut Vec<[f64; 3]>,
     sources: &mut Vec<VertexSource>,
@@ -296,22 +300,25 @@ pub(super) fn assign(
             entry.1 = if r == NONE { NONE } else { base[f] + r };
         }
     });
-    let faces: Vec<FaceIds> = (0..work.len())
-        .into_par_iter()
-        .map(|f| -> Result<FaceIds, RuntimeError> {
-            let marks = &work[f];
+    faces.truncate(work.len());
+    faces.resize_with(work.len(), FaceIds::default);
+    faces
+        .par_iter_mut()
+        .zip(work.par_iter())
+        .enumerate()
+        .map(|(f, (face, marks))| -> Result<(), RuntimeError> {
             let no_id =
                 |(u, v): (u32, u32)| internal(format!("face {f} point ({u}, {v}) has no id"));
             // Per side, its points and those of the side across, in this side's parameter,
             // each with the id of the face that owns it (the other entry has none: `NONE`
             // sorts after it and the first of equal keys is kept).
-            let edges: [Vec<(u32, u32)>; 4] = std::array::from_fn(|s| {
+            for (s, all) in face.edges.iter_mut().enumerate() {
                 let edge = edges[f][s];
                 let own = &sides[side_range(f, s)];
                 let across = edge
                     .twin
                     .map_or(&[][..], |(g, side)| &sides[side_range(g, side)]);
-                let mut all = Vec::with_capacity(own.len() + across.len());
+                all.clear();
                 all.extend(
                     own.iter()
                         .chain(across)
@@ -319,11 +326,16 @@ pub(super) fn assign(
                 );
                 all.sort_unstable();
                 all.dedup_by_key(|x| x.0);
-                all
-            });
-            let mut at_edge = vec![NONE; marks.places.len()];
-            let mut ids = Vec::with_capacity(marks.places.len());
-            for (p, (&(u, v), at)) in (0u32..).zip(marks.places.iter().zip(&mut at_edge)) {
+            }
+            let FaceIds {
+                ids,
+                at_edge,
+                edges,
+            } = face;
+            at_edge.clear();
+            at_edge.resize(marks.places.len(), NONE);
+            ids.clear();
+            for (p, (&(u, v), at)) in (0u32..).zip(marks.places.iter().zip(at_edge.iter_mut())) {
                 let r = rank(f, p);
                 let owned = (r != NONE).then(|| base[f] + r);
                 let id = match place(u, v) {
@@ -340,13 +352,9 @@ pub(super) fn assign(
                 let id = id.filter(|&id| id != NONE).ok_or_else(|| no_id((u, v)))?;
                 ids.push(id);
             }
-            Ok(FaceIds {
-                ids,
-                at_edge,
-                edges,
-            })
+            Ok(())
         })
-        .collect::<Result<_, _>>()?;
+        .collect::<Result<(), _>>()?;
     Ok(GlobalIds { faces })
 }
 

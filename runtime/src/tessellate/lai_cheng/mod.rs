@@ -206,7 +206,7 @@ pub struct AdaptiveMesh {
     workspace: Workspace,
 }
 
-/// The passes' per-face and per-run buffers, kept with an output that the caller keeps from
+/// The passes' per-face (marks, ids) and per-run buffers, kept with an output that the caller keeps from
 /// frame to frame ([`crate::Surface::tessellate_adaptive_into`]): each face refills its own
 /// lists of the frame before, each run of pass 3 its own, so a frame of a moving mesh allocates
 /// and frees almost nothing (every face's lists made and freed each frame were some fifteen
@@ -217,6 +217,7 @@ pub struct AdaptiveMesh {
 #[derive(Default)]
 struct Workspace {
     marks: Vec<FaceMarks>,
+    ids: Vec<global_ids::FaceIds>,
     runs: Vec<PolygonRun>,
 }
 
@@ -1377,6 +1378,7 @@ fn passes(
     let ids = global_ids::assign(
         mesh,
         &work,
+        std::mem::take(&mut out.workspace.ids),
         &mut out.positions,
         &mut out.normals,
         &mut out.sources,
@@ -1422,7 +1424,11 @@ fn passes(
     let stats = runs
         .iter()
         .fold(LeafStats::default(), |all, run| all.merge(run.leaves));
-    out.workspace = Workspace { marks: work, runs };
+    out.workspace = Workspace {
+        marks: work,
+        ids: ids.faces,
+        runs,
+    };
     Ok(stats)
 }
 
