@@ -761,11 +761,13 @@ impl FaceWork<'_> {
             // them does not, it is exact and below the other, so the smaller is exact too, as
             // the leaf records it.
             let floor = self.diameter_floor(depth, tolerance);
-            let bound = if ops.nonnegative {
+            let bound = if !ops.nonnegative {
+                f64::INFINITY
+            } else if let Some(lower) = corners_apart(&corner_points[1..], &level.points, floor) {
+                lower
+            } else {
                 diameter_above(&level.points, floor)
                     .min(diameter_above(&ev_enclosure(levels), floor))
-            } else {
-                f64::INFINITY
             };
             if self.done(depth, bound, tolerance) {
                 let normal = |k: usize| match k {
@@ -984,6 +986,32 @@ fn ev_enclosure(levels: &[EvLevel]) -> Vec<Point> {
         out.extend_from_slice(&innermost.points);
     }
     out
+}
+
+/// The largest distance between the extraordinary square's three regular corners `corners`
+/// (the corners of its quarters' Bézier nets), where it exceeds `floor` by a rounding margin:
+/// a lower bound of both of [`FaceWork::extraordinary`]'s diameters above `floor`, which settles
+/// a split (most levels of the descent) without them. `None` otherwise.
+///
+/// Why it bounds both: the corners are points of the surface over the square, so they lie in
+/// the hull of its layout `layout` (non-negative rules) and are points of its enclosure
+/// ([`ev_enclosure`]: their nets are in it). Computed from `layout` they may stray from that
+/// hull by rounding, a few units in the last place of the layout's coordinates, far below the
+/// margin of `1e-12` of their size; so where the corners are more than `floor` plus the margin
+/// apart, both diameters as [`diameter_above`] computes them are above `floor`, and the split
+/// is the one they give.
+fn corners_apart(corners: &[Point], layout: &[Point], floor: f64) -> Option<f64> {
+    if !floor.is_finite() {
+        return None;
+    }
+    let mut apart: f64 = 0.0;
+    for (i, &a) in corners.iter().enumerate() {
+        for &b in &corners[i + 1..] {
+            apart = apart.max(bezier_net::norm(bezier_net::sub(a, b)));
+        }
+    }
+    let scale = layout.iter().flatten().fold(0.0f64, |s, &c| s.max(c.abs()));
+    (apart > floor + 1e-12 * scale).then_some(apart)
 }
 
 /// The largest distance between two of the points (the diameter of their convex hull), to the
@@ -1577,6 +1605,24 @@ mod tests {
             }
         }
         best
+    }
+
+    /// The corners settle a split only beyond the floor and its margin, which grows with the
+    /// layout's coordinates; the lower bound they give is their largest distance, never above
+    /// the diameter of any cloud holding them.
+    #[test]
+    fn corners_apart_only_beyond_the_floor_and_its_margin() {
+        let corners = [[0.0, 0.0, 0.0], [3.0, 0.0, 0.0], [3.0, 4.0, 0.0]];
+        let layout = [[-1.0, -1.0, 0.0], [4.0, 5.0, 1.0]];
+        assert_eq!(corners_apart(&corners, &layout, 4.9), Some(5.0));
+        assert_eq!(corners_apart(&corners, &layout, 5.0), None);
+        assert_eq!(corners_apart(&corners, &layout, f64::INFINITY), None);
+        // Far from the origin the margin (1e-12 of the coordinates) hides a small excess.
+        let far = [[1e11, 0.0, 0.0]];
+        assert_eq!(corners_apart(&corners, &far, 4.95), None);
+        assert_eq!(corners_apart(&corners, &far, 4.8), Some(5.0));
+        let cloud: Vec<Point> = corners.iter().chain(&layout).copied().collect();
+        assert!(diameter_above(&cloud, f64::INFINITY) >= 5.0);
     }
 
     #[test]
