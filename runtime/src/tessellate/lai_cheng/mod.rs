@@ -735,8 +735,8 @@ impl FaceWork<'_> {
         };
         loop {
             while window.len() < wanted {
-                if let Some(last) = window.back() {
-                    let next = ops.a.apply(&last.points);
+                if let Some(last) = window.back_mut() {
+                    let next = std::mem::take(&mut last.next);
                     window.push_back(EvLevel::new(ops, next));
                 }
             }
@@ -782,9 +782,9 @@ impl FaceWork<'_> {
             self.regular(&nets[0], half, 0, depth + 1);
             self.regular(&nets[1], half, half, depth + 1);
             self.regular(&nets[2], 0, half, depth + 1);
-            if let Some(done) = window.pop_front() {
+            if let Some(mut done) = window.pop_front() {
                 if window.is_empty() {
-                    window.push_back(EvLevel::new(ops, ops.a.apply(&done.points)));
+                    window.push_back(EvLevel::new(ops, std::mem::take(&mut done.next)));
                 }
             }
             depth += 1;
@@ -942,16 +942,18 @@ impl Leaf {
 }
 
 /// One level `k` of the extraordinary descent: the layout `A^k P` of the square
-/// `[0, 2^-k]^2` at the vertex and the Bézier nets `R_b A^k P` of its three regular quarters.
+/// `[0, 2^-k]^2` at the vertex, the Bézier nets `R_b A^k P` of its three regular quarters, and
+/// the next level's layout `A^{k+1} P` (until the next level takes it).
 struct EvLevel {
     points: Vec<Point>,
     nets: [Net; 3],
+    next: Vec<Point>,
 }
 
 impl EvLevel {
     fn new(ops: &Operators, points: Vec<Point>) -> Self {
-        let nets = std::array::from_fn(|b| ops.sub_patch(b, &points));
-        EvLevel { points, nets }
+        let (next, nets) = ops.level(&points);
+        EvLevel { points, nets, next }
     }
 }
 

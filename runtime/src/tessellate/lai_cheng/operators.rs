@@ -2,6 +2,8 @@
 //! the regular net, the limit mask. Converted once per kind from the exact rationals of
 //! [`schemes::local_matrices::LocalMatrices`].
 
+use std::collections::HashMap;
+
 use num_rational::BigRational;
 use num_traits::ToPrimitive;
 use schemes::local_matrices::LocalMatrices;
@@ -93,6 +95,37 @@ impl Matrix {
             }
         })
     }
+
+    /// The distinct rows of `parts` stacked (rows with the same entries once), and per part
+    /// the stacked row of each of its rows. Only the sparse product is kept (no dense rows).
+    fn stack(parts: &[&Matrix]) -> (Matrix, Vec<Vec<usize>>) {
+        let mut stacked = Matrix {
+            data: Vec::new(),
+            entries: Vec::new(),
+            starts: vec![0],
+        };
+        let mut index: HashMap<Vec<(usize, u64)>, usize> = HashMap::new();
+        let mut maps = Vec::with_capacity(parts.len());
+        for part in parts {
+            let mut map = Vec::with_capacity(part.rows());
+            for r in 0..part.rows() {
+                let row = part
+                    .entries
+                    .get(part.starts[r]..part.starts[r + 1])
+                    .unwrap_or(&[]);
+                let key = row.iter().map(|&(c, w)| (c, w.to_bits())).collect();
+                let next = stacked.rows();
+                let at = *index.entry(key).or_insert(next);
+                if at == next {
+                    stacked.entries.extend_from_slice(row);
+                    stacked.starts.push(stacked.entries.len());
+                }
+                map.push(at);
+            }
+            maps.push(map);
+        }
+        (stacked, maps)
+    }
 }
 
 /// One patch kind's operators.
@@ -100,11 +133,17 @@ impl Matrix {
 pub(crate) struct Operators {
     /// Control points `K`.
     pub(crate) size: usize,
-    /// `A` (K x K); `P_{k+1} = A P_k` is the layout one level down, around the same vertex.
-    pub(crate) a: Matrix,
-    /// `R_b` (16 x K): B-spline nets of the sub-patches `[1/2,1]x[0,1/2]`, `[1/2,1]^2`,
-    /// `[0,1/2]x[1/2,1]`.
-    pub(crate) sub_patches: [Matrix; 3],
+    /// The rows of `A` (K x K; `P_{k+1} = A P_k` is the layout one level down, around the
+    /// same vertex) and of the `R_b` (16 x K: B-spline nets of the sub-patches
+    /// `[1/2,1]x[0,1/2]`, `[1/2,1]^2`, `[0,1/2]x[1/2,1]`) stacked, each distinct row once: a
+    /// level's next layout and its three nets share most of their points (every point of
+    /// level `k + 1` that two of them hold), so one product makes them all, each row the
+    /// arithmetic its own matrix would do.
+    level: Matrix,
+    /// Per row of `A`, its row of `level`.
+    a_rows: Vec<usize>,
+    /// Per sub-patch and net point, its row of `level`.
+    net_rows: [[usize; 16]; 3],
     /// The B-spline net of a regular patch (phantom points included), else `None`.
     pub(crate) regular: Option<Matrix>,
     /// The limit mask `l` (`l A = l`, `sum l = 1`): the position at the vertex.
@@ -128,6 +167,14 @@ impl Operators {
             Matrix::from_exact(&exact.sub_patches[1])?,
             Matrix::from_exact(&exact.sub_patches[2])?,
         ];
+        let (level, maps) = Matrix::stack(&[&a, &sub_patches[0], &sub_patches[1], &sub_patches[2]]);
+        let net = |b: usize| -> Result<[usize; 16], RuntimeError> {
+            maps[b + 1].as_slice().try_into().map_err(|_| {
+                RuntimeError::Unsupported(format!("a sub-patch of {kind:?} without 16 points"))
+            })
+        };
+        let net_rows = [net(0)?, net(1)?, net(2)?];
+        let a_rows = maps[0].clone();
         let regular = match exact.regular_net() {
             Some(n) => Some(Matrix::from_exact(&n)?),
             None => None,
@@ -150,17 +197,24 @@ impl Operators {
         let nonnegative = a.data.iter().all(|&x| x >= 0.0);
         Ok(Operators {
             size,
-            a,
-            sub_patches,
+            level,
+            a_rows,
+            net_rows,
             regular,
             limit,
             nonnegative,
         })
     }
 
-    /// The Bézier net of sub-patch `b` of the layout `points`.
-    pub(crate) fn sub_patch(&self, b: usize, points: &[Point]) -> Net {
-        bspline_to_bezier(&self.sub_patches[b].apply_net(points))
+    /// The layout `A P` one level down from the layout `points`, and the Bézier nets of its
+    /// three regular sub-patches, from one product.
+    pub(crate) fn level(&self, points: &[Point]) -> (Vec<Point>, [Net; 3]) {
+        let rows = self.level.apply(points);
+        let next = self.a_rows.iter().map(|&r| rows[r]).collect();
+        let nets = self
+            .net_rows
+            .map(|net| bspline_to_bezier(&net.map(|r| rows[r])));
+        (next, nets)
     }
 
     /// The Bézier net of the whole (regular) patch.
