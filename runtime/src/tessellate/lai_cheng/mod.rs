@@ -206,11 +206,11 @@ pub struct AdaptiveMesh {
     workspace: Workspace,
 }
 
-/// The passes' per-face (marks, ids) and per-run buffers, kept with an output that the caller keeps from
-/// frame to frame ([`crate::Surface::tessellate_adaptive_into`]): each face refills its own
-/// lists of the frame before, each run of pass 3 its own, so a frame of a moving mesh allocates
-/// and frees almost nothing (every face's lists made and freed each frame were some fifteen
-/// allocations a face, the frees on one thread at the end; docs/benchmarks.md).
+/// The passes' per-face (marks, ids) and per-run buffers, kept with an output that the caller
+/// keeps from frame to frame ([`crate::Surface::tessellate_adaptive_into`]): each face refills
+/// its own lists of the frame before, each run of pass 3 its own, so a frame of a moving mesh
+/// allocates and frees almost nothing (every face's lists made and freed each frame were some
+/// fifteen allocations a face, the frees on one thread at the end; docs/benchmarks.md).
 ///
 /// Not part of the tessellation: outputs compare equal whatever their buffers hold, and a
 /// clone starts without them.
@@ -757,9 +757,9 @@ impl FaceWork<'_> {
             }
             let tolerance = self.tolerance(root_diagonal);
             // A level that may be split needs to know only whether both diameters exceed the
-            // tolerance, which their first pairs often show ([`diameter_above`]); where one of
-            // them does not, it is exact and below the other, so the smaller is exact too, as
-            // the leaf records it.
+            // tolerance, which its regular corners often show ([`corners_apart`]), else their
+            // first pairs ([`diameter_above`]); where one of them does not, it is exact and
+            // below the other, so the smaller is exact too, as the leaf records it.
             let floor = self.diameter_floor(depth, tolerance);
             let bound = if !ops.nonnegative {
                 f64::INFINITY
@@ -1420,11 +1420,11 @@ fn passes(
     // Each run's leaves are found from the faces' leaf counts (a list of every leaf, made on
     // one thread, took a twentieth of the cage's frame on two).
     let leaf_ends = prefix_sums(work.iter().map(|marks| marks.leaves.len()));
-    let leaves = leaf_ends.last().copied().unwrap_or(0);
-    resize_to_overwrite(&mut out.regions, leaves, PolygonRegion::default());
+    let leaf_count = leaf_ends.last().copied().unwrap_or(0);
+    resize_to_overwrite(&mut out.regions, leaf_count, PolygonRegion::default());
     let positions = &out.positions;
     let mut runs = std::mem::take(&mut out.workspace.runs);
-    let chunks = leaves.div_ceil(LEAVES_PER_RUN);
+    let chunks = leaf_count.div_ceil(LEAVES_PER_RUN);
     runs.truncate(chunks);
     runs.resize_with(chunks, PolygonRun::default);
     out.regions
