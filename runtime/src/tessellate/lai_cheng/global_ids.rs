@@ -386,15 +386,7 @@ impl GlobalIds {
                 .copied()
                 .ok_or_else(broken)
         };
-        let (u0, v0) = (leaf.u0, leaf.v0);
-        let (u1, v1) = (u0 + leaf.size, v0 + leaf.size);
-        // Per side, its ends in the side's own parameter where it lies on the face's side.
-        let on_face_side = [
-            (v0 == 0).then_some((u0, u1)),
-            (u1 == GRID).then_some((v0, v1)),
-            (v1 == GRID).then_some((GRID - u1, GRID - u0)),
-            (u0 == 0).then_some((GRID - v1, GRID - v0)),
-        ];
+        let on_face_side = leaf.on_face_side();
         let mut from = match index.checked_sub(1) {
             Some(before) => marks.side_ends.get(before).ok_or_else(broken)?[3],
             None => 0,

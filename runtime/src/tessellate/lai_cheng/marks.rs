@@ -17,7 +17,7 @@
 //! globalization.
 
 use super::bezier_net::Point;
-use super::{Leaf, GRID};
+use super::Leaf;
 use crate::mesh::topology::NONE;
 use crate::RuntimeError;
 
@@ -105,13 +105,11 @@ impl FaceMarks {
             if siblings.is_none() {
                 siblings = sibling_leaves(&self.leaves[i..]).map(|(pu, pv)| (pu, pv, i + 4));
             }
-            let (u0, v0) = (leaf.u0, leaf.v0);
-            let (u1, v1) = (u0 + leaf.size, v0 + leaf.size);
-            let corners = [(u0, v0), (u1, v0), (u1, v1), (u0, v1)];
-            let mut inside = [v0 != 0, u1 != GRID, v1 != GRID, u0 != 0];
+            let corners = leaf.corners();
+            let mut inside = leaf.on_face_side().map(|on| on.is_none());
             // A side facing a sibling that is a leaf too has no point inside.
             if let Some((pu, pv, _)) = siblings {
-                let (left, bottom) = (u0 == pu, v0 == pv);
+                let (left, bottom) = (leaf.u0 == pu, leaf.v0 == pv);
                 inside[if bottom { 2 } else { 0 }] = false;
                 inside[if left { 1 } else { 3 }] = false;
             }
@@ -213,17 +211,8 @@ impl PlaceTable {
     /// The point at `key`, or `new` where there is none yet (then it is the point at `key`).
     /// `places` are the points numbered so far, by number (for the doubling).
     fn get_or_insert(&mut self, key: u64, new: u32, places: &[(u32, u32)]) -> u32 {
-        let mask = self.slots.len() - 1;
-        let mut i = self.slot(key);
-        loop {
-            let slot = &mut self.slots[i];
-            if slot.0 == key {
-                return slot.1;
-            }
-            if slot.0 == EMPTY {
-                break;
-            }
-            i = (i + 1) & mask;
+        if let Some(point) = self.get(key) {
+            return point;
         }
         if 2 * (self.full + 1) > self.slots.len() {
             self.reset(self.slots.len());
@@ -287,6 +276,7 @@ impl PlaceTable {
 
 #[cfg(test)]
 mod tests {
+    use super::super::GRID;
     use super::*;
     use std::collections::HashMap;
 

@@ -857,18 +857,21 @@ impl LeafStats {
     }
 }
 
-/// The leaves of `work` from leaf `index` of face `face` on, in face order: `(face, index,
-/// leaf)`.
+/// The leaves of `work` from leaf `index` of face `face` on, in face order, each with its
+/// face's marks: `(marks, (face, index, leaf))`.
 fn leaves_from(
     work: &[FaceMarks],
     face: usize,
     index: usize,
-) -> impl Iterator<Item = (usize, usize, &Leaf)> {
+) -> impl Iterator<Item = (&FaceMarks, (usize, usize, &Leaf))> {
     work.get(face..)
         .unwrap_or(&[])
         .iter()
         .zip(face..)
-        .flat_map(|(marks, f)| marks.leaves.iter().enumerate().map(move |(i, l)| (f, i, l)))
+        .flat_map(|(marks, f)| {
+            let leaves = marks.leaves.iter().enumerate();
+            leaves.map(move |(i, l)| (marks, (f, i, l)))
+        })
         .skip(index)
 }
 
@@ -924,6 +927,27 @@ impl PolygonBuffers {
 }
 
 impl Leaf {
+    /// The square's corners on the face's grid, counter-clockwise from `(u0, v0)`.
+    fn corners(&self) -> [(u32, u32); 4] {
+        let (u0, v0) = (self.u0, self.v0);
+        let (u1, v1) = (u0 + self.size, v0 + self.size);
+        [(u0, v0), (u1, v0), (u1, v1), (u0, v1)]
+    }
+
+    /// Per side `s` (from corner `s` to corner `s + 1`), where it lies on side `s` of the face
+    /// (the only face side it can lie on), its ends in that side's own parameter (counter-
+    /// clockwise around the face); `None` for a side inside the face.
+    fn on_face_side(&self) -> [Option<(u32, u32)>; 4] {
+        let (u0, v0) = (self.u0, self.v0);
+        let (u1, v1) = (u0 + self.size, v0 + self.size);
+        [
+            (v0 == 0).then_some((u0, u1)),
+            (u1 == GRID).then_some((v0, v1)),
+            (v1 == GRID).then_some((GRID - u1, GRID - u0)),
+            (u0 == 0).then_some((GRID - v1, GRID - v0)),
+        ]
+    }
+
     /// The parameter square of this leaf of `face`, with its bound.
     fn region(&self, face: usize) -> PolygonRegion {
         PolygonRegion {
@@ -1438,13 +1462,10 @@ fn passes(
                 let face = leaf_ends.partition_point(|&end| end <= first);
                 run.clear();
                 let leaves = leaves_from(&work, face, first - global_ids::start(&leaf_ends, face));
-                for (region, (face, index, leaf)) in regions.iter_mut().zip(leaves) {
-                    *region = leaf.region(face);
+                for (region, (marks, leaf)) in regions.iter_mut().zip(leaves) {
+                    *region = leaf.2.region(leaf.0);
                     run.leaves.add(region);
-                    let marks = work.get(face).ok_or_else(|| {
-                        global_ids::internal(format!("a leaf of face {face}, past the faces"))
-                    })?;
-                    buffers.polygon((&ids, marks), positions, (face, index, leaf), run)?;
+                    buffers.polygon((&ids, marks), positions, leaf, run)?;
                 }
                 Ok(())
             },

@@ -61,14 +61,17 @@ impl Matrix {
         self.starts.len() - 1
     }
 
+    /// Row `r`'s non-zero entries.
+    fn row(&self, r: usize) -> &[(usize, f64)] {
+        self.entries
+            .get(self.starts[r]..self.starts[r + 1])
+            .unwrap_or(&[])
+    }
+
     /// Row `r` of `M P`.
     fn row_times(&self, r: usize, points: &[Point]) -> Point {
         let mut p = [0.0; 3];
-        let row = self
-            .entries
-            .get(self.starts[r]..self.starts[r + 1])
-            .unwrap_or(&[]);
-        for &(column, w) in row {
+        for &(column, w) in self.row(r) {
             if let Some(q) = points.get(column) {
                 for c in 0..3 {
                     p[c] += w * q[c];
@@ -109,10 +112,7 @@ impl Matrix {
         for part in parts {
             let mut map = Vec::with_capacity(part.rows());
             for r in 0..part.rows() {
-                let row = part
-                    .entries
-                    .get(part.starts[r]..part.starts[r + 1])
-                    .unwrap_or(&[]);
+                let row = part.row(r);
                 let key = row.iter().map(|&(c, w)| (c, w.to_bits())).collect();
                 let next = stacked.rows();
                 let at = *index.entry(key).or_insert(next);
