@@ -1312,16 +1312,25 @@ fn passes(
         root_diagonal[f] = longer_diagonal(&p);
     }
     // Pass 1 (parallel): the adaptive marking of every face, within the polygon budget.
+    // The faces go out most leaves first by the frame before's count (a kept workspace; else
+    // in face order), in jobs of at most one 64th of a thread's share: a face's cost goes with
+    // its leaves, so the jobs left when a thread runs dry are small and the threads end
+    // together. In face order, in halves, the cage's 16 extraordinary faces (20–40 µs
+    // each, against 0.5–4 µs for the others) left one thread waiting, and a thread that waits
+    // sleeps, which on the development host costs some 100 µs to wake (docs/benchmarks.md).
     let polygons = AtomicUsize::new(0);
     let mut work = std::mem::take(&mut out.workspace.marks);
     work.truncate(patches.len());
     work.resize_with(patches.len(), FaceMarks::default);
-    work.par_iter_mut()
-        .zip(patches.par_iter())
-        .enumerate()
+    let mut order: Vec<(usize, &mut FaceMarks)> = work.iter_mut().enumerate().collect();
+    order.sort_by_key(|(_, marks)| std::cmp::Reverse(marks.leaves.len()));
+    order
+        .par_iter_mut()
+        .with_max_len((patches.len() / (64 * rayon::current_num_threads())).max(1))
         .map_init(
             PlaceTable::default,
-            |table, (f, (marks, patch))| -> Result<(), RuntimeError> {
+            |table, (f, marks)| -> Result<(), RuntimeError> {
+                let (f, patch) = (*f, &patches[*f]);
                 let mut run = |corner, body: &mut dyn FnMut(&mut FaceWork)| {
                     FaceWork::run(options, corner, (&mut *marks, &mut *table), &polygons, body)
                 };
@@ -1457,17 +1466,26 @@ fn passes(
         .enumerate()
         .map_init(
             PolygonBuffers::default,
-            |buffers, (chunk, (regions, run))| {
+            |buffers, (chunk, (regions, kept))| {
                 let first = chunk * LEAVES_PER_RUN;
                 let face = leaf_ends.partition_point(|&end| end <= first);
+                // Filled where it lives on this thread's stack: the runs are neighbours in
+                // `runs`, and each push writing a list's length into a cache line that the
+                // other thread writes too made both runs 2.5 times slower (false sharing).
+                let mut run = std::mem::take(kept);
                 run.clear();
                 let leaves = leaves_from(&work, face, first - global_ids::start(&leaf_ends, face));
-                for (region, (marks, leaf)) in regions.iter_mut().zip(leaves) {
-                    *region = leaf.2.region(leaf.0);
-                    run.leaves.add(region);
-                    buffers.polygon((&ids, marks), positions, leaf, run)?;
-                }
-                Ok(())
+                let result =
+                    regions
+                        .iter_mut()
+                        .zip(leaves)
+                        .try_for_each(|(region, (marks, leaf))| {
+                            *region = leaf.2.region(leaf.0);
+                            run.leaves.add(region);
+                            buffers.polygon((&ids, marks), positions, leaf, &mut run)
+                        });
+                *kept = run;
+                result
             },
         )
         .collect::<Result<(), RuntimeError>>()?;
