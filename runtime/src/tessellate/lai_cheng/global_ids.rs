@@ -20,6 +20,11 @@ use crate::mesh::triangle_mesh::VertexSource;
 use crate::tessellate::kernel::{for_each_range, prefix_sums, resize_to_overwrite};
 use crate::RuntimeError;
 
+/// The fewest faces a job of a per-face stage takes when the work a face is a few
+/// nanoseconds: handing a job to the other thread costs some microseconds (on the development
+/// host, 5 µs a stage on the 112-face cage against 1 µs of work, docs/benchmarks.md).
+const FACES_PER_JOB: usize = 1024;
+
 /// Where a point of a face's grid lies.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Place {
@@ -155,6 +160,7 @@ pub(super) fn assign(
 ) -> Result<GlobalIds, RuntimeError> {
     let edges: Vec<[SideEdge; 4]> = (0..work.len())
         .into_par_iter()
+        .with_min_len(FACES_PER_JOB)
         .map(|f| std::array::from_fn(|s| SideEdge::new(mesh, f, s)))
         .collect();
     // Per face, how many points it marks inside each side, and its corners' points.
@@ -172,8 +178,7 @@ pub(super) fn assign(
             (counts, corners)
         })
         .collect();
-    // Per face and side, the points marked inside it by canonical parameter: `(t, point)`
-    // here, `(t, id)` once the ids are known (`NONE` for a point a lower face owns).
+    // Per face and side, the points marked inside it by canonical parameter, `(t, point)`.
     let side_ends = prefix_sums(outline.iter().map(|(c, _)| c.iter().sum()));
     let side_range = |f: usize, s: usize| {
         let first = start(&side_ends, f) + outline[f].0[..s].iter().sum::<usize>();
@@ -238,13 +243,15 @@ pub(super) fn assign(
     let rank = |f: usize, p: u32| ranks[start(&point_ends, f) + p as usize];
     // Ids are `u32`: the count is checked (the polygon budget keeps it far below).
     let too_many = || internal("more than u32::MAX marked points".to_owned());
+    // A face's owned points are ranked 0, 1, ... in order: their count is the last rank plus
+    // one (the last point is mostly one the face owns).
     let owned_counts: Vec<usize> = (0..work.len())
-        .into_par_iter()
         .map(|f| {
             ranks[start(&point_ends, f)..point_ends[f]]
                 .iter()
-                .filter(|&&r| r != NONE)
-                .count()
+                .rev()
+                .find(|&&r| r != NONE)
+                .map_or(0, |&r| r as usize + 1)
         })
         .collect();
     let mut base = Vec::with_capacity(work.len());
@@ -254,6 +261,11 @@ pub(super) fn assign(
         let owned = u32::try_from(owned).map_err(|_| too_many())?;
         total = total.checked_add(owned).ok_or_else(too_many)?;
     }
+    // A point's id: its face's first plus its rank (`NONE` for a point a lower face owns).
+    let id = |f: usize, p: u32| match rank(f, p) {
+        NONE => NONE,
+        r => base[f] + r,
+    };
     // The owned points' vertices, face by face in parallel into their places (ids are
     // consecutive within a face): the output's pages are first written on both threads, where
     // pushing them one by one took 15 ms on one (Spot at `8.248e-5`, 359,558 points). Into
@@ -293,13 +305,6 @@ pub(super) fn assign(
             }
         }
     }
-    // The side lists' points to their ids.
-    for_each_range(&side_ends, &mut sides[..], |f, list| {
-        for entry in list {
-            let r = rank(f, entry.1);
-            entry.1 = if r == NONE { NONE } else { base[f] + r };
-        }
-    });
     faces.truncate(work.len());
     faces.resize_with(work.len(), FaceIds::default);
     faces
@@ -314,16 +319,15 @@ pub(super) fn assign(
             // sorts after it and the first of equal keys is kept).
             for (s, all) in face.edges.iter_mut().enumerate() {
                 let edge = edges[f][s];
-                let own = &sides[side_range(f, s)];
-                let across = edge
-                    .twin
-                    .map_or(&[][..], |(g, side)| &sides[side_range(g, side)]);
+                let listed = |(g, side): (usize, usize)| {
+                    let by_id = move |&(tc, p): &(u32, u32)| (edge.canonical(tc), id(g, p));
+                    sides[side_range(g, side)].iter().map(by_id)
+                };
                 all.clear();
-                all.extend(
-                    own.iter()
-                        .chain(across)
-                        .map(|&(tc, id)| (edge.canonical(tc), id)),
-                );
+                all.extend(listed((f, s)));
+                if let Some(across) = edge.twin {
+                    all.extend(listed(across));
+                }
                 all.sort_unstable();
                 all.dedup_by_key(|x| x.0);
             }

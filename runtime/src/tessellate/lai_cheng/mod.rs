@@ -1531,8 +1531,11 @@ fn gather_polygons(runs: &[PolygonRun], out: &mut AdaptiveMesh) -> Result<(), Ru
         // In range: the total was checked above.
         first += run.vertices.len() as u32;
     }
+    // A run is some 50 KB to copy (a few µs): a job of fewer than four costs more to hand to
+    // the other thread than it saves.
     pieces
         .into_par_iter()
+        .with_min_len(4)
         .for_each(|(run, first, starts, vertices, triangles)| {
             let mut end = first;
             for (start, &count) in starts.iter_mut().zip(&run.counts) {
