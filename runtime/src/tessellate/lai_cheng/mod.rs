@@ -57,7 +57,7 @@ mod marks;
 mod operators;
 mod polygons;
 
-use std::collections::{HashMap, VecDeque};
+use std::collections::HashMap;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
@@ -71,7 +71,7 @@ use crate::mesh::watertight::DirectedEdges;
 use crate::scheme::catmull_clark::adaptive::{limit_of, limit_stencils, LimitQuery};
 use crate::scheme::patch::{is_table_patch, FacePatch, PatchKind};
 use crate::stencil_table::StencilTable;
-use crate::tessellate::kernel::{prefix_sums, resize_to_overwrite};
+use crate::tessellate::kernel::{for_each_dealt, prefix_sums, resize_to_overwrite};
 use crate::RuntimeError;
 use bezier_net::{corner_normal, corners, cross, longer_diagonal, unit, Deviation, Net, Point};
 use marks::{counter_clockwise, FaceMarks, PlaceTable};
@@ -722,28 +722,34 @@ impl FaceWork<'_> {
     /// 4.1), the three regular quarters of each level as Bézier squares.
     ///
     /// The levels `k..=k + EV_ENCLOSURE_LEVELS` that the enclosure of level `k` needs are kept
-    /// in a window and each is made once (the next level's enclosure shares all but one).
+    /// in a ring and each is made once (the next level's enclosure shares all but one), in
+    /// place: level `k + 1 + EV_ENCLOSURE_LEVELS` takes the slot and the lists of level `k`
+    /// (moving whole levels through a window and allocating two lists a level were a sixth
+    /// of the descent, docs/benchmarks.md).
     fn extraordinary(&mut self, ops: &Operators, points: &[Point], vertex_normal: Point) {
+        const SLOTS: usize = EV_ENCLOSURE_LEVELS + 1;
         let mut depth = 0;
         let mut root_diagonal = 0.0;
-        let mut window = VecDeque::from([EvLevel::new(ops, points.to_vec())]);
-        // Without non-negative rules there is no enclosure, only the level itself.
-        let wanted = if ops.nonnegative {
-            EV_ENCLOSURE_LEVELS + 1
-        } else {
-            1
-        };
+        let mut ring: [EvLevel; SLOTS] = Default::default();
+        let mut rows = Vec::new();
+        ring[0].points.extend_from_slice(points);
+        ring[0].make(ops, &mut rows);
+        // Levels made from `depth` on; without non-negative rules there is no enclosure, only
+        // the level itself.
+        let mut made = 1;
+        let wanted = if ops.nonnegative { SLOTS } else { 1 };
         loop {
-            while window.len() < wanted {
-                if let Some(last) = window.back_mut() {
-                    let next = std::mem::take(&mut last.next);
-                    window.push_back(EvLevel::new(ops, next));
-                }
+            // Level `depth + i`'s slot.
+            let slot = |i: usize| (depth as usize + i) % SLOTS;
+            while made < wanted {
+                let (last, slot) = (slot(made + SLOTS - 1), slot(made));
+                let next = std::mem::take(&mut ring[last].next);
+                let level = &mut ring[slot];
+                level.next = std::mem::replace(&mut level.points, next);
+                level.make(ops, &mut rows);
+                made += 1;
             }
-            let levels = window.make_contiguous();
-            let Some(level) = levels.first() else {
-                return;
-            };
+            let level = &ring[slot(0)];
             let nets = &level.nets;
             let corner_points = [
                 ops.vertex_position(&level.points),
@@ -766,6 +772,7 @@ impl FaceWork<'_> {
             } else if let Some(lower) = corners_apart(&corner_points[1..], &level.points, floor) {
                 lower
             } else {
+                let levels = (0..made).map(|i| &ring[slot(i)]);
                 diameter_above(&level.points, floor)
                     .min(diameter_above(&ev_enclosure(levels), floor))
             };
@@ -782,12 +789,8 @@ impl FaceWork<'_> {
             self.regular(&nets[0], half, 0, depth + 1);
             self.regular(&nets[1], half, half, depth + 1);
             self.regular(&nets[2], 0, half, depth + 1);
-            if let Some(mut done) = window.pop_front() {
-                if window.is_empty() {
-                    window.push_back(EvLevel::new(ops, std::mem::take(&mut done.next)));
-                }
-            }
             depth += 1;
+            made -= 1;
         }
     }
 }
@@ -968,6 +971,7 @@ impl Leaf {
 /// One level `k` of the extraordinary descent: the layout `A^k P` of the square
 /// `[0, 2^-k]^2` at the vertex, the Bézier nets `R_b A^k P` of its three regular quarters, and
 /// the next level's layout `A^{k+1} P` (until the next level takes it).
+#[derive(Default)]
 struct EvLevel {
     points: Vec<Point>,
     nets: [Net; 3],
@@ -975,9 +979,10 @@ struct EvLevel {
 }
 
 impl EvLevel {
-    fn new(ops: &Operators, points: Vec<Point>) -> Self {
-        let (next, nets) = ops.level(&points);
-        EvLevel { points, nets, next }
+    /// The nets and the next layout of the level's layout `points`, into the level's lists
+    /// (`rows`: the product's, kept by the caller).
+    fn make(&mut self, ops: &Operators, rows: &mut Vec<Point>) {
+        ops.level(&self.points, rows, &mut self.next, &mut self.nets);
     }
 }
 
@@ -1003,13 +1008,14 @@ const EV_ENCLOSURE_LEVELS: usize = 3;
 /// (`A >= 0`, the extraordinary bound's condition), and the squares tile the extraordinary one.
 /// The hull is inside that of `points` when the quarters' operators are non-negative too, and
 /// shrinks towards the surface piece itself as the levels grow.
-fn ev_enclosure(levels: &[EvLevel]) -> Vec<Point> {
+fn ev_enclosure<'a>(levels: impl Iterator<Item = &'a EvLevel>) -> Vec<Point> {
     let mut out: Vec<Point> = Vec::with_capacity(EV_ENCLOSURE_LEVELS * 48 + 64);
-    for level in levels.iter().take(EV_ENCLOSURE_LEVELS) {
-        out.extend(level.nets.iter().flat_map(|n| n.iter().copied()));
-    }
-    if let Some(innermost) = levels.get(EV_ENCLOSURE_LEVELS) {
-        out.extend_from_slice(&innermost.points);
+    for (k, level) in levels.enumerate().take(EV_ENCLOSURE_LEVELS + 1) {
+        if k < EV_ENCLOSURE_LEVELS {
+            out.extend(level.nets.iter().flat_map(|n| n.iter().copied()));
+        } else {
+            out.extend_from_slice(&level.points);
+        }
     }
     out
 }
@@ -1312,11 +1318,11 @@ fn passes(
         root_diagonal[f] = longer_diagonal(&p);
     }
     // Pass 1 (parallel): the adaptive marking of every face, within the polygon budget.
-    // The faces go out most leaves first by the frame before's count (a kept workspace; else
-    // in face order), in jobs of at most one 64th of a thread's share: a face's cost goes with
-    // its leaves, so the jobs left when a thread runs dry are small and the threads end
-    // together. In face order, in halves, the cage's 16 extraordinary faces (20–40 µs
-    // each, against 0.5–4 µs for the others) left one thread waiting, and a thread that waits
+    // The faces are dealt to the threads one at a time, most leaves first by the frame
+    // before's count (a kept workspace; else in face order): a face's cost goes with its
+    // leaves, so the faces left when a thread runs dry are cheap and the threads end together.
+    // In face order, in halves, the cage's 16 extraordinary faces (20–40 µs each,
+    // against 0.5–4 µs for the others) left one thread waiting, and a thread that waits
     // sleeps, which on the development host costs some 100 µs to wake (docs/benchmarks.md).
     let polygons = AtomicUsize::new(0);
     let mut work = std::mem::take(&mut out.workspace.marks);
@@ -1324,60 +1330,57 @@ fn passes(
     work.resize_with(patches.len(), FaceMarks::default);
     let mut order: Vec<(usize, &mut FaceMarks)> = work.iter_mut().enumerate().collect();
     order.sort_by_key(|(_, marks)| std::cmp::Reverse(marks.leaves.len()));
-    order
-        .par_iter_mut()
-        .with_max_len((patches.len() / (64 * rayon::current_num_threads())).max(1))
-        .map_init(
-            PlaceTable::default,
-            |table, (f, marks)| -> Result<(), RuntimeError> {
-                let (f, patch) = (*f, &patches[*f]);
-                let mut run = |corner, body: &mut dyn FnMut(&mut FaceWork)| {
-                    FaceWork::run(options, corner, (&mut *marks, &mut *table), &polygons, body)
-                };
-                match path[f] {
-                    Path::Hole => {
-                        marks.clear();
-                        return Ok(());
-                    }
-                    Path::Feature => {
-                        let (level, g) = feature::root(mesh, f);
-                        let frame = [(0, 0), (GRID, 0), (GRID, GRID), (0, GRID)];
-                        return run(0, &mut |face| {
-                            face.feature(&level, g, frame, 0, true, root_diagonal[f]);
-                        });
-                    }
-                    Path::Table => {}
+    for_each_dealt(
+        &mut order,
+        PlaceTable::default,
+        |table, (f, marks)| -> Result<(), RuntimeError> {
+            let (f, patch) = (*f, &patches[*f]);
+            let mut run = |corner, body: &mut dyn FnMut(&mut FaceWork)| {
+                FaceWork::run(options, corner, (&mut *marks, &mut *table), &polygons, body)
+            };
+            match path[f] {
+                Path::Hole => {
+                    marks.clear();
+                    return Ok(());
                 }
-                let ops = operators.get(&patch.kind).ok_or_else(|| {
-                    RuntimeError::Unsupported(format!("no operators for {:?}", patch.kind))
-                })?;
-                if ops.size != patch.points.len() {
-                    return Err(RuntimeError::Unsupported(format!(
-                        "a patch {:?} has {} control points, its layout {}",
-                        patch.kind,
-                        patch.points.len(),
-                        ops.size
-                    )));
+                Path::Feature => {
+                    let (level, g) = feature::root(mesh, f);
+                    let frame = [(0, 0), (GRID, 0), (GRID, GRID), (0, GRID)];
+                    return run(0, &mut |face| {
+                        face.feature(&level, g, frame, 0, true, root_diagonal[f]);
+                    });
                 }
-                let points: Vec<Point> = patch
-                    .points
-                    .iter()
-                    .map(|&v| mesh.positions[v as usize])
-                    .collect();
-                match ops.regular_patch(&points) {
-                    Some(net) => run(patch.corner, &mut |face| {
-                        face.regular(&net, 0, 0, 0);
-                    }),
-                    None => {
-                        let normal = vertex_normal(stencils, patch, &points).unwrap_or([0.0; 3]);
-                        run(patch.corner, &mut |face| {
-                            face.extraordinary(ops, &points, normal);
-                        })
-                    }
+                Path::Table => {}
+            }
+            let ops = operators.get(&patch.kind).ok_or_else(|| {
+                RuntimeError::Unsupported(format!("no operators for {:?}", patch.kind))
+            })?;
+            if ops.size != patch.points.len() {
+                return Err(RuntimeError::Unsupported(format!(
+                    "a patch {:?} has {} control points, its layout {}",
+                    patch.kind,
+                    patch.points.len(),
+                    ops.size
+                )));
+            }
+            let points: Vec<Point> = patch
+                .points
+                .iter()
+                .map(|&v| mesh.positions[v as usize])
+                .collect();
+            match ops.regular_patch(&points) {
+                Some(net) => run(patch.corner, &mut |face| {
+                    face.regular(&net, 0, 0, 0);
+                }),
+                None => {
+                    let normal = vertex_normal(stencils, patch, &points).unwrap_or([0.0; 3]);
+                    run(patch.corner, &mut |face| {
+                        face.extraordinary(ops, &points, normal);
+                    })
                 }
-            },
-        )
-        .collect::<Result<(), _>>()?;
+            }
+        },
+    )?;
     if polygons.load(Ordering::Relaxed) > options.max_polygons {
         return Err(RuntimeError::OverBudget {
             what: format!(

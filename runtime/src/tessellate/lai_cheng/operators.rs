@@ -81,11 +81,10 @@ impl Matrix {
         p
     }
 
-    /// `M P` for a column of points.
-    pub(crate) fn apply(&self, points: &[Point]) -> Vec<Point> {
-        (0..self.rows())
-            .map(|r| self.row_times(r, points))
-            .collect()
+    /// `M P` into `out` (its memory kept).
+    fn apply_into(&self, points: &[Point], out: &mut Vec<Point>) {
+        out.clear();
+        out.extend((0..self.rows()).map(|r| self.row_times(r, points)));
     }
 
     /// `M P` as a 4 x 4 net (`M` has 16 rows).
@@ -206,15 +205,26 @@ impl Operators {
         })
     }
 
-    /// The layout `A P` one level down from the layout `points`, and the Bézier nets of its
-    /// three regular sub-patches, from one product.
-    pub(crate) fn level(&self, points: &[Point]) -> (Vec<Point>, [Net; 3]) {
-        let rows = self.level.apply(points);
-        let next = self.a_rows.iter().map(|&r| rows[r]).collect();
-        let nets = self
-            .net_rows
-            .map(|net| bspline_to_bezier(&net.map(|r| rows[r])));
-        (next, nets)
+    /// The layout `A P` one level down from the layout `points` into `next`, and the Bézier
+    /// nets of its three regular sub-patches into `nets`, from one product (into `rows`).
+    pub(crate) fn level(
+        &self,
+        points: &[Point],
+        rows: &mut Vec<Point>,
+        next: &mut Vec<Point>,
+        nets: &mut [Net; 3],
+    ) {
+        self.level.apply_into(points, rows);
+        // Every stacked row index is below the stacked rows' count (`Matrix::stack`).
+        next.clear();
+        next.extend(self.a_rows.iter().map(|&r| rows[r]));
+        for (net, indices) in nets.iter_mut().zip(&self.net_rows) {
+            let mut spline = [[0.0; 3]; 16];
+            for (p, &r) in spline.iter_mut().zip(indices) {
+                *p = rows[r];
+            }
+            *net = bspline_to_bezier(&spline);
+        }
     }
 
     /// The Bézier net of the whole (regular) patch.
