@@ -159,10 +159,10 @@ pub(crate) fn for_each_range_with<T: SplitSlices + Send, S>(
         });
 }
 
-/// Run `work(scratch, item)` on every item of `items` in order, each thread taking the next item
-/// not yet taken (one shared counter: self-scheduling) with a scratch value of its own
-/// (`make`); the first error stops the dealing and is returned (one of them, where two threads
-/// fail).
+/// Run `work(scratch, item)` on every item of `items`, dealt in their order: each thread takes
+/// the next item not yet taken (one shared counter: self-scheduling) and works on it with a
+/// scratch value of its own (`make`); the first error stops the dealing and is returned (one of
+/// them, where two threads fail).
 ///
 /// Why not rayon's halving of the list: it makes a tree of joins, and a thread that waits at one
 /// for longer than it spins goes to sleep, which on the development host costs tens of µs to
