@@ -261,7 +261,8 @@ pub(super) fn assign(
         let owned = u32::try_from(owned).map_err(|_| too_many())?;
         total = total.checked_add(owned).ok_or_else(too_many)?;
     }
-    // A point's id: its face's first plus its rank (`NONE` for a point a lower face owns).
+    // A point's id: its face's first plus its rank (`NONE` for a point a lower face owns; an
+    // id is below the checked total, so never `NONE`).
     let id = |f: usize, p: u32| match rank(f, p) {
         NONE => NONE,
         r => base[f] + r,
@@ -300,8 +301,8 @@ pub(super) fn assign(
     let mut vertices = vec![NONE; mesh.positions.len()];
     for (f, (_, corners)) in outline.iter().enumerate() {
         for (k, &p) in corners.iter().enumerate() {
-            if p != NONE && rank(f, p) != NONE {
-                vertices[mesh.face(f)[k] as usize] = base[f] + rank(f, p);
+            if p != NONE && id(f, p) != NONE {
+                vertices[mesh.face(f)[k] as usize] = id(f, p);
             }
         }
     }
@@ -340,9 +341,8 @@ pub(super) fn assign(
             at_edge.resize(marks.places.len(), NONE);
             ids.clear();
             for (p, (&(u, v), at)) in (0u32..).zip(marks.places.iter().zip(at_edge.iter_mut())) {
-                let r = rank(f, p);
-                let owned = (r != NONE).then(|| base[f] + r);
-                let id = match place(u, v) {
+                let owned = Some(id(f, p)).filter(|&i| i != NONE);
+                let found = match place(u, v) {
                     Place::Interior => owned,
                     Place::Corner(k) => owned.or(Some(vertices[mesh.face(f)[k] as usize])),
                     Place::Side(s, t) => {
@@ -353,8 +353,8 @@ pub(super) fn assign(
                         owned.or(Some(entry.1))
                     }
                 };
-                let id = id.filter(|&id| id != NONE).ok_or_else(|| no_id((u, v)))?;
-                ids.push(id);
+                let found = found.filter(|&i| i != NONE).ok_or_else(|| no_id((u, v)))?;
+                ids.push(found);
             }
             Ok(())
         })

@@ -206,7 +206,8 @@ impl Operators {
     }
 
     /// The layout `A P` one level down from the layout `points` into `next`, and the Bézier
-    /// nets of its three regular sub-patches into `nets`, from one product (into `rows`).
+    /// nets of the three regular quarters of `points`' own square (`R_b P`, to Bézier form)
+    /// into `nets`, from one product (into `rows`).
     pub(crate) fn level(
         &self,
         points: &[Point],
